@@ -1,0 +1,9 @@
+/* The lmbake subcommands; each takes its own argv (argv[0] is the subcommand name) and
+ * returns the process exit code (README: "Exit codes"). */
+#ifndef LMBAKE_COMMANDS_H
+#define LMBAKE_COMMANDS_H
+
+int cmd_inspect(int argc, char **argv);
+int cmd_bake(int argc, char **argv);
+
+#endif

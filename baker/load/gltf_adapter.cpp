@@ -1,0 +1,330 @@
+/*
+ * tinygltf adapter: the only place lmbake's loader touches C++. Parses the file with
+ * tinygltf (images are not decoded: a no-op image loader), then copies the fields lmbake
+ * reads into the plain C arrays of lmb_gltf_view. Strings point into the tinygltf model,
+ * which the doc keeps alive for the writer. No C++ exception or type crosses the header.
+ */
+#include "gltf_adapter.h"
+
+#include <tiny_gltf.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+struct lmb_gltf_doc {
+    tinygltf::Model model;
+    std::string extras_key;
+    std::vector<lmb_gltf_buffer> buffers;
+    std::vector<lmb_gltf_buffer_view> buffer_views;
+    std::vector<lmb_gltf_accessor> accessors;
+    std::vector<lmb_gltf_mesh> meshes;
+    std::vector<lmb_gltf_primitive> primitives;
+    std::vector<lmb_gltf_node> nodes;
+    std::vector<int32_t> children;
+    std::vector<lmb_gltf_material> materials;
+    std::vector<lmb_gltf_light> lights;
+    std::vector<int32_t> scene_roots;
+    std::vector<const char *> ext_required, ext_used;
+    lmb_gltf_view view;
+};
+
+namespace {
+
+bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int, int,
+                const unsigned char *, int, void *)
+{
+    return true; /* lightmapping reads textures later, through OpenImageIO, when it needs them */
+}
+
+/* Returns obj[key] if obj is an object holding key, else nullptr. */
+const tinygltf::Value *member(const tinygltf::Value &obj, const char *key)
+{
+    if (!obj.IsObject() || !obj.Has(key))
+        return nullptr;
+    return &obj.Get(key);
+}
+
+const tinygltf::Value *extension(const tinygltf::ExtensionMap &map, const char *name)
+{
+    auto it = map.find(name);
+    return it == map.end() ? nullptr : &it->second;
+}
+
+int32_t int_member(const tinygltf::Value *obj, const char *key, int32_t fallback)
+{
+    const tinygltf::Value *v = obj ? member(*obj, key) : nullptr;
+    return (v && v->IsNumber()) ? v->GetNumberAsInt() : fallback;
+}
+
+int components_of(int type)
+{
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    case TINYGLTF_TYPE_MAT2: return 4;
+    case TINYGLTF_TYPE_MAT3: return 9;
+    case TINYGLTF_TYPE_MAT4: return 16;
+    default: return 0;
+    }
+}
+
+int32_t attribute(const tinygltf::Primitive &p, const char *name)
+{
+    auto it = p.attributes.find(name);
+    return it == p.attributes.end() ? -1 : it->second;
+}
+
+void copy_doubles(double *dst, const std::vector<double> &src, size_t n)
+{
+    for (size_t i = 0; i < n && i < src.size(); i++)
+        dst[i] = src[i];
+}
+
+void fill_buffers(lmb_gltf_doc &d)
+{
+    for (const auto &b : d.model.buffers)
+        d.buffers.push_back({b.data.data(), b.data.size()});
+    for (const auto &v : d.model.bufferViews)
+        d.buffer_views.push_back({v.buffer, v.byteOffset, v.byteLength, v.byteStride});
+    for (const auto &a : d.model.accessors) {
+        lmb_gltf_accessor c{};
+        c.name = a.name.c_str();
+        c.buffer_view = a.bufferView;
+        c.offset = a.byteOffset;
+        c.component_type = a.componentType;
+        c.components = components_of(a.type);
+        c.count = a.count;
+        c.normalized = a.normalized;
+        if (a.sparse.isSparse) {
+            c.sparse_count = a.sparse.count < 0 ? 0 : (size_t)a.sparse.count;
+            c.sparse_indices_view = a.sparse.indices.bufferView;
+            c.sparse_indices_offset = a.sparse.indices.byteOffset < 0 ? 0 : (size_t)a.sparse.indices.byteOffset;
+            c.sparse_indices_type = a.sparse.indices.componentType;
+            c.sparse_values_view = a.sparse.values.bufferView;
+            c.sparse_values_offset = a.sparse.values.byteOffset < 0 ? 0 : (size_t)a.sparse.values.byteOffset;
+        } else {
+            c.sparse_indices_view = c.sparse_values_view = -1;
+        }
+        d.accessors.push_back(c);
+    }
+}
+
+void fill_meshes(lmb_gltf_doc &d)
+{
+    for (const auto &m : d.model.meshes) {
+        lmb_gltf_mesh c{};
+        c.name = m.name.c_str();
+        c.first_primitive = (uint32_t)d.primitives.size();
+        c.primitive_count = (uint32_t)m.primitives.size();
+        for (const auto &p : m.primitives) {
+            lmb_gltf_primitive q{};
+            q.mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+            q.material = p.material;
+            q.indices = p.indices;
+            q.position = attribute(p, "POSITION");
+            q.normal = attribute(p, "NORMAL");
+            q.texcoord0 = attribute(p, "TEXCOORD_0");
+            q.texcoord1 = attribute(p, "TEXCOORD_1");
+            q.any_attribute = p.attributes.empty() ? -1 : p.attributes.begin()->second;
+            d.primitives.push_back(q);
+        }
+        d.meshes.push_back(c);
+    }
+}
+
+void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
+{
+    c.name = n.name.c_str();
+    c.mesh = n.mesh;
+    c.light = int_member(extension(n.extensions, "KHR_lights_punctual"), "light", -1);
+    c.first_child = (uint32_t)d.children.size();
+    c.child_count = (uint32_t)n.children.size();
+    d.children.insert(d.children.end(), n.children.begin(), n.children.end());
+    c.has_matrix = n.matrix.size() == 16;
+    copy_doubles(c.matrix, n.matrix, 16);
+    c.rotation[3] = 1.0;
+    c.scale[0] = c.scale[1] = c.scale[2] = 1.0;
+    copy_doubles(c.translation, n.translation, 3);
+    copy_doubles(c.rotation, n.rotation, 4);
+    copy_doubles(c.scale, n.scale, 3);
+    c.extras_lightmap = -1;
+    if (!d.extras_key.empty()) {
+        const tinygltf::Value *flag = member(n.extras, d.extras_key.c_str());
+        if (flag && flag->IsBool())
+            c.extras_lightmap = flag->Get<bool>() ? 1 : 0;
+        else if (flag && flag->IsNumber())
+            c.extras_lightmap = flag->GetNumberAsDouble() != 0.0;
+    }
+    const tinygltf::Value *gpu = extension(n.extensions, "EXT_mesh_gpu_instancing");
+    const tinygltf::Value *attrs = gpu ? member(*gpu, "attributes") : nullptr;
+    c.has_gpu_instancing = attrs != nullptr;
+    c.gpu_translation = int_member(attrs, "TRANSLATION", -1);
+    c.gpu_rotation = int_member(attrs, "ROTATION", -1);
+    c.gpu_scale = int_member(attrs, "SCALE", -1);
+}
+
+void fill_materials(lmb_gltf_doc &d)
+{
+    for (const auto &m : d.model.materials) {
+        lmb_gltf_material c{};
+        c.name = m.name.c_str();
+        const auto &pbr = m.pbrMetallicRoughness;
+        c.base_color[0] = c.base_color[1] = c.base_color[2] = c.base_color[3] = 1.0;
+        copy_doubles(c.base_color, pbr.baseColorFactor, 4);
+        c.base_color_texture = pbr.baseColorTexture.index;
+        c.base_color_texcoord = pbr.baseColorTexture.texCoord;
+        c.metallic = pbr.metallicFactor;
+        copy_doubles(c.emissive, m.emissiveFactor, 3);
+        c.emissive_strength = 1.0;
+        const tinygltf::Value *es = extension(m.extensions, "KHR_materials_emissive_strength");
+        const tinygltf::Value *s = es ? member(*es, "emissiveStrength") : nullptr;
+        if (s && s->IsNumber())
+            c.emissive_strength = s->GetNumberAsDouble();
+        c.emissive_texture = m.emissiveTexture.index;
+        c.emissive_texcoord = m.emissiveTexture.texCoord;
+        c.double_sided = m.doubleSided;
+        d.materials.push_back(c);
+    }
+}
+
+void fill_lights(lmb_gltf_doc &d)
+{
+    for (const auto &l : d.model.lights) {
+        lmb_gltf_light c{};
+        c.name = l.name.c_str();
+        c.type = l.type.c_str();
+        c.color[0] = c.color[1] = c.color[2] = 1.0;
+        copy_doubles(c.color, l.color, 3);
+        c.intensity = l.intensity;
+        c.range = l.range;
+        c.inner_cone = l.spot.innerConeAngle;
+        c.outer_cone = l.spot.outerConeAngle;
+        d.lights.push_back(c);
+    }
+}
+
+void fill_scene(lmb_gltf_doc &d)
+{
+    const auto &m = d.model;
+    int s = m.defaultScene >= 0 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
+    d.view.has_scene = s >= 0 && s < (int)m.scenes.size();
+    if (d.view.has_scene) {
+        d.scene_roots.assign(m.scenes[(size_t)s].nodes.begin(), m.scenes[(size_t)s].nodes.end());
+        return;
+    }
+    /* No scene: glTF allows it; lmbake bakes every parentless node. */
+    std::vector<char> is_child(m.nodes.size(), 0);
+    for (const auto &n : m.nodes)
+        for (int c : n.children)
+            if (c >= 0 && (size_t)c < m.nodes.size())
+                is_child[(size_t)c] = 1;
+    for (size_t i = 0; i < m.nodes.size(); i++)
+        if (!is_child[i])
+            d.scene_roots.push_back((int32_t)i);
+}
+
+template <typename T> void expose(const std::vector<T> &v, const T *&ptr, uint32_t &count)
+{
+    ptr = v.empty() ? nullptr : v.data();
+    count = (uint32_t)v.size();
+}
+
+void build_view(lmb_gltf_doc &d)
+{
+    fill_buffers(d);
+    fill_meshes(d);
+    d.nodes.resize(d.model.nodes.size());
+    for (size_t i = 0; i < d.model.nodes.size(); i++)
+        fill_node(d, d.model.nodes[i], d.nodes[i]);
+    fill_materials(d);
+    fill_lights(d);
+    fill_scene(d);
+    for (const auto &e : d.model.extensionsRequired)
+        d.ext_required.push_back(e.c_str());
+    for (const auto &e : d.model.extensionsUsed)
+        d.ext_used.push_back(e.c_str());
+    lmb_gltf_view &v = d.view;
+    expose(d.buffers, v.buffers, v.buffer_count);
+    expose(d.buffer_views, v.buffer_views, v.buffer_view_count);
+    expose(d.accessors, v.accessors, v.accessor_count);
+    expose(d.meshes, v.meshes, v.mesh_count);
+    expose(d.primitives, v.primitives, v.primitive_count);
+    expose(d.nodes, v.nodes, v.node_count);
+    expose(d.children, v.children, v.children_total);
+    expose(d.materials, v.materials, v.material_count);
+    expose(d.lights, v.lights, v.light_count);
+    expose(d.scene_roots, v.scene_roots, v.scene_root_count);
+    expose(d.ext_required, v.extensions_required, v.extensions_required_count);
+    expose(d.ext_used, v.extensions_used, v.extensions_used_count);
+}
+
+/* tinygltf's messages end in newlines and may hold several lines: keep the first one. */
+std::string first_line(const std::string &s)
+{
+    size_t start = s.find_first_not_of(" \n\r\t");
+    if (start == std::string::npos)
+        return "unknown error";
+    size_t end = s.find('\n', start);
+    return s.substr(start, end == std::string::npos ? std::string::npos : end - start);
+}
+
+bool is_glb(const char *path)
+{
+    unsigned char magic[4] = {0, 0, 0, 0};
+    FILE *f = std::fopen(path, "rb");
+    if (!f)
+        return false;
+    size_t n = std::fread(magic, 1, 4, f);
+    std::fclose(f);
+    return n == 4 && std::memcmp(magic, "glTF", 4) == 0;
+}
+
+} // namespace
+
+extern "C" lmb_status lmb_gltf_open(const char *path, const char *extras_key, lmb_gltf_doc **out,
+                                    const lmb_log *log, lmb_error *err)
+{
+    *out = nullptr;
+    FILE *probe = std::fopen(path, "rb");
+    if (!probe)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot open: %s", path, std::strerror(errno));
+    std::fclose(probe);
+    try {
+        std::unique_ptr<lmb_gltf_doc> d(new lmb_gltf_doc());
+        d->extras_key = extras_key ? extras_key : "";
+        tinygltf::TinyGLTF loader;
+        loader.SetImageLoader(skip_image, nullptr);
+        std::string terr, twarn;
+        bool ok = is_glb(path) ? loader.LoadBinaryFromFile(&d->model, &terr, &twarn, path)
+                               : loader.LoadASCIIFromFile(&d->model, &terr, &twarn, path);
+        if (!ok)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: not a loadable glTF: %s", path,
+                                 first_line(terr.empty() ? twarn : terr).c_str());
+        if (!twarn.empty())
+            lmb_warn(log, "%s: %s", path, first_line(twarn).c_str());
+        build_view(*d);
+        *out = d.release();
+        return LMB_OK;
+    } catch (const std::bad_alloc &) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory while parsing", path);
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: glTF parser failed: %s", path, e.what());
+    }
+}
+
+extern "C" const lmb_gltf_view *lmb_gltf_get_view(const lmb_gltf_doc *doc)
+{
+    return &doc->view;
+}
+
+extern "C" void lmb_gltf_close(lmb_gltf_doc *doc)
+{
+    delete doc;
+}

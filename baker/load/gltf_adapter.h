@@ -1,0 +1,117 @@
+/*
+ * The tinygltf adapter (C header over C++): parses a .gltf/.glb with tinygltf and exposes
+ * what lmbake reads as plain C structs that mirror the glTF JSON. It decodes nothing and
+ * validates only what tinygltf does: accessor decoding, bounds checks, the node graph and
+ * every lmbake-specific rule live in C (scene_load.c, accessor.c).
+ * The same handle later takes the lightmap additions and writes the output glTF.
+ */
+#ifndef LMBAKE_GLTF_ADAPTER_H
+#define LMBAKE_GLTF_ADAPTER_H
+
+#include <lmbake/lmbake.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct lmb_gltf_buffer {
+    const uint8_t *data; /* owned by the doc */
+    size_t size;
+} lmb_gltf_buffer;
+
+typedef struct lmb_gltf_buffer_view {
+    int32_t buffer;
+    size_t offset, length, stride; /* stride 0: tightly packed */
+} lmb_gltf_buffer_view;
+
+typedef struct lmb_gltf_accessor {
+    const char *name;
+    int32_t buffer_view; /* -1: all zeros (or sparse only) */
+    size_t offset;
+    int32_t component_type; /* 5120..5126 (GL enums) */
+    int32_t components;     /* 1,2,3,4,9,16 from the type, 0 if unknown */
+    size_t count;
+    int normalized;
+    /* sparse substitution, count 0 if not sparse */
+    size_t sparse_count;
+    int32_t sparse_indices_view, sparse_indices_type;
+    size_t sparse_indices_offset;
+    int32_t sparse_values_view;
+    size_t sparse_values_offset;
+} lmb_gltf_accessor;
+
+typedef struct lmb_gltf_primitive {
+    int32_t mode;     /* 0..6, glTF default 4 */
+    int32_t material; /* -1: default */
+    int32_t indices;  /* accessor or -1 */
+    int32_t position, normal, texcoord0, texcoord1; /* accessors or -1 */
+    int32_t any_attribute; /* the first attribute's accessor, -1 if none (for counting) */
+} lmb_gltf_primitive;
+
+typedef struct lmb_gltf_mesh {
+    const char *name; /* "" if unnamed */
+    uint32_t first_primitive, primitive_count; /* into lmb_gltf_view.primitives */
+} lmb_gltf_mesh;
+
+typedef struct lmb_gltf_node {
+    const char *name;
+    int32_t mesh, light; /* -1 if none */
+    uint32_t first_child, child_count; /* into lmb_gltf_view.children */
+    int has_matrix;
+    double matrix[16];   /* column-major, when has_matrix */
+    double translation[3], rotation[4], scale[3]; /* TRS, defaults filled in */
+    int extras_lightmap; /* -1 absent, 0/1: the bool under the requested extras key */
+    int32_t gpu_translation, gpu_rotation, gpu_scale; /* EXT_mesh_gpu_instancing accessors, -1 */
+    int has_gpu_instancing;
+} lmb_gltf_node;
+
+typedef struct lmb_gltf_material {
+    const char *name;
+    double base_color[4];
+    int32_t base_color_texture, base_color_texcoord;
+    double metallic;
+    double emissive[3];
+    double emissive_strength; /* 1 if KHR_materials_emissive_strength is absent */
+    int32_t emissive_texture, emissive_texcoord;
+    int double_sided;
+} lmb_gltf_material;
+
+typedef struct lmb_gltf_light {
+    const char *name;
+    const char *type; /* as written: "point", "spot", "directional" or anything else */
+    double color[3];
+    double intensity, range;
+    double inner_cone, outer_cone;
+} lmb_gltf_light;
+
+/* Everything lmbake reads, as plain arrays. All pointers are owned by the doc. */
+typedef struct lmb_gltf_view {
+    const lmb_gltf_buffer *buffers;             uint32_t buffer_count;
+    const lmb_gltf_buffer_view *buffer_views;   uint32_t buffer_view_count;
+    const lmb_gltf_accessor *accessors;         uint32_t accessor_count;
+    const lmb_gltf_mesh *meshes;                uint32_t mesh_count;
+    const lmb_gltf_primitive *primitives;       uint32_t primitive_count;
+    const lmb_gltf_node *nodes;                 uint32_t node_count;
+    const int32_t *children;                    uint32_t children_total;
+    const lmb_gltf_material *materials;         uint32_t material_count;
+    const lmb_gltf_light *lights;               uint32_t light_count;
+    const int32_t *scene_roots;                 uint32_t scene_root_count; /* the scene to bake */
+    int has_scene; /* 0: the file has no scene; roots are the parentless nodes */
+    const char *const *extensions_required;     uint32_t extensions_required_count;
+    const char *const *extensions_used;         uint32_t extensions_used_count;
+} lmb_gltf_view;
+
+/* Parses path (.gltf or .glb by content). `extras_key` names the node extras bool read
+ * into lmb_gltf_node.extras_lightmap (NULL: none). Images are not decoded. */
+lmb_status lmb_gltf_open(const char *path, const char *extras_key, lmb_gltf_doc **out,
+                         const lmb_log *log, lmb_error *err);
+
+const lmb_gltf_view *lmb_gltf_get_view(const lmb_gltf_doc *doc);
+
+void lmb_gltf_close(lmb_gltf_doc *doc);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,194 @@
+/*
+ * Preflight: a look at the glTF's JSON (with cJSON) before tinygltf parses it, so that
+ * files lmbake cannot bake fail with a message naming the reason rather than with the
+ * symptom tinygltf would report later ("'uri' is missing", "invalid bufferView"):
+ *   - asset.version must be 2.x (and minVersion, if any, <= 2.0);
+ *   - extensionsRequired must only name extensions lmbake implements;
+ *   - compressed geometry (KHR_draco_mesh_compression on a primitive,
+ *     EXT_meshopt_compression on a buffer view) is refused, naming the mesh or view.
+ * For .glb the JSON chunk is read from the container (glTF 2.0 spec section 4.4).
+ */
+#include "preflight.h"
+#include "load_internal.h"
+
+#include <cJSON.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Extensions lmbake implements fully; a file may require these. */
+static const char *const supported_required[] = {
+    "KHR_lights_punctual", "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing",
+    "KHR_mesh_quantization",
+};
+
+static lmb_status read_file(const char *path, char **out, size_t *size, lmb_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot open: %s", path, strerror(errno));
+    char *buf = NULL;
+    size_t cap = 0, n = 0;
+    for (;;) {
+        if (n == cap) {
+            size_t ncap = cap ? cap * 2 : 65536;
+            char *nb = realloc(buf, ncap + 1);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
+            }
+            buf = nb;
+            cap = ncap;
+        }
+        size_t r = fread(buf + n, 1, cap - n, f);
+        n += r;
+        if (r == 0)
+            break;
+    }
+    int failed = ferror(f);
+    fclose(f);
+    if (failed) {
+        free(buf);
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: read error", path);
+    }
+    buf[n] = '\0';
+    *out = buf;
+    *size = n;
+    return LMB_OK;
+}
+
+static uint32_t le32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* Locates the JSON text: the whole file, or a .glb's first chunk. */
+static lmb_status json_span(const char *path, const char *buf, size_t size, const char **json,
+                            size_t *len, lmb_error *err)
+{
+    const unsigned char *u = (const unsigned char *)buf;
+    if (size < 4 || memcmp(buf, "glTF", 4) != 0) {
+        *json = buf;
+        *len = size;
+        return LMB_OK;
+    }
+    if (size < 20)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: truncated .glb header (%zu bytes)", path, size);
+    uint32_t version = le32(u + 4), chunk_len = le32(u + 12), chunk_type = le32(u + 16);
+    if (version != 2)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: .glb container version %u; lmbake reads glTF 2.0", path, version);
+    if (chunk_type != 0x4E4F534Au || chunk_len > size - 20)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: .glb first chunk is not a complete JSON chunk", path);
+    *json = buf + 20;
+    *len = chunk_len;
+    return LMB_OK;
+}
+
+static lmb_status check_version(const char *path, const cJSON *root, lmb_error *err)
+{
+    const cJSON *asset = cJSON_GetObjectItemCaseSensitive(root, "asset");
+    const cJSON *version = cJSON_GetObjectItemCaseSensitive(asset, "version");
+    const cJSON *min = cJSON_GetObjectItemCaseSensitive(asset, "minVersion");
+    if (!cJSON_IsString(version))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: asset.version is missing; a glTF 2.0 file must state it", path);
+    if (strncmp(version->valuestring, "2.", 2) != 0)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: asset.version is '%s'; lmbake reads glTF 2.x", path,
+                             version->valuestring);
+    if (cJSON_IsString(min) && strcmp(min->valuestring, "2.0") != 0)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: asset.minVersion is '%s'; lmbake reads glTF 2.0", path,
+                             min->valuestring);
+    return LMB_OK;
+}
+
+static lmb_status check_required(const char *path, const cJSON *root, lmb_error *err)
+{
+    char missing[512] = "";
+    const cJSON *e;
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(root, "extensionsRequired"))
+    {
+        int known = 0;
+        if (!cJSON_IsString(e))
+            continue;
+        for (size_t k = 0; k < sizeof supported_required / sizeof *supported_required; k++)
+            known |= !strcmp(e->valuestring, supported_required[k]);
+        if (!known) {
+            size_t len = strlen(missing);
+            snprintf(missing + len, sizeof missing - len, "%s%s", len ? ", " : "", e->valuestring);
+        }
+    }
+    if (*missing)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: requires glTF extension(s) lmbake does not support: %s",
+                             path, missing);
+    return LMB_OK;
+}
+
+static lmb_status check_compression(const char *path, const cJSON *root, lmb_error *err)
+{
+    const cJSON *mesh, *prim, *view;
+    uint32_t mi = 0;
+    char label[160];
+    cJSON_ArrayForEach(mesh, cJSON_GetObjectItemCaseSensitive(root, "meshes"))
+    {
+        uint32_t pi = 0;
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(mesh, "name");
+        cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives"))
+        {
+            const cJSON *ext = cJSON_GetObjectItemCaseSensitive(prim, "extensions");
+            if (cJSON_GetObjectItemCaseSensitive(ext, "KHR_draco_mesh_compression"))
+                return lmb_error_set(err, LMB_ERR_INPUT,
+                                     "%s: %s primitive %u is compressed with KHR_draco_mesh_compression, which lmbake "
+                                     "does not decode; export the level uncompressed",
+                                     path, lmb_object_label(label, "mesh", mi, cJSON_IsString(name) ? name->valuestring : NULL), pi);
+            pi++;
+        }
+        mi++;
+    }
+    uint32_t vi = 0;
+    cJSON_ArrayForEach(view, cJSON_GetObjectItemCaseSensitive(root, "bufferViews"))
+    {
+        const cJSON *ext = cJSON_GetObjectItemCaseSensitive(view, "extensions");
+        if (cJSON_GetObjectItemCaseSensitive(ext, "EXT_meshopt_compression"))
+            return lmb_error_set(err, LMB_ERR_INPUT,
+                                 "%s: bufferView %u is compressed with EXT_meshopt_compression, which lmbake does not "
+                                 "decode; export the level uncompressed",
+                                 path, vi);
+        vi++;
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_preflight(const char *path, lmb_error *err)
+{
+    char *buf;
+    size_t size, len;
+    const char *json;
+    lmb_status st = read_file(path, &buf, &size, err);
+    if (st != LMB_OK)
+        return st;
+    if ((st = json_span(path, buf, size, &json, &len, err)) != LMB_OK) {
+        free(buf);
+        return st;
+    }
+    cJSON *root = cJSON_ParseWithLength(json, len);
+    if (!root || !cJSON_IsObject(root)) {
+        /* cJSON points at where parsing stopped: turn it into a line number */
+        const char *at = cJSON_GetErrorPtr();
+        unsigned line = 1;
+        if (at && at >= json && at <= json + len)
+            for (const char *c = json; c < at; c++)
+                line += *c == '\n';
+        cJSON_Delete(root);
+        free(buf);
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: not valid glTF JSON (a JSON object was expected)", path, line);
+    }
+    st = check_version(path, root, err);
+    if (st == LMB_OK)
+        st = check_required(path, root, err);
+    if (st == LMB_OK)
+        st = check_compression(path, root, err);
+    cJSON_Delete(root);
+    free(buf);
+    return st;
+}

@@ -1,0 +1,179 @@
+/*
+ * The load stage: glTF file -> lmb_scene. Preflight (preflight.c) refuses what lmbake
+ * cannot honour, the tinygltf adapter parses, then this builds meshes, materials, instances and
+ * lights in plain C, checking everything tinygltf lets through (see ../shared INDEX notes:
+ * Draco accessors without data, cycles, out-of-range indices). On error nothing leaks and
+ * *out stays NULL.
+ */
+#include "load_internal.h"
+#include "preflight.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Extensions lmbake knows it ignores when they are only used: what a user should expect. */
+static const struct { const char *name, *effect; } ignored_used[] = {
+    {"KHR_texture_transform", "texture transforms are ignored for bounce albedo"},
+    {"KHR_materials_transmission", "transmissive surfaces are baked as opaque"},
+    {"KHR_materials_volume", "volumes are baked as opaque surfaces"},
+    {"KHR_materials_pbrSpecularGlossiness", "spec-gloss materials use their diffuse factor only"},
+};
+
+char *lmb_strdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+const char *lmb_object_label(char *buf, const char *kind, uint32_t index, const char *name)
+{
+    if (name && *name)
+        snprintf(buf, 160, "%s '%s'", kind, name);
+    else
+        snprintf(buf, 160, "%s %u", kind, index);
+    return buf;
+}
+
+static void warn_ignored_extensions(const char *path, const lmb_gltf_view *v, const lmb_log *log)
+{
+    for (uint32_t i = 0; i < v->extensions_used_count; i++)
+        for (size_t k = 0; k < sizeof ignored_used / sizeof *ignored_used; k++)
+            if (!strcmp(v->extensions_used[i], ignored_used[k].name))
+                lmb_warn(log, "%s: uses %s: %s", path, ignored_used[k].name, ignored_used[k].effect);
+}
+
+static lmb_status load_materials(const char *path, const lmb_gltf_view *v, lmb_scene *s, lmb_error *err)
+{
+    s->materials = calloc(v->material_count + 1, sizeof *s->materials);
+    if (!s->materials)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
+    for (uint32_t i = 0; i < v->material_count; i++) {
+        const lmb_gltf_material *g = &v->materials[i];
+        lmb_material *m = &s->materials[i];
+        char label[160];
+        m->name = lmb_strdup(lmb_object_label(label, "material", i, g->name) + strlen("material "));
+        if (!m->name)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
+        s->material_count = i + 1;
+        if (!(g->emissive_strength >= 0.0) || g->emissive_strength > 1e30)
+            return lmb_error_set(err, LMB_ERR_INPUT,
+                                 "%s: %s: KHR_materials_emissive_strength %g must be a finite number >= 0",
+                                 path, label, g->emissive_strength);
+        for (int c = 0; c < 4; c++)
+            m->base_color[c] = (float)g->base_color[c];
+        for (int c = 0; c < 3; c++)
+            m->emissive[c] = (float)(g->emissive[c] * g->emissive_strength);
+        m->emissive_strength = (float)g->emissive_strength;
+        m->base_color_texture = g->base_color_texture;
+        m->base_color_texcoord = g->base_color_texcoord;
+        m->emissive_texture = g->emissive_texture;
+        m->emissive_texcoord = g->emissive_texcoord;
+        m->metallic = (float)g->metallic;
+        m->double_sided = g->double_sided;
+    }
+    return LMB_OK;
+}
+
+static lmb_status load_meshes(const lmb_accessor_ctx *ctx, lmb_scene *s, const lmb_log *log, lmb_error *err)
+{
+    const lmb_gltf_view *v = ctx->view;
+    s->meshes = calloc(v->mesh_count + 1, sizeof *s->meshes);
+    s->primitives = calloc(v->primitive_count + 1, sizeof *s->primitives);
+    if (!s->meshes || !s->primitives)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", ctx->path);
+    for (uint32_t m = 0; m < v->mesh_count; m++) {
+        lmb_mesh *mesh = &s->meshes[m];
+        char label[160];
+        lmb_object_label(label, "mesh", m, v->meshes[m].name);
+        mesh->name = lmb_strdup(v->meshes[m].name && *v->meshes[m].name ? v->meshes[m].name : label);
+        if (!mesh->name)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", ctx->path);
+        s->mesh_count = m + 1;
+        mesh->first_primitive = s->primitive_count;
+        for (uint32_t p = 0; p < v->meshes[m].primitive_count; p++) {
+            lmb_primitive prim;
+            int skipped;
+            memset(&prim, 0, sizeof prim);
+            lmb_status st = lmb_load_primitive(ctx, m, p, mesh->name, s->material_count, &prim, &skipped, log, err);
+            if (st != LMB_OK) {
+                lmb_primitive_release(&prim);
+                return st;
+            }
+            if (skipped) {
+                mesh->skipped_primitives++;
+                mesh->skipped_triangles += prim.triangle_count;
+                lmb_primitive_release(&prim);
+                continue;
+            }
+            mesh->triangle_count += prim.triangle_count;
+            mesh->degenerate_count += prim.degenerate_count;
+            s->primitives[s->primitive_count++] = prim;
+            mesh->primitive_count++;
+        }
+        if (mesh->degenerate_count)
+            lmb_warn(log, "%s: mesh '%s': %u of %u triangles have zero area and are left out of lightmapping",
+                     ctx->path, mesh->name, mesh->degenerate_count, mesh->triangle_count);
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_scene_load(const char *path, const lmb_config *cfg, lmb_scene **out,
+                          const lmb_log *log, lmb_error *err)
+{
+    const char *extras_key = cfg && cfg->extras_key[0] ? cfg->extras_key : NULL;
+    *out = NULL;
+    lmb_scene *s = calloc(1, sizeof *s);
+    if (!s)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
+    lmb_status st = lmb_preflight(path, err);
+    if (st == LMB_OK)
+        st = lmb_gltf_open(path, extras_key, &s->doc, log, err);
+    if (st == LMB_OK && !(s->path = lmb_strdup(path)))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
+    if (st == LMB_OK) {
+        const lmb_gltf_view *v = lmb_gltf_get_view(s->doc);
+        lmb_accessor_ctx ctx = {v, path};
+        s->node_count = v->node_count;
+        warn_ignored_extensions(path, v, log);
+        st = load_materials(path, v, s, err);
+        if (st == LMB_OK)
+            st = load_meshes(&ctx, s, log, err);
+        if (st == LMB_OK)
+            st = lmb_load_nodes(&ctx, s, log, err);
+    }
+    if (st != LMB_OK) {
+        lmb_scene_free(s);
+        return st;
+    }
+    *out = s;
+    return LMB_OK;
+}
+
+void lmb_scene_free(lmb_scene *s)
+{
+    if (!s)
+        return;
+    for (uint32_t i = 0; i < s->primitive_count; i++)
+        lmb_primitive_release(&s->primitives[i]);
+    for (uint32_t i = 0; i < s->mesh_count; i++)
+        free(s->meshes[i].name);
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        free(s->instances[i].name);
+    for (uint32_t i = 0; i < s->material_count; i++)
+        free(s->materials[i].name);
+    for (uint32_t i = 0; i < s->light_count; i++)
+        free(s->lights[i].name);
+    free(s->primitives);
+    free(s->meshes);
+    free(s->instances);
+    free(s->materials);
+    free(s->lights);
+    free(s->path);
+    if (s->doc)
+        lmb_gltf_close(s->doc);
+    free(s);
+}

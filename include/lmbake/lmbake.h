@@ -1,0 +1,258 @@
+/*
+ * lmbake public C API: status codes, the scene model, the bake config, progress.
+ *
+ * lmbake is a library the `lmbake` CLI is a thin user of; an asset pipeline or an
+ * engine tool links the same functions. Conventions (after cgltf and Embree):
+ *   - plain structs for data, opaque handles where a C++ library sits behind;
+ *   - every fallible function returns lmb_status and fills an lmb_error with a message
+ *     that names the file and the thing (mesh, key, line);
+ *   - the caller owns what it creates and frees it with the matching *_free function;
+ *   - no global mutable state.
+ */
+#ifndef LMBAKE_LMBAKE_H
+#define LMBAKE_LMBAKE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LMB_VERSION_STRING "0.1.0"
+
+/* ---- status and errors ---------------------------------------------------- */
+
+/* Values double as the CLI's exit codes (README: "Exit codes"). */
+typedef enum lmb_status {
+    LMB_OK = 0,
+    LMB_ERR_USAGE = 1,    /* bad command line */
+    LMB_ERR_INPUT = 2,    /* bad scene, config or other input file */
+    LMB_ERR_INTERNAL = 3  /* out of memory, I/O failure, a bug */
+} lmb_status;
+
+typedef struct lmb_error {
+    lmb_status status;
+    char message[1024];
+} lmb_error;
+
+/* Sets err (if not NULL) and returns status; printf-style message. */
+lmb_status lmb_error_set(lmb_error *err, lmb_status status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* ---- diagnostics: warnings go through a sink the caller chooses ----------- */
+
+typedef void (*lmb_warn_fn)(void *user, const char *message);
+
+typedef struct lmb_log {
+    lmb_warn_fn warn; /* NULL: warnings are dropped */
+    void *user;
+} lmb_log;
+
+void lmb_warn(const lmb_log *log, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* ---- progress (after xatlas's progress callback) -------------------------- */
+
+/* Called from the thread that drives a stage, never concurrently. done <= total. */
+typedef void (*lmb_progress_fn)(void *user, const char *stage, uint64_t done, uint64_t total);
+
+/* ---- scene model ---------------------------------------------------------- */
+
+typedef enum lmb_light_type {
+    LMB_LIGHT_POINT = 0,
+    LMB_LIGHT_SPOT = 1,
+    LMB_LIGHT_DIRECTIONAL = 2
+} lmb_light_type;
+
+/* A triangle list built from one glTF primitive (strips and fans are converted). */
+typedef struct lmb_primitive {
+    uint32_t gltf_mesh;      /* index into the glTF's meshes */
+    uint32_t gltf_primitive; /* index into that mesh's primitives */
+    int32_t material;        /* index into lmb_scene.materials, -1: glTF default material */
+    uint32_t vertex_count;
+    float *positions; /* 3 * vertex_count, object space */
+    float *normals;   /* 3 * vertex_count, or NULL (flat normals are used) */
+    float *uv0;       /* 2 * vertex_count, or NULL */
+    float *uv1;       /* 2 * vertex_count, or NULL (the glTF had no TEXCOORD_1) */
+    uint32_t triangle_count;
+    uint32_t *indices;        /* 3 * triangle_count, counter-clockwise front faces */
+    uint32_t degenerate_count; /* zero-area triangles (kept in indices, flagged below) */
+    uint8_t *degenerate;       /* triangle_count flags: 1 = zero area, left out of lightmapping */
+} lmb_primitive;
+
+typedef struct lmb_mesh {
+    char *name; /* glTF name or "mesh N" */
+    uint32_t first_primitive; /* into lmb_scene.primitives */
+    uint32_t primitive_count;
+    uint32_t triangle_count;  /* over its primitives */
+    uint32_t degenerate_count;
+    uint32_t skipped_primitives; /* points/lines or no-POSITION primitives, left out with a warning */
+    uint32_t skipped_triangles;  /* triangles the no-POSITION ones would have had (not in triangle_count) */
+} lmb_mesh;
+
+/* One placement of a mesh in the world: a node, or one EXT_mesh_gpu_instancing copy. */
+typedef struct lmb_instance {
+    char *name;            /* node name or "node N"; GPU copies get "#k" appended */
+    uint32_t node;         /* glTF node index */
+    int32_t gpu_instance;  /* -1, or the index within EXT_mesh_gpu_instancing */
+    uint32_t mesh;         /* into lmb_scene.meshes */
+    double world[16];      /* column-major object-to-world */
+    int flips_winding;     /* det(world) < 0: triangles' winding is reversed in world space */
+    int lightmapped;       /* decided by lmb_scene_select_lightmapped */
+    char skip_reason[96];  /* why not lightmapped, "" if it is */
+    int extras_lightmap;   /* node extras flag: -1 absent, 0 false, 1 true */
+} lmb_instance;
+
+typedef struct lmb_material {
+    char *name;
+    float base_color[4];        /* linear RGBA factor */
+    int32_t base_color_texture; /* glTF texture index or -1 */
+    int32_t base_color_texcoord;
+    float metallic;
+    float emissive[3];          /* emissiveFactor x KHR_materials_emissive_strength */
+    float emissive_strength;    /* the strength alone (1 if absent) */
+    int32_t emissive_texture;   /* glTF texture index or -1 */
+    int32_t emissive_texcoord;
+    int double_sided;
+} lmb_material;
+
+typedef struct lmb_light {
+    char *name;
+    lmb_light_type type;
+    uint32_t gltf_light; /* index into KHR_lights_punctual.lights */
+    uint32_t node;       /* node that places it */
+    float color[3];      /* linear */
+    float intensity;     /* candela (point, spot) or lux (directional) */
+    float range;         /* 0: infinite */
+    float inner_cone, outer_cone; /* radians, spot only */
+    double position[3];  /* world */
+    double direction[3]; /* world, unit: the way light travels (node's -Z) */
+} lmb_light;
+
+typedef struct lmb_gltf_doc lmb_gltf_doc; /* opaque: the parsed glTF, kept for writing */
+
+typedef struct lmb_scene {
+    char *path; /* the file it was loaded from */
+    lmb_mesh *meshes;
+    uint32_t mesh_count;
+    lmb_primitive *primitives;
+    uint32_t primitive_count;
+    lmb_instance *instances;
+    uint32_t instance_count;
+    lmb_material *materials;
+    uint32_t material_count;
+    lmb_light *lights;
+    uint32_t light_count;
+    uint32_t node_count;
+    uint32_t gpu_instanced_nodes; /* nodes expanded from EXT_mesh_gpu_instancing */
+    lmb_gltf_doc *doc;            /* owned */
+} lmb_scene;
+
+/* ---- bake config ---------------------------------------------------------- */
+
+typedef enum lmb_gather_method {
+    LMB_GATHER_COSINE = 0,         /* classic final gathering */
+    LMB_GATHER_AMIS = 1,           /* the paper exactly */
+    LMB_GATHER_AMIS_DEFENSIVE = 2  /* AMIS with a share of cosine samples in every pdf */
+} lmb_gather_method;
+
+enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4 };
+
+#define LMB_MAX_PATTERNS 64
+#define LMB_PATTERN_LEN 128
+
+typedef struct lmb_density_override {
+    char pattern[LMB_PATTERN_LEN]; /* glob over node and mesh names */
+    double texel_density;
+} lmb_density_override;
+
+typedef struct lmb_config {
+    /* unwrap / pack */
+    double texel_density;          /* texels per world unit */
+    lmb_density_override density_overrides[LMB_MAX_PATTERNS];
+    uint32_t density_override_count;
+    uint32_t max_atlas_size;       /* texels per side */
+    uint32_t padding;              /* texels between charts */
+    int keep_uv1;                  /* keep a mesh's own TEXCOORD_1 */
+    /* samples */
+    uint32_t texel_samples;        /* gather points per texel (stratified) */
+    uint32_t direct_samples;       /* shadow rays per area-light evaluation */
+    uint32_t gather_rays;          /* final gather rays per gather point */
+    uint32_t amis_iterations;
+    uint32_t bounces;
+    lmb_gather_method gather_method;
+    double defensive_fraction;     /* share of cosine samples, AMIS defensive */
+    uint64_t seed;
+    uint32_t threads;              /* 0: all cores */
+    unsigned output_formats;       /* LMB_OUTPUT_* bits */
+    /* what is lightmapped */
+    char include[LMB_MAX_PATTERNS][LMB_PATTERN_LEN];
+    uint32_t include_count;
+    char exclude[LMB_MAX_PATTERNS][LMB_PATTERN_LEN];
+    uint32_t exclude_count;
+    char extras_key[LMB_PATTERN_LEN]; /* node extras flag name, e.g. "lightmap" */
+    /* lights */
+    double light_intensity_scale;  /* multiplies punctual lights */
+    double emissive_scale;         /* multiplies emissive materials */
+} lmb_config;
+
+/* Fills cfg with the documented defaults (README: "Bake config"). */
+void lmb_config_default(lmb_config *cfg);
+
+/* Reads a YAML bake config over the defaults already in cfg. Unknown keys, wrong
+ * types and out-of-range values are LMB_ERR_INPUT naming file, line and key. */
+lmb_status lmb_config_load(const char *path, lmb_config *cfg, lmb_error *err);
+
+/* Same, from a string; `name` is used in messages in place of a file name. */
+lmb_status lmb_config_parse(const char *name, const char *text, size_t length, lmb_config *cfg,
+                            lmb_error *err);
+
+/* glob match with '*' and '?', used for node/mesh name patterns. */
+int lmb_glob_match(const char *pattern, const char *name);
+
+/* ---- loading -------------------------------------------------------------- */
+
+/* Loads a .gltf or .glb into *out (caller frees with lmb_scene_free). On error nothing
+ * needs freeing. Unsupported required extensions, broken accessors, cycles... are
+ * LMB_ERR_INPUT with a message naming the file and the object. cfg may be NULL (defaults);
+ * the loader reads only cfg->extras_key from it. */
+lmb_status lmb_scene_load(const char *path, const lmb_config *cfg, lmb_scene **out,
+                          const lmb_log *log, lmb_error *err);
+
+void lmb_scene_free(lmb_scene *scene);
+
+/* Marks each instance lightmapped or not (with a reason) from the config's include /
+ * exclude globs, the node extras flag and the geometry itself. */
+void lmb_scene_select_lightmapped(lmb_scene *scene, const lmb_config *cfg);
+
+/* Counts for reports. Triangle counts include zero-area ones; "in_nodes" counts each node
+ * once (as the glTF's JSON reads), "instanced" expands EXT_mesh_gpu_instancing copies. */
+typedef struct lmb_scene_stats {
+    uint64_t triangles_unique;     /* over all meshes */
+    uint64_t triangles_skipped;    /* in primitives without POSITION, not baked */
+    uint64_t degenerate_unique;    /* zero-area, over all meshes */
+    uint64_t triangles_in_nodes;   /* over nodes that place a mesh */
+    uint64_t triangles_instanced;  /* over all instances */
+    uint32_t lightmapped_instances;
+    uint64_t lightmapped_triangles; /* non-degenerate, over lightmapped instances */
+    uint32_t emissive_materials;    /* emissive factor x strength > 0 */
+    uint64_t emissive_triangles;    /* over instances, non-degenerate: the area lights */
+} lmb_scene_stats;
+
+void lmb_scene_stats_compute(const lmb_scene *scene, lmb_scene_stats *out);
+
+/* 1 if the material emits (emissive factor x strength > 0 in any channel). */
+int lmb_material_is_emissive(const lmb_material *m);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Writes small broken (and borderline) glTF files, one defect each, into OUTDIR.
+
+Each file is a single triangle-list primitive in an embedded (data URI) buffer, then
+edited to carry exactly one problem. tests/CMakeLists.txt pairs each with the exit code
+and the message lmbake must give.
+"""
+import base64
+import copy
+import json
+import math
+import os
+import struct
+import sys
+
+
+def base_doc(positions, indices, normals=None):
+    """A valid one-mesh glTF: POSITION (+NORMAL) floats, uint16 indices."""
+    blob = b"".join(struct.pack("<3f", *p) for p in positions)
+    pos_len = len(blob)
+    nrm_off = len(blob)
+    if normals is not None:
+        blob += b"".join(struct.pack("<3f", *n) for n in normals)
+    idx_off = len(blob)
+    blob += b"".join(struct.pack("<H", i) for i in indices)
+    while len(blob) % 4:
+        blob += b"\0"
+    finite = [p for p in positions if all(math.isfinite(c) for c in p)] or [(0, 0, 0)]
+    doc = {
+        "asset": {"version": "2.0", "generator": "lmbake tests/cli/make_bad_gltf.py"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"name": "Floor", "mesh": 0}],
+        "meshes": [{"name": "FloorMesh", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": pos_len},
+            {"buffer": 0, "byteOffset": idx_off, "byteLength": 2 * len(indices)},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": len(positions), "type": "VEC3",
+             "min": [min(p[i] for p in finite) for i in range(3)],
+             "max": [max(p[i] for p in finite) for i in range(3)]},
+            {"bufferView": 1, "componentType": 5123, "count": len(indices), "type": "SCALAR"},
+        ],
+    }
+    if normals is not None:
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": nrm_off, "byteLength": 12 * len(normals)})
+        doc["accessors"].append({"bufferView": 2, "componentType": 5126, "count": len(normals), "type": "VEC3"})
+        doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 2
+    return doc
+
+
+QUAD = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]
+QUAD_IDX = [0, 2, 1, 0, 3, 2]
+
+
+def cases():
+    ok = base_doc(QUAD, QUAD_IDX)
+    yield "ok-quad", ok
+
+    yield "index-out-of-range", base_doc(QUAD, [0, 2, 1, 0, 3, 7])
+    yield "nan-position", base_doc([(0, 0, 0), (1, 0, 0), (float("nan"), 0, 1), (0, 0, 1)], QUAD_IDX)
+    yield "inf-position", base_doc([(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, float("inf"), 1)], QUAD_IDX)
+    yield "normal-count-mismatch", base_doc(QUAD, QUAD_IDX, normals=[(0, 1, 0)] * 3)
+
+    d = copy.deepcopy(ok)
+    d["accessors"][0]["count"] = 40  # runs past its buffer view
+    yield "accessor-past-view", d
+
+    d = copy.deepcopy(ok)
+    d["bufferViews"][0]["byteLength"] = 4096  # runs past its buffer
+    yield "view-past-buffer", d
+
+    d = copy.deepcopy(ok)
+    d["buffers"][0]["uri"] = "missing-level-data.bin"
+    yield "missing-bin", d
+
+    d = copy.deepcopy(ok)
+    d["nodes"] = [{"name": "A", "children": [1]}, {"name": "B", "children": [0], "mesh": 0}]
+    d["scenes"] = [{"nodes": []}]
+    yield "node-cycle", d
+
+    d = copy.deepcopy(ok)
+    d["nodes"][0]["children"] = [5]
+    yield "child-out-of-range", d
+
+    d = copy.deepcopy(ok)
+    d["meshes"][0]["primitives"][0]["material"] = 3
+    yield "material-out-of-range", d
+
+    d = copy.deepcopy(ok)
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "BadSpot", "type": "spot", "intensity": 10, "spot": {"innerConeAngle": 1.0, "outerConeAngle": 0.5}}]}}
+    d["nodes"].append({"name": "Lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    d["scenes"][0]["nodes"].append(1)
+    yield "spot-cone-inverted", d
+
+    d = copy.deepcopy(ok)
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [{"name": "Dark", "type": "point", "intensity": -5}]}}
+    d["nodes"].append({"name": "Lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    d["scenes"][0]["nodes"].append(1)
+    yield "negative-intensity", d
+
+    # borderline but valid: half the triangles have zero area (warning, exit 0)
+    yield "degenerate-triangles", base_doc(QUAD + [(2, 0, 0)], QUAD_IDX + [1, 4, 1, 0, 1, 4])
+
+    # not JSON at all
+    yield "not-json", "{ this is not json"
+
+
+def main():
+    out = sys.argv[1]
+    os.makedirs(out, exist_ok=True)
+    for name, doc in cases():
+        with open(os.path.join(out, name + ".gltf"), "w") as f:
+            f.write(doc if isinstance(doc, str) else json.dumps(doc, indent=1))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Installs what lmbake needs (Debian packages; later npm pieces), only what is missing,
+# then configures and builds one build tree. Idempotent and quiet when nothing is missing.
+#   usage: tools/setup.sh [BUILD_DIR] [extra cmake args...]   (default: build, Release)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+build_dir=${1:-build}
+shift || true
+
+# Why each is here: README.md "Dependencies".
+packages=(
+  build-essential cmake pkg-config  # compiler, build
+  libyaml-dev                       # bake config (YAML with line numbers for errors)
+  libtinygltf-dev                   # glTF 2.0 reading and writing
+  libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
+  libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
+  libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
+  libopenmesh-dev                   # half-edge mesh for the unwrapper
+  python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${#missing[@]} missing Debian package(s): ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" = 0 ] || sudo="sudo"
+  log=$(mktemp)
+  if ! { $sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$log" 2>&1; then
+    tail -n 30 "$log"; echo "setup: apt-get failed (full log: $log)"; exit 1
+  fi
+  rm -f "$log"
+fi
+
+log="$build_dir/setup.log"
+mkdir -p "$build_dir"
+if ! cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "$@" >"$log" 2>&1; then
+  cat "$log"; echo "setup: cmake configure failed"; exit 1
+fi
+if ! cmake --build "$build_dir" -j"$(nproc)" >>"$log" 2>&1; then
+  grep -E "error|Error" "$log" | head -n 40; echo "setup: build failed (full log: $log)"; exit 1
+fi
+if grep -q "warning:" "$log"; then
+  echo "setup: the build printed warnings (see $log)"
+fi
