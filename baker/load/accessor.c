@@ -122,7 +122,7 @@ static lmb_status apply_sparse(const lmb_accessor_ctx *ctx, const lmb_gltf_acces
 static lmb_status read_doubles(const lmb_accessor_ctx *ctx, int32_t index, int comps, const char *what,
                                double **out, size_t *count, lmb_error *err)
 {
-    const lmb_gltf_accessor *a;
+    const lmb_gltf_accessor *a = NULL;
     lmb_status st = check_accessor(ctx, index, what, &a, err);
     if (st != LMB_OK)
         return st;
@@ -163,8 +163,8 @@ static lmb_status read_doubles(const lmb_accessor_ctx *ctx, int32_t index, int c
 lmb_status lmb_accessor_read_floats(const lmb_accessor_ctx *ctx, int32_t index, int components,
                                     const char *what, float **out, size_t *count, lmb_error *err)
 {
-    double *d;
-    size_t n;
+    double *d = NULL;
+    size_t n = 0;
     lmb_status st = read_doubles(ctx, index, components, what, &d, &n, err);
     if (st != LMB_OK)
         return st;
@@ -184,7 +184,7 @@ lmb_status lmb_accessor_read_floats(const lmb_accessor_ctx *ctx, int32_t index, 
 lmb_status lmb_accessor_read_indices(const lmb_accessor_ctx *ctx, int32_t index, const char *what,
                                      uint32_t **out, size_t *count, lmb_error *err)
 {
-    const lmb_gltf_accessor *a;
+    const lmb_gltf_accessor *a = NULL;
     lmb_status st = check_accessor(ctx, index, what, &a, err);
     if (st != LMB_OK)
         return st;
@@ -193,8 +193,8 @@ lmb_status lmb_accessor_read_indices(const lmb_accessor_ctx *ctx, int32_t index,
                              ctx->path, what, index, a->component_type);
     if (a->normalized)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: index accessor %d must not be normalized", ctx->path, what, index);
-    double *d;
-    size_t n;
+    double *d = NULL;
+    size_t n = 0;
     if ((st = read_doubles(ctx, index, 1, what, &d, &n, err)) != LMB_OK)
         return st;
     uint32_t *u = malloc((n + 1) * sizeof *u);

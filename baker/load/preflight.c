@@ -161,9 +161,9 @@ static lmb_status check_compression(const char *path, const cJSON *root, lmb_err
 
 lmb_status lmb_preflight(const char *path, lmb_error *err)
 {
-    char *buf;
-    size_t size, len;
-    const char *json;
+    char *buf = NULL;
+    size_t size = 0, len = 0;
+    const char *json = NULL;
     lmb_status st = read_file(path, &buf, &size, err);
     if (st != LMB_OK)
         return st;

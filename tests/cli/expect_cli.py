@@ -6,7 +6,8 @@ usage: expect_cli.py --exit N [--stderr RE]... [--stdout RE]... [--absent PATH].
 
 --stderr/--stdout: a regular expression that must match somewhere in that stream.
 --absent: a path that must not exist afterwards (nothing written on failure).
---unchanged: a file whose bytes must be the same after the command (input never touched).
+--unchanged: a file whose bytes must be the same after the command (input never touched);
+  one that did not exist must still not exist.
 """
 import argparse
 import os
@@ -28,7 +29,7 @@ def main():
     ap.add_argument("--unchanged", action="append", default=[])
     opts = ap.parse_args(argv[:split])
     cmd = argv[split + 1:]
-    before = {p: open(p, "rb").read() for p in opts.unchanged}
+    before = {p: open(p, "rb").read() if os.path.exists(p) else None for p in opts.unchanged}
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     failures = []
     if proc.returncode != opts.exit:
@@ -43,8 +44,9 @@ def main():
         if os.path.exists(p):
             failures.append(f"{p} exists but must not")
     for p, data in before.items():
-        if open(p, "rb").read() != data:
-            failures.append(f"{p} was modified")
+        now = open(p, "rb").read() if os.path.exists(p) else None
+        if now != data:
+            failures.append(f"{p} was modified (or created)")
     if failures:
         print("command:", " ".join(cmd))
         print("--- stdout\n" + proc.stdout[-4000:])
