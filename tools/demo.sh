@@ -8,4 +8,8 @@ out=${LMB_DEMO_OUT:-$PWD/demo-out}
 scene=assets/scenes/cornell-box-bevy/CornellBox.glb
 echo "demo: baking $scene"
 build/lmbake bake "$scene" -c assets/demo-config.yaml -o "$out/cornell-box-bevy"
-echo "demo: output in $out"
+if [ -n "$(ls -A "$out/cornell-box-bevy" 2>/dev/null)" ]; then
+  echo "demo: output in $out/cornell-box-bevy"
+else
+  echo "demo: nothing written yet: the stages after load are still to come (see the bake line above)"
+fi
