@@ -81,6 +81,8 @@ static void print_text(const lmb_scene *s, const lmb_scene_stats *st)
         const lmb_material *mat = &s->materials[m];
         printf("  [%u] '%s': base colour (%.3g, %.3g, %.3g)%s, metallic %.3g", m, mat->name, mat->base_color[0],
                mat->base_color[1], mat->base_color[2], mat->base_color_texture >= 0 ? " x texture" : "", mat->metallic);
+        if (mat->metallic >= 1.0f)
+            printf(" (fully metallic: no diffuse, so a lightmap shows black on it in viewers)");
         if (lmb_material_is_emissive(mat))
             printf(", emissive (%.4g, %.4g, %.4g) nits (strength %.4g)%s -> area light", mat->emissive[0],
                    mat->emissive[1], mat->emissive[2], mat->emissive_strength, mat->emissive_texture >= 0 ? " x texture" : "");
@@ -89,7 +91,7 @@ static void print_text(const lmb_scene *s, const lmb_scene_stats *st)
     printf("lights:\n");
     for (uint32_t l = 0; l < s->light_count; l++) {
         const lmb_light *li = &s->lights[l];
-        printf("  [%u] %s %s: intensity %.4g %s, colour (%.3g, %.3g, %.3g)", l, light_type_name(li->type), li->name,
+        printf("  [%u] %s '%s': intensity %.4g %s, colour (%.3g, %.3g, %.3g)", l, light_type_name(li->type), li->name,
                li->intensity, li->type == LMB_LIGHT_DIRECTIONAL ? "lux" : "cd", li->color[0], li->color[1], li->color[2]);
         if (li->type != LMB_LIGHT_DIRECTIONAL)
             printf(", at (%.4g, %.4g, %.4g)", li->position[0], li->position[1], li->position[2]);

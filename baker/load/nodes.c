@@ -199,7 +199,7 @@ static lmb_status add_light(walk *w, uint32_t node, const double world[16], lmb_
     if (!p)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", w->ctx->path);
     s->lights = p;
-    l.name = lmb_strdup(label);
+    l.name = lmb_strdup(gl->name && *gl->name ? gl->name : label);
     if (!l.name)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", w->ctx->path);
     l.gltf_light = (uint32_t)n->light;

@@ -55,7 +55,8 @@ static lmb_status load_materials(const char *path, const lmb_gltf_view *v, lmb_s
         const lmb_gltf_material *g = &v->materials[i];
         lmb_material *m = &s->materials[i];
         char label[160];
-        m->name = lmb_strdup(lmb_object_label(label, "material", i, g->name) + strlen("material "));
+        lmb_object_label(label, "material", i, g->name);
+        m->name = lmb_strdup(g->name && *g->name ? g->name : label);
         if (!m->name)
             return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
         s->material_count = i + 1;
