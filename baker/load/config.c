@@ -8,6 +8,8 @@
  */
 #include <lmbake/lmbake.h>
 
+#include "../util/file.h"
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -427,31 +429,12 @@ lmb_status lmb_config_parse(const char *name, const char *text, size_t length, l
 
 lmb_status lmb_config_load(const char *path, lmb_config *cfg, lmb_error *err)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lmb_error_set(err, LMB_ERR_INPUT, "cannot open config '%s': %s", path, strerror(errno));
-    char *buf = NULL;
-    size_t n = 0, cap = 0, r;
-    do {
-        if (n == cap) {
-            char *nb = realloc(buf, (cap = cap ? 2 * cap : 4096) + 1);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
-            }
-            buf = nb;
-        }
-        r = fread(buf + n, 1, cap - n, f);
-        n += r;
-    } while (r > 0);
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return lmb_error_set(err, LMB_ERR_INPUT, "cannot read config '%s'", path);
-    }
-    lmb_status st = lmb_config_parse(path, buf, n, cfg, err);
+    char *buf;
+    size_t n;
+    lmb_status st = lmb_read_file(path, "config", &buf, &n, err);
+    if (st != LMB_OK)
+        return st;
+    st = lmb_config_parse(path, buf, n, cfg, err);
     free(buf);
     return st;
 }

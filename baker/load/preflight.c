@@ -10,9 +10,9 @@
  */
 #include "preflight.h"
 #include "load_internal.h"
+#include "../util/file.h"
 
 #include <cJSON.h>
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,42 +22,6 @@ static const char *const supported_required[] = {
     "KHR_lights_punctual", "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing",
     "KHR_mesh_quantization",
 };
-
-static lmb_status read_file(const char *path, char **out, size_t *size, lmb_error *err)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot open: %s", path, strerror(errno));
-    char *buf = NULL;
-    size_t cap = 0, n = 0;
-    for (;;) {
-        if (n == cap) {
-            size_t ncap = cap ? cap * 2 : 65536;
-            char *nb = realloc(buf, ncap + 1);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        size_t r = fread(buf + n, 1, cap - n, f);
-        n += r;
-        if (r == 0)
-            break;
-    }
-    int failed = ferror(f);
-    fclose(f);
-    if (failed) {
-        free(buf);
-        return lmb_error_set(err, LMB_ERR_INPUT, "%s: read error", path);
-    }
-    buf[n] = '\0';
-    *out = buf;
-    *size = n;
-    return LMB_OK;
-}
 
 static uint32_t le32(const unsigned char *p)
 {
@@ -164,7 +128,7 @@ lmb_status lmb_preflight(const char *path, lmb_error *err)
     char *buf = NULL;
     size_t size = 0, len = 0;
     const char *json = NULL;
-    lmb_status st = read_file(path, &buf, &size, err);
+    lmb_status st = lmb_read_file(path, "glTF", &buf, &size, err);
     if (st != LMB_OK)
         return st;
     if ((st = json_span(path, buf, size, &json, &len, err)) != LMB_OK) {
