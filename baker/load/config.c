@@ -1,10 +1,15 @@
 /*
- * The per-level bake config: YAML read with libyaml's document API (which keeps each
- * node's line), checked against one schema table. Every key is optional; its default is
- * set by lmb_config_default (and documented in docs/config.md and
- * assets/example-config.yaml). Unknown keys, duplicate keys, wrong types and values out of
- * range are LMB_ERR_INPUT naming "file:line: key 'a.b'". On error cfg may be partly
- * updated; callers discard it.
+ * The per-level bake config: YAML read with libyaml's document API (it keeps every node's
+ * line, so messages can name it) and checked against one schema table below: each key's
+ * dotted path, its setter (the type), its range and where it lands in lmb_config. Sections
+ * ("atlas", "samples", ...) are implied by the dotted paths. Every key is optional; the
+ * defaults are set by lmb_config_default and documented in docs/config.md and
+ * assets/example-config.yaml.
+ *
+ * Every problem is LMB_ERR_INPUT "FILE:LINE: key 'a.b': expected ..., got '...'" (or
+ * "unknown key", "given twice", "YAML syntax error"); out of memory is LMB_ERR_INTERNAL.
+ * On error cfg may be partly updated (keys before the bad one are applied): callers
+ * discard it. Plain YAML nulls (nothing, ~, null) stand for an empty section or list.
  */
 #include <lmbake/lmbake.h>
 
@@ -13,53 +18,110 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <yaml.h>
 
-typedef enum kind {
-    K_DOUBLE, K_U32, K_U64, K_BOOL, K_METHOD, K_FORMATS, K_INCLUDE, K_EXCLUDE, K_WORD, K_OVERRIDES
-} kind;
+#if defined(__GNUC__)
+#define LMB_PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define LMB_PRINTF(f, a)
+#endif
 
-typedef struct key_spec {
-    const char *path;
-    kind kind;
-    double min, max;
-    int min_exclusive; /* value must be > min */
-    size_t offset;
-} key_spec;
+typedef struct parse_ctx {
+    const char *file;
+    yaml_document_t *doc;
+    lmb_error *err;
+} parse_ctx;
+
+typedef struct key_spec key_spec;
+
+/* Reads node n into the struct at base (at k->offset), or fails naming k->path. */
+typedef lmb_status (*setter_fn)(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+
+enum { OPEN_LO = 1, OPEN_HI = 2 }; /* float ranges: '>' lo and '<' hi instead of >=, <= */
+
+struct key_spec {
+    const char *path; /* dotted, as in the file */
+    setter_fn set;
+    size_t offset;           /* of the value in the struct being filled */
+    double flo, fhi;         /* floats: range */
+    int open;                /* floats: OPEN_* bits */
+    long long ilo, ihi;      /* integers: range */
+    const char *const *names; /* enums and flag lists: NULL-terminated; index = value or bit */
+    size_t count_offset;     /* lists: the uint32_t entry count */
+    uint32_t max_items;      /* lists: most entries */
+};
+
+typedef struct schema {
+    const key_spec *keys;
+    size_t count;
+} schema;
+
+static lmb_status set_float(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_u32(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_u64(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_bool(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_enum(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_flags(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_string(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_globs(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 
 #define OFF(f) offsetof(lmb_config, f)
-static const key_spec keys[] = {
-    {"texel_density", K_DOUBLE, 0, 100000, 1, OFF(texel_density)},
-    {"density_overrides", K_OVERRIDES, 0, 0, 0, 0},
-    {"atlas.max_size", K_U32, 16, 16384, 0, OFF(max_atlas_size)},
-    {"atlas.padding", K_U32, 0, 64, 0, OFF(padding)},
-    {"atlas.keep_uv1", K_BOOL, 0, 1, 0, OFF(keep_uv1)},
-    {"samples.texel", K_U32, 1, 256, 0, OFF(texel_samples)},
-    {"samples.direct", K_U32, 1, 65536, 0, OFF(direct_samples)},
-    {"samples.gather", K_U32, 1, 1048576, 0, OFF(gather_rays)},
-    {"samples.amis_iterations", K_U32, 1, 64, 0, OFF(amis_iterations)},
-    {"bounces", K_U32, 0, 64, 0, OFF(bounces)},
-    {"gather.method", K_METHOD, 0, 0, 0, OFF(gather_method)},
-    {"gather.defensive", K_DOUBLE, 0, 0.999, 0, OFF(defensive_fraction)},
-    {"seed", K_U64, 0, 9.2233720368547758e18, 0, OFF(seed)},
-    {"threads", K_U32, 0, 1024, 0, OFF(threads)},
-    {"output.formats", K_FORMATS, 0, 0, 0, OFF(output_formats)},
-    {"lightmap.include", K_INCLUDE, 0, 0, 0, 0},
-    {"lightmap.exclude", K_EXCLUDE, 0, 0, 0, 0},
-    {"lightmap.extras_key", K_WORD, 0, 0, 0, OFF(extras_key)},
-    {"lights.intensity_scale", K_DOUBLE, 0, 1e9, 0, OFF(light_intensity_scale)},
-    {"lights.emissive_scale", K_DOUBLE, 0, 1e9, 0, OFF(emissive_scale)},
+#define FLOAT(p, off, lo, hi, op) {.path = p, .set = set_float, .offset = off, .flo = lo, .fhi = hi, .open = op}
+#define U32(p, off, lo, hi) {.path = p, .set = set_u32, .offset = off, .ilo = lo, .ihi = hi}
+#define U64(p, off, lo, hi) {.path = p, .set = set_u64, .offset = off, .ilo = lo, .ihi = hi}
+#define BOOL(p, off) {.path = p, .set = set_bool, .offset = off}
+#define ENUM(p, off, nm) {.path = p, .set = set_enum, .offset = off, .names = nm}
+#define FLAGS(p, off, nm) {.path = p, .set = set_flags, .offset = off, .names = nm, .max_items = LMB_MAX_PATTERNS}
+#define STRING(p, off) {.path = p, .set = set_string, .offset = off}
+#define LIST(p, fn, off, cnt) {.path = p, .set = fn, .offset = off, .count_offset = cnt, .max_items = LMB_MAX_PATTERNS}
+
+/* Index = lmb_gather_method value; bit i = 1 << i = LMB_OUTPUT_* */
+static const char *const gather_methods[] = {"cosine", "amis", "amis_defensive", NULL};
+static const char *const output_formats[] = {"exr", "hdr", "png", NULL};
+_Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
+_Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4, "output_formats");
+
+static const key_spec config_keys[] = {
+    FLOAT("texel_density", OFF(texel_density), 0, 100000, OPEN_LO),
+    LIST("density_overrides", set_overrides, OFF(density_overrides), OFF(density_override_count)),
+    U32("atlas.max_size", OFF(max_atlas_size), 16, 16384),
+    U32("atlas.padding", OFF(padding), 0, 64),
+    BOOL("atlas.keep_uv1", OFF(keep_uv1)),
+    U32("samples.texel", OFF(texel_samples), 1, 256),
+    U32("samples.direct", OFF(direct_samples), 1, 65536),
+    U32("samples.gather", OFF(gather_rays), 1, 1048576),
+    U32("samples.amis_iterations", OFF(amis_iterations), 1, 64),
+    U32("bounces", OFF(bounces), 0, 64),
+    ENUM("gather.method", OFF(gather_method), gather_methods),
+    FLOAT("gather.defensive", OFF(defensive_fraction), 0, 1, OPEN_HI),
+    U64("seed", OFF(seed), 0, 9223372036854775807LL),
+    U32("threads", OFF(threads), 0, 1024),
+    FLAGS("output.formats", OFF(output_formats), output_formats),
+    LIST("lightmap.include", set_globs, OFF(include), OFF(include_count)),
+    LIST("lightmap.exclude", set_globs, OFF(exclude), OFF(exclude_count)),
+    STRING("lightmap.extras_key", OFF(extras_key)),
+    FLOAT("lights.intensity_scale", OFF(light_intensity_scale), 0, 1e9, 0),
+    FLOAT("lights.emissive_scale", OFF(emissive_scale), 0, 1e9, 0),
 };
-static const char *const sections[] = {"atlas", "samples", "gather", "output", "lightmap", "lights"};
-static const char *const methods[] = {"cosine", "amis", "amis_defensive"};
+
+/* One density_overrides entry, filled into an lmb_density_override. */
+static const key_spec override_keys[] = {
+    STRING("density_overrides.match", offsetof(lmb_density_override, pattern)),
+    FLOAT("density_overrides.texel_density", offsetof(lmb_density_override, texel_density), 0, 100000, OPEN_LO),
+};
+
+static const schema config_schema = {config_keys, sizeof config_keys / sizeof *config_keys};
+static const schema override_schema = {override_keys, sizeof override_keys / sizeof *override_keys};
 
 void lmb_config_default(lmb_config *cfg)
 {
-    memset(cfg, 0, sizeof *cfg);
+    memset(cfg, 0, sizeof *cfg); /* also the padding bytes, so configs compare with memcmp */
     cfg->texel_density = 8.0;
     cfg->max_atlas_size = 1024;
     cfg->padding = 2;
@@ -74,80 +136,160 @@ void lmb_config_default(lmb_config *cfg)
     cfg->seed = 1;
     cfg->threads = 0;
     cfg->output_formats = LMB_OUTPUT_EXR | LMB_OUTPUT_HDR | LMB_OUTPUT_PNG;
-    snprintf(cfg->include[0], LMB_PATTERN_LEN, "*");
+    strcpy(cfg->include[0], "*");
     cfg->include_count = 1;
-    snprintf(cfg->extras_key, LMB_PATTERN_LEN, "lightmap");
+    strcpy(cfg->extras_key, "lightmap");
     cfg->light_intensity_scale = 1.0;
     cfg->emissive_scale = 1.0;
 }
 
-typedef struct parse_ctx {
-    const char *file;
-    yaml_document_t *doc;
-    lmb_config *cfg;
-    lmb_error *err;
-    char seen[64][160];/* key paths already set: duplicates are errors */
-    unsigned seen_count;
-} parse_ctx;
+/* ---- nodes and messages ---------------------------------------------------- */
 
-static unsigned line_of(const yaml_node_t *n)
+static size_t line_of(const yaml_node_t *n)
 {
-    return (unsigned)n->start_mark.line + 1;
+    return n->start_mark.line + 1;
 }
 
-static lmb_status fail(parse_ctx *c, const yaml_node_t *n, const char *path, const char *fmt, const char *detail)
+static const yaml_node_t *node(const parse_ctx *c, int id)
 {
-    char what[512];
-    snprintf(what, sizeof what, fmt, detail);
-    return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%u: key '%s': %s", c->file, line_of(n), path, what);
+    return yaml_document_get_node(c->doc, id);
 }
 
+/* The scalar's text, or NULL for a list or mapping. */
 static const char *scalar(const yaml_node_t *n)
 {
-    return n && n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value : NULL;
+    return n->type == YAML_SCALAR_NODE ? (const char *)n->data.scalar.value : NULL;
 }
 
-static lmb_status expect_scalar(parse_ctx *c, const yaml_node_t *n, const char *path, const char *expected,
-                                const char **out)
+/* A plain (unquoted) YAML null: nothing after the colon, ~ or null. */
+static int is_null(const yaml_node_t *n)
 {
-    *out = scalar(n);
-    if (!*out)
-        return fail(c, n, path, "expected %s, got a list or mapping", expected);
+    static const char *const nulls[] = {"", "~", "null", "Null", "NULL"};
+    if (n->type != YAML_SCALAR_NODE || n->data.scalar.style != YAML_PLAIN_SCALAR_STYLE)
+        return 0;
+    for (size_t i = 0; i < sizeof nulls / sizeof *nulls; i++)
+        if (!strcmp(scalar(n), nulls[i]))
+            return 1;
+    return 0;
+}
+
+/* What a node is, for "got ...": the quoted text, shortened, or its kind. */
+static void describe_got(const yaml_node_t *n, char *out, size_t size)
+{
+    const char *s = scalar(n);
+    if (!s)
+        snprintf(out, size, "%s", n->type == YAML_SEQUENCE_NODE ? "a list" : "a mapping");
+    else if (strlen(s) != n->data.scalar.length)
+        snprintf(out, size, "a string with a NUL character");
+    else if (!*s)
+        snprintf(out, size, "an empty value");
+    else if (strlen(s) > 60)
+        snprintf(out, size, "'%.40s...' (%zu characters)", s, strlen(s));
+    else
+        snprintf(out, size, "'%s'", s);
+}
+
+static lmb_status key_error(parse_ctx *c, const yaml_node_t *n, const char *path, const char *fmt, ...)
+    LMB_PRINTF(4, 5);
+
+/* "FILE:LINE: key 'PATH': WHAT" */
+static lmb_status key_error(parse_ctx *c, const yaml_node_t *n, const char *path, const char *fmt, ...)
+{
+    char what[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%zu: key '%s': %s", c->file, line_of(n), path, what);
+}
+
+/* "expected WANT, got WHAT-N-IS" */
+static lmb_status bad_value(parse_ctx *c, const key_spec *k, const yaml_node_t *n, const char *want)
+{
+    char got[128];
+    describe_got(n, got, sizeof got);
+    return key_error(c, n, k->path, "expected %s, got %s", want, got);
+}
+
+/* "cosine, amis, amis_defensive" */
+static void join_names(const char *const *names, char *out, size_t size)
+{
+    size_t len = 0;
+    out[0] = '\0';
+    for (size_t i = 0; names[i] && len < size; i++)
+        len += (size_t)snprintf(out + len, size - len, "%s%s", i ? ", " : "", names[i]);
+}
+
+/* ---- scalar setters --------------------------------------------------------- */
+
+/* Decimal only: digits, sign, point, exponent (no hex, inf, nan, spaces or '_'). */
+static int parse_float(const char *s, double *out)
+{
+    char *end;
+    if (!*s || strspn(s, "0123456789+-.eE") != strlen(s))
+        return 0;
+    errno = 0;
+    *out = strtod(s, &end);
+    return *end == '\0' && errno == 0 && isfinite(*out);
+}
+
+static int float_in_range(const key_spec *k, double v)
+{
+    int lo_ok = (k->open & OPEN_LO) ? v > k->flo : v >= k->flo;
+    int hi_ok = (k->open & OPEN_HI) ? v < k->fhi : v <= k->fhi;
+    return lo_ok && hi_ok;
+}
+
+static lmb_status set_float(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    const char *s = scalar(n);
+    double v;
+    if (!s || !parse_float(s, &v) || !float_in_range(k, v)) {
+        char want[96];
+        snprintf(want, sizeof want, "a number %s %.15g and %s %.15g", (k->open & OPEN_LO) ? ">" : ">=", k->flo,
+                 (k->open & OPEN_HI) ? "<" : "<=", k->fhi);
+        return bad_value(c, k, n, want);
+    }
+    memcpy(base + k->offset, &v, sizeof v);
     return LMB_OK;
 }
 
-/* Parses a number into dst (a double, uint32_t or uint64_t as k->kind says). */
-static lmb_status set_number(parse_ctx *c, const key_spec *k, const yaml_node_t *n, void *dst)
+/* Decimal integer, optional sign, nothing after it (no fraction, exponent or spaces). */
+static int parse_int(const yaml_node_t *n, long long lo, long long hi, long long *out)
 {
-    const char *s;
-    char range[128], *end;
-    int integer = k->kind != K_DOUBLE;
-    if (integer)
-        snprintf(range, sizeof range, "expected an integer in %.0f..%.0f, got '%%s'", k->min, k->max);
-    else
-        snprintf(range, sizeof range, "expected a number %s %g and <= %g, got '%%s'", k->min_exclusive ? ">" : ">=", k->min,
-                 k->max);
-    lmb_status st = expect_scalar(c, n, k->path, integer ? "an integer" : "a number", &s);
-    if (st != LMB_OK)
-        return st;
+    const char *s = scalar(n);
+    char *end;
+    if (!s || !(isdigit((unsigned char)s[0]) || ((s[0] == '+' || s[0] == '-') && isdigit((unsigned char)s[1]))))
+        return 0;
     errno = 0;
-    double v;
-    if (integer) {
-        if (*s == '-' && strcmp(s, "-0") != 0)
-            return fail(c, n, k->path, range, s);
-        unsigned long long u = strtoull(s, &end, 10);
-        if (end == s || *end || errno || (double)u > k->max || (double)u < k->min)
-            return fail(c, n, k->path, range, s);
-        if (k->kind == K_U64)
-            *(uint64_t *)dst = (uint64_t)u;
-        else
-            *(uint32_t *)dst = (uint32_t)u;
-        return LMB_OK;
-    }
-    v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v > k->max || v < k->min || (k->min_exclusive && v <= k->min))
-        return fail(c, n, k->path, range, s);
-    *(double *)dst = v;
+    *out = strtoll(s, &end, 10);
+    return *end == '\0' && errno == 0 && *out >= lo && *out <= hi;
+}
+
+static lmb_status bad_int(parse_ctx *c, const key_spec *k, const yaml_node_t *n)
+{
+    char want[96];
+    snprintf(want, sizeof want, "an integer in %lld..%lld", k->ilo, k->ihi);
+    return bad_value(c, k, n, want);
+}
+
+static lmb_status set_u32(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    long long v;
+    if (!parse_int(n, k->ilo, k->ihi, &v))
+        return bad_int(c, k, n);
+    uint32_t u = (uint32_t)v;
+    memcpy(base + k->offset, &u, sizeof u);
+    return LMB_OK;
+}
+
+static lmb_status set_u64(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    long long v;
+    if (!parse_int(n, k->ilo, k->ihi, &v))
+        return bad_int(c, k, n);
+    uint64_t u = (uint64_t)v;
+    memcpy(base + k->offset, &u, sizeof u);
     return LMB_OK;
 }
 
@@ -159,270 +301,374 @@ static int ieq(const char *a, const char *b)
     return *a == *b;
 }
 
-static lmb_status set_bool(parse_ctx *c, const key_spec *k, const yaml_node_t *n)
+/* YAML 1.1 booleans: true/false, yes/no, on/off, any case. */
+static lmb_status set_bool(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    const char *s;
-    lmb_status st = expect_scalar(c, n, k->path, "true or false", &s);
-    if (st != LMB_OK)
-        return st;
-    int *dst = (int *)((char *)c->cfg + k->offset);
-    if (ieq(s, "true") || ieq(s, "yes") || ieq(s, "on"))
-        *dst = 1;
-    else if (ieq(s, "false") || ieq(s, "no") || ieq(s, "off"))
-        *dst = 0;
-    else
-        return fail(c, n, k->path, "expected true or false, got '%s'", s);
-    return LMB_OK;
-}
-
-static lmb_status set_method(parse_ctx *c, const key_spec *k, const yaml_node_t *n)
-{
-    const char *s;
-    lmb_status st = expect_scalar(c, n, k->path, "a gather method", &s);
-    if (st != LMB_OK)
-        return st;
-    for (size_t i = 0; i < sizeof methods / sizeof *methods; i++)
-        if (!strcmp(s, methods[i])) {
-            c->cfg->gather_method = (lmb_gather_method)i;
+    static const char *const words[] = {"false", "true", "no", "yes", "off", "on"};
+    const char *s = scalar(n);
+    for (size_t i = 0; s && i < sizeof words / sizeof *words; i++)
+        if (ieq(s, words[i])) {
+            int v = (int)(i % 2);
+            memcpy(base + k->offset, &v, sizeof v);
             return LMB_OK;
         }
-    return fail(c, n, k->path, "expected one of cosine, amis, amis_defensive, got '%s'", s);
+    return bad_value(c, k, n, "true or false");
 }
 
-static lmb_status set_word(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *dst)
+/* Index of n's text in k->names, or -1. */
+static int name_index(const key_spec *k, const yaml_node_t *n)
 {
-    const char *s;
-    lmb_status st = expect_scalar(c, n, k->path, "a string", &s);
-    if (st != LMB_OK)
-        return st;
-    if (!*s || strlen(s) >= LMB_PATTERN_LEN) {
-        char detail[32];
-        snprintf(detail, sizeof detail, "%d", LMB_PATTERN_LEN - 1);
-        return fail(c, n, k->path, "expected a non-empty string of at most %s characters", detail);
-    }
-    memcpy(dst, s, strlen(s) + 1);
+    const char *s = scalar(n);
+    for (int i = 0; s && k->names[i]; i++)
+        if (!strcmp(s, k->names[i]))
+            return i;
+    return -1;
+}
+
+static lmb_status bad_name(parse_ctx *c, const key_spec *k, const yaml_node_t *n)
+{
+    char names[256], want[300];
+    join_names(k->names, names, sizeof names);
+    snprintf(want, sizeof want, "one of %s", names);
+    return bad_value(c, k, n, want);
+}
+
+/* The only enum key is gather.method, so the value is stored as an lmb_gather_method. */
+static lmb_status set_enum(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    int i = name_index(k, n);
+    if (i < 0)
+        return bad_name(c, k, n);
+    lmb_gather_method v = (lmb_gather_method)i;
+    memcpy(base + k->offset, &v, sizeof v);
     return LMB_OK;
 }
 
-/* A sequence of scalars (or one scalar) visited one by one. */
-typedef lmb_status (*item_fn)(parse_ctx *c, const key_spec *k, const yaml_node_t *item, unsigned index);
+/* Into a char[LMB_PATTERN_LEN]: non-empty, fits with its NUL, no NUL inside. */
+static lmb_status copy_string(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *dst)
+{
+    const char *s = scalar(n);
+    if (!s || !*s || n->data.scalar.length >= LMB_PATTERN_LEN || strlen(s) != n->data.scalar.length) {
+        char want[96];
+        snprintf(want, sizeof want, "a non-empty string of at most %d characters", LMB_PATTERN_LEN - 1);
+        return bad_value(c, k, n, want);
+    }
+    memcpy(dst, s, n->data.scalar.length + 1);
+    return LMB_OK;
+}
 
-static lmb_status for_each_item(parse_ctx *c, const key_spec *k, const yaml_node_t *n, item_fn fn, unsigned *count)
+static lmb_status set_string(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    return copy_string(c, k, n, base + k->offset);
+}
+
+/* ---- lists ------------------------------------------------------------------ */
+
+typedef lmb_status (*item_fn)(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index);
+
+/* A list's entries one by one: a null is an empty list, a lone value a list of one. */
+static lmb_status each_item(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base, item_fn fn,
+                            uint32_t *count)
 {
     *count = 0;
-    if (n->type == YAML_SCALAR_NODE && n->data.scalar.length > 0)
-        return fn(c, k, n, (*count)++);
-    if (n->type == YAML_SCALAR_NODE)
-        return LMB_OK; /* "key:" with nothing: an empty list */
-    if (n->type != YAML_SEQUENCE_NODE)
-        return fail(c, n, k->path, "expected a list, got a mapping%s", "");
-    for (yaml_node_item_t *it = n->data.sequence.items.start; it < n->data.sequence.items.top; it++) {
-        if (*count >= LMB_MAX_PATTERNS) {
-            char detail[16];
-            snprintf(detail, sizeof detail, "%d", LMB_MAX_PATTERNS);
-            return fail(c, n, k->path, "at most %s entries", detail);
-        }
-        lmb_status st = fn(c, k, yaml_document_get_node(c->doc, *it), (*count)++);
+    if (is_null(n))
+        return LMB_OK;
+    if (n->type != YAML_SEQUENCE_NODE) {
+        *count = 1;
+        return fn(c, k, n, base, 0);
+    }
+    for (const yaml_node_item_t *it = n->data.sequence.items.start; it < n->data.sequence.items.top; it++) {
+        const yaml_node_t *item = node(c, *it);
+        if (*count >= k->max_items)
+            return key_error(c, item, k->path, "expected at most %u entries, got %ld", (unsigned)k->max_items,
+                             (long)(n->data.sequence.items.top - n->data.sequence.items.start));
+        lmb_status st = fn(c, k, item, base, (*count)++);
         if (st != LMB_OK)
             return st;
     }
     return LMB_OK;
 }
 
-static lmb_status format_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, unsigned index)
+static lmb_status set_count(const key_spec *k, char *base, uint32_t count, lmb_status st)
 {
-    static const char *const names[] = {"exr", "hdr", "png"};
-    const char *s;
+    if (st == LMB_OK)
+        memcpy(base + k->count_offset, &count, sizeof count);
+    return st;
+}
+
+static lmb_status flag_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
+{
+    int i = name_index(k, item);
+    unsigned bits;
     (void)index;
-    lmb_status st = expect_scalar(c, item, k->path, "exr, hdr or png", &s);
-    if (st != LMB_OK)
-        return st;
-    for (unsigned i = 0; i < 3; i++)
-        if (!strcmp(s, names[i])) {
-            c->cfg->output_formats |= 1u << i;
-            return LMB_OK;
-        }
-    return fail(c, item, k->path, "expected exr, hdr or png, got '%s'", s);
+    if (i < 0)
+        return bad_name(c, k, item);
+    memcpy(&bits, base + k->offset, sizeof bits);
+    bits |= 1u << i;
+    memcpy(base + k->offset, &bits, sizeof bits);
+    return LMB_OK;
 }
 
-static lmb_status include_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, unsigned index)
+/* A non-empty list of names, each setting bit (1 << its index). */
+static lmb_status set_flags(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    return set_word(c, k, item, c->cfg->include[index]);
+    unsigned zero = 0;
+    uint32_t count;
+    memcpy(base + k->offset, &zero, sizeof zero);
+    lmb_status st = each_item(c, k, n, base, flag_item, &count);
+    if (st == LMB_OK && count == 0) {
+        char names[256];
+        join_names(k->names, names, sizeof names);
+        return key_error(c, n, k->path, "expected at least one of %s, got an empty list", names);
+    }
+    return st;
 }
 
-static lmb_status exclude_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, unsigned index)
+static lmb_status glob_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
 {
-    return set_word(c, k, item, c->cfg->exclude[index]);
+    if (item->type == YAML_MAPPING_NODE) /* [?all] reads as a mapping */
+        return key_error(c, item, k->path, "expected a glob, got a mapping (put a glob that starts with ? in quotes)");
+    return copy_string(c, k, item, base + k->offset + (size_t)index * LMB_PATTERN_LEN);
 }
 
-/* density_overrides: - {match: "Floor*", texel_density: 16} */
-static lmb_status override_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, unsigned index)
+/* Into char[LMB_MAX_PATTERNS][LMB_PATTERN_LEN] and its count; replaces the default. */
+static lmb_status set_globs(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    static const key_spec density = {"density_overrides.texel_density", K_DOUBLE, 0, 100000, 1, 0};
-    static const key_spec match = {"density_overrides.match", K_WORD, 0, 0, 0, 0};
-    lmb_density_override *o = &c->cfg->density_overrides[index];
+    uint32_t count;
+    return set_count(k, base, count, each_item(c, k, n, base, glob_item, &count));
+}
+
+static lmb_status walk_mapping(parse_ctx *c, const schema *s, const yaml_node_t *map, const char *prefix,
+                               char *base);
+
+/* {match: GLOB, texel_density: N}, both required */
+static lmb_status override_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
+{
+    lmb_density_override *o = (lmb_density_override *)(void *)(base + k->offset) + index;
+    memset(o, 0, sizeof *o); /* empty pattern, density 0: both invalid, so "missing" shows */
     if (item->type != YAML_MAPPING_NODE)
-        return fail(c, item, k->path, "each entry is a mapping {match: GLOB, texel_density: N}%s", "");
-    int have_match = 0, have_density = 0;
-    for (yaml_node_pair_t *p = item->data.mapping.pairs.start; p < item->data.mapping.pairs.top; p++) {
-        const yaml_node_t *kn = yaml_document_get_node(c->doc, p->key), *vn = yaml_document_get_node(c->doc, p->value);
-        const char *name = scalar(kn);
-        lmb_status st;
-        if (name && !strcmp(name, "match")) {
-            st = set_word(c, &match, vn, o->pattern);
-            have_match = 1;
-        } else if (name && !strcmp(name, "texel_density")) {
-            st = set_number(c, &density, vn, &o->texel_density);
-            have_density = 1;
-        } else {
-            return lmb_error_set(c->err, LMB_ERR_INPUT,
-                                 "%s:%u: unknown key 'density_overrides.%s' (known keys: match, texel_density)", c->file,
-                                 line_of(kn), name ? name : "?");
-        }
-        if (st != LMB_OK)
-            return st;
-    }
-    if (!have_match || !have_density)
-        return fail(c, item, k->path, "each entry needs both match and texel_density%s", "");
-    return LMB_OK;
+        return bad_value(c, k, item, "a mapping {match: GLOB, texel_density: N}");
+    lmb_status st = walk_mapping(c, &override_schema, item, k->path, (char *)o);
+    if (st == LMB_OK && (!o->pattern[0] || !(o->texel_density > 0)))
+        return key_error(c, item, k->path, "each entry needs both match and texel_density");
+    return st;
 }
 
-static lmb_status set_value(parse_ctx *c, const key_spec *k, const yaml_node_t *n)
+static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    unsigned count;
-    lmb_status st;
-    switch (k->kind) {
-    case K_DOUBLE: case K_U32: case K_U64:
-        return set_number(c, k, n, (char *)c->cfg + k->offset);
-    case K_BOOL:
-        return set_bool(c, k, n);
-    case K_METHOD:
-        return set_method(c, k, n);
-    case K_WORD:
-        return set_word(c, k, n, (char *)c->cfg + k->offset);
-    case K_FORMATS:
-        c->cfg->output_formats = 0;
-        st = for_each_item(c, k, n, format_item, &count);
-        if (st == LMB_OK && !c->cfg->output_formats)
-            return fail(c, n, k->path, "name at least one output format (exr, hdr, png)%s", "");
-        return st;
-    case K_INCLUDE:
-        st = for_each_item(c, k, n, include_item, &count);
-        c->cfg->include_count = count;
-        return st;
-    case K_EXCLUDE:
-        st = for_each_item(c, k, n, exclude_item, &count);
-        c->cfg->exclude_count = count;
-        return st;
-    case K_OVERRIDES:
-        st = for_each_item(c, k, n, override_item, &count);
-        c->cfg->density_override_count = count;
-        return st;
-    }
-    return LMB_OK;
+    uint32_t count;
+    return set_count(k, base, count, each_item(c, k, n, base, override_item, &count));
 }
 
-static int is_section(const char *name)
+/* ---- mappings ----------------------------------------------------------------- */
+
+static const key_spec *find_key(const schema *s, const char *path)
 {
-    for (size_t i = 0; i < sizeof sections / sizeof *sections; i++)
-        if (!strcmp(name, sections[i]))
+    for (size_t i = 0; i < s->count; i++)
+        if (!strcmp(s->keys[i].path, path))
+            return &s->keys[i];
+    return NULL;
+}
+
+/* A section is a path that some key's path continues with '.'. */
+static int is_section(const schema *s, const char *path)
+{
+    size_t len = strlen(path);
+    for (size_t i = 0; i < s->count; i++)
+        if (!strncmp(s->keys[i].path, path, len) && s->keys[i].path[len] == '.')
             return 1;
     return 0;
 }
 
-static lmb_status unknown_key(parse_ctx *c, const yaml_node_t *kn, const char *prefix, const char *path)
+/* The name after "prefix." in key i's path (up to the next '.'), or 0 if not under prefix. */
+static size_t child_name(const schema *s, size_t i, const char *prefix, const char **name)
 {
-    char known[512] = "";
+    const char *p = s->keys[i].path;
     size_t plen = strlen(prefix);
-    for (size_t i = 0; i < sizeof keys / sizeof *keys; i++) {
-        const char *p = keys[i].path;
-        if (plen ? (!strncmp(p, prefix, plen) && p[plen] == '.') : !strchr(p, '.')) {
-            size_t len = strlen(known);
-            snprintf(known + len, sizeof known - len, "%s%s", len ? ", " : "", p + (plen ? plen + 1 : 0));
-        }
-    }
-    if (!plen)
-        for (size_t i = 0; i < sizeof sections / sizeof *sections; i++) {
-            size_t len = strlen(known);
-            snprintf(known + len, sizeof known - len, ", %s", sections[i]);
-        }
-    return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%u: unknown key '%s' (known keys%s%s%s: %s)", c->file,
-                         line_of(kn), path, plen ? " under '" : "", prefix, plen ? "'" : "", known);
+    if (plen && (strncmp(p, prefix, plen) || p[plen] != '.'))
+        return 0;
+    *name = p + (plen ? plen + 1 : 0);
+    return strcspn(*name, ".");
 }
 
-static lmb_status mark_seen(parse_ctx *c, const yaml_node_t *kn, const char *path)
+/* "max_size, padding, keep_uv1": the names directly under prefix, each once. */
+static void known_names(const schema *s, const char *prefix, char *out, size_t size)
 {
-    for (unsigned i = 0; i < c->seen_count; i++)
-        if (!strcmp(c->seen[i], path))
-            return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%u: key '%s' is given twice", c->file, line_of(kn), path);
-    if (c->seen_count < sizeof c->seen / sizeof c->seen[0])
-        snprintf(c->seen[c->seen_count++], sizeof c->seen[0], "%s", path);
+    size_t len = 0;
+    out[0] = '\0';
+    for (size_t i = 0; i < s->count && len < size; i++) {
+        const char *name, *prev;
+        size_t n = child_name(s, i, prefix, &name), j;
+        for (j = 0; n && j < i; j++)
+            if (child_name(s, j, prefix, &prev) == n && !strncmp(prev, name, n))
+                break;
+        if (n && j == i)
+            len += (size_t)snprintf(out + len, size - len, "%s%.*s", len ? ", " : "", (int)n, name);
+    }
+}
+
+static lmb_status unknown_key(parse_ctx *c, const schema *s, const yaml_node_t *kn, const char *prefix,
+                              const char *path)
+{
+    char known[512];
+    known_names(s, prefix, known, sizeof known);
+    if (!*prefix)
+        return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%zu: unknown key '%s' (known keys: %s)", c->file,
+                             line_of(kn), path, known);
+    return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%zu: unknown key '%s' (known keys under '%s': %s)", c->file,
+                         line_of(kn), path, prefix, known);
+}
+
+/* The pair's dotted path into out; keys must be scalars. */
+static lmb_status key_path(parse_ctx *c, const yaml_node_t *kn, const char *prefix, char *out, size_t size)
+{
+    const char *name = scalar(kn);
+    if (!name)
+        return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%zu: a key must be a plain name, not %s%s%s%s", c->file,
+                             line_of(kn), kn->type == YAML_SEQUENCE_NODE ? "a list" : "a mapping",
+                             *prefix ? " (under '" : "", prefix, *prefix ? "')" : "");
+    snprintf(out, size, "%s%s%s", prefix, *prefix ? "." : "", name);
     return LMB_OK;
 }
 
-static lmb_status walk_mapping(parse_ctx *c, const yaml_node_t *map, const char *prefix)
+/* A key given twice in one mapping is an error (libyaml keeps both). */
+static lmb_status check_duplicate(parse_ctx *c, const yaml_node_t *map, const yaml_node_pair_t *p, const char *path)
 {
-    for (yaml_node_pair_t *p = map->data.mapping.pairs.start; p < map->data.mapping.pairs.top; p++) {
-        const yaml_node_t *kn = yaml_document_get_node(c->doc, p->key), *vn = yaml_document_get_node(c->doc, p->value);
-        const char *name = scalar(kn);
-        char path[160];
-        if (!name)
-            return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%u: keys must be plain names", c->file, line_of(kn));
-        snprintf(path, sizeof path, "%s%s%s", prefix, *prefix ? "." : "", name);
-        lmb_status st = mark_seen(c, kn, path);
+    const yaml_node_t *kn = node(c, p->key);
+    for (const yaml_node_pair_t *q = map->data.mapping.pairs.start; q < p; q++) {
+        const yaml_node_t *qn = node(c, q->key);
+        if (scalar(qn) && !strcmp(scalar(qn), scalar(kn)))
+            return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%zu: key '%s' is given twice (first on line %zu)", c->file,
+                                 line_of(kn), path, line_of(qn));
+    }
+    return LMB_OK;
+}
+
+static lmb_status walk_section(parse_ctx *c, const schema *s, const yaml_node_t *vn, const char *path, char *base)
+{
+    if (is_null(vn))
+        return LMB_OK; /* "atlas:" with nothing under it */
+    if (vn->type != YAML_MAPPING_NODE) {
+        char got[128];
+        describe_got(vn, got, sizeof got);
+        return key_error(c, vn, path, "expected a mapping of keys, got %s", got);
+    }
+    return walk_mapping(c, s, vn, path, base);
+}
+
+static lmb_status walk_pair(parse_ctx *c, const schema *s, const yaml_node_t *map, const yaml_node_pair_t *p,
+                            const char *prefix, char *base)
+{
+    const yaml_node_t *kn = node(c, p->key), *vn = node(c, p->value);
+    char path[256];
+    lmb_status st = key_path(c, kn, prefix, path, sizeof path);
+    if (st == LMB_OK)
+        st = check_duplicate(c, map, p, path);
+    if (st != LMB_OK)
+        return st;
+    if (is_section(s, path))
+        return walk_section(c, s, vn, path, base);
+    const key_spec *k = find_key(s, path);
+    if (!k)
+        return unknown_key(c, s, kn, prefix, path);
+    return k->set(c, k, vn, base);
+}
+
+static lmb_status walk_mapping(parse_ctx *c, const schema *s, const yaml_node_t *map, const char *prefix,
+                               char *base)
+{
+    for (const yaml_node_pair_t *p = map->data.mapping.pairs.start; p < map->data.mapping.pairs.top; p++) {
+        lmb_status st = walk_pair(c, s, map, p, prefix, base);
         if (st != LMB_OK)
             return st;
-        if (!*prefix && is_section(name)) {
-            if (vn->type == YAML_SCALAR_NODE && vn->data.scalar.length == 0)
-                continue; /* "atlas:" with nothing under it */
-            if (vn->type != YAML_MAPPING_NODE)
-                return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%u: key '%s': expected a mapping of keys", c->file,
-                                     line_of(vn), path);
-            if ((st = walk_mapping(c, vn, name)) != LMB_OK)
-                return st;
-            continue;
-        }
-        const key_spec *k = NULL;
-        for (size_t i = 0; i < sizeof keys / sizeof *keys && !k; i++)
-            if (!strcmp(keys[i].path, path))
-                k = &keys[i];
-        if (!k)
-            return unknown_key(c, kn, prefix, path);
-        if ((st = set_value(c, k, vn)) != LMB_OK)
-            return st;
     }
     return LMB_OK;
+}
+
+/* ---- the document -------------------------------------------------------------- */
+
+/* 1-based line of a byte offset (libyaml's reader errors give only the offset). */
+static size_t line_at(const char *text, size_t length, size_t offset)
+{
+    size_t line = 1;
+    for (size_t i = 0; i < offset && i < length; i++)
+        line += text[i] == '\n';
+    return line;
+}
+
+static lmb_status yaml_error(const char *name, const yaml_parser_t *p, const char *text, size_t length,
+                             lmb_error *err)
+{
+    if (p->error == YAML_MEMORY_ERROR)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory reading the YAML", name);
+    size_t line = p->error == YAML_READER_ERROR ? line_at(text, length, p->problem_offset) : p->problem_mark.line + 1;
+    const char *problem = p->problem ? p->problem : "unreadable YAML";
+    if (strstr(problem, "undefined alias")) /* *Floor reads as an alias */
+        return lmb_error_set(err, LMB_ERR_INPUT,
+                             "%s:%zu: YAML syntax error: %s (put a glob that starts with * in quotes)", name, line,
+                             problem);
+    if (p->context)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s:%zu: YAML syntax error: %s (%s at line %zu)", name, line,
+                             problem, p->context, p->context_mark.line + 1);
+    return lmb_error_set(err, LMB_ERR_INPUT, "%s:%zu: YAML syntax error: %s", name, line, problem);
+}
+
+/* Loads the first document into doc and checks that no second one follows. On error
+ * nothing is left to delete. */
+static lmb_status load_document(const char *name, yaml_parser_t *p, const char *text, size_t length,
+                                yaml_document_t *doc, lmb_error *err)
+{
+    yaml_document_t next;
+    if (!yaml_parser_load(p, doc))
+        return yaml_error(name, p, text, length, err);
+    if (!yaml_parser_load(p, &next)) {
+        yaml_document_delete(doc);
+        return yaml_error(name, p, text, length, err);
+    }
+    const yaml_node_t *root = yaml_document_get_root_node(&next);
+    size_t line = next.start_mark.line + 1;
+    int second = root && !is_null(root);
+    yaml_document_delete(&next);
+    if (second) {
+        yaml_document_delete(doc);
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s:%zu: a second YAML document starts here; a config is one mapping",
+                             name, line);
+    }
+    return LMB_OK;
+}
+
+static lmb_status apply_root(parse_ctx *c, const yaml_node_t *root, lmb_config *cfg)
+{
+    if (!root || is_null(root))
+        return LMB_OK; /* empty file or only comments: the defaults */
+    if (root->type != YAML_MAPPING_NODE) {
+        char got[128];
+        describe_got(root, got, sizeof got);
+        return lmb_error_set(c->err, LMB_ERR_INPUT, "%s:%zu: the config must be a mapping of keys (key: value), got %s",
+                             c->file, line_of(root), got);
+    }
+    return walk_mapping(c, &config_schema, root, "", (char *)cfg);
 }
 
 lmb_status lmb_config_parse(const char *name, const char *text, size_t length, lmb_config *cfg, lmb_error *err)
 {
     yaml_parser_t parser;
     yaml_document_t doc;
+    if (!name)
+        name = "config";
+    if (!text) {
+        text = "";
+        length = 0;
+    }
     if (!yaml_parser_initialize(&parser))
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot start the YAML parser", name);
     yaml_parser_set_input_string(&parser, (const unsigned char *)text, length);
-    if (!yaml_parser_load(&parser, &doc)) {
-        lmb_status st = lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: YAML syntax error: %s%s%s", name,
-                                      (unsigned)parser.problem_mark.line + 1,
-                                      parser.problem ? parser.problem : "unreadable",
-                                      parser.context ? " " : "", parser.context ? parser.context : "");
-        yaml_parser_delete(&parser);
-        return st;
+    lmb_status st = load_document(name, &parser, text, length, &doc, err);
+    if (st == LMB_OK) {
+        parse_ctx c = {name, &doc, err};
+        st = apply_root(&c, yaml_document_get_root_node(&doc), cfg);
+        yaml_document_delete(&doc);
     }
-    lmb_status st = LMB_OK;
-    yaml_node_t *root = yaml_document_get_root_node(&doc);
-    parse_ctx c;
-    memset(&c, 0, sizeof c);
-    c.file = name;
-    c.doc = &doc;
-    c.cfg = cfg;
-    c.err = err;
-    if (root && root->type == YAML_MAPPING_NODE)
-        st = walk_mapping(&c, root, "");
-    else if (root && !(root->type == YAML_SCALAR_NODE && root->data.scalar.length == 0))
-        st = lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: the config must be a mapping of keys (key: value)", name,
-                           line_of(root));
-    yaml_document_delete(&doc);
     yaml_parser_delete(&parser);
     return st;
 }

@@ -1,17 +1,30 @@
 /*
- * Bake config tests: defaults, every key parsed to its value, each kind of error naming
- * file, line and key, the shipped example equal to the defaults, glob matching.
+ * Bake config tests: defaults, every key parsed to its value, range edges, each kind of
+ * error naming file, line and key, the shipped example equal to the defaults, glob matching.
  * usage: test_config EXAMPLE_CONFIG
  */
+#define _POSIX_C_SOURCE 200809L /* mkstemp, for one test through a real file */
+
 #include "check.h"
 
 #include <lmbake/lmbake.h>
 
+#include <stdlib.h>
+#include <unistd.h>
+
 static lmb_status parse(const char *text, lmb_config *cfg, lmb_error *err)
 {
     lmb_config_default(cfg);
+    err->status = LMB_OK;
     err->message[0] = '\0';
     return lmb_config_parse("level.yaml", text, strlen(text), cfg, err);
+}
+
+static int same_as_defaults(const lmb_config *c)
+{
+    lmb_config d;
+    lmb_config_default(&d);
+    return memcmp(c, &d, sizeof d) == 0;
 }
 
 static void test_defaults(void)
@@ -19,23 +32,36 @@ static void test_defaults(void)
     lmb_config c;
     lmb_config_default(&c);
     CHECK_NEAR(c.texel_density, 8.0, 0);
+    CHECK_INT(c.density_override_count, 0);
     CHECK_INT(c.max_atlas_size, 1024);
     CHECK_INT(c.padding, 2);
+    CHECK_INT(c.keep_uv1, 0);
+    CHECK_INT(c.texel_samples, 4);
+    CHECK_INT(c.direct_samples, 16);
     CHECK_INT(c.gather_rays, 256);
     CHECK_INT(c.amis_iterations, 4);
+    CHECK_INT(c.bounces, 2);
     CHECK_INT(c.gather_method, LMB_GATHER_AMIS_DEFENSIVE);
+    CHECK_NEAR(c.defensive_fraction, 0.1, 0);
+    CHECK(c.seed == 1);
+    CHECK_INT(c.threads, 0);
     CHECK_INT(c.output_formats, LMB_OUTPUT_EXR | LMB_OUTPUT_HDR | LMB_OUTPUT_PNG);
     CHECK_INT(c.include_count, 1);
     CHECK(!strcmp(c.include[0], "*"));
+    CHECK_INT(c.exclude_count, 0);
     CHECK(!strcmp(c.extras_key, "lightmap"));
+    CHECK_NEAR(c.light_intensity_scale, 1.0, 0);
+    CHECK_NEAR(c.emissive_scale, 1.0, 0);
 }
 
+/* Every key set away from its default, in block and flow style. */
 static void test_full(void)
 {
     const char *text = "texel_density: 12.5\n"
                        "density_overrides:\n"
                        "  - match: \"Floor*\"\n"
                        "    texel_density: 32\n"
+                       "  - {match: Prop?, texel_density: 0.5}\n"
                        "atlas: {max_size: 2048, padding: 4, keep_uv1: yes}\n"
                        "samples:\n"
                        "  texel: 1\n"
@@ -59,9 +85,11 @@ static void test_full(void)
     lmb_error err;
     CHECK_INT(parse(text, &c, &err), LMB_OK);
     CHECK_NEAR(c.texel_density, 12.5, 0);
-    CHECK_INT(c.density_override_count, 1);
+    CHECK_INT(c.density_override_count, 2);
     CHECK(!strcmp(c.density_overrides[0].pattern, "Floor*"));
     CHECK_NEAR(c.density_overrides[0].texel_density, 32, 0);
+    CHECK(!strcmp(c.density_overrides[1].pattern, "Prop?"));
+    CHECK_NEAR(c.density_overrides[1].texel_density, 0.5, 0);
     CHECK_INT(c.max_atlas_size, 2048);
     CHECK_INT(c.padding, 4);
     CHECK_INT(c.keep_uv1, 1);
@@ -76,6 +104,7 @@ static void test_full(void)
     CHECK_INT(c.threads, 2);
     CHECK_INT(c.output_formats, LMB_OUTPUT_EXR | LMB_OUTPUT_PNG);
     CHECK_INT(c.include_count, 2);
+    CHECK(!strcmp(c.include[0], "Room*"));
     CHECK(!strcmp(c.include[1], "Prop?"));
     CHECK_INT(c.exclude_count, 1);
     CHECK(!strcmp(c.exclude[0], "Sky"));
@@ -84,91 +113,227 @@ static void test_full(void)
     CHECK_NEAR(c.emissive_scale, 2, 0);
 }
 
-/* Each error: LMB_ERR_INPUT and a message with file:line and the key. */
+/* Keys not named keep what cfg held; values at the edges of their ranges are accepted. */
+static void test_partial_and_edges(void)
+{
+    lmb_config c;
+    lmb_error err;
+    CHECK_INT(parse("atlas:\n  padding: 0\n", &c, &err), LMB_OK);
+    CHECK_INT(c.padding, 0);
+    CHECK_INT(c.max_atlas_size, 1024);
+    CHECK_INT(c.bounces, 2);
+
+    CHECK_INT(parse("seed: 9223372036854775807\nthreads: 1024\ntexel_density: 100000\n", &c, &err), LMB_OK);
+    CHECK(c.seed == 9223372036854775807ULL);
+    CHECK_INT(c.threads, 1024);
+    CHECK_NEAR(c.texel_density, 100000, 0);
+
+    CHECK_INT(parse("gather: {method: amis, defensive: 0.9995}\nlights: {intensity_scale: 0}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.gather_method, LMB_GATHER_AMIS);
+    CHECK_NEAR(c.defensive_fraction, 0.9995, 0);
+    CHECK_NEAR(c.light_intensity_scale, 0, 0);
+
+    CHECK_INT(parse("atlas: {keep_uv1: On}\noutput: {formats: hdr}\nlightmap: {include: []}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.keep_uv1, 1);
+    CHECK_INT(c.output_formats, LMB_OUTPUT_HDR);
+    CHECK_INT(c.include_count, 0);
+
+    CHECK_INT(parse("atlas: {keep_uv1: off}\nsamples: {gather: 1048576}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.keep_uv1, 0);
+    CHECK_INT(c.gather_rays, 1048576);
+}
+
+/* Each error: LMB_ERR_INPUT, "level.yaml:LINE:" and the key and problem. */
 static void expect_error(const char *text, const char *where, const char *what)
 {
     lmb_config c;
     lmb_error err;
     CHECK_INT(parse(text, &c, &err), LMB_ERR_INPUT);
+    CHECK_INT(err.status, LMB_ERR_INPUT);
     CHECK_CONTAINS(err.message, where);
     CHECK_CONTAINS(err.message, what);
 }
 
-static void test_errors(void)
+static void test_value_errors(void)
 {
-    expect_error("texel_density: 8\natlas:\n  maxsize: 512\n", "level.yaml:3:", "unknown key 'atlas.maxsize'");
-    expect_error("atlas:\n  maxsize: 512\n", "level.yaml:2:", "max_size, padding, keep_uv1");
-    expect_error("samples:\n  gather: lots\n", "level.yaml:2:", "key 'samples.gather': expected an integer in 1..1048576, got 'lots'");
-    expect_error("samples:\n  gather: -3\n", "level.yaml:2:", "got '-3'");
-    expect_error("samples:\n  gather: 2.5\n", "level.yaml:2:", "got '2.5'");
-    expect_error("samples:\n  gather: 0\n", "level.yaml:2:", "got '0'");
-    expect_error("texel_density: 0\n", "level.yaml:1:", "key 'texel_density': expected a number > 0");
-    expect_error("texel_density: .nan\n", "level.yaml:1:", "key 'texel_density'");
-    expect_error("\n\ngather:\n  method: fancy\n", "level.yaml:4:", "expected one of cosine, amis, amis_defensive, got 'fancy'");
-    expect_error("atlas:\n  keep_uv1: maybe\n", "level.yaml:2:", "expected true or false, got 'maybe'");
-    expect_error("output:\n  formats: [exr, tiff]\n", "level.yaml:2:", "expected exr, hdr or png, got 'tiff'");
-    expect_error("output:\n  formats: []\n", "level.yaml:2:", "at least one output format");
-    expect_error("seed: 1\nseed: 2\n", "level.yaml:2:", "key 'seed' is given twice");
-    expect_error("samples: [1, 2]\n", "level.yaml:1:", "key 'samples': expected a mapping");
-    expect_error("- a\n- b\n", "level.yaml:1:", "must be a mapping");
-    expect_error("atlas:\n  padding: [1\n", "level.yaml:", "YAML syntax error");
-    expect_error("density_overrides:\n  - match: Floor\n", "level.yaml:2:", "needs both match and texel_density");
-    expect_error("density_overrides:\n  - match: Floor\n    size: 3\n", "level.yaml:3:", "unknown key 'density_overrides.size'");
-    expect_error("bouncez: 3\n", "level.yaml:1:", "unknown key 'bouncez'");
-    lmb_config c;
-    lmb_error err;
-    lmb_config_default(&c);
-    CHECK_INT(lmb_config_load("/nonexistent/level.yaml", &c, &err), LMB_ERR_INPUT);
-    CHECK_CONTAINS(err.message, "cannot open config '/nonexistent/level.yaml'");
+    expect_error("samples:\n  gather: lots\n", "level.yaml:2: ",
+                 "key 'samples.gather': expected an integer in 1..1048576, got 'lots'");
+    expect_error("samples:\n  direct: 4\n  gather: -3\n", "level.yaml:3: ",
+                 "key 'samples.gather': expected an integer in 1..1048576, got '-3'");
+    expect_error("samples:\n  gather: 2.5\n", "level.yaml:2: ", "key 'samples.gather': expected an integer");
+    expect_error("samples:\n  gather: 12abc\n", "level.yaml:2: ", "got '12abc'");
+    expect_error("samples:\n  gather: 0\n", "level.yaml:2: ", "got '0'");
+    expect_error("samples:\n  gather: 1048577\n", "level.yaml:2: ", "got '1048577'");
+    expect_error("seed: 9223372036854775808\n", "level.yaml:1: ",
+                 "key 'seed': expected an integer in 0..9223372036854775807, got '9223372036854775808'");
+    expect_error("atlas:\n  max_size: 8\n", "level.yaml:2: ", "key 'atlas.max_size': expected an integer in 16..16384");
+    expect_error("threads: [1]\n", "level.yaml:1: ", "key 'threads': expected an integer in 0..1024, got a list");
+    expect_error("texel_density: 0\n", "level.yaml:1: ",
+                 "key 'texel_density': expected a number > 0 and <= 100000, got '0'");
+    expect_error("texel_density: .nan\n", "level.yaml:1: ", "key 'texel_density': expected a number");
+    expect_error("texel_density: .inf\n", "level.yaml:1: ", "got '.inf'");
+    expect_error("texel_density: 0x10\n", "level.yaml:1: ", "got '0x10'");
+    expect_error("texel_density:\n", "level.yaml:1: ", "got an empty value");
+    expect_error("gather:\n  defensive: 1\n", "level.yaml:2: ",
+                 "key 'gather.defensive': expected a number >= 0 and < 1, got '1'");
+    expect_error("lights:\n  emissive_scale: -0.5\n", "level.yaml:2: ", "key 'lights.emissive_scale'");
+    expect_error("\n\ngather:\n  method: fancy\n", "level.yaml:4: ",
+                 "key 'gather.method': expected one of cosine, amis, amis_defensive, got 'fancy'");
+    expect_error("atlas:\n  keep_uv1: maybe\n", "level.yaml:2: ",
+                 "key 'atlas.keep_uv1': expected true or false, got 'maybe'");
+    expect_error("output:\n  formats:\n    - exr\n    - tiff\n", "level.yaml:4: ",
+                 "key 'output.formats': expected one of exr, hdr, png, got 'tiff'");
+    expect_error("output:\n  formats: []\n", "level.yaml:2: ", "key 'output.formats': expected at least one of exr");
+    expect_error("lightmap:\n  extras_key: \"\"\n", "level.yaml:2: ",
+                 "key 'lightmap.extras_key': expected a non-empty string");
+}
+
+static void test_structure_errors(void)
+{
+    expect_error("texel_density: 8\natlas:\n  maxsize: 512\n", "level.yaml:3: ",
+                 "unknown key 'atlas.maxsize' (known keys under 'atlas': max_size, padding, keep_uv1)");
+    expect_error("bouncez: 3\n", "level.yaml:1: ",
+                 "unknown key 'bouncez' (known keys: texel_density, density_overrides, atlas");
+    expect_error("seed: 1\nthreads: 2\nseed: 2\n", "level.yaml:3: ", "key 'seed' is given twice (first on line 1)");
+    expect_error("atlas:\n  padding: 1\n  padding: 2\n", "level.yaml:3: ", "key 'atlas.padding' is given twice");
+    expect_error("atlas: {padding: 1}\natlas: {max_size: 64}\n", "level.yaml:2: ", "key 'atlas' is given twice");
+    expect_error("samples: [1, 2]\n", "level.yaml:1: ", "key 'samples': expected a mapping of keys, got a list");
+    expect_error("- a\n- b\n", "level.yaml:1: ", "the config must be a mapping of keys");
+    expect_error("just words\n", "level.yaml:1: ", "must be a mapping of keys (key: value), got 'just words'");
+    expect_error("a: 1\n---\nb: 2\n", "level.yaml:2: ", "a second YAML document");
+    expect_error("density_overrides:\n  - match: Floor\n", "level.yaml:2: ",
+                 "key 'density_overrides': each entry needs both match and texel_density");
+    expect_error("density_overrides:\n  - match: Floor\n    size: 3\n", "level.yaml:3: ",
+                 "unknown key 'density_overrides.size' (known keys under 'density_overrides': match, texel_density)");
+    expect_error("density_overrides:\n  - {match: A, match: B, texel_density: 2}\n", "level.yaml:2: ",
+                 "key 'density_overrides.match' is given twice");
+    expect_error("density_overrides:\n  - match: A\n    texel_density: -1\n", "level.yaml:3: ",
+                 "key 'density_overrides.texel_density': expected a number > 0");
+}
+
+static void test_yaml_errors(void)
+{
+    /* libyaml's own problem text, at the line where it found it */
+    expect_error("atlas:\n  padding: [1\n  max_size: 2\n", "level.yaml:3: ",
+                 "YAML syntax error: did not find expected ',' or ']'");
+    expect_error("atlas:\n\tpadding: 1\n", "level.yaml:2: ", "YAML syntax error: found character that cannot start");
+    expect_error("seed: 1\nbad: \xff\n", "level.yaml:2: ", "YAML syntax error: invalid leading UTF-8 octet");
+    /* the two ways an unquoted glob goes wrong, with a hint */
+    expect_error("lightmap:\n  include: *Floor\n", "level.yaml:2: ",
+                 "undefined alias (put a glob that starts with * in quotes)");
+    expect_error("lightmap:\n  exclude: [Sky, ?all]\n", "level.yaml:2: ",
+                 "key 'lightmap.exclude': expected a glob, got a mapping (put a glob that starts with ? in quotes)");
+}
+
+/* More than LMB_MAX_PATTERNS globs: an error at the first entry too many. */
+static void test_too_many_patterns(void)
+{
+    char text[LMB_MAX_PATTERNS * 16 + 64], *p = text;
+    p += sprintf(p, "lightmap:\n  exclude:\n");
+    for (int i = 0; i <= LMB_MAX_PATTERNS; i++)
+        p += sprintf(p, "    - N%d\n", i);
+    char where[32];
+    snprintf(where, sizeof where, "level.yaml:%d: ", 3 + LMB_MAX_PATTERNS);
+    expect_error(text, where, "key 'lightmap.exclude': expected at most 64 entries, got 65");
+
+    char longname[LMB_PATTERN_LEN + 32];
+    snprintf(longname, sizeof longname, "lightmap:\n  include: [%0*d]\n", LMB_PATTERN_LEN, 7);
+    expect_error(longname, "level.yaml:2: ", "at most 127 characters, got '0000");
 }
 
 static void test_empty_is_defaults(void)
 {
-    lmb_config c, d;
+    static const char *const texts[] = {"", "# nothing but a comment\n\n# and another\n", "---\n", "~\n",
+                                        "atlas:\nsamples: ~\n", "density_overrides:\nlightmap: {exclude: null}\n"};
+    for (size_t i = 0; i < sizeof texts / sizeof *texts; i++) {
+        lmb_config c;
+        lmb_error err;
+        CHECK_INT(parse(texts[i], &c, &err), LMB_OK);
+        CHECK(same_as_defaults(&c));
+    }
+}
+
+static void test_files(void)
+{
+    lmb_config c;
     lmb_error err;
-    CHECK_INT(parse("# nothing but a comment\n", &c, &err), LMB_OK);
-    lmb_config_default(&d);
-    CHECK(memcmp(&c, &d, sizeof c) == 0);
+    lmb_config_default(&c);
+    CHECK_INT(lmb_config_load("/nonexistent/level.yaml", &c, &err), LMB_ERR_INPUT);
+    CHECK_CONTAINS(err.message, "cannot open config '/nonexistent/level.yaml': No such file or directory");
+
+    char path[] = "/tmp/lmbake-test-config-XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    if (fd < 0)
+        return;
+    const char *text = "# a level\nsamples:\n  texel: 300\n";
+    CHECK(write(fd, text, strlen(text)) == (ssize_t)strlen(text));
+    close(fd);
+    CHECK_INT(lmb_config_load(path, &c, &err), LMB_ERR_INPUT);
+    char where[160];
+    snprintf(where, sizeof where, "%s:3: key 'samples.texel': expected an integer in 1..256, got '300'", path);
+    CHECK_CONTAINS(err.message, where);
+    unlink(path);
 }
 
 /* The shipped, commented example holds exactly the defaults. */
 static void test_example(const char *path)
 {
-    lmb_config c, d;
+    lmb_config c;
     lmb_error err = {LMB_OK, ""};
     lmb_config_default(&c);
-    lmb_config_default(&d);
     CHECK_INT(lmb_config_load(path, &c, &err), LMB_OK);
     if (err.message[0])
         fprintf(stderr, "%s\n", err.message);
-    CHECK(memcmp(&c, &d, sizeof c) == 0);
+    CHECK(same_as_defaults(&c));
 }
 
 static void test_glob(void)
 {
     CHECK(lmb_glob_match("*", ""));
     CHECK(lmb_glob_match("*", "Floor"));
+    CHECK(lmb_glob_match("Floor*", "Floor"));
     CHECK(lmb_glob_match("Floor*", "Floor_01"));
     CHECK(!lmb_glob_match("Floor*", "MainFloor"));
+    CHECK(!lmb_glob_match("Floor*", "floor_01")); /* case-sensitive */
     CHECK(lmb_glob_match("?all", "Wall"));
+    CHECK(lmb_glob_match("?all", "Hall"));
     CHECK(!lmb_glob_match("?all", "all"));
+    CHECK(!lmb_glob_match("?all", "Walls"));
+    CHECK(lmb_glob_match("a*b*c", "abc"));
     CHECK(lmb_glob_match("a*b*c", "a__b__b__c"));
     CHECK(!lmb_glob_match("a*b*c", "a__b__b__"));
+    CHECK(!lmb_glob_match("a*b*c", "a__c__b"));
+    CHECK(!lmb_glob_match("Door", "Window"));
     CHECK(lmb_glob_match("", ""));
     CHECK(!lmb_glob_match("", "x"));
     CHECK(lmb_glob_match("*Minus1", "DarkMinus1"));
+    CHECK(lmb_glob_match("**?", "x"));
+    CHECK(!lmb_glob_match("**?", ""));
+    /* backtracking is linear per star: a pattern that is exponential for naive recursion */
+    static char many_a[20001];
+    memset(many_a, 'a', sizeof many_a - 1);
+    CHECK(!lmb_glob_match("*a*a*a*a*a*a*a*a*a*a*a*a*b", many_a));
+    CHECK(lmb_glob_match("*a*a*a*a*a*a*a*a*a*a*a*a*", many_a));
 }
 
 int main(int argc, char **argv)
 {
     test_defaults();
     test_full();
-    test_errors();
+    test_partial_and_edges();
+    test_value_errors();
+    test_structure_errors();
+    test_yaml_errors();
+    test_too_many_patterns();
     test_empty_is_defaults();
-    if (argc > 1)
+    test_files();
+    if (argc > 1) {
         test_example(argv[1]);
-    else
+    } else {
+        fprintf(stderr, "usage: test_config EXAMPLE_CONFIG\n");
         check_failed_count++;
+    }
     test_glob();
     return check_failures();
 }
