@@ -16,7 +16,8 @@ packages=(
   libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
   libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
   libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
-  libopenmesh-dev                   # half-edge mesh for the unwrapper
+  libopenmesh-dev                   # half-edge mesh library (found by CMake; see README)
+  libsuitesparse-dev                # CHOLMOD sparse Cholesky for the LSCM flattening
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
 )
 

@@ -1,0 +1,35 @@
+/* Shared between the unwrap stage's files (see unwrap.h for the pipeline). */
+#ifndef LMBAKE_UNWRAP_INTERNAL_H
+#define LMBAKE_UNWRAP_INTERNAL_H
+
+#include "unwrap.h"
+
+#define LMB_NONE UINT32_MAX
+
+/* Welded topology of one mesh: vertices merged by exact position, and for each triangle
+ * corner k the triangle across edge (k, k+1), or LMB_NONE at a boundary, a non-manifold
+ * edge (3+ triangles) or a winding flip (both triangles run the edge the same way). */
+typedef struct lmb_topology {
+    uint32_t welded_count;
+    uint32_t *weld;      /* per input vertex -> welded id */
+    uint32_t *neighbor;  /* 3 per triangle */
+    double *normal;      /* 3 per triangle, unit (0 for skipped) */
+    double *area;        /* per triangle */
+    double *centroid;    /* 3 per triangle */
+    uint32_t nonmanifold_edges;
+} lmb_topology;
+
+lmb_status lmb_topology_build(const lmb_unwrap_input *in, lmb_topology *t, lmb_error *err);
+void lmb_topology_free(lmb_topology *t);
+
+/* Grows charts over the triangles listed in tris[0..n) (all unassigned in chart_of, which
+ * holds LMB_NONE for them); new charts get ids from *next_chart on. */
+lmb_status lmb_segment(const lmb_unwrap_input *in, const lmb_topology *t, const uint32_t *tris, uint32_t n,
+                       double max_angle, uint32_t *chart_of, uint32_t *next_chart, lmb_error *err);
+
+/* Flattens the triangles tris[0..n) of one chart into uv (6 per triangle, indexed by
+ * triangle). *planar is set when a projection was exact. */
+lmb_status lmb_flatten(const lmb_unwrap_input *in, const lmb_topology *t, const uint32_t *tris, uint32_t n,
+                       double *uv, int *planar, lmb_error *err);
+
+#endif
