@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# README command 1: install what is missing, build, bake the bundled demo scene, and print
-# where the output is.
+# README command 1: install what is missing, build, bake the bundled demo scenes and print
+# where the output is: the project's own Cornell box with a point light just under the
+# ceiling (tools/make_scenes.py) and bevy's Cornell box with its emissive ceiling.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh build
 out=${LMB_DEMO_OUT:-$PWD/demo-out}
-scene=assets/scenes/cornell-box-bevy/CornellBox.glb
-echo "demo: baking $scene"
-build/lmbake bake "$scene" -c assets/demo-config.yaml -o "$out/cornell-box-bevy"
-if [ -n "$(ls -A "$out/cornell-box-bevy" 2>/dev/null)" ]; then
-  echo "demo: output in $out/cornell-box-bevy"
-else
-  echo "demo: nothing written yet: the stages after load are still to come (see the bake line above)"
-fi
+mkdir -p "$out/scenes"
+/usr/bin/python3 tools/make_scenes.py "$out/scenes" >/dev/null
+echo "demo: baking the Cornell box with a point light (generated: $out/scenes/cornell-point.gltf)"
+build/lmbake bake "$out/scenes/cornell-point.gltf" -c assets/demo-point-config.yaml -o "$out/cornell-point"
+echo "demo: baking bevy's Cornell box (assets/scenes/cornell-box-bevy/CornellBox.glb)"
+build/lmbake bake assets/scenes/cornell-box-bevy/CornellBox.glb -c assets/demo-config.yaml -o "$out/cornell-box-bevy"
+echo "demo: output in $out/cornell-point and $out/cornell-box-bevy (.gltf + lightmap .exr/.hdr/.png)"

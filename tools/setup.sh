@@ -21,6 +21,9 @@ packages=(
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
 )
 
+# node and npm: the machine's own if it has them, else Debian's
+command -v npm >/dev/null || packages+=(nodejs npm)
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -34,6 +37,12 @@ if ((${#missing[@]})); then
     tail -n 30 "$log"; echo "setup: apt-get failed (full log: $log)"; exit 1
   fi
   rm -f "$log"
+fi
+
+# npm pieces (package.json): the Khronos glTF validator for the tests
+if [ ! -d node_modules/gltf-validator ]; then
+  echo "setup: installing npm packages (package.json)"
+  npm install --no-audit --no-fund --silent >/dev/null 2>&1 || { echo "setup: npm install failed"; exit 1; }
 fi
 
 log="$build_dir/setup.log"

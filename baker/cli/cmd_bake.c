@@ -1,9 +1,8 @@
 /*
  * `lmbake bake SCENE [-c CONFIG] [-o OUTDIR]`: the whole pipeline on one level.
  * Command-line values override the config file, which overrides the defaults.
- * Stages run so far: load + select. The stages after them (unwrap, pack, texels, lights,
- * gather, post, write) arrive with their issues; until then bake checks the inputs, prints
- * the plan and says plainly that no lightmap was written.
+ * Stages: load, select, then lmb_bake (unwrap, pack, texels, direct light, dilation, write).
+ * Indirect light (bounce cache, final gather) is not in yet: the lightmaps hold direct light.
  */
 #include "cli_common.h"
 #include "commands.h"
@@ -98,16 +97,30 @@ int cmd_bake(int argc, char **argv)
     lmb_scene_select_lightmapped(scene, &cfg);
     lmb_scene_stats st;
     lmb_scene_stats_compute(scene, &st);
-    if (!a.quiet) {
+    if (!a.quiet)
         printf("load: %s in %.2fs: %u instances (%u lightmapped, %llu triangles), %u punctual lights, "
                "%llu emissive triangles\n",
                a.scene, cli_now() - t0, scene->instance_count, st.lightmapped_instances,
                (unsigned long long)st.lightmapped_triangles, scene->light_count,
                (unsigned long long)st.emissive_triangles);
-        printf("bake: stages after load (unwrap, pack, texels, lights, gather, post, write) are not implemented "
-               "yet; no lightmap was written to %s\n",
-               a.outdir);
+    if (!st.lightmapped_instances) {
+        lmb_error_set(&err, LMB_ERR_INPUT, "%s: nothing to lightmap (see 'lmbake inspect' for each instance's reason)",
+                      a.scene);
+        lmb_scene_free(scene);
+        return cli_fail(&err);
     }
+    cli_progress progress;
+    cli_progress_init(&progress, stderr, a.quiet);
+    lmb_bake_stats bs;
+    lmb_status rc = lmb_bake(scene, &cfg, a.outdir, cli_progress_update, &progress, &bs, &log, &err);
     lmb_scene_free(scene);
+    if (rc != LMB_OK)
+        return cli_fail(&err);
+    if (!a.quiet)
+        printf("bake: %.2f s (lighting %.2f s), %u atlas(es), %llu texels (%llu valid), %llu rays, %.3g rays/s\n"
+               "output: %s (lightmaps beside it)\n",
+               bs.seconds, bs.light_seconds, bs.atlases, (unsigned long long)bs.texels,
+               (unsigned long long)bs.valid_texels, (unsigned long long)bs.rays,
+               bs.light_seconds > 0 ? (double)bs.rays / bs.light_seconds : 0.0, bs.gltf_path);
     return LMB_OK;
 }

@@ -18,6 +18,7 @@ static const char usage[] =
     "  bake SCENE [-c CONFIG] [-o OUTDIR]   bake lightmaps for a .gltf/.glb level\n"
     "  inspect SCENE [-c CONFIG] [--json]   list meshes, instances, materials, lights and\n"
     "                                       what will be lightmapped (and why not)\n"
+    "  unwrap SCENE [-c CONFIG] [--png DIR] lightmap UV layout and its quality report\n"
     "\n"
     "options:\n"
     "  -h, --help      this help; 'lmbake <command> --help' for a command's options\n"
@@ -42,6 +43,8 @@ int main(int argc, char **argv)
     }
     if (!strcmp(cmd, "inspect"))
         return cmd_inspect(argc - 1, argv + 1);
+    if (!strcmp(cmd, "unwrap"))
+        return cmd_unwrap(argc - 1, argv + 1);
     if (!strcmp(cmd, "bake"))
         return cmd_bake(argc - 1, argv + 1);
     fprintf(stderr, "lmbake: unknown command '%s'\n\n%s", cmd, usage);

@@ -6,8 +6,6 @@
  */
 #include "gltf_adapter.h"
 
-#include <tiny_gltf.h>
-
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -16,29 +14,18 @@
 #include <string>
 #include <vector>
 
-struct lmb_gltf_doc {
-    tinygltf::Model model;
-    std::string extras_key;
-    std::vector<lmb_gltf_buffer> buffers;
-    std::vector<lmb_gltf_buffer_view> buffer_views;
-    std::vector<lmb_gltf_accessor> accessors;
-    std::vector<lmb_gltf_mesh> meshes;
-    std::vector<lmb_gltf_primitive> primitives;
-    std::vector<lmb_gltf_node> nodes;
-    std::vector<int32_t> children;
-    std::vector<lmb_gltf_material> materials;
-    std::vector<lmb_gltf_light> lights;
-    std::vector<int32_t> scene_roots;
-    std::vector<const char *> ext_required, ext_used;
-    lmb_gltf_view view;
-};
+#include "gltf_doc.hpp"
 
 namespace {
 
-bool skip_image(tinygltf::Image *, const int, std::string *, std::string *, int, int,
-                const unsigned char *, int, void *)
+/* Images are not decoded (the baker reads textures through OpenImageIO when it needs
+ * them); their encoded bytes are kept so the writer can re-emit data-URI images as is. */
+bool skip_image(tinygltf::Image *image, const int, std::string *, std::string *, int, int,
+                const unsigned char *bytes, int size, void *)
 {
-    return true; /* lightmapping reads textures later, through OpenImageIO, when it needs them */
+    if (image->uri.empty() && image->bufferView < 0 && bytes && size > 0)
+        image->image.assign(bytes, bytes + size);
+    return true;
 }
 
 /* Returns obj[key] if obj is an object holding key, else nullptr. */
@@ -250,6 +237,8 @@ void build_view(lmb_gltf_doc &d)
         d.ext_required.push_back(e.c_str());
     for (const auto &e : d.model.extensionsUsed)
         d.ext_used.push_back(e.c_str());
+    for (const auto &img : d.model.images)
+        d.image_uris.push_back(img.uri.c_str());
     lmb_gltf_view &v = d.view;
     expose(d.buffers, v.buffers, v.buffer_count);
     expose(d.buffer_views, v.buffer_views, v.buffer_view_count);
@@ -263,6 +252,7 @@ void build_view(lmb_gltf_doc &d)
     expose(d.scene_roots, v.scene_roots, v.scene_root_count);
     expose(d.ext_required, v.extensions_required, v.extensions_required_count);
     expose(d.ext_used, v.extensions_used, v.extensions_used_count);
+    expose(d.image_uris, v.image_uris, v.image_count);
 }
 
 /* tinygltf's messages end in newlines and may hold several lines: keep the first one. */

@@ -99,6 +99,7 @@ typedef struct lmb_gltf_view {
     int has_scene; /* 0: the file has no scene; roots are the parentless nodes */
     const char *const *extensions_required;     uint32_t extensions_required_count;
     const char *const *extensions_used;         uint32_t extensions_used_count;
+    const char *const *image_uris;              uint32_t image_count; /* "" when in a buffer view */
 } lmb_gltf_view;
 
 /* Parses path (.gltf or .glb by content). `extras_key` names the node extras bool read

@@ -248,6 +248,26 @@ typedef struct lmb_scene_stats {
 
 void lmb_scene_stats_compute(const lmb_scene *scene, lmb_scene_stats *out);
 
+/* ---- baking -------------------------------------------------------------- */
+
+typedef struct lmb_bake_stats {
+    uint32_t atlases;
+    uint64_t texels;        /* texels holding gather points */
+    uint64_t valid_texels;  /* of those, not inside geometry */
+    uint64_t rays;          /* shadow and validity rays traced */
+    double seconds;         /* wall time of the bake (layout to last file) */
+    double light_seconds;   /* wall time of the lighting stages */
+    char gltf_path[8600];   /* the output glTF */
+} lmb_bake_stats;
+
+/* Bakes the lightmapped instances of scene (after lmb_scene_select_lightmapped) into
+ * outdir: per atlas <stem>-lightmap-N.exr / .hdr / .png (as cfg->output_formats says; EXR
+ * and HDR are linear irradiance in lux, PNG a tonemapped preview) and <stem>.gltf with
+ * TEXCOORD_1 and MOZ_lightmap. Files appear only when everything succeeded; outdir must
+ * not be the input's folder. The scene's glTF document is modified (it becomes the output). */
+lmb_status lmb_bake(lmb_scene *scene, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress,
+                    void *progress_user, lmb_bake_stats *stats, const lmb_log *log, lmb_error *err);
+
 /* 1 if the material emits (emissive factor x strength > 0 in any channel). */
 int lmb_material_is_emissive(const lmb_material *m);
 

@@ -126,3 +126,17 @@ int gen_torus(gen_mesh *m, uint32_t seg, uint32_t sides, float major, float mino
         }
     return 0;
 }
+
+int gen_bumpy_sphere(gen_mesh *m, uint32_t seg, uint32_t rings, float r, float bump)
+{
+    if (gen_uv_sphere(m, seg, rings, r))
+        return -1;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        float *p = m->positions + 3 * v;
+        double th = acos(fmax(-1.0, fmin(1.0, p[1] / r))), ph = atan2(-p[2], p[0]);
+        double k = 1.0 + bump * (sin(5 * th) * sin(7 * ph) + 0.5 * sin(11 * th + 3 * ph) + 0.25 * cos(17 * ph - 13 * th));
+        for (int c = 0; c < 3; c++)
+            p[c] = (float)(p[c] * k);
+    }
+    return 0;
+}

@@ -19,6 +19,9 @@ typedef struct gen_mesh {
 int gen_cornell_box(gen_mesh *m);                                   /* 30 triangles, 0..1 cube room */
 int gen_uv_sphere(gen_mesh *m, uint32_t segments, uint32_t rings, float radius); /* 2*seg*(rings-1) */
 int gen_torus(gen_mesh *m, uint32_t segments, uint32_t sides, float major, float minor); /* 2*seg*sides */
+/* A UV sphere whose radius is displaced by a few smooth waves (amplitude `bump` x radius):
+ * a closed, curved, non-trivial mesh for the 100k-triangle charting benchmark. */
+int gen_bumpy_sphere(gen_mesh *m, uint32_t segments, uint32_t rings, float radius, float bump);
 void gen_mesh_free(gen_mesh *m);
 
 #endif

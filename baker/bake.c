@@ -1,0 +1,325 @@
+/*
+ * The bake pipeline driver: layout (unwrap + pack) -> ray-tracing scene -> per atlas:
+ * texels -> direct light -> dilation -> images; then the glTF with TEXCOORD_1 and
+ * MOZ_lightmap. Output is written into a staging folder inside outdir and moved into
+ * place only when everything succeeded, so a failed bake leaves nothing behind; outdir may
+ * not be the input's own folder (the input and its .bin files are never written over).
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <lmbake/lmbake.h>
+
+#include "lights/direct.h"
+#include "load/gltf_adapter.h"
+#include "pack/layout.h"
+#include "post/dilate.h"
+#include "texels/texels.h"
+#include "write/gltf_write.h"
+#include "write/image_adapter.h"
+#include "write/output_dir.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Tonemapped 8-bit preview of irradiance: exposure maps the 95th percentile of the valid
+ * texels' luminance to 0.8 before Reinhard x/(1+x) and the sRGB curve. For a quick look
+ * only; the EXR is the lightmap. */
+static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t h, uint8_t *out)
+{
+    size_t n = (size_t)w * h, m = 0;
+    float *lum = malloc((n + 1) * sizeof *lum);
+    double scale = 1.0;
+    if (lum) {
+        for (size_t i = 0; i < n; i++)
+            if (valid[i] == LMB_TEXEL_VALID)
+                lum[m++] = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
+        if (m) {
+            /* 95th percentile by partial selection would be faster; a sort is fine at atlas sizes */
+            for (size_t gap = m / 2; gap > 0; gap /= 2)
+                for (size_t i = gap; i < m; i++)
+                    for (size_t j = i; j >= gap && lum[j - gap] > lum[j]; j -= gap) {
+                        float t = lum[j];
+                        lum[j] = lum[j - gap];
+                        lum[j - gap] = t;
+                    }
+            double p95 = lum[(size_t)(0.95 * (double)(m - 1))];
+            scale = p95 > 0 ? 0.8 / p95 : 1.0;
+        }
+        free(lum);
+    }
+    for (size_t i = 0; i < 3 * n; i++) {
+        double x = rgb[i] * scale, y = x / (1.0 + x);
+        y = y <= 0.0031308 ? 12.92 * y : 1.055 * pow(y, 1 / 2.4) - 0.055;
+        out[i] = (uint8_t)(y <= 0 ? 0 : y >= 1 ? 255 : lround(y * 255.0));
+    }
+}
+
+static lmb_status write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
+                                     const float *rgb, const uint8_t *valid, uint32_t w, uint32_t h, lmb_error *err)
+{
+    char path[8600];
+    lmb_status st = LMB_OK;
+    if (cfg->output_formats & LMB_OUTPUT_EXR) {
+        snprintf(path, sizeof path, "%s/%s-lightmap-%u.exr", dir, stem, a);
+        st = lmb_image_write_f32(path, w, h, 3, rgb, err);
+    }
+    /* the glTF references the .hdr and .png: write them whatever the formats say */
+    if (st == LMB_OK) {
+        snprintf(path, sizeof path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
+        st = lmb_image_write_f32(path, w, h, 3, rgb, err);
+    }
+    if (st == LMB_OK) {
+        uint8_t *png = malloc((size_t)w * h * 3 + 1);
+        if (!png)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "png: out of memory");
+        tonemap(rgb, valid, w, h, png);
+        snprintf(path, sizeof path, "%s/%s-lightmap-%u.png", dir, stem, a);
+        st = lmb_image_write_u8(path, w, h, 3, png, err);
+        free(png);
+    }
+    return st;
+}
+
+/* Lights one atlas into rgb (w*h*3, dilated) and valid (w*h). */
+static lmb_status light_atlas(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
+                              const lmb_emitters *em, uint32_t a, lmb_progress_fn progress, void *user, float *rgb,
+                              uint8_t *valid, lmb_bake_stats *stats, lmb_error *err)
+{
+    lmb_texels t;
+    lmb_status st = lmb_texels_build(s, l, a, cfg->texel_samples, &t, err);
+    if (st != LMB_OK)
+        return st;
+    float *e = calloc((size_t)t.count * 3 + 1, sizeof *e);
+    if (!e) {
+        lmb_texels_free(&t);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory");
+    }
+    lmb_direct_job job = {s, cfg, rt, em, a, progress, user};
+    st = lmb_direct_compute(&job, &t, e, &stats->rays, err);
+    for (uint32_t i = 0; st == LMB_OK && i < t.count; i++) {
+        valid[t.texel[i]] = t.valid[i] ? LMB_TEXEL_VALID : LMB_TEXEL_INSIDE;
+        for (int c = 0; c < 3; c++)
+            rgb[3 * (size_t)t.texel[i] + c] = e[3 * (size_t)i + c];
+        stats->texels++;
+        stats->valid_texels += t.valid[i];
+    }
+    if (st == LMB_OK)
+        st = lmb_dilate(rgb, valid, l->width[a], l->height[a], err);
+    free(e);
+    lmb_texels_free(&t);
+    return st;
+}
+
+/* New vertices of one glTF primitive: one per (original vertex, chart). */
+static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, uint32_t i, lmb_gltf_prim_out **out,
+                                      uint32_t *count, void ***owned, uint32_t *owned_n, lmb_error *err);
+
+/* Texture files the input references by relative path go along with the output glTF
+ * (read from the view before lightmap images are added; tinygltf keeps the strings). */
+static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
+{
+    const lmb_gltf_view *v = lmb_gltf_get_view(s->doc);
+    for (uint32_t k = 0; k < v->image_count; k++) {
+        const char *uri = v->image_uris[k];
+        lmb_error e;
+        if (uri[0] && strncmp(uri, "data:", 5) != 0 && lmb_output_dir_copy_input_file(od, s->path, uri, &e) != LMB_OK)
+            lmb_warn(log, "%s: texture not copied to the output: %s", s->path, e.message);
+    }
+}
+
+static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir, const char *stem, lmb_bake_stats *stats,
+                             lmb_error *err)
+{
+    int32_t *tex = malloc(((size_t)l->atlas_count + 1) * sizeof *tex);
+    if (!tex)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < l->atlas_count && st == LMB_OK; a++) {
+        char png[512], hdr[512];
+        snprintf(png, sizeof png, "%s-lightmap-%u.png", stem, a);
+        snprintf(hdr, sizeof hdr, "%s-lightmap-%u.hdr", stem, a);
+        tex[a] = lmb_gltf_add_lightmap_texture(s->doc, png, hdr, err);
+        if (tex[a] < 0)
+            st = LMB_ERR_INTERNAL;
+    }
+    for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
+        if (!l->instances[i].lightmapped)
+            continue;
+        lmb_gltf_prim_out *prims = NULL;
+        uint32_t n = 0, owned_n = 0;
+        void **owned = NULL;
+        st = instance_primitives(s, l, i, &prims, &n, &owned, &owned_n, err);
+        if (st == LMB_OK)
+            st = lmb_gltf_lightmap_node(s->doc, s->instances[i].node, prims, n, tex[l->instances[i].atlas], err);
+        for (uint32_t k = 0; k < owned_n; k++)
+            free(owned[k]);
+        free(owned);
+        free(prims);
+    }
+    char path[8600], bin[512];
+    snprintf(path, sizeof path, "%s/%s.gltf", dir, stem);
+    snprintf(bin, sizeof bin, "%s-lightmap.bin", stem);
+    if (st == LMB_OK)
+        st = lmb_gltf_save(s->doc, path, bin, err);
+    free(tex);
+    (void)stats;
+    return st;
+}
+
+static int keep(void ***owned, uint32_t *n, void *p)
+{
+    void **q = realloc(*owned, (*n + 1) * sizeof *q);
+    if (!q || !p) {
+        free(p);
+        if (q)
+            *owned = q;
+        return 0;
+    }
+    *owned = q;
+    q[(*n)++] = p;
+    return 1;
+}
+
+static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, uint32_t i, lmb_gltf_prim_out **out,
+                                      uint32_t *count, void ***owned, uint32_t *owned_n, lmb_error *err)
+{
+    const lmb_mesh *mesh = &s->meshes[s->instances[i].mesh];
+    const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
+    const lmb_layout_instance *li = &l->instances[i];
+    double w = l->width[li->atlas], h = l->height[li->atlas];
+    *out = calloc(mesh->primitive_count + 1, sizeof **out);
+    if (!*out)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+    uint32_t tbase = 0;
+    for (uint32_t p = 0; p < mesh->primitive_count; p++) {
+        const lmb_primitive *pr = &s->primitives[mesh->first_primitive + p];
+        uint32_t nt = pr->triangle_count, nv = 0;
+        /* key (vertex, chart) -> new vertex, by sorting the 3 nt corners */
+        uint64_t *key = malloc(((size_t)3 * nt + 1) * sizeof *key);
+        uint32_t *idx = malloc(((size_t)3 * nt + 1) * sizeof *idx), *src = malloc(((size_t)3 * nt + 1) * sizeof *src);
+        float *pos = malloc(((size_t)9 * nt + 1) * sizeof *pos), *nrm = pr->normals ? malloc(((size_t)9 * nt + 1) * sizeof *nrm) : NULL;
+        float *uv0 = pr->uv0 ? malloc(((size_t)6 * nt + 1) * sizeof *uv0) : NULL, *uv1 = malloc(((size_t)6 * nt + 1) * sizeof *uv1);
+        int ok = keep(owned, owned_n, key) & keep(owned, owned_n, idx) & keep(owned, owned_n, src) &
+                 keep(owned, owned_n, pos) & keep(owned, owned_n, uv1);
+        if (pr->normals)
+            ok &= keep(owned, owned_n, nrm);
+        if (pr->uv0)
+            ok &= keep(owned, owned_n, uv0);
+        if (!ok)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+        /* brute force but linear: new vertex per corner, then merge equal (vertex, chart) keys */
+        for (uint32_t c = 0; c < 3 * nt; c++) {
+            uint32_t f = tbase + c / 3, chart = lm->charts.chart_of[f];
+            key[c] = ((uint64_t)pr->indices[c] << 32) | (chart == UINT32_MAX ? 0xFFFFFFFFu : chart);
+        }
+        /* map each distinct key to the first corner that has it (sorted copy + binary search) */
+        uint64_t *sorted = malloc(((size_t)3 * nt + 1) * sizeof *sorted);
+        if (!keep(owned, owned_n, sorted))
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+        memcpy(sorted, key, (size_t)3 * nt * sizeof *sorted);
+        for (uint32_t gap = (3 * nt) / 2; gap > 0; gap /= 2) /* shell sort: no qsort context needed */
+            for (uint32_t a = gap; a < 3 * nt; a++)
+                for (uint32_t b = a; b >= gap && sorted[b - gap] > sorted[b]; b -= gap) {
+                    uint64_t t = sorted[b];
+                    sorted[b] = sorted[b - gap];
+                    sorted[b - gap] = t;
+                }
+        uint32_t distinct = 0;
+        for (uint32_t a = 0; a < 3 * nt; a++)
+            if (a == 0 || sorted[a] != sorted[a - 1])
+                sorted[distinct++] = sorted[a];
+        for (uint32_t c = 0; c < 3 * nt; c++) {
+            uint32_t lo = 0, hi = distinct;
+            while (lo < hi) {
+                uint32_t mid = (lo + hi) / 2;
+                if (sorted[mid] < key[c])
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            idx[c] = lo;
+            uint32_t v = pr->indices[c], f = tbase + c / 3;
+            src[lo] = v;
+            memcpy(pos + 3 * (size_t)lo, pr->positions + 3 * (size_t)v, 3 * sizeof(float));
+            if (nrm)
+                memcpy(nrm + 3 * (size_t)lo, pr->normals + 3 * (size_t)v, 3 * sizeof(float));
+            if (uv0)
+                memcpy(uv0 + 2 * (size_t)lo, pr->uv0 + 2 * (size_t)v, 2 * sizeof(float));
+            uv1[2 * (size_t)lo] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3)] / w);
+            uv1[2 * (size_t)lo + 1] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h);
+        }
+        nv = distinct;
+        lmb_gltf_prim_out *o = &(*out)[(*count)++];
+        o->gltf_primitive = pr->gltf_primitive;
+        o->vertex_count = nv;
+        o->source = src;
+        o->positions = pos;
+        o->normals = nrm;
+        o->uv0 = uv0;
+        o->uv1 = uv1;
+        o->triangle_count = nt;
+        o->indices = idx;
+        tbase += nt;
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress, void *user,
+                    lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
+{
+    double t0 = now();
+    memset(stats, 0, sizeof *stats);
+    lmb_output_dir od;
+    lmb_status st = lmb_output_dir_open(&od, outdir, s->path, err);
+    if (st != LMB_OK)
+        return st;
+    lmb_layout l;
+    lmb_rt rt;
+    lmb_emitters *em = NULL;
+    memset(&rt, 0, sizeof rt);
+    st = lmb_layout_build(s, cfg, progress, user, &l, err);
+    if (st == LMB_OK)
+        st = lmb_rt_build(s, &rt, err);
+    if (st == LMB_OK)
+        st = lmb_emitters_build(s, cfg, &em, err);
+    double tl = now();
+    for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
+        size_t n = (size_t)l.width[a] * l.height[a];
+        float *rgb = calloc(3 * n + 1, sizeof *rgb);
+        uint8_t *valid = calloc(n + 1, 1);
+        if (!rgb || !valid)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "bake: out of memory for atlas %u", a);
+        if (st == LMB_OK)
+            st = light_atlas(s, cfg, &l, &rt, em, a, progress, user, rgb, valid, stats, err);
+        if (st == LMB_OK)
+            st = write_atlas_images(cfg, od.staging, od.stem, a, rgb, valid, l.width[a], l.height[a], err);
+        free(rgb);
+        free(valid);
+    }
+    stats->light_seconds = now() - tl;
+    stats->atlases = l.atlas_count;
+    if (st == LMB_OK) {
+        copy_textures(s, &od, log);
+        st = write_gltf(s, &l, od.staging, od.stem, stats, err);
+    }
+    if (st == LMB_OK)
+        st = lmb_output_dir_commit(&od, err);
+    else
+        lmb_output_dir_abort(&od);
+    if (st == LMB_OK)
+        snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
+    lmb_emitters_free(em);
+    lmb_rt_free(&rt);
+    lmb_layout_free(&l);
+    stats->seconds = now() - t0;
+    return st;
+}

@@ -1,0 +1,226 @@
+/*
+ * `lmbake unwrap SCENE [-c CONFIG] [--report] [--png DIR]`: the lightmap UV layout alone
+ * (unwrap + pack), with the quality report of issue 3: per mesh triangles, charts, L2
+ * stretch and charting time; per atlas size, charts, coverage, L2 stretch, density
+ * p1/p50/p99, overlapping texels; packing time. --png writes one chart image per atlas.
+ */
+#include "cli_common.h"
+#include "commands.h"
+#include "progress.h"
+
+#include "pack/layout.h"
+#include "unwrap/metrics.h"
+#include "write/image_adapter.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const char help[] =
+    "usage: lmbake unwrap SCENE [-c CONFIG] [--report] [--png DIR] [-q]\n"
+    "\n"
+    "Computes the lightmap UV layout (charts and atlases) of SCENE without baking.\n"
+    "\n"
+    "  -c, --config FILE   bake config: texel_density, density_overrides, atlas.*\n"
+    "      --report        per mesh and per atlas quality figures (the default output)\n"
+    "      --png DIR       write DIR/atlas-N-charts.png, one colour per chart\n"
+    "  -q, --quiet         no progress or warnings\n"
+    "  -h, --help          this help\n"
+    "\n"
+    "Metrics (README, \"UV layout metrics\"): coverage = texel centres inside a triangle /\n"
+    "atlas area; L2 stretch (Sander 2001, 1 = ideal); density = UV/3D area per triangle over\n"
+    "the mean, area-weighted percentiles; overlapping texels = centres covered twice.\n";
+
+/* Mesh-level metrics: chart-local UVs against object-space positions. */
+static void mesh_stretch(const lmb_layout_mesh *lm, lmb_uv_metrics *m)
+{
+    const lmb_mesh_soup *s = &lm->soup;
+    uint32_t n = 0;
+    double *pos = malloc(sizeof(double) * 9 * s->triangle_count + 1), *uv = malloc(sizeof(double) * 6 * s->triangle_count + 1);
+    memset(m, 0, sizeof *m);
+    for (uint32_t f = 0; pos && uv && f < s->triangle_count; f++) {
+        if (lm->charts.chart_of[f] == UINT32_MAX)
+            continue;
+        for (int k = 0; k < 3; k++)
+            for (int d = 0; d < 3; d++)
+                pos[9 * n + 3 * k + d] = s->positions[3 * s->indices[3 * f + k] + d];
+        memcpy(uv + 6 * n, lm->charts.uv + 6 * f, 6 * sizeof(double));
+        n++;
+    }
+    lmb_uv_layout l = {n, pos, uv, 0, 0};
+    lmb_error err;
+    if (pos && uv)
+        lmb_uv_metrics_compute(&l, m, &err);
+    free(pos);
+    free(uv);
+}
+
+/* Triangles of every instance placed in atlas a, world positions and atlas UVs. */
+static lmb_status atlas_metrics(const lmb_scene *s, const lmb_layout *l, uint32_t a, lmb_uv_metrics *m, uint32_t *charts,
+                                lmb_error *err)
+{
+    uint32_t n = 0, cap = 0;
+    *charts = 0;
+    for (uint32_t i = 0; i < l->instance_count; i++)
+        if (l->instances[i].lightmapped && l->instances[i].atlas == a) {
+            cap += l->meshes[s->instances[i].mesh].soup.triangle_count;
+            *charts += l->meshes[s->instances[i].mesh].charts.chart_count;
+        }
+    double *pos = malloc(sizeof(double) * 9 * cap + 1), *uv = malloc(sizeof(double) * 6 * cap + 1);
+    if (!pos || !uv) {
+        free(pos);
+        free(uv);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "report: out of memory");
+    }
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        const lmb_layout_instance *li = &l->instances[i];
+        if (!li->lightmapped || li->atlas != a)
+            continue;
+        const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
+        for (uint32_t f = 0; f < lm->soup.triangle_count; f++) {
+            if (lm->charts.chart_of[f] == UINT32_MAX)
+                continue;
+            lmb_layout_world_triangle(s, l, i, f, pos + 9 * n);
+            memcpy(uv + 6 * n, li->uv1 + 6 * f, 6 * sizeof(double));
+            n++;
+        }
+    }
+    lmb_uv_layout lay = {n, pos, uv, l->width[a], l->height[a]};
+    lmb_status st = lmb_uv_metrics_compute(&lay, m, err);
+    free(pos);
+    free(uv);
+    return st;
+}
+
+typedef struct paint {
+    uint8_t *rgb;
+    uint32_t width;
+    uint8_t colour[3];
+} paint;
+
+static void paint_texel(void *user, uint32_t x, uint32_t y)
+{
+    paint *p = user;
+    memcpy(p->rgb + 3 * ((size_t)y * p->width + x), p->colour, 3);
+}
+
+/* A bright colour per (instance, chart), from an integer hash. */
+static void chart_colour(uint32_t instance, uint32_t chart, uint8_t out[3])
+{
+    uint32_t h = instance * 0x9E3779B1u ^ (chart + 1) * 0x85EBCA77u;
+    h ^= h >> 15;
+    h *= 0x2C1B3C6Du;
+    h ^= h >> 12;
+    for (int c = 0; c < 3; c++)
+        out[c] = (uint8_t)(64 + ((h >> (8 * c)) & 0xFF) * 191 / 255);
+}
+
+static lmb_status write_png(const lmb_scene *s, const lmb_layout *l, uint32_t a, const char *dir, lmb_error *err)
+{
+    paint p = {calloc((size_t)l->width[a] * l->height[a] * 3 + 1, 1), l->width[a], {0, 0, 0}};
+    if (!p.rgb)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "png: out of memory");
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        const lmb_layout_instance *li = &l->instances[i];
+        if (!li->lightmapped || li->atlas != a)
+            continue;
+        const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+        for (uint32_t f = 0; f < c->triangle_count; f++)
+            if (c->chart_of[f] != UINT32_MAX) {
+                chart_colour(i, c->chart_of[f], p.colour);
+                lmb_raster_triangle_centres(li->uv1 + 6 * f, l->width[a], l->height[a], paint_texel, &p);
+            }
+    }
+    char path[4096];
+    snprintf(path, sizeof path, "%s/atlas-%u-charts.png", dir, a);
+    lmb_status st = lmb_image_write_u8(path, l->width[a], l->height[a], 3, p.rgb, err);
+    free(p.rgb);
+    if (st == LMB_OK)
+        printf("wrote %s\n", path);
+    return st;
+}
+
+static void print_report(const lmb_scene *s, const lmb_layout *l)
+{
+    double chart_total = 0;
+    for (uint32_t m = 0; m < l->mesh_count; m++) {
+        const lmb_layout_mesh *lm = &l->meshes[m];
+        if (!lm->used)
+            continue;
+        lmb_uv_metrics um;
+        mesh_stretch(lm, &um);
+        chart_total += lm->chart_seconds;
+        printf("mesh '%s': %u triangles (%u zero-area), %u charts (%u planar, %u split), L2 stretch %.4f, "
+               "charting %.3f s\n",
+               s->meshes[m].name, lm->soup.triangle_count, s->meshes[m].degenerate_count, lm->charts.chart_count,
+               lm->charts.planar_charts, lm->charts.splits, um.l2_stretch, lm->chart_seconds);
+    }
+    printf("total: charting %.3f s, packing %.3f s, %u charts in %u atlas(es)\n", chart_total, l->pack_seconds,
+           l->chart_total, l->atlas_count);
+}
+
+int cmd_unwrap(int argc, char **argv)
+{
+    const char *scene_path = NULL, *config_path = NULL, *png_dir = NULL;
+    int quiet = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *v;
+        int r;
+        if (cli_is_flag(argv[i], "--help", "-h")) {
+            fputs(help, stdout);
+            return LMB_OK;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--config", "-c", &v)) != 0) {
+            if (r < 0)
+                return cli_usage_error("unwrap", "%s needs a file", argv[i]);
+            config_path = v;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--png", NULL, &v)) != 0) {
+            if (r < 0)
+                return cli_usage_error("unwrap", "--png needs a folder");
+            png_dir = v;
+        } else if (cli_is_flag(argv[i], "--report", NULL)) {
+            /* the report is always printed */
+        } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
+            quiet = 1;
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            return cli_usage_error("unwrap", "unknown option '%s'", argv[i]);
+        } else if (scene_path) {
+            return cli_usage_error("unwrap", "one scene at a time ('%s' and '%s')", scene_path, argv[i]);
+        } else {
+            scene_path = argv[i];
+        }
+    }
+    if (!scene_path)
+        return cli_usage_error("unwrap", "no SCENE given");
+    lmb_config cfg;
+    lmb_error err = {LMB_OK, ""};
+    lmb_config_default(&cfg);
+    if (config_path && lmb_config_load(config_path, &cfg, &err) != LMB_OK)
+        return cli_fail(&err);
+    cli_warnings warnings = {0, quiet};
+    lmb_log log = cli_log(&warnings);
+    lmb_scene *scene;
+    if (lmb_scene_load(scene_path, &cfg, &scene, &log, &err) != LMB_OK)
+        return cli_fail(&err);
+    lmb_scene_select_lightmapped(scene, &cfg);
+    cli_progress progress;
+    cli_progress_init(&progress, stderr, quiet);
+    lmb_layout layout;
+    lmb_status st = lmb_layout_build(scene, &cfg, cli_progress_update, &progress, &layout, &err);
+    if (st == LMB_OK) {
+        print_report(scene, &layout);
+        for (uint32_t a = 0; a < layout.atlas_count && st == LMB_OK; a++) {
+            lmb_uv_metrics m;
+            uint32_t charts;
+            st = atlas_metrics(scene, &layout, a, &m, &charts, &err);
+            if (st == LMB_OK)
+                printf("atlas %u: %ux%u, %u charts, coverage %.4f, L2 stretch %.4f, density p1/p50/p99 "
+                       "%.3f/%.3f/%.3f, overlapping texels %llu\n",
+                       a, layout.width[a], layout.height[a], charts, m.coverage, m.l2_stretch, m.density_p1,
+                       m.density_p50, m.density_p99, (unsigned long long)m.overlapping_texels);
+            if (st == LMB_OK && png_dir)
+                st = write_png(scene, &layout, a, png_dir, &err);
+        }
+    }
+    lmb_layout_free(&layout);
+    lmb_scene_free(scene);
+    return st == LMB_OK ? LMB_OK : cli_fail(&err);
+}

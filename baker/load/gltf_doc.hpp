@@ -1,0 +1,37 @@
+/*
+ * The tinygltf adapter's document (C++ only): the parsed tinygltf model, kept alive for the
+ * writer, and the plain C view of it. Shared by gltf_adapter.cpp (read) and
+ * ../write/gltf_write.cpp (write); never included from C.
+ */
+#ifndef LMBAKE_GLTF_DOC_HPP
+#define LMBAKE_GLTF_DOC_HPP
+
+#include "gltf_adapter.h"
+
+#include <tiny_gltf.h>
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+struct lmb_gltf_doc {
+    tinygltf::Model model;
+    std::string extras_key;
+    std::vector<lmb_gltf_buffer> buffers;
+    std::vector<lmb_gltf_buffer_view> buffer_views;
+    std::vector<lmb_gltf_accessor> accessors;
+    std::vector<lmb_gltf_mesh> meshes;
+    std::vector<lmb_gltf_primitive> primitives;
+    std::vector<lmb_gltf_node> nodes;
+    std::vector<int32_t> children;
+    std::vector<lmb_gltf_material> materials;
+    std::vector<lmb_gltf_light> lights;
+    std::vector<int32_t> scene_roots;
+    std::vector<const char *> ext_required, ext_used, image_uris;
+    lmb_gltf_view view;
+    /* writer: (original material, lightmap texture) -> lightmapped material copy */
+    std::map<std::pair<int, int>, int> lightmap_materials;
+};
+
+#endif

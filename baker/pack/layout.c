@@ -1,0 +1,309 @@
+/*
+ * Scene lightmap layout (see layout.h). Texel density per instance: the first
+ * density_overrides glob matching the instance's node or mesh name, else texel_density.
+ * Each chart of an instance is scaled by density * sqrt(world area / UV area), so texels
+ * are square in world units whatever the instance's (even non-uniform) scale.
+ * Atlases: everything is packed together first; if that needs several atlases, instances
+ * are grouped in scene order by estimated size and each group packed alone, halving a
+ * group that still spills over, so that every instance sits whole in one atlas.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "layout.h"
+#include "pack.h"
+#include "../util/mat4.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Area-weighted face normals summed per vertex, for a primitive that has no NORMAL (glTF
+ * says flat shading then; per vertex of an unwelded primitive this is the face normal). */
+static void smooth_normals(lmb_mesh_soup *soup, uint32_t tbase, uint32_t tcount)
+{
+    for (uint32_t f = tbase; f < tbase + tcount; f++) {
+        const uint32_t *t = soup->indices + 3 * (size_t)f;
+        const float *a = soup->positions + 3 * t[0], *b = soup->positions + 3 * t[1], *c = soup->positions + 3 * t[2];
+        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        for (int k = 0; k < 3; k++)
+            for (int d = 0; d < 3; d++)
+                soup->normals[3 * t[k] + d] += n[d];
+    }
+}
+
+static lmb_status build_soup(const lmb_scene *s, uint32_t mesh, lmb_mesh_soup *soup, lmb_error *err)
+{
+    const lmb_mesh *m = &s->meshes[mesh];
+    memset(soup, 0, sizeof *soup);
+    for (uint32_t p = 0; p < m->primitive_count; p++) {
+        soup->vertex_count += s->primitives[m->first_primitive + p].vertex_count;
+        soup->triangle_count += s->primitives[m->first_primitive + p].triangle_count;
+    }
+    soup->positions = malloc(((size_t)soup->vertex_count * 3 + 1) * sizeof *soup->positions);
+    soup->indices = malloc(((size_t)soup->triangle_count * 3 + 1) * sizeof *soup->indices);
+    soup->skip = malloc((size_t)soup->triangle_count + 1);
+    soup->normals = calloc((size_t)soup->vertex_count * 3 + 1, sizeof *soup->normals);
+    if (!soup->positions || !soup->indices || !soup->skip || !soup->normals)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "mesh '%s': out of memory", m->name);
+    uint32_t vbase = 0, tbase = 0;
+    for (uint32_t p = 0; p < m->primitive_count; p++) {
+        const lmb_primitive *pr = &s->primitives[m->first_primitive + p];
+        memcpy(soup->positions + 3 * (size_t)vbase, pr->positions, (size_t)pr->vertex_count * 3 * sizeof(float));
+        for (uint32_t i = 0; i < 3 * pr->triangle_count; i++)
+            soup->indices[3 * (size_t)tbase + i] = pr->indices[i] + vbase;
+        memcpy(soup->skip + tbase, pr->degenerate, pr->triangle_count);
+        if (pr->normals)
+            memcpy(soup->normals + 3 * (size_t)vbase, pr->normals, (size_t)pr->vertex_count * 3 * sizeof(float));
+        else
+            smooth_normals(soup, tbase, pr->triangle_count);
+        vbase += pr->vertex_count;
+        tbase += pr->triangle_count;
+    }
+    return LMB_OK;
+}
+
+void lmb_layout_world_triangle(const lmb_scene *s, const lmb_layout *l, uint32_t i, uint32_t f, double out[9])
+{
+    const lmb_instance *in = &s->instances[i];
+    const lmb_mesh_soup *soup = &l->meshes[in->mesh].soup;
+    for (int k = 0; k < 3; k++) {
+        const float *p = soup->positions + 3 * soup->indices[3 * f + k];
+        double q[3] = {p[0], p[1], p[2]};
+        lmb_mat4_point(in->world, q, out + 3 * k);
+    }
+}
+
+static double area3(const double *q)
+{
+    double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
+    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    return 0.5 * sqrt(x * x + y * y + z * z);
+}
+
+static double density_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i)
+{
+    const lmb_instance *in = &s->instances[i];
+    for (uint32_t k = 0; k < cfg->density_override_count; k++)
+        if (lmb_glob_match(cfg->density_overrides[k].pattern, in->name) ||
+            lmb_glob_match(cfg->density_overrides[k].pattern, s->meshes[in->mesh].name))
+            return cfg->density_overrides[k].texel_density;
+    return cfg->texel_density;
+}
+
+/* Scales instance i's charts into uv1 (texel units, chart-local) and returns its texel area. */
+static double scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
+{
+    lmb_layout_instance *li = &l->instances[i];
+    const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
+    const lmb_charts *c = &lm->charts;
+    double texels = 0;
+    for (uint32_t k = 0; k < c->chart_count; k++) {
+        double aw = 0, auv = 0, q[9];
+        for (uint32_t j = c->first[k]; j < c->first[k + 1]; j++) {
+            uint32_t f = c->order[j];
+            const double *u = c->uv + 6 * f;
+            lmb_layout_world_triangle(s, l, i, f, q);
+            aw += area3(q);
+            auv += 0.5 * fabs((u[2] - u[0]) * (u[5] - u[1]) - (u[4] - u[0]) * (u[3] - u[1]));
+        }
+        double sc = auv > 0 ? li->texel_density * sqrt(aw / auv) : 0;
+        for (uint32_t j = c->first[k]; j < c->first[k + 1]; j++) {
+            uint32_t f = c->order[j];
+            for (int d = 0; d < 6; d++)
+                li->uv1[6 * f + d] = c->uv[6 * f + d] * sc;
+        }
+        texels += aw * li->texel_density * li->texel_density;
+    }
+    return texels;
+}
+
+/* Packs the charts of instances list[0..n) into their own atlases (appended to l). Returns
+ * LMB_OK, or 1 in *spilled if one instance's charts ended in different atlases. */
+static lmb_status pack_group(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list, uint32_t n,
+                             int *spilled, lmb_error *err)
+{
+    uint32_t nc = 0;
+    for (uint32_t j = 0; j < n; j++)
+        nc += l->meshes[s->instances[list[j]].mesh].charts.chart_count;
+    lmb_pack_chart *charts = calloc((size_t)nc + 1, sizeof *charts);
+    uint32_t *owner = malloc(((size_t)nc + 1) * sizeof *owner), *chart_id = malloc(((size_t)nc + 1) * sizeof *chart_id);
+    double **bufs = calloc((size_t)nc + 1, sizeof *bufs);
+    lmb_pack_result r;
+    memset(&r, 0, sizeof r);
+    lmb_status st = (!charts || !owner || !chart_id || !bufs)
+                        ? lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory") : LMB_OK;
+    uint32_t q = 0;
+    for (uint32_t j = 0; j < n && st == LMB_OK; j++) {
+        const lmb_charts *c = &l->meshes[s->instances[list[j]].mesh].charts;
+        const double *uv1 = l->instances[list[j]].uv1;
+        for (uint32_t k = 0; k < c->chart_count && st == LMB_OK; k++, q++) {
+            uint32_t len = c->first[k + 1] - c->first[k];
+            bufs[q] = malloc(sizeof(double) * 6 * len + 1);
+            if (!bufs[q]) {
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
+                break;
+            }
+            for (uint32_t t = 0; t < len; t++)
+                memcpy(bufs[q] + 6 * t, uv1 + 6 * c->order[c->first[k] + t], 6 * sizeof(double));
+            charts[q].triangle_count = len;
+            charts[q].uv = bufs[q];
+            owner[q] = list[j];
+            chart_id[q] = k;
+        }
+    }
+    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding};
+    if (st == LMB_OK)
+        st = lmb_pack_charts(charts, nc, &opt, &r, err);
+    *spilled = 0;
+    for (uint32_t c = 1; st == LMB_OK && c < nc; c++)
+        if (owner[c] == owner[c - 1] && r.placements[c].atlas != r.placements[c - 1].atlas)
+            *spilled = 1;
+    if (st == LMB_OK && !*spilled) {
+        uint32_t base = l->atlas_count;
+        uint32_t *w = realloc(l->width, (base + r.atlas_count + 1) * sizeof *w);
+        if (w) l->width = w;
+        uint32_t *h = realloc(l->height, (base + r.atlas_count + 1) * sizeof *h);
+        if (h) l->height = h;
+        if (!w || !h)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
+        for (uint32_t a = 0; st == LMB_OK && a < r.atlas_count; a++) {
+            l->width[base + a] = r.width[a];
+            l->height[base + a] = r.height[a];
+        }
+        if (st == LMB_OK)
+            l->atlas_count += r.atlas_count;
+        for (uint32_t c = 0; st == LMB_OK && c < nc; c++) {
+            const lmb_charts *ch = &l->meshes[s->instances[owner[c]].mesh].charts;
+            lmb_layout_instance *li = &l->instances[owner[c]];
+            const double *m = r.placements[c].m;
+            li->atlas = base + r.placements[c].atlas;
+            for (uint32_t t = ch->first[chart_id[c]]; t < ch->first[chart_id[c] + 1]; t++) {
+                double *u = li->uv1 + 6 * ch->order[t];
+                for (int k = 0; k < 3; k++) {
+                    double x = u[2 * k], y = u[2 * k + 1];
+                    u[2 * k] = m[0] * x + m[1] * y + m[2];
+                    u[2 * k + 1] = m[3] * x + m[4] * y + m[5];
+                }
+            }
+        }
+        l->chart_total += nc;
+    }
+    lmb_pack_result_free(&r);
+    for (uint32_t c = 0; bufs && c < nc; c++)
+        free(bufs[c]);
+    free(bufs);
+    free(charts);
+    free(owner);
+    free(chart_id);
+    return st;
+}
+
+/* Packs list[0..n) whole, halving on spill-over. */
+static lmb_status pack_split(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list, uint32_t n,
+                             lmb_error *err)
+{
+    int spilled;
+    lmb_status st = pack_group(s, cfg, l, list, n, &spilled, err);
+    if (st != LMB_OK || !spilled)
+        return st;
+    if (n == 1)
+        return lmb_error_set(err, LMB_ERR_INPUT,
+                             "instance '%s' does not fit in one %ux%u atlas at %g texels per unit: lower "
+                             "texel_density (or a density_overrides entry) or raise atlas.max_size",
+                             s->instances[list[0]].name, cfg->max_atlas_size, cfg->max_atlas_size,
+                             l->instances[list[0]].texel_density);
+    st = pack_split(s, cfg, l, list, n / 2, err);
+    return st == LMB_OK ? pack_split(s, cfg, l, list + n / 2, n - n / 2, err) : st;
+}
+
+static lmb_status unwrap_meshes(const lmb_scene *s, lmb_layout *l, lmb_progress_fn progress, void *user, lmb_error *err)
+{
+    uint64_t total = 0, done = 0;
+    for (uint32_t m = 0; m < s->mesh_count; m++)
+        total += l->meshes[m].used ? s->meshes[m].triangle_count : 0;
+    lmb_unwrap_options opt;
+    lmb_unwrap_options_default(&opt);
+    for (uint32_t m = 0; m < s->mesh_count; m++) {
+        lmb_layout_mesh *lm = &l->meshes[m];
+        if (!lm->used)
+            continue;
+        lmb_status st = build_soup(s, m, &lm->soup, err);
+        double t0 = now();
+        lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
+                               lm->soup.skip};
+        if (st == LMB_OK)
+            st = lmb_unwrap_mesh(&in, &opt, &lm->charts, err);
+        lm->chart_seconds = now() - t0;
+        if (st != LMB_OK)
+            return st;
+        done += s->meshes[m].triangle_count;
+        if (progress)
+            progress(user, "unwrap", done, total);
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progress_fn progress, void *user,
+                            lmb_layout *l, lmb_error *err)
+{
+    memset(l, 0, sizeof *l);
+    l->mesh_count = s->mesh_count;
+    l->instance_count = s->instance_count;
+    l->meshes = calloc((size_t)s->mesh_count + 1, sizeof *l->meshes);
+    l->instances = calloc((size_t)s->instance_count + 1, sizeof *l->instances);
+    uint32_t *list = malloc(((size_t)s->instance_count + 1) * sizeof *list), n = 0;
+    if (!l->meshes || !l->instances || !list) {
+        free(list);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    }
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        if (s->instances[i].lightmapped) {
+            l->meshes[s->instances[i].mesh].used = 1;
+            list[n++] = i;
+        }
+    lmb_status st = unwrap_meshes(s, l, progress, user, err);
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
+        lmb_layout_instance *li = &l->instances[list[j]];
+        li->lightmapped = 1;
+        li->texel_density = density_for(s, cfg, list[j]);
+        li->uv1 = calloc((size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6 + 1, sizeof *li->uv1);
+        if (!li->uv1)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+        else
+            scale_instance(s, l, list[j]);
+    }
+    double t0 = now();
+    if (st == LMB_OK && n)
+        st = pack_split(s, cfg, l, list, n, err);
+    l->pack_seconds = now() - t0;
+    if (progress && st == LMB_OK)
+        progress(user, "pack", 1, 1);
+    free(list);
+    return st;
+}
+
+void lmb_layout_free(lmb_layout *l)
+{
+    for (uint32_t m = 0; l->meshes && m < l->mesh_count; m++) {
+        free(l->meshes[m].soup.positions);
+        free(l->meshes[m].soup.normals);
+        free(l->meshes[m].soup.indices);
+        free(l->meshes[m].soup.skip);
+        lmb_charts_free(&l->meshes[m].charts);
+    }
+    for (uint32_t i = 0; l->instances && i < l->instance_count; i++)
+        free(l->instances[i].uv1);
+    free(l->meshes);
+    free(l->instances);
+    free(l->width);
+    free(l->height);
+    memset(l, 0, sizeof *l);
+}

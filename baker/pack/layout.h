@@ -1,0 +1,59 @@
+/*
+ * The lightmap layout of a scene: unwrap every lightmapped mesh once (instances of a mesh
+ * share its chart layout), scale each instance's charts to the texel density in world
+ * units (so a scaled instance gets more texels), and pack them into atlases. Every
+ * instance gets its own texels and lands whole in one atlas (one lightmap texture per
+ * instance, as glTF materials need); the writer gives each instance its own TEXCOORD_1.
+ */
+#ifndef LMBAKE_LAYOUT_H
+#define LMBAKE_LAYOUT_H
+
+#include <lmbake/lmbake.h>
+
+#include "unwrap/unwrap.h"
+
+/* One mesh's primitives as a single triangle list (vertex ids offset per primitive). */
+typedef struct lmb_mesh_soup {
+    uint32_t vertex_count, triangle_count;
+    float *positions;  /* 3 per vertex, object space */
+    float *normals;    /* 3 per vertex, object space; a primitive without NORMAL gets its face normals' average */
+    uint32_t *indices; /* 3 per triangle */
+    uint8_t *skip;     /* per triangle: zero area */
+} lmb_mesh_soup;
+
+typedef struct lmb_layout_mesh {
+    int used;           /* some lightmapped instance uses it */
+    lmb_mesh_soup soup;
+    lmb_charts charts;  /* chart-local UVs, isometric */
+    double chart_seconds;
+} lmb_layout_mesh;
+
+typedef struct lmb_layout_instance {
+    int lightmapped;
+    uint32_t atlas;
+    double texel_density; /* texels per world unit used for it */
+    double *uv1;          /* 6 per mesh triangle, atlas texel coordinates; 0 for skipped triangles */
+} lmb_layout_instance;
+
+typedef struct lmb_layout {
+    uint32_t mesh_count, instance_count;
+    lmb_layout_mesh *meshes;
+    lmb_layout_instance *instances;
+    uint32_t atlas_count;
+    uint32_t *width, *height;
+    uint32_t chart_total;  /* charts placed, over all instances */
+    double pack_seconds;
+} lmb_layout;
+
+/* Builds the layout for the lightmapped instances of scene (see lmb_scene_select_lightmapped).
+ * progress may be NULL. Free with lmb_layout_free, also after an error. */
+lmb_status lmb_layout_build(const lmb_scene *scene, const lmb_config *cfg, lmb_progress_fn progress,
+                            void *progress_user, lmb_layout *out, lmb_error *err);
+
+void lmb_layout_free(lmb_layout *l);
+
+/* World-space corners of instance i's mesh triangle f (9 doubles). */
+void lmb_layout_world_triangle(const lmb_scene *scene, const lmb_layout *l, uint32_t instance, uint32_t f,
+                               double out[9]);
+
+#endif

@@ -1,0 +1,43 @@
+/*
+ * The pack stage: places charts (triangles in texel units, from the unwrapper after
+ * scaling to the texel density) into atlases no larger than max_size, each chart rotated
+ * to its minimal bounding box, separated by `padding` texels beyond the texels it touches
+ * (its conservative raster footprint) plus one texel for bilinear filtering, so that no
+ * texel is reachable from two charts. Deterministic: the same input gives the same output.
+ */
+#ifndef LMBAKE_PACK_H
+#define LMBAKE_PACK_H
+
+#include <lmbake/lmbake.h>
+
+typedef struct lmb_pack_chart {
+    uint32_t triangle_count;
+    const double *uv; /* 6 per triangle: chart-local coordinates in texel units */
+} lmb_pack_chart;
+
+typedef struct lmb_pack_options {
+    uint32_t max_size; /* atlas side limit, texels */
+    uint32_t padding;  /* texels between footprints */
+} lmb_pack_options;
+
+/* Chart-local uv -> atlas texel coordinates: x = m[0] u + m[1] v + m[2], y = m[3] u + m[4] v + m[5]
+ * (a rotation, possibly with a flip, and a translation: lengths are kept). */
+typedef struct lmb_pack_placement {
+    uint32_t atlas;
+    double m[6];
+} lmb_pack_placement;
+
+typedef struct lmb_pack_result {
+    uint32_t atlas_count;
+    uint32_t *width, *height; /* per atlas, each <= max_size, cropped to what is used */
+    lmb_pack_placement *placements; /* one per input chart */
+} lmb_pack_result;
+
+/* Fills out (caller frees with lmb_pack_result_free). A chart whose footprint cannot fit in
+ * max_size x max_size is LMB_ERR_INPUT naming its index and size (lower the density). */
+lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const lmb_pack_options *opt,
+                           lmb_pack_result *out, lmb_error *err);
+
+void lmb_pack_result_free(lmb_pack_result *r);
+
+#endif

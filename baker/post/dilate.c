@@ -1,0 +1,91 @@
+/* Ring-by-ring dilation (see dilate.h). Each ring reads only texels filled in earlier rings,
+ * so the result does not depend on visiting order. */
+#include "dilate.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* May texel i be filled in ring `ring` (1 = next to a valid texel)? */
+static int fillable(const uint8_t *kind, size_t i, uint32_t ring)
+{
+    return kind[i] == LMB_TEXEL_EMPTY || ring <= LMB_DILATE_INSIDE_RINGS;
+}
+
+lmb_status lmb_dilate(float *rgb, const uint8_t *kind, uint32_t w, uint32_t h, lmb_error *err)
+{
+    size_t n = (size_t)w * h;
+    uint32_t *ring = malloc((n + 1) * sizeof *ring), *next = malloc((n + 1) * sizeof *next);
+    uint8_t *state = malloc(n + 1); /* 0 empty, 1 filled, 2 queued for this ring */
+    if (!ring || !next || !state) {
+        free(ring);
+        free(next);
+        free(state);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "dilate: out of memory for %ux%u", w, h);
+    }
+    size_t nr = 0;
+    for (size_t i = 0; i < n; i++)
+        state[i] = kind[i] == LMB_TEXEL_VALID ? 1 : 0;
+    /* first ring: empty texels next to a filled one */
+    for (size_t i = 0; i < n; i++) {
+        if (state[i])
+            continue;
+        uint32_t x = (uint32_t)(i % w), y = (uint32_t)(i / w);
+        int near = 0;
+        for (int dy = -1; dy <= 1 && !near; dy++)
+            for (int dx = -1; dx <= 1 && !near; dx++) {
+                long xx = (long)x + dx, yy = (long)y + dy;
+                near = xx >= 0 && yy >= 0 && xx < (long)w && yy < (long)h && state[(size_t)yy * w + (size_t)xx] == 1;
+            }
+        if (near && fillable(kind, i, 1)) {
+            ring[nr++] = (uint32_t)i;
+            state[i] = 2;
+        }
+    }
+    for (uint32_t ring_no = 1; nr; ring_no++) {
+        /* average filled neighbours into each ring texel */
+        for (size_t r = 0; r < nr; r++) {
+            uint32_t i = ring[r], x = i % w, y = i / w, cnt = 0;
+            float s[3] = {0, 0, 0};
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    long xx = (long)x + dx, yy = (long)y + dy;
+                    if (xx < 0 || yy < 0 || xx >= (long)w || yy >= (long)h)
+                        continue;
+                    size_t j = (size_t)yy * w + (size_t)xx;
+                    if (state[j] != 1)
+                        continue;
+                    for (int c = 0; c < 3; c++)
+                        s[c] += rgb[3 * j + c];
+                    cnt++;
+                }
+            for (int c = 0; c < 3; c++)
+                rgb[3 * (size_t)i + c] = cnt ? s[c] / (float)cnt : 0.0f;
+        }
+        /* mark the ring filled, then collect the next one */
+        for (size_t r = 0; r < nr; r++)
+            state[ring[r]] = 1;
+        size_t nn = 0;
+        for (size_t r = 0; r < nr; r++) {
+            uint32_t i = ring[r], x = i % w, y = i / w;
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    long xx = (long)x + dx, yy = (long)y + dy;
+                    if (xx < 0 || yy < 0 || xx >= (long)w || yy >= (long)h)
+                        continue;
+                    size_t j = (size_t)yy * w + (size_t)xx;
+                    if (state[j] == 0 && fillable(kind, j, ring_no + 1)) {
+                        state[j] = 2;
+                        next[nn++] = (uint32_t)j;
+                    }
+                }
+        }
+        uint32_t *t = ring;
+        ring = next;
+        next = t;
+        nr = nn;
+    }
+    free(ring);
+    free(next);
+    free(state);
+    return LMB_OK;
+}

@@ -1,0 +1,234 @@
+/*
+ * Gather points per texel (see texels.h). One pass over the triangles of the atlas keeps,
+ * for every sub-sample, the closest triangle (distance 0 when inside, ties: the first in
+ * scene order) within one texel; a second pass turns the winners into world-space points.
+ * Normals: shading normals go through the inverse transpose of the instance matrix
+ * (the cofactor matrix times the sign of the determinant); the geometric normal is the
+ * world-space face normal, negated for mirrored instances so it stays on the front side.
+ */
+#include "texels.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct best {
+    float dist; /* texels */
+    float b1, b2;
+    uint32_t instance, triangle;
+} best;
+
+void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2])
+{
+    uint32_t sx = (uint32_t)ceil(sqrt((double)samples)), sy = (samples + sx - 1) / sx;
+    out[0] = ((k % sx) + 0.5) / sx;
+    out[1] = ((k / sx) + 0.5) / sy;
+}
+
+void lmb_texels_free(lmb_texels *t)
+{
+    free(t->texel);
+    free(t->points_in);
+    free(t->texel_size);
+    free(t->points);
+    free(t->valid);
+    memset(t, 0, sizeof *t);
+}
+
+/* Closest point of triangle uv (6) to p, as barycentrics (b1, b2 of corners 1 and 2); returns
+ * the distance (0 inside). */
+static double closest_on_triangle(const double *uv, const double p[2], double *b1, double *b2)
+{
+    double ax = uv[0], ay = uv[1];
+    double e1x = uv[2] - ax, e1y = uv[3] - ay, e2x = uv[4] - ax, e2y = uv[5] - ay;
+    double det = e1x * e2y - e2x * e1y;
+    *b1 = *b2 = 0;
+    if (!(fabs(det) > 0))
+        return DBL_MAX; /* zero UV area: never a gather point */
+    double px = p[0] - ax, py = p[1] - ay;
+    double u = (px * e2y - e2x * py) / det, v = (e1x * py - px * e1y) / det;
+    if (u >= 0 && v >= 0 && u + v <= 1) {
+        *b1 = u;
+        *b2 = v;
+        return 0;
+    }
+    /* closest over the three edges, each as a parameter t along it */
+    const double c[3][2] = {{uv[0], uv[1]}, {uv[2], uv[3]}, {uv[4], uv[5]}};
+    double bestd = DBL_MAX;
+    for (int k = 0; k < 3; k++) {
+        const double *a = c[k], *b = c[(k + 1) % 3];
+        double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+        double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
+        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+        double qx = a[0] + t * dx - p[0], qy = a[1] + t * dy - p[1], d = sqrt(qx * qx + qy * qy);
+        if (d < bestd) {
+            bestd = d;
+            double w[3] = {0, 0, 0};
+            w[k] = 1 - t;
+            w[(k + 1) % 3] = t;
+            *b1 = w[1];
+            *b2 = w[2];
+        }
+    }
+    return bestd;
+}
+
+static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, uint32_t samples, best *b)
+{
+    uint32_t w = l->width[atlas], h = l->height[atlas];
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        const lmb_layout_instance *li = &l->instances[i];
+        if (!li->lightmapped || li->atlas != atlas)
+            continue;
+        const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+        for (uint32_t f = 0; f < c->triangle_count; f++) {
+            if (c->chart_of[f] == UINT32_MAX)
+                continue;
+            const double *uv = li->uv1 + 6 * f;
+            double lo[2] = {fmin(uv[0], fmin(uv[2], uv[4])), fmin(uv[1], fmin(uv[3], uv[5]))};
+            double hi[2] = {fmax(uv[0], fmax(uv[2], uv[4])), fmax(uv[1], fmax(uv[3], uv[5]))};
+            long x0 = (long)floor(lo[0]) - 1, x1 = (long)floor(hi[0]) + 1, y0 = (long)floor(lo[1]) - 1,
+                 y1 = (long)floor(hi[1]) + 1;
+            x0 = x0 < 0 ? 0 : x0;
+            y0 = y0 < 0 ? 0 : y0;
+            x1 = x1 >= (long)w ? (long)w - 1 : x1;
+            y1 = y1 >= (long)h ? (long)h - 1 : y1;
+            for (long y = y0; y <= y1; y++)
+                for (long x = x0; x <= x1; x++)
+                    for (uint32_t k = 0; k < samples; k++) {
+                        double sp[2], b1 = 0, b2 = 0;
+                        lmb_texel_subsample(k, samples, sp);
+                        sp[0] += (double)x;
+                        sp[1] += (double)y;
+                        double d = closest_on_triangle(uv, sp, &b1, &b2);
+                        best *bb = &b[((size_t)y * w + (size_t)x) * samples + k];
+                        if (d <= 1.0 && d < bb->dist) {
+                            bb->dist = (float)d;
+                            bb->b1 = (float)b1;
+                            bb->b2 = (float)b2;
+                            bb->instance = i;
+                            bb->triangle = f;
+                        }
+                    }
+        }
+    }
+}
+
+/* Cofactor (adjugate transpose) of the upper 3x3 of a column-major 4x4, times sign(det):
+ * the normal matrix, up to a positive scale. */
+static void normal_matrix(const double m[16], double out[9])
+{
+    double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], i = m[10];
+    double cof[9] = {e * i - f * h, -(d * i - f * g), d * h - e * g,
+                     -(b * i - c * h), a * i - c * g, -(a * h - b * g),
+                     b * f - c * e, -(a * f - c * d), a * e - b * d};
+    double det = a * cof[0] + b * cof[1] + c * cof[2];
+    double sg = det < 0 ? -1.0 : 1.0;
+    /* row r of the normal matrix = cofactors of row r */
+    for (int k = 0; k < 9; k++)
+        out[k] = cof[k] * sg;
+}
+
+static void normalize3f(const double v[3], float out[3])
+{
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; k++)
+        out[k] = (float)(l > 0 ? v[k] / l : (k == 2));
+}
+
+/* Points are moved 1/100 texel toward their triangle's centroid: a point clamped onto a
+ * chart border lies exactly where the next wall begins, and a shadow ray from there would
+ * start inside that wall and leak light through it. */
+static void pull_inside(const double q[9], double texel_size, double p[3])
+{
+    double c[3], d2 = 0;
+    for (int r = 0; r < 3; r++) {
+        c[r] = (q[r] + q[3 + r] + q[6 + r]) / 3.0 - p[r];
+        d2 += c[r] * c[r];
+    }
+    double d = sqrt(d2), step = fmin(0.01 * texel_size, 0.5 * d);
+    for (int r = 0; r < 3 && d > 0; r++)
+        p[r] += c[r] / d * step;
+}
+
+static void make_point(const lmb_scene *s, const lmb_layout *l, const best *b, lmb_gather_point *out)
+{
+    const lmb_instance *in = &s->instances[b->instance];
+    const lmb_mesh_soup *soup = &l->meshes[in->mesh].soup;
+    const uint32_t *t = soup->indices + 3 * (size_t)b->triangle;
+    double w[3] = {1.0 - b->b1 - b->b2, b->b1, b->b2}, q[9], nm[9], n[3] = {0, 0, 0}, p[3] = {0, 0, 0};
+    lmb_layout_world_triangle(s, l, b->instance, b->triangle, q);
+    normal_matrix(in->world, nm);
+    for (int k = 0; k < 3; k++) {
+        const float *vn = soup->normals + 3 * t[k];
+        for (int r = 0; r < 3; r++) {
+            p[r] += w[k] * q[3 * k + r];
+            n[r] += w[k] * (nm[3 * r] * vn[0] + nm[3 * r + 1] * vn[1] + nm[3 * r + 2] * vn[2]);
+        }
+    }
+    double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
+    double g[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    if (in->flips_winding)
+        for (int r = 0; r < 3; r++)
+            g[r] = -g[r];
+    pull_inside(q, 1.0 / l->instances[b->instance].texel_density, p);
+    memcpy(out->p, p, sizeof p);
+    normalize3f(g, out->ng);
+    normalize3f(n, out->n);
+    if (!(fabsf(out->n[0]) + fabsf(out->n[1]) + fabsf(out->n[2]) > 0) || !isfinite(out->n[0]))
+        memcpy(out->n, out->ng, sizeof out->n);
+    out->instance = b->instance;
+    out->triangle = b->triangle;
+}
+
+lmb_status lmb_texels_build(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t samples, lmb_texels *out,
+                            lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    uint32_t w = l->width[atlas], h = l->height[atlas];
+    size_t n = (size_t)w * h * samples;
+    best *b = malloc((n + 1) * sizeof *b);
+    if (!b)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for a %ux%u atlas", w, h);
+    for (size_t i = 0; i < n; i++)
+        b[i].dist = FLT_MAX;
+    rasterize(l, s, atlas, samples, b);
+    out->width = w;
+    out->height = h;
+    out->samples = samples;
+    for (size_t t = 0; t < (size_t)w * h; t++)
+        for (uint32_t k = 0; k < samples; k++)
+            if (b[t * samples + k].dist < FLT_MAX) {
+                out->count++;
+                break;
+            }
+    out->texel = malloc(((size_t)out->count + 1) * sizeof *out->texel);
+    out->points_in = calloc((size_t)out->count + 1, 1);
+    out->texel_size = malloc(((size_t)out->count + 1) * sizeof *out->texel_size);
+    out->points = calloc((size_t)out->count * samples + 1, sizeof *out->points);
+    out->valid = malloc((size_t)out->count + 1);
+    if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->valid) {
+        free(b);
+        lmb_texels_free(out);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", out->count);
+    }
+    uint32_t c = 0;
+    for (size_t t = 0; t < (size_t)w * h; t++) {
+        uint32_t m = 0;
+        for (uint32_t k = 0; k < samples; k++) {
+            const best *bb = &b[t * samples + k];
+            if (bb->dist < FLT_MAX)
+                make_point(s, l, bb, &out->points[(size_t)c * samples + m++]);
+        }
+        if (!m)
+            continue;
+        out->texel[c] = (uint32_t)t;
+        out->points_in[c] = (uint8_t)m;
+        out->texel_size[c] = (float)(1.0 / l->instances[out->points[(size_t)c * samples].instance].texel_density);
+        out->valid[c] = 1;
+        c++;
+    }
+    free(b);
+    return LMB_OK;
+}

@@ -1,0 +1,43 @@
+/*
+ * The texels stage: gather points per lightmap texel. Every triangle is rasterized
+ * conservatively into its atlas; each texel gets up to `samples` stratified sub-sample
+ * points; a sub-sample inside a triangle lies on it, one outside every triangle but within
+ * a texel of one (an edge texel the triangle only partly covers) is clamped onto the
+ * closest triangle, so edge texels are lit by their own surface and bilinear filtering at
+ * chart borders reads meaningful values. Points carry the world position, the shading
+ * normal and the geometric normal; the lights stage decides which are inside geometry.
+ */
+#ifndef LMBAKE_TEXELS_H
+#define LMBAKE_TEXELS_H
+
+#include <lmbake/lmbake.h>
+
+#include "pack/layout.h"
+
+typedef struct lmb_gather_point {
+    double p[3];   /* world position on the surface */
+    float n[3];    /* shading normal, world, unit */
+    float ng[3];   /* geometric normal, world, unit, front side */
+    uint32_t instance, triangle; /* triangle: index into the instance's mesh soup */
+} lmb_gather_point;
+
+typedef struct lmb_texels {
+    uint32_t width, height, samples;
+    uint32_t count;            /* texels that hold at least one point */
+    uint32_t *texel;           /* per listed texel: y * width + x */
+    uint8_t *points_in;        /* per listed texel: points (1..samples) */
+    float *texel_size;         /* per listed texel: world units per texel */
+    lmb_gather_point *points;  /* count * samples; the first points_in[i] of each are set */
+    uint8_t *valid;            /* per listed texel: 1, or 0 when inside geometry (set by the lights stage) */
+} lmb_texels;
+
+/* Gather points for atlas `atlas` of layout l. `samples` per texel, 1..256. */
+lmb_status lmb_texels_build(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, uint32_t samples,
+                            lmb_texels *out, lmb_error *err);
+
+void lmb_texels_free(lmb_texels *t);
+
+/* Sub-sample k of `samples` inside a texel, in [0,1)^2: stratum centres of a sx x sy grid. */
+void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2]);
+
+#endif

@@ -1,0 +1,270 @@
+/*
+ * glTF output through tinygltf (see gltf_write.h): the write half of the tinygltf adapter.
+ * New vertex data goes into one new buffer; each new attribute gets its own buffer view.
+ * Attributes lmbake does not decode (TANGENT, COLOR_n, TEXCOORD_2+, ...) are gathered
+ * byte-wise through the vertex map when they are plain (non-sparse) accessors; others
+ * are dropped. Morph targets of a lightmapped primitive are dropped (a baked lightmap is
+ * for the rest pose).
+ */
+#include "gltf_write.h"
+
+#include "../load/gltf_doc.hpp"
+
+#include <cstring>
+#include <map>
+#include <utility>
+
+namespace {
+
+using tinygltf::Value;
+
+struct writer {
+    tinygltf::Model &m;
+    int buffer; /* the new buffer */
+};
+
+int new_buffer(tinygltf::Model &m)
+{
+    for (size_t i = 0; i < m.buffers.size(); i++)
+        if (m.buffers[i].name == "lmbake")
+            return (int)i;
+    tinygltf::Buffer b;
+    b.name = "lmbake";
+    m.buffers.push_back(b);
+    return (int)m.buffers.size() - 1;
+}
+
+/* Appends bytes as a new buffer view (4-byte aligned); returns the view index. */
+int add_view(writer &w, const void *data, size_t size, int target)
+{
+    auto &buf = w.m.buffers[(size_t)w.buffer].data;
+    while (buf.size() % 4)
+        buf.push_back(0);
+    tinygltf::BufferView v;
+    v.buffer = w.buffer;
+    v.byteOffset = buf.size();
+    v.byteLength = size;
+    v.target = target;
+    const unsigned char *p = static_cast<const unsigned char *>(data);
+    buf.insert(buf.end(), p, p + size);
+    w.m.bufferViews.push_back(v);
+    return (int)w.m.bufferViews.size() - 1;
+}
+
+int add_float_accessor(writer &w, const float *data, uint32_t count, int comps, bool minmax)
+{
+    tinygltf::Accessor a;
+    a.bufferView = add_view(w, data, sizeof(float) * comps * count, TINYGLTF_TARGET_ARRAY_BUFFER);
+    a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+    a.count = count;
+    a.type = comps == 2 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
+    if (minmax && count) {
+        a.minValues.assign((size_t)comps, 1e300);
+        a.maxValues.assign((size_t)comps, -1e300);
+        for (uint32_t i = 0; i < count; i++)
+            for (int c = 0; c < comps; c++) {
+                double v = data[(size_t)i * comps + c];
+                a.minValues[(size_t)c] = std::min(a.minValues[(size_t)c], v);
+                a.maxValues[(size_t)c] = std::max(a.maxValues[(size_t)c], v);
+            }
+    }
+    w.m.accessors.push_back(a);
+    return (int)w.m.accessors.size() - 1;
+}
+
+/* Gathers a plain accessor's elements through `source`; -1 if it cannot be copied. */
+int gather_accessor(writer &w, int index, const uint32_t *source, uint32_t count)
+{
+    const tinygltf::Accessor src = w.m.accessors[(size_t)index];
+    if (src.sparse.isSparse || src.bufferView < 0)
+        return -1;
+    const tinygltf::BufferView view = w.m.bufferViews[(size_t)src.bufferView];
+    int stride = src.ByteStride(view);
+    size_t elem = (size_t)tinygltf::GetComponentSizeInBytes((uint32_t)src.componentType) *
+                  (size_t)tinygltf::GetNumComponentsInType((uint32_t)src.type);
+    if (stride <= 0 || elem == 0)
+        return -1;
+    const auto &data = w.m.buffers[(size_t)view.buffer].data;
+    std::vector<unsigned char> out(elem * count);
+    for (uint32_t i = 0; i < count; i++) {
+        size_t at = view.byteOffset + src.byteOffset + (size_t)source[i] * (size_t)stride;
+        if (source[i] >= src.count || at + elem > data.size())
+            return -1;
+        std::memcpy(&out[(size_t)i * elem], &data[at], elem);
+    }
+    tinygltf::Accessor a = src;
+    a.byteOffset = 0;
+    a.count = count;
+    a.minValues.clear();
+    a.maxValues.clear();
+    a.bufferView = add_view(w, out.data(), out.size(), TINYGLTF_TARGET_ARRAY_BUFFER);
+    w.m.accessors.push_back(a);
+    return (int)w.m.accessors.size() - 1;
+}
+
+int lightmapped_material(tinygltf::Model &m, int material, int texture, std::map<std::pair<int, int>, int> &cache)
+{
+    auto key = std::make_pair(material, texture);
+    auto it = cache.find(key);
+    if (it != cache.end())
+        return it->second;
+    tinygltf::Material mat = material >= 0 ? m.materials[(size_t)material] : tinygltf::Material();
+    if (material < 0)
+        mat.name = "default";
+    mat.name += " (lightmap)";
+    Value::Object ext;
+    ext["index"] = Value(texture);
+    ext["texCoord"] = Value(1);
+    ext["intensity"] = Value(1.0);
+    mat.extensions["MOZ_lightmap"] = Value(ext);
+    m.materials.push_back(mat);
+    int index = (int)m.materials.size() - 1;
+    cache[key] = index;
+    return index;
+}
+
+void use_extension(tinygltf::Model &m, const char *name)
+{
+    for (const auto &e : m.extensionsUsed)
+        if (e == name)
+            return;
+    m.extensionsUsed.push_back(name);
+}
+
+tinygltf::Primitive rebuild(writer &w, const tinygltf::Primitive &orig, const lmb_gltf_prim_out &p)
+{
+    tinygltf::Primitive q;
+    q.material = orig.material;
+    q.mode = TINYGLTF_MODE_TRIANGLES;
+    q.extras = orig.extras;
+    q.attributes["POSITION"] = add_float_accessor(w, p.positions, p.vertex_count, 3, true);
+    if (p.normals)
+        q.attributes["NORMAL"] = add_float_accessor(w, p.normals, p.vertex_count, 3, false);
+    q.attributes["TEXCOORD_1"] = add_float_accessor(w, p.uv1, p.vertex_count, 2, false);
+    /* glTF requires TEXCOORD_n to start at 0: a primitive without UV0 gets the lightmap UVs
+     * there too (no texture of its material reads them) */
+    q.attributes["TEXCOORD_0"] = p.uv0 ? add_float_accessor(w, p.uv0, p.vertex_count, 2, false) : q.attributes["TEXCOORD_1"];
+    for (const auto &attr : orig.attributes) {
+        if (attr.first == "POSITION" || attr.first == "NORMAL" || attr.first == "TEXCOORD_0" || attr.first == "TEXCOORD_1")
+            continue;
+        int a = gather_accessor(w, attr.second, p.source, p.vertex_count);
+        if (a >= 0)
+            q.attributes[attr.first] = a;
+    }
+    tinygltf::Accessor ix;
+    ix.bufferView = add_view(w, p.indices, sizeof(uint32_t) * 3 * p.triangle_count, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    ix.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    ix.count = 3 * (size_t)p.triangle_count;
+    ix.type = TINYGLTF_TYPE_SCALAR;
+    w.m.accessors.push_back(ix);
+    q.indices = (int)w.m.accessors.size() - 1;
+    return q;
+}
+
+std::string base64(const std::vector<unsigned char> &in)
+{
+    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    size_t i = 0;
+    for (; i + 2 < in.size(); i += 3) {
+        unsigned v = (unsigned)in[i] << 16 | (unsigned)in[i + 1] << 8 | in[i + 2];
+        out += t[v >> 18 & 63]; out += t[v >> 12 & 63]; out += t[v >> 6 & 63]; out += t[v & 63];
+    }
+    if (i + 1 == in.size()) {
+        unsigned v = (unsigned)in[i] << 16;
+        out += t[v >> 18 & 63]; out += t[v >> 12 & 63]; out += "==";
+    } else if (i + 2 == in.size()) {
+        unsigned v = (unsigned)in[i] << 16 | (unsigned)in[i + 1] << 8;
+        out += t[v >> 18 & 63]; out += t[v >> 12 & 63]; out += t[v >> 6 & 63]; out += '=';
+    }
+    return out;
+}
+
+/* Images keep their URIs (lmbake does not re-encode textures); an image that came as a data
+ * URI (tinygltf drops the string on load) is written back as one from its kept bytes. */
+bool keep_image(const std::string *, const std::string *, const tinygltf::Image *image, bool, std::string *out_uri,
+                void *)
+{
+    if (!image->uri.empty() || image->bufferView >= 0 || image->image.empty())
+        return false;
+    *out_uri = "data:" + (image->mimeType.empty() ? std::string("application/octet-stream") : image->mimeType) +
+               ";base64," + base64(image->image);
+    return true;
+}
+
+} // namespace
+
+extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *png_uri, const char *hdr_uri, lmb_error *err)
+{
+    try {
+        tinygltf::Model &m = doc->model;
+        tinygltf::Image png, hdr;
+        png.uri = png_uri;
+        png.mimeType = "image/png";
+        hdr.uri = hdr_uri;
+        m.images.push_back(png);
+        m.images.push_back(hdr);
+        tinygltf::Texture t;
+        t.source = (int)m.images.size() - 2;
+        Value::Object rgbe;
+        rgbe["source"] = Value((int)m.images.size() - 1);
+        t.extensions["MOZ_texture_rgbe"] = Value(rgbe);
+        m.textures.push_back(t);
+        use_extension(m, "MOZ_lightmap");
+        use_extension(m, "MOZ_texture_rgbe");
+        return (int32_t)m.textures.size() - 1;
+    } catch (const std::exception &e) {
+        lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: %s", e.what());
+        return -1;
+    }
+}
+
+extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
+                                             uint32_t count, int32_t texture, lmb_error *err)
+{
+    try {
+        tinygltf::Model &m = doc->model;
+        writer w{m, new_buffer(m)};
+        tinygltf::Node &n = m.nodes[node];
+        tinygltf::Mesh mesh = m.meshes[(size_t)n.mesh];
+        mesh.name = (mesh.name.empty() ? std::string("mesh") : mesh.name) + " (" +
+                    (n.name.empty() ? "node " + std::to_string(node) : n.name) + " lightmap)";
+        mesh.weights.clear();
+        for (uint32_t k = 0; k < count; k++) {
+            const lmb_gltf_prim_out &p = prims[k];
+            tinygltf::Primitive q = rebuild(w, mesh.primitives[p.gltf_primitive], p);
+            q.material = lightmapped_material(m, q.material, texture, doc->lightmap_materials);
+            mesh.primitives[p.gltf_primitive] = q;
+        }
+        m.meshes.push_back(mesh);
+        m.nodes[node].mesh = (int)m.meshes.size() - 1;
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: node %u: %s", node, e.what());
+    }
+}
+
+extern "C" lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err)
+{
+    try {
+        tinygltf::Model &m = doc->model;
+        std::string stem(bin_name);
+        size_t dot = stem.rfind('.');
+        if (dot != std::string::npos)
+            stem = stem.substr(0, dot);
+        for (size_t i = 0; i < m.buffers.size(); i++) {
+            if (m.buffers[i].name == "lmbake")
+                m.buffers[i].uri = bin_name;
+            else if (m.buffers[i].uri.empty() || m.buffers[i].uri.rfind("data:", 0) == 0)
+                m.buffers[i].uri = stem + "-input" + std::to_string(i) + ".bin";
+        }
+        m.asset.generator = "lmbake " LMB_VERSION_STRING;
+        tinygltf::TinyGLTF g;
+        g.SetImageWriter(keep_image, nullptr);
+        if (!g.WriteGltfSceneToFile(&m, path, false, false, true, false))
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write the glTF", path);
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write the glTF: %s", path, e.what());
+    }
+}

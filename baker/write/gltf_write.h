@@ -1,0 +1,47 @@
+/*
+ * Writing the baked glTF through the tinygltf adapter (C header over C++). Each
+ * lightmapped node gets its own copy of its mesh whose triangle primitives carry
+ * TEXCOORD_1 (vertices split where charts meet) and materials that reference the atlas
+ * through MOZ_lightmap {index, texCoord: 1, intensity}; the texture's source is a PNG and
+ * its MOZ_texture_rgbe source the Radiance .hdr (the convention three.js-based viewers
+ * such as Mozilla Hubs read). Everything else in the file is kept as it was.
+ */
+#ifndef LMBAKE_GLTF_WRITE_H
+#define LMBAKE_GLTF_WRITE_H
+
+#include <lmbake/lmbake.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct lmb_gltf_prim_out {
+    uint32_t gltf_primitive; /* index among the glTF mesh's primitives */
+    uint32_t vertex_count;   /* new vertices */
+    const uint32_t *source;  /* per new vertex: its vertex in the original primitive */
+    const float *positions;  /* 3 per new vertex */
+    const float *normals;    /* 3 per new vertex, or NULL */
+    const float *uv0;        /* 2 per new vertex, or NULL */
+    const float *uv1;        /* 2 per new vertex, normalized to the atlas ([0,1], glTF's top-left origin) */
+    uint32_t triangle_count;
+    const uint32_t *indices; /* 3 per triangle, into the new vertices */
+} lmb_gltf_prim_out;
+
+/* Adds a texture for one atlas (png_uri: the texture's source; hdr_uri: MOZ_texture_rgbe).
+ * Returns its index, or -1 on failure. */
+int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *png_uri, const char *hdr_uri, lmb_error *err);
+
+/* Gives node `node` a copy of its mesh with the primitives in prims replaced (others kept)
+ * and lightmapped materials using `texture`. */
+lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count,
+                                  int32_t texture, lmb_error *err);
+
+/* Writes the document as path (.gltf) with its new data in `bin_name` beside it. Buffers of
+ * the input are written beside it too; images keep their URIs (the caller copies files). */
+lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

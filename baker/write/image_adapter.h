@@ -1,0 +1,28 @@
+/*
+ * The OpenImageIO adapter (C header over C++): writes images. The format follows the
+ * file extension (.png, .exr, .hdr). Files are written to a temporary name beside the
+ * target and renamed into place, so a failed or interrupted write never leaves a partial
+ * file under the final name.
+ */
+#ifndef LMBAKE_IMAGE_ADAPTER_H
+#define LMBAKE_IMAGE_ADAPTER_H
+
+#include <lmbake/lmbake.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* 8-bit pixels, `channels` per pixel, rows top to bottom. */
+lmb_status lmb_image_write_u8(const char *path, uint32_t width, uint32_t height, uint32_t channels,
+                              const uint8_t *pixels, lmb_error *err);
+
+/* Float pixels; .exr is written as half float with zip compression. */
+lmb_status lmb_image_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
+                               const float *pixels, lmb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

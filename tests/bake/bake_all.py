@@ -1,0 +1,54 @@
+#!/usr/bin/env python3
+"""`lmbake bake` on every .gltf/.glb under the given folders: each exits 0 (and its output
+passes the Khronos validator with 0 errors) or 2 with an "error:" line naming the reason.
+A low-resolution config keeps it quick; quality is tested elsewhere.
+
+usage: bake_all.py LMBAKE WORKDIR VALIDATOR_JS DIR...
+"""
+import glob
+import os
+import subprocess
+import sys
+
+CONFIG = "texel_density: 4\natlas: {max_size: 2048}\nsamples: {texel: 1, direct: 2}\n"
+
+
+def main():
+    lmbake, work, validator, dirs = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+    os.makedirs(work, exist_ok=True)
+    cfg = os.path.join(work, "low.yaml")
+    with open(cfg, "w") as f:
+        f.write(CONFIG)
+    bad, n, baked = [], 0, 0
+    for d in dirs:
+        for path in sorted(glob.glob(os.path.join(d, "**", "*.gl*"), recursive=True)):
+            if not path.endswith((".gltf", ".glb")):
+                continue
+            n += 1
+            out = os.path.join(work, "out-%d" % n)
+            p = subprocess.run([lmbake, "bake", path, "-c", cfg, "-o", out, "-q"], capture_output=True, text=True,
+                               timeout=900)
+            rel = os.path.relpath(path, d)
+            if p.returncode == 0:
+                gl = [f for f in os.listdir(out) if f.endswith(".gltf")]
+                v = subprocess.run(["node", validator, os.path.join(out, gl[0])], capture_output=True, text=True)
+                status = "ok, validator: " + v.stdout.splitlines()[0].split(": ", 1)[1] if v.stdout else "no report"
+                if v.returncode != 0:
+                    bad.append("%s: output fails the validator:\n%s" % (rel, v.stdout[:2000]))
+                baked += 1
+            elif p.returncode == 2 and "error:" in p.stderr:
+                status = "rejected: " + p.stderr.strip().splitlines()[-1][:160]
+                if os.path.exists(out):
+                    bad.append("%s: exit 2 but %s exists" % (rel, out))
+            else:
+                status = "exit %d" % p.returncode
+                bad.append("%s: exit %d\n%s" % (rel, p.returncode, p.stderr[-2000:]))
+            print("%-70s %s" % (rel, status))
+    print("%d files, %d baked, %d problems" % (n, baked, len(bad)))
+    for b in bad:
+        print("FAIL", b)
+    return 1 if bad or n < 30 else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

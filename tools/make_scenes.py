@@ -1,0 +1,198 @@
+#!/usr/bin/env python3
+"""Generates lmbake's own test and demo scenes as glTF 2.0 (embedded buffers).
+
+usage: make_scenes.py OUTDIR
+
+  cornell-point.gltf  the demo: a 1 m Cornell box (5 walls, 2 blocks), a 10 cd point light
+                      just under the ceiling (the AMIS paper's Figure 1 set-up)
+  point-plane.gltf    10 x 10 plane, point light of I = 100 cd at h = 2 above (0, 0)
+  sun-box.gltf        10 x 10 plane, closed 1 m cube on it, directional light of 1000 lux
+  disk.gltf           plane, emissive disk (64 segments, R = 0.5, L = 10 nits) facing down at h = 1
+  sealed-room.gltf    closed 2 m room (inward faces), point light outside it
+  box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
+
+The analytic values the tests compare with are in tests/bake/check_analytic.py.
+"""
+import base64
+import json
+import math
+import os
+import struct
+import sys
+
+
+class Scene:
+    def __init__(self):
+        self.doc = {"asset": {"version": "2.0", "generator": "lmbake tools/make_scenes.py"},
+                    "scene": 0, "scenes": [{"nodes": []}], "nodes": [], "meshes": [],
+                    "materials": [], "accessors": [], "bufferViews": [], "buffers": []}
+        self.blob = bytearray()
+
+    def _view(self, data, target):
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data),
+                                        "target": target})
+        self.blob += data
+        return len(self.doc["bufferViews"]) - 1
+
+    def _accessor(self, values, comps, is_index=False):
+        if is_index:
+            data = struct.pack("<%dI" % len(values), *values)
+            acc = {"componentType": 5125, "count": len(values), "type": "SCALAR"}
+        else:
+            flat = [c for v in values for c in v]
+            data = struct.pack("<%df" % len(flat), *flat)
+            acc = {"componentType": 5126, "count": len(values), "type": "VEC%d" % comps}
+            if comps == 3:
+                acc["min"] = [min(v[i] for v in values) for i in range(3)]
+                acc["max"] = [max(v[i] for v in values) for i in range(3)]
+        acc["bufferView"] = self._view(data, 34963 if is_index else 34962)
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def material(self, name, color, emissive=None, strength=None):
+        m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0}}
+        if emissive:
+            m["emissiveFactor"] = list(emissive)
+        if strength:
+            m["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": strength}}
+            self._use("KHR_materials_emissive_strength")
+        self.doc["materials"].append(m)
+        return len(self.doc["materials"]) - 1
+
+    def _use(self, ext):
+        used = self.doc.setdefault("extensionsUsed", [])
+        if ext not in used:
+            used.append(ext)
+
+    def mesh(self, name, tris, material, translation=(0, 0, 0)):
+        """tris: list of ((p0, p1, p2)) counter-clockwise seen from the front; flat normals."""
+        pos, nrm, idx = [], [], []
+        for a, b, c in tris:
+            e1 = [b[i] - a[i] for i in range(3)]
+            e2 = [c[i] - a[i] for i in range(3)]
+            n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+            ln = math.sqrt(sum(x * x for x in n))
+            n = [x / ln for x in n]
+            for p in (a, b, c):
+                idx.append(len(pos))
+                pos.append(tuple(float(x) for x in p))
+                nrm.append(tuple(n))
+        prim = {"attributes": {"POSITION": self._accessor(pos, 3), "NORMAL": self._accessor(nrm, 3)},
+                "indices": self._accessor(idx, 1, True), "material": material}
+        self.doc["meshes"].append({"name": name, "primitives": [prim]})
+        self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1,
+                                  "translation": list(translation)})
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def light(self, name, kind, intensity, color=(1, 1, 1), translation=(0, 0, 0), rotation=None, **spot):
+        self._use("KHR_lights_punctual")
+        lights = self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
+        l = {"name": name, "type": kind, "intensity": intensity, "color": list(color)}
+        if kind == "spot":
+            l["spot"] = spot
+        lights.append(l)
+        node = {"name": name, "translation": list(translation),
+                "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}}
+        if rotation:
+            node["rotation"] = list(rotation)
+        self.doc["nodes"].append(node)
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def write(self, path):
+        self.doc["buffers"] = [{"byteLength": len(self.blob),
+                                "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(self.blob)).decode()}]
+        with open(path, "w") as f:
+            json.dump(self.doc, f, indent=1)
+
+
+def quad(a, b, c, d):
+    """Two triangles of the quad a b c d (counter-clockwise from the front)."""
+    return [(a, b, c), (a, c, d)]
+
+
+def plane(size, y=0.0):
+    h = size / 2
+    return quad((-h, y, h), (h, y, h), (h, y, -h), (-h, y, -h))  # faces +y
+
+
+def box(x0, y0, z0, x1, y1, z1, inward=False, bottom=True):
+    """Axis-aligned box faces, outward (or inward for a room)."""
+    p = [(x0, y0, z0), (x1, y0, z0), (x1, y0, z1), (x0, y0, z1), (x0, y1, z0), (x1, y1, z0), (x1, y1, z1), (x0, y1, z1)]
+    faces = [(4, 7, 6, 5), (0, 4, 5, 1), (1, 5, 6, 2), (2, 6, 7, 3), (3, 7, 4, 0)]
+    if bottom:
+        faces.append((0, 1, 2, 3))
+    tris = []
+    for f in faces:
+        q = [p[i] for i in f]
+        if inward:
+            q = q[::-1]
+        tris += quad(*q)
+    return tris
+
+
+def cornell(out):
+    s = Scene()
+    white = s.material("white", (0.73, 0.73, 0.73))
+    red = s.material("red", (0.65, 0.05, 0.05))
+    green = s.material("green", (0.12, 0.45, 0.15))
+    c = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)]
+    s.mesh("floor", quad(c[0], c[3], c[2], c[1]), white)
+    s.mesh("ceiling", quad(c[4], c[5], c[6], c[7]), white)
+    s.mesh("back", quad(c[0], c[1], c[5], c[4]), white)
+    s.mesh("left", quad(c[0], c[4], c[7], c[3]), red)
+    s.mesh("right", quad(c[1], c[2], c[6], c[5]), green)
+    s.mesh("tall_block", box(0.13, 0, 0.37, 0.43, 0.6, 0.67, bottom=False), white)
+    s.mesh("short_block", box(0.55, 0, 0.15, 0.85, 0.3, 0.45, bottom=False), white)
+    s.light("ceiling_point", "point", 10.0, translation=(0.5, 0.97, 0.5))
+    s.write(os.path.join(out, "cornell-point.gltf"))
+
+
+def analytic(out):
+    s = Scene()
+    s.mesh("plane", plane(10), s.material("grey", (0.5, 0.5, 0.5)))
+    s.light("point", "point", 100.0, translation=(0, 2, 0))
+    s.write(os.path.join(out, "point-plane.gltf"))
+
+    s = Scene()
+    grey = s.material("grey", (0.5, 0.5, 0.5))
+    s.mesh("plane", plane(10), grey)
+    s.mesh("cube", box(-0.5, 0, -0.5, 0.5, 1, 0.5), grey)
+    # sun 30 degrees from the zenith, light travelling toward -y and +x: node -Z rotated
+    ang = math.radians(30)
+    # rotation turning -Z into d = (sin a, -cos a, 0): about the axis (0,0,-1) x d
+    d = (math.sin(ang), -math.cos(ang), 0.0)
+    axis = (d[1], -d[0], 0.0)  # (0, 0, -1) x d
+    ln = math.sqrt(sum(x * x for x in axis))
+    th = math.acos(-d[2])
+    q = [axis[0] / ln * math.sin(th / 2), axis[1] / ln * math.sin(th / 2), 0.0, math.cos(th / 2)]
+    s.light("sun", "directional", 1000.0, rotation=q)
+    s.write(os.path.join(out, "sun-box.gltf"))
+
+    s = Scene()
+    s.mesh("plane", plane(6), s.material("grey", (0.5, 0.5, 0.5)))
+    n, r, h = 64, 0.5, 1.0
+    ring = [(r * math.cos(2 * math.pi * k / n), h, r * math.sin(2 * math.pi * k / n)) for k in range(n)]
+    disk = [((0, h, 0), ring[k], ring[(k + 1) % n]) for k in range(n)]  # faces -y
+    s.mesh("disk", disk, s.material("emitter", (0.0, 0.0, 0.0), emissive=(1, 1, 1), strength=10.0))
+    s.write(os.path.join(out, "disk.gltf"))
+
+    s = Scene()
+    s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), s.material("grey", (0.5, 0.5, 0.5)))
+    s.light("outside", "point", 1000.0, translation=(3, 1, 0))
+    s.write(os.path.join(out, "sealed-room.gltf"))
+
+    s = Scene()
+    grey = s.material("grey", (0.5, 0.5, 0.5))
+    s.mesh("plane", plane(6), grey)
+    s.mesh("cube", box(-1, 0, -1, 1, 2, 1), grey)
+    s.light("above", "point", 100.0, translation=(1.6, 4, 0.6))
+    s.write(os.path.join(out, "box-floor.gltf"))
+
+
+if __name__ == "__main__":
+    out = sys.argv[1]
+    os.makedirs(out, exist_ok=True)
+    cornell(out)
+    analytic(out)
