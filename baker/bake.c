@@ -10,6 +10,7 @@
 
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
+#include "load/textures.h"
 #include "pack/layout.h"
 #include "post/dilate.h"
 #include "texels/texels.h"
@@ -285,12 +286,16 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     lmb_layout l;
     lmb_rt rt;
     lmb_emitters *em = NULL;
+    lmb_textures tx;
     memset(&rt, 0, sizeof rt);
+    memset(&tx, 0, sizeof tx);
     st = lmb_layout_build(s, cfg, progress, user, &l, err);
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
     if (st == LMB_OK)
-        st = lmb_emitters_build(s, cfg, &em, err);
+        st = lmb_textures_load_emissive(s, &tx, log, err);
+    if (st == LMB_OK)
+        st = lmb_emitters_build(s, cfg, &tx, &em, err);
     double tl = now();
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
         size_t n = (size_t)l.width[a] * l.height[a];
@@ -318,6 +323,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
     lmb_emitters_free(em);
+    lmb_textures_free(&tx);
     lmb_rt_free(&rt);
     lmb_layout_free(&l);
     stats->seconds = now() - t0;

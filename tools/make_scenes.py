@@ -8,6 +8,8 @@ usage: make_scenes.py OUTDIR
   point-plane.gltf    10 x 10 plane, point light of I = 100 cd at h = 2 above (0, 0)
   sun-box.gltf        10 x 10 plane, closed 1 m cube on it, directional light of 1000 lux
   disk.gltf           plane, emissive disk (64 segments, R = 0.5, L = 10 nits) facing down at h = 1
+  many-lights.gltf    10 x 10 plane under 20 point lights (sampled by power, not looped)
+  disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
   sealed-room.gltf    closed 2 m room (inward faces), point light outside it
   box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
 
@@ -19,6 +21,7 @@ import math
 import os
 import struct
 import sys
+import zlib
 
 
 class Scene:
@@ -61,13 +64,26 @@ class Scene:
         self.doc["materials"].append(m)
         return len(self.doc["materials"]) - 1
 
+    def texture_png(self, rgb, size=2):
+        """A size x size PNG of one 8-bit sRGB colour, as a data-URI image; returns the texture."""
+        raw = b"".join(b"\0" + bytes(rgb) * size for _ in range(size))
+        def chunk(kind, data):
+            return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+        png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", size, size, 8, 2, 0, 0, 0)) +
+               chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+        self.doc.setdefault("images", []).append(
+            {"uri": "data:image/png;base64," + base64.b64encode(png).decode(), "mimeType": "image/png"})
+        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
+        return len(self.doc["textures"]) - 1
+
     def _use(self, ext):
         used = self.doc.setdefault("extensionsUsed", [])
         if ext not in used:
             used.append(ext)
 
-    def mesh(self, name, tris, material, translation=(0, 0, 0)):
-        """tris: list of ((p0, p1, p2)) counter-clockwise seen from the front; flat normals."""
+    def mesh(self, name, tris, material, translation=(0, 0, 0), uv=False):
+        """tris: list of ((p0, p1, p2)) counter-clockwise seen from the front; flat normals;
+        uv: TEXCOORD_0 = (x, z) of each corner."""
         pos, nrm, idx = [], [], []
         for a, b, c in tris:
             e1 = [b[i] - a[i] for i in range(3)]
@@ -81,6 +97,8 @@ class Scene:
                 nrm.append(tuple(n))
         prim = {"attributes": {"POSITION": self._accessor(pos, 3), "NORMAL": self._accessor(nrm, 3)},
                 "indices": self._accessor(idx, 1, True), "material": material}
+        if uv:
+            prim["attributes"]["TEXCOORD_0"] = self._accessor([(p[0], p[2]) for p in pos], 2)
         self.doc["meshes"].append({"name": name, "primitives": [prim]})
         self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1,
                                   "translation": list(translation)})
@@ -105,6 +123,10 @@ class Scene:
                                 "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(self.blob)).decode()}]
         with open(path, "w") as f:
             json.dump(self.doc, f, indent=1)
+
+
+# 20 point lights 2 m above the plane (x, z, candela): more than lmbake evaluates exactly
+MANY_LIGHTS = [(-4 + 2 * (k % 5), -3 + 2 * (k // 5), 10.0 + 7.0 * k) for k in range(20)]
 
 
 def quad(a, b, c, d):
@@ -177,6 +199,19 @@ def analytic(out):
     disk = [((0, h, 0), ring[k], ring[(k + 1) % n]) for k in range(n)]  # faces -y
     s.mesh("disk", disk, s.material("emitter", (0.0, 0.0, 0.0), emissive=(1, 1, 1), strength=10.0))
     s.write(os.path.join(out, "disk.gltf"))
+
+    s = Scene()
+    s.mesh("plane", plane(6), s.material("grey", (0.5, 0.5, 0.5)))
+    mat = s.material("emitter", (0.0, 0.0, 0.0), emissive=(1, 1, 1), strength=10.0)
+    s.doc["materials"][mat]["emissiveTexture"] = {"index": s.texture_png((128, 128, 128))}
+    s.mesh("disk", disk, mat, uv=True)
+    s.write(os.path.join(out, "disk-textured.gltf"))
+
+    s = Scene()
+    s.mesh("plane", plane(10), s.material("grey", (0.5, 0.5, 0.5)))
+    for k, (x, z, i) in enumerate(MANY_LIGHTS):
+        s.light("lamp%d" % k, "point", i, translation=(x, 2, z))
+    s.write(os.path.join(out, "many-lights.gltf"))
 
     s = Scene()
     s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), s.material("grey", (0.5, 0.5, 0.5)))

@@ -25,13 +25,25 @@
 #include <string.h>
 
 #define VALIDITY_RAYS 16
+/* Up to this many point/spot lights are all evaluated at every point (exact, no noise);
+ * beyond it, samples.direct lights are drawn per point in proportion to power, so the
+ * cost does not grow with the light count. Directional lights are always evaluated. */
+#define EXACT_LOCAL_LIGHTS 8
+
+typedef struct light_set {
+    uint32_t *local, local_count;       /* point and spot lights */
+    uint32_t *directional, directional_count;
+    double *cdf;                        /* local_count + 1, by power */
+} light_set;
 
 typedef struct emitter {
     double p[9];   /* world corners */
     double n[3];   /* unit front normal */
     double area;
-    float le[3];   /* radiance, nits */
+    float le[3];   /* radiance, nits (times the texture when there is one) */
     int two_sided;
+    const lmb_texture *tex; /* emissive texture or NULL */
+    float uv[6];   /* its texture coordinates at the corners */
 } emitter;
 
 struct lmb_emitters {
@@ -74,7 +86,25 @@ static void world_point(const double m[16], const float *p, double *out)
         out[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
 }
 
-lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, lmb_emitters **out, lmb_error *err)
+/* The emissive texture of material `mat` on primitive pr, and its corner UVs for face f. */
+static const lmb_texture *emitter_texture(const lmb_textures *tx, const lmb_material *mat, const lmb_primitive *pr,
+                                          uint32_t f, float uv[6])
+{
+    if (!tx || mat->emissive_texture < 0 || (uint32_t)mat->emissive_texture >= tx->count ||
+        !tx->t[mat->emissive_texture].rgb)
+        return NULL;
+    const float *set = mat->emissive_texcoord == 1 ? pr->uv1 : mat->emissive_texcoord == 0 ? pr->uv0 : NULL;
+    if (!set)
+        return NULL;
+    for (int k = 0; k < 3; k++) {
+        uv[2 * k] = set[2 * pr->indices[3 * f + k]];
+        uv[2 * k + 1] = set[2 * pr->indices[3 * f + k] + 1];
+    }
+    return &tx->t[mat->emissive_texture];
+}
+
+lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const lmb_textures *tx, lmb_emitters **out,
+                              lmb_error *err)
 {
     lmb_emitters *es = calloc(1, sizeof *es);
     uint32_t cap = 0;
@@ -105,6 +135,7 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, lmb_emi
                 for (int k = 0; k < 3; k++)
                     x.le[k] = (float)(mat->emissive[k] * cfg->emissive_scale);
                 x.two_sided = mat->double_sided;
+                x.tex = emitter_texture(tx, mat, pr, f, x.uv);
                 st = add_emitter(es, &cap, &x, err);
             }
         }
@@ -122,7 +153,9 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, lmb_emi
     es->cdf[0] = 0;
     for (uint32_t k = 0; k < es->count; k++) {
         const emitter *x = &es->e[k];
-        double lum = 0.2126 * x->le[0] + 0.7152 * x->le[1] + 0.0722 * x->le[2];
+        const double *m = x->tex ? x->tex->mean : NULL;
+        double lum = 0.2126 * x->le[0] * (m ? m[0] : 1) + 0.7152 * x->le[1] * (m ? m[1] : 1) +
+                     0.0722 * x->le[2] * (m ? m[2] : 1);
         acc += x->area * (lum > 0 ? lum : 1e-12) * (x->two_sided ? 2 : 1);
         es->cdf[k + 1] = acc;
     }
@@ -147,6 +180,7 @@ static uint32_t pick(const lmb_emitters *es, double u, double *prob)
 
 typedef struct point_ctx {
     const lmb_direct_job *job;
+    const light_set *lights;
     double o[3];    /* offset origin */
     double p[3], n[3], ng[3];
     double eps;
@@ -158,7 +192,8 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static void punctual(point_ctx *c, const lmb_light *l, double e[3])
+/* Adds the light's contribution times `weight` to e. */
+static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
     double scale = c->job->cfg->light_intensity_scale, d[3], dist = 1e300, cosang, w = 1.0;
     if (l->type == LMB_LIGHT_DIRECTIONAL) {
@@ -192,7 +227,34 @@ static void punctual(point_ctx *c, const lmb_light *l, double e[3])
     if (lmb_rt_occluded(c->job->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
         return;
     for (int k = 0; k < 3; k++)
-        e[k] += scale * l->intensity * l->color[k] * cosang * w;
+        e[k] += weight * scale * l->intensity * l->color[k] * cosang * w;
+}
+
+/* Point and spot lights: all of them when few, else power-proportional samples. */
+static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
+{
+    const light_set *ls = c->lights;
+    const lmb_light *all = c->job->scene->lights;
+    if (ls->local_count <= EXACT_LOCAL_LIGHTS) {
+        for (uint32_t i = 0; i < ls->local_count; i++)
+            punctual(c, &all[ls->local[i]], 1.0, e);
+        return;
+    }
+    uint32_t n = c->job->cfg->direct_samples;
+    double total = ls->cdf[ls->local_count];
+    for (uint32_t s = 0; s < n; s++) {
+        double target = lmb_rng_next(rng) * total;
+        uint32_t lo = 0, hi = ls->local_count - 1;
+        while (lo < hi) {
+            uint32_t mid = (lo + hi) / 2;
+            if (ls->cdf[mid + 1] <= target)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        double p = (ls->cdf[lo + 1] - ls->cdf[lo]) / total;
+        punctual(c, &all[ls->local[lo]], 1.0 / (p * n), e);
+    }
 }
 
 static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
@@ -221,8 +283,12 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
         if (lmb_rt_occluded(c->job->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps))
             continue;
         double g = cx * cy / dist2 * x->area / prob / n;
+        float t[3] = {1, 1, 1};
+        if (x->tex)
+            lmb_texture_sample(x->tex, b0 * x->uv[0] + b1 * x->uv[2] + b2 * x->uv[4],
+                               b0 * x->uv[1] + b1 * x->uv[3] + b2 * x->uv[5], t);
         for (int k = 0; k < 3; k++)
-            e[k] += x->le[k] * g;
+            e[k] += x->le[k] * t[k] * g;
     }
 }
 
@@ -253,7 +319,8 @@ static int inside_geometry(point_ctx *c, lmb_rng *rng)
     return 2 * back > VALIDITY_RAYS;
 }
 
-static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, float *out, uint64_t *rays)
+static void texel_direct(const lmb_direct_job *job, const light_set *lights, lmb_texels *t, uint32_t i, float *out,
+                         uint64_t *rays)
 {
     double sum[3] = {0, 0, 0};
     uint32_t used = 0;
@@ -261,6 +328,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, f
     point_ctx c;
     memset(&c, 0, sizeof c);
     c.job = job;
+    c.lights = lights;
     for (uint32_t k = 0; k < t->points_in[i]; k++) {
         const lmb_gather_point *g = &t->points[(size_t)i * t->samples + k];
         lmb_rng rng = lmb_rng_make(job->cfg->seed, key, k);
@@ -275,8 +343,9 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, f
         if (inside_geometry(&c, &rng))
             continue;
         double e[3] = {0, 0, 0};
-        for (uint32_t l = 0; l < job->scene->light_count; l++)
-            punctual(&c, &job->scene->lights[l], e);
+        for (uint32_t l = 0; l < c.lights->directional_count; l++)
+            punctual(&c, &job->scene->lights[c.lights->directional[l]], 1.0, e);
+        local_lights(&c, &rng, e);
         if (lmb_emitters_count(job->emitters))
             area_lights(&c, &rng, e);
         for (int d = 0; d < 3; d++)
@@ -289,9 +358,46 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, f
     *rays += c.rays;
 }
 
+/* Splits the scene's lights into directional and local, with the local lights' power CDF
+ * (power ~ 4 pi I for a point light, 2 pi (1 - cos outer) I for a spot, times luminance). */
+static int light_set_build(const lmb_scene *s, light_set *ls)
+{
+    memset(ls, 0, sizeof *ls);
+    ls->local = malloc(((size_t)s->light_count + 1) * sizeof *ls->local);
+    ls->directional = malloc(((size_t)s->light_count + 1) * sizeof *ls->directional);
+    ls->cdf = malloc(((size_t)s->light_count + 2) * sizeof *ls->cdf);
+    if (!ls->local || !ls->directional || !ls->cdf)
+        return 0;
+    ls->cdf[0] = 0;
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        const lmb_light *l = &s->lights[i];
+        if (l->type == LMB_LIGHT_DIRECTIONAL) {
+            ls->directional[ls->directional_count++] = i;
+            continue;
+        }
+        double lum = 0.2126 * l->color[0] + 0.7152 * l->color[1] + 0.0722 * l->color[2];
+        double solid = l->type == LMB_LIGHT_SPOT ? 2 * LMB_PI * (1 - cos(l->outer_cone)) : 4 * LMB_PI;
+        ls->local[ls->local_count] = i;
+        ls->cdf[ls->local_count + 1] = ls->cdf[ls->local_count] + fmax(1e-12, l->intensity * lum * solid);
+        ls->local_count++;
+    }
+    return 1;
+}
+
+static void light_set_free(light_set *ls)
+{
+    free(ls->local);
+    free(ls->directional);
+    free(ls->cdf);
+}
+
 lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays, lmb_error *err)
 {
-    (void)err;
+    light_set lights;
+    if (!light_set_build(job->scene, &lights)) {
+        light_set_free(&lights);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory");
+    }
     const uint32_t block = 1024;
     uint64_t total = 0;
     int threads = job->cfg->threads ? (int)job->cfg->threads : 0;
@@ -303,12 +409,13 @@ lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *i
             lmb_rt_thread_init();
 #pragma omp for schedule(dynamic, 16)
             for (uint32_t i = start; i < end; i++)
-                texel_direct(job, t, i, irradiance, &block_rays);
+                texel_direct(job, &lights, t, i, irradiance, &block_rays);
         }
         total += block_rays;
         if (job->progress)
             job->progress(job->progress_user, "direct", end, t->count);
     }
     *rays += total;
+    light_set_free(&lights);
     return LMB_OK;
 }

@@ -10,11 +10,15 @@
 #define LMBAKE_DIRECT_H
 
 #include "rt_scene.h"
+#include "load/textures.h"
 #include "texels/texels.h"
 
 typedef struct lmb_emitters lmb_emitters; /* opaque: emissive triangles and their power CDF */
 
-lmb_status lmb_emitters_build(const lmb_scene *scene, const lmb_config *cfg, lmb_emitters **out, lmb_error *err);
+/* Emissive triangles of every instance; `textures` (may be NULL) holds decoded emissive
+ * textures, which multiply the material's emissive factor x strength. */
+lmb_status lmb_emitters_build(const lmb_scene *scene, const lmb_config *cfg, const lmb_textures *textures,
+                              lmb_emitters **out, lmb_error *err);
 void lmb_emitters_free(lmb_emitters *e);
 uint32_t lmb_emitters_count(const lmb_emitters *e);
 

@@ -237,8 +237,24 @@ void build_view(lmb_gltf_doc &d)
         d.ext_required.push_back(e.c_str());
     for (const auto &e : d.model.extensionsUsed)
         d.ext_used.push_back(e.c_str());
-    for (const auto &img : d.model.images)
+    for (const auto &img : d.model.images) {
         d.image_uris.push_back(img.uri.c_str());
+        lmb_gltf_image g{img.uri.c_str(), img.mimeType.c_str(), nullptr, 0};
+        if (!img.image.empty()) {
+            g.bytes = img.image.data();
+            g.size = img.image.size();
+        } else if (img.bufferView >= 0 && (size_t)img.bufferView < d.model.bufferViews.size()) {
+            const auto &v = d.model.bufferViews[(size_t)img.bufferView];
+            if (v.buffer >= 0 && (size_t)v.buffer < d.model.buffers.size() &&
+                v.byteOffset + v.byteLength <= d.model.buffers[(size_t)v.buffer].data.size()) {
+                g.bytes = d.model.buffers[(size_t)v.buffer].data.data() + v.byteOffset;
+                g.size = v.byteLength;
+            }
+        }
+        d.images.push_back(g);
+    }
+    for (const auto &t : d.model.textures)
+        d.texture_source.push_back(t.source);
     lmb_gltf_view &v = d.view;
     expose(d.buffers, v.buffers, v.buffer_count);
     expose(d.buffer_views, v.buffer_views, v.buffer_view_count);
@@ -253,6 +269,8 @@ void build_view(lmb_gltf_doc &d)
     expose(d.ext_required, v.extensions_required, v.extensions_required_count);
     expose(d.ext_used, v.extensions_used, v.extensions_used_count);
     expose(d.image_uris, v.image_uris, v.image_count);
+    v.images = d.images.empty() ? nullptr : d.images.data();
+    expose(d.texture_source, v.texture_source, v.texture_count);
 }
 
 /* tinygltf's messages end in newlines and may hold several lines: keep the first one. */

@@ -84,6 +84,13 @@ typedef struct lmb_gltf_light {
     double inner_cone, outer_cone;
 } lmb_gltf_light;
 
+typedef struct lmb_gltf_image {
+    const char *uri;      /* external file relative to the glTF, or "" */
+    const char *mime;     /* "" if not given */
+    const uint8_t *bytes; /* encoded bytes when embedded (buffer view or data URI), else NULL */
+    size_t size;
+} lmb_gltf_image;
+
 /* Everything lmbake reads, as plain arrays. All pointers are owned by the doc. */
 typedef struct lmb_gltf_view {
     const lmb_gltf_buffer *buffers;             uint32_t buffer_count;
@@ -100,6 +107,8 @@ typedef struct lmb_gltf_view {
     const char *const *extensions_required;     uint32_t extensions_required_count;
     const char *const *extensions_used;         uint32_t extensions_used_count;
     const char *const *image_uris;              uint32_t image_count; /* "" when in a buffer view */
+    const lmb_gltf_image *images;               /* image_count of them */
+    const int32_t *texture_source;              uint32_t texture_count; /* image index or -1 */
 } lmb_gltf_view;
 
 /* Parses path (.gltf or .glb by content). `extras_key` names the node extras bool read

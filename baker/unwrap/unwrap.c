@@ -3,8 +3,9 @@
  * chart and splitting until every chart is valid. A chart is valid when every triangle
  * keeps its orientation in UV (no flips) and its boundary does not cross itself; with both,
  * the flattening of a chart is injective, so no two of its triangles share a texel. An
- * invalid chart is segmented again with half the normal cone; below 0.06 degrees every
- * triangle becomes its own chart (a single triangle is always valid).
+ * invalid chart, or one with a hole (a ring), is cut in two across its longest axis and
+ * each half segmented again; a chart that cannot be cut becomes one chart per triangle
+ * (a single triangle is always valid).
  */
 #include "unwrap_internal.h"
 
@@ -24,6 +25,25 @@ void lmb_charts_free(lmb_charts *c)
     free(c->first);
     free(c->order);
     memset(c, 0, sizeof *c);
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static uint32_t find_sorted(const uint32_t *ids, uint32_t n, uint32_t key)
+{
+    uint32_t lo = 0, hi = n;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (ids[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
 }
 
 static double orient(const double *a, const double *b, const double *c)
@@ -129,6 +149,107 @@ static int chart_valid(const lmb_unwrap_input *in, const lmb_topology *t, const 
         }
     }
     return !boundary_crosses(scratch, ne);
+}
+
+/* A chart whose boundary falls into more than one connected piece has a hole (a ring,
+ * such as the flat top of a torus): valid, but its hole wastes atlas space, so it is cut.
+ * Boundary end points are merged with union-find over the chart's welded vertex ids. */
+static int has_hole(const lmb_unwrap_input *in, const lmb_topology *t, const uint32_t *tris, uint32_t n,
+                    const uint32_t *chart_of, bedge *scratch)
+{
+    uint32_t ne = 0, id = chart_of[tris[0]];
+    for (uint32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t g = t->neighbor[3 * tris[i] + k];
+            if (g != LMB_NONE && chart_of[g] == id)
+                continue;
+            scratch[ne].wa = t->weld[in->indices[3 * tris[i] + k]];
+            scratch[ne].wb = t->weld[in->indices[3 * tris[i] + (k + 1) % 3]];
+            ne++;
+        }
+    if (ne < 6)
+        return 0;
+    /* local ids: sort the end points, then union-find over positions in the sorted list */
+    uint32_t *ids = malloc(2 * (size_t)ne * sizeof *ids), *parent = malloc(2 * (size_t)ne * sizeof *parent);
+    if (!ids || !parent) {
+        free(ids);
+        free(parent);
+        return 0;
+    }
+    for (uint32_t e = 0; e < ne; e++) {
+        ids[2 * e] = scratch[e].wa;
+        ids[2 * e + 1] = scratch[e].wb;
+    }
+    qsort(ids, 2 * (size_t)ne, sizeof *ids, cmp_u32);
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < 2 * ne; i++)
+        if (i == 0 || ids[i] != ids[m - 1])
+            ids[m++] = ids[i];
+    for (uint32_t i = 0; i < m; i++)
+        parent[i] = i;
+    uint32_t pieces = m;
+    for (uint32_t e = 0; e < ne; e++) {
+        uint32_t a = find_sorted(ids, m, scratch[e].wa), b = find_sorted(ids, m, scratch[e].wb);
+        while (parent[a] != a)
+            a = parent[a] = parent[parent[a]];
+        while (parent[b] != b)
+            b = parent[b] = parent[parent[b]];
+        if (a != b) {
+            parent[a < b ? b : a] = a < b ? a : b;
+            pieces--;
+        }
+    }
+    free(ids);
+    free(parent);
+    return pieces > 1;
+}
+
+/* Reorders tris so the triangles on the negative side of the plane through the chart's
+ * area-weighted centroid, normal to its principal axis (power iteration on the centroid
+ * covariance), come first; returns their count. */
+static uint32_t split_in_two(const lmb_topology *t, uint32_t *tris, uint32_t n)
+{
+    double c[3] = {0, 0, 0}, a = 0, cov[9] = {0}, v[3] = {1, 0.7, 0.4};
+    for (uint32_t i = 0; i < n; i++) {
+        double w = t->area[tris[i]];
+        for (int d = 0; d < 3; d++)
+            c[d] += w * t->centroid[3 * tris[i] + d];
+        a += w;
+    }
+    if (!(a > 0))
+        return 0;
+    for (int d = 0; d < 3; d++)
+        c[d] /= a;
+    for (uint32_t i = 0; i < n; i++) {
+        double w = t->area[tris[i]], q[3];
+        for (int d = 0; d < 3; d++)
+            q[d] = t->centroid[3 * tris[i] + d] - c[d];
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++)
+                cov[3 * r + k] += w * q[r] * q[k];
+    }
+    for (int it = 0; it < 32; it++) {
+        double nv[3] = {0, 0, 0}, l = 0;
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++)
+                nv[r] += cov[3 * r + k] * v[k];
+        for (int r = 0; r < 3; r++)
+            l += nv[r] * nv[r];
+        if (!(l > 0))
+            break;
+        for (int r = 0; r < 3; r++)
+            v[r] = nv[r] / sqrt(l);
+    }
+    uint32_t lo = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *q = t->centroid + 3 * tris[i];
+        if ((q[0] - c[0]) * v[0] + (q[1] - c[1]) * v[1] + (q[2] - c[2]) * v[2] < 0) {
+            uint32_t x = tris[i];
+            tris[i] = tris[lo];
+            tris[lo++] = x;
+        }
+    }
+    return lo;
 }
 
 /* Chart membership lists kept in one growing pool: chart c owns pool[at[c] .. at[c]+len[c]). */
@@ -253,21 +374,28 @@ lmb_status lmb_unwrap_mesh(const lmb_unwrap_input *in, const lmb_unwrap_options 
         const uint32_t *members = p.tris + p.at[c];
         int planar = 0;
         st = lmb_flatten(in, &t, members, len, out->uv, &planar, err);
-        if (st != LMB_OK || len == 1 || chart_valid(in, &t, members, len, out->chart_of, out->uv, scratch)) {
+        if (st != LMB_OK || len == 1 ||
+            (chart_valid(in, &t, members, len, out->chart_of, out->uv, scratch) &&
+             !has_hole(in, &t, members, len, out->chart_of, scratch))) {
             out->planar_charts += planar;
             continue;
         }
-        /* split: segment this chart's triangles again with half the cone */
-        double angle = p.angle[c] * 0.5;
+        /* split in two across the chart's longest axis, then grow charts in each half */
         memcpy(tris, members, len * sizeof *tris);
+        uint32_t before = next, na = split_in_two(&t, tris, len);
+        double angle = p.angle[c];
         for (uint32_t i = 0; i < len; i++)
-            out->chart_of[tris[i]] = LMB_NONE;
-        uint32_t before = next;
-        if (angle < 1e-3) /* every triangle alone */
+            out->chart_of[tris[i]] = i < na ? LMB_NONE : LMB_NONE - 1; /* second half held back */
+        if (na == 0 || na == len) { /* cannot cut: every triangle alone */
             for (uint32_t i = 0; i < len; i++)
                 out->chart_of[tris[i]] = next++;
-        else
-            st = lmb_segment(in, &t, tris, len, angle, out->chart_of, &next, err);
+        } else {
+            st = lmb_segment(in, &t, tris, na, angle, out->chart_of, &next, err);
+            for (uint32_t i = na; i < len; i++)
+                out->chart_of[tris[i]] = LMB_NONE;
+            if (st == LMB_OK)
+                st = lmb_segment(in, &t, tris + na, len - na, angle, out->chart_of, &next, err);
+        }
         p.len[c] = 0;
         out->splits++;
         if (st == LMB_OK && !pool_add(&p, tris, len, out->chart_of, before, next, angle))

@@ -3,7 +3,11 @@
  */
 #include "image_adapter.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+
+#include <cstdlib>
+#include <vector>
 
 #include <cstdio>
 #include <memory>
@@ -68,5 +72,36 @@ extern "C" lmb_status lmb_image_write_f32(const char *path, uint32_t w, uint32_t
         return write_image(path, w, h, ch, OIIO::TypeDesc::FLOAT, pixels, err);
     } catch (const std::exception &e) {
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: image writer failed: %s", path, e.what());
+    }
+}
+
+extern "C" lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t size, uint32_t *w, uint32_t *h,
+                                         float **rgb, lmb_error *err)
+{
+    try {
+        *rgb = nullptr;
+        OIIO::Filesystem::IOMemReader mem(bytes, bytes ? size : 0);
+        auto in = OIIO::ImageInput::open(name, nullptr, bytes ? &mem : nullptr);
+        if (!in)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot read image: %s", name, OIIO::geterror().c_str());
+        const OIIO::ImageSpec &spec = in->spec();
+        int ch = spec.nchannels;
+        if (spec.width <= 0 || spec.height <= 0 || ch <= 0 || (size_t)spec.width * spec.height > (size_t)1 << 28)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: unusable image size %dx%d", name, spec.width, spec.height);
+        std::vector<float> px((size_t)spec.width * spec.height * ch);
+        if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data()))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot decode image: %s", name, in->geterror().c_str());
+        float *out = (float *)std::malloc((size_t)spec.width * spec.height * 3 * sizeof(float) + 1);
+        if (!out)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", name);
+        for (size_t i = 0; i < (size_t)spec.width * spec.height; i++)
+            for (int c = 0; c < 3; c++)
+                out[3 * i + c] = px[i * ch + (ch >= 3 ? c : 0)];
+        *w = (uint32_t)spec.width;
+        *h = (uint32_t)spec.height;
+        *rgb = out;
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", name, e.what());
     }
 }

@@ -1,5 +1,5 @@
 /*
- * The OpenImageIO adapter (C header over C++): writes images. The format follows the
+ * The OpenImageIO adapter (C header over C++): writes lightmaps, reads textures. The format follows the
  * file extension (.png, .exr, .hdr). Files are written to a temporary name beside the
  * target and renamed into place, so a failed or interrupted write never leaves a partial
  * file under the final name.
@@ -20,6 +20,13 @@ lmb_status lmb_image_write_u8(const char *path, uint32_t width, uint32_t height,
 /* Float pixels; .exr is written as half float with zip compression. */
 lmb_status lmb_image_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                                const float *pixels, lmb_error *err);
+
+/* Reads an image as RGB floats (grey is replicated, alpha dropped), rows top to bottom,
+ * values as stored: 8-bit formats come back sRGB-encoded in [0, 1]. From the file `name`,
+ * or from memory when bytes != NULL (then `name` only picks the format by its extension).
+ * The caller frees *rgb. */
+lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t size, uint32_t *width, uint32_t *height,
+                              float **rgb, lmb_error *err);
 
 #ifdef __cplusplus
 }

@@ -3,7 +3,7 @@
 EXR lightmaps with the formulas of ../shared/DESIGN.md section 3.
 
 usage: check_analytic.py LMBAKE WORKDIR CASE
-  CASE: point-plane | sun-box | disk | sealed-room | box-floor
+  CASE: point-plane | many-lights | sun-box | disk | disk-textured | sealed-room | box-floor
 
 For each texel the expected value is computed at the same points the baker uses: the
 stratum centres of the texel (samples.texel), each clamped onto the closest triangle of
@@ -84,8 +84,8 @@ def load_output(out):
                 tris.append((w, u))
             charts.append((node["name"], tex, tris))
     images = {}
-    for ti, tex in enumerate(doc["textures"]):
-        png = doc["images"][tex["source"]]["uri"]
+    for ti in sorted({c[1] for c in charts}):
+        png = doc["images"][doc["textures"][ti]["source"]]["uri"]
         exr = os.path.join(out, png[:-4] + ".exr")
         inp = oiio.ImageInput.open(exr)
         images[ti] = inp.read_image("float")
@@ -167,6 +167,21 @@ def point_plane(charts, images):
     return n > 5000 and worst <= 0.005
 
 
+def many_lights(charts, images):
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    from make_scenes import MANY_LIGHTS
+    ratios = []
+    for node, v, pts, x, y, _ in texels(charts, images):
+        e = np.mean([sum(i * 2.0 / ((p[0] - lx) ** 2 + 4.0 + (p[2] - lz) ** 2) ** 1.5 for lx, lz, i in MANY_LIGHTS)
+                     for p in pts])
+        ratios.append(v[0] / e)
+    r = np.array(ratios)
+    mean, within = float(np.mean(r)), float(np.mean(np.abs(r - 1) < 0.1))
+    print("many-lights: 20 point lights sampled by power (256 per point): mean ratio to the exact sum %.4f over %d "
+          "texels (bound 1 +- 1%%), %.1f%% of texels within 10%% (bound 95%%)" % (mean, len(r), 100 * within))
+    return abs(mean - 1) < 0.01 and within >= 0.95
+
+
 def in_cube_shadow(p, d):
     """Ray from p toward the sun (-d) hits the cube [-0.5, 0.5] x [0, 1] x [-0.5, 0.5]?"""
     o, r = p, (-d[0], -d[1], -d[2])
@@ -225,8 +240,8 @@ def disk_e(L, R, h, r):
     return math.pi * L / 2 * (1 - (a - R * R) / math.sqrt((a + R * R) ** 2 - 4 * r * r * R * R))
 
 
-def disk(charts, images):
-    L, R, h = 10.0, 0.5, 1.0
+def disk(charts, images, L=10.0):
+    R, h = 0.5, 1.0
     centre = disk_e(L, R, h, 0.0)
     best = None
     for node, v, pts, x, y, _ in texels(charts, images):
@@ -242,6 +257,11 @@ def disk(charts, images):
           "pi L R^2 / (h^2 + R^2)), error %.3f%% (bound 2%%); 256 area samples x %d points per texel; the 64-gon "
           "has 0.16%% less area than the disk" % (best[0], best[1], best[2], centre, 100 * err, SAMPLES))
     return err <= 0.02
+
+
+def disk_textured(charts, images):
+    srgb = 128 / 255.0
+    return disk(charts, images, L=10.0 * ((srgb + 0.055) / 1.055) ** 2.4)
 
 
 def sealed_room(charts, images):
@@ -280,7 +300,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     out = bake(lmbake, work, case)
     charts, images = load_output(out)
-    check = {"point-plane": point_plane, "sun-box": sun_box, "disk": disk, "sealed-room": sealed_room,
+    check = {"point-plane": point_plane, "many-lights": many_lights, "sun-box": sun_box, "disk": disk, "disk-textured": disk_textured, "sealed-room": sealed_room,
              "box-floor": box_floor}[case]
     return 0 if check(charts, images) else 1
 
