@@ -103,6 +103,7 @@ int cmd_bake(int argc, char **argv)
                a.scene, cli_now() - t0, scene->instance_count, st.lightmapped_instances,
                (unsigned long long)st.lightmapped_triangles, scene->light_count,
                (unsigned long long)st.emissive_triangles);
+    fflush(stdout); /* before the progress lines on stderr */
     if (!st.lightmapped_instances) {
         lmb_error_set(&err, LMB_ERR_INPUT, "%s: nothing to lightmap (see 'lmbake inspect' for each instance's reason)",
                       a.scene);
