@@ -260,6 +260,23 @@ static int prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, ite
     return ok;
 }
 
+static uint32_t longest_side(const item *x)
+{
+    return x->shape[0].w > x->shape[0].h ? x->shape[0].w : x->shape[0].h;
+}
+
+/* Second order tried for small inputs: longest side first (rectangles stack better). */
+static int longer_first(const void *a, const void *b)
+{
+    const item *x = a, *y = b;
+    uint32_t lx = longest_side(x), ly = longest_side(y);
+    if (lx != ly)
+        return lx > ly ? -1 : 1;
+    if (x->area != y->area)
+        return x->area > y->area ? -1 : 1;
+    return (x->chart > y->chart) - (x->chart < y->chart);
+}
+
 static int larger_first(const void *a, const void *b)
 {
     const item *x = a, *y = b;
@@ -476,19 +493,20 @@ lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const l
                                i, items[i].shape[0].w, items[i].shape[0].h, size);
         total += items[i].area;
     }
-    if (st == LMB_OK)
-        qsort(items, count, sizeof *items, larger_first);
-    /* placement widths to try: squares holding the footprints with some slack (a few for
-     * small inputs, where packing is cheap and the right width matters most), at least the
+    /* orders and placement widths to try: squares holding the footprints with some slack (a
+     * few for small inputs, where packing is cheap and the choice matters most), at least the
      * widest chart; the result with fewest atlases, then least area, wins */
-    static const double slack[] = {1.0, 1.08, 1.16, 1.25, 1.4, 1.6};
-    uint32_t widest = 0, tries = count <= 300 ? 6 : 1;
+    static const double slack[] = {1.0, 1.16, 1.4, 1.08, 1.25, 1.6};
+    static int (*const orders[])(const void *, const void *) = {larger_first, longer_first};
+    uint32_t widest = 0, tries = count <= 50 ? 6 : count <= 300 ? 3 : 1, norders = count <= 300 ? 2 : 1;
     for (uint32_t i = 0; i < count; i++)
         widest = items[i].shape[0].w > widest ? items[i].shape[0].w : widest;
     lmb_pack_result best;
     memset(&best, 0, sizeof best);
-    for (uint32_t k = 0; st == LMB_OK && k < tries; k++) {
-        uint32_t width = (uint32_t)ceil(sqrt((double)total * 1.05) * slack[k]);
+    for (uint32_t k = 0; st == LMB_OK && k < tries * norders; k++) {
+        if (k % tries == 0)
+            qsort(items, count, sizeof *items, orders[k / tries]);
+        uint32_t width = (uint32_t)ceil(sqrt((double)total * 1.05) * slack[k % tries]);
         width = width < widest ? widest : width;
         width = width > size ? size : width;
         lmb_pack_result r;
