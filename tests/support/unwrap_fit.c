@@ -154,6 +154,15 @@ int fit_mesh(const gen_mesh *g, uint32_t size, uint32_t padding, fit_result *r)
             hi = mid;
         }
     }
+    /* a finer look just below the largest density that fits: a slightly smaller scale can
+     * tile the charts better (small inputs only, where a pack takes milliseconds) */
+    for (int i = 1; ok && c.chart_count <= 50 && i <= 24; i++) {
+        memset(&cur, 0, sizeof cur);
+        if (measure(g, &c, lo * (1.0 - 0.01 * i), size, padding, &cur) && cur.coverage > best.coverage &&
+            (cur.width > cur.height ? cur.width : cur.height) >= 0.9 * size)
+            best = cur;
+        packs++;
+    }
     uint32_t charts = c.chart_count;
     lmb_charts_free(&c);
     if (!ok)

@@ -2,8 +2,7 @@
  * Unwrap + pack quality on issue 3's reference meshes, each packed into one atlas of about
  * 1024 x 1024 (padding 2) at a fixed density (the one tools/bench_unwrap.c found), measured
  * with the README's metrics: zero overlapping texels, L2 stretch <= 1.01, and coverage at
- * least xatlas's on the sphere (0.662) and torus (0.553). The Cornell box is asserted at
- * our own measured 0.87 (below xatlas's 0.894; see the issue notes).
+ * least xatlas's: Cornell box 0.894, sphere 0.662, torus 0.553.
  */
 #include "check.h"
 
@@ -57,7 +56,7 @@ static void check(const char *name, const gen_mesh *g, double density, double mi
     printf("%s: %u charts, atlas %ux%u, coverage %.4f (bound %.3f), L2 stretch %.5f, overlapping texels %llu\n", name,
            c.chart_count, r.width[0], r.height[0], m.coverage, min_coverage, m.l2_stretch,
            (unsigned long long)m.overlapping_texels);
-    CHECK(r.width[0] <= 1024 && r.height[0] <= 1024 && r.width[0] >= 900 && r.height[0] >= 700);
+    CHECK(r.width[0] <= 1024 && r.height[0] <= 1024 && (r.width[0] >= 920 || r.height[0] >= 920));
     CHECK_INT(m.overlapping_texels, 0);
     CHECK(m.coverage >= min_coverage);
     CHECK(m.l2_stretch <= 1.01);
@@ -72,7 +71,7 @@ int main(void)
 {
     gen_mesh g;
     if (gen_cornell_box(&g) == 0) {
-        check("cornell", &g, 332.534, 0.87);
+        check("cornell", &g, 288.729, 0.894);
         gen_mesh_free(&g);
     }
     if (gen_uv_sphere(&g, 128, 80, 1.0f) == 0) {
