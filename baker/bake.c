@@ -289,7 +289,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     lmb_textures tx;
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
-    st = lmb_layout_build(s, cfg, progress, user, &l, err);
+    st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
     if (st == LMB_OK)

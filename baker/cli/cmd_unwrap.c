@@ -204,7 +204,7 @@ int cmd_unwrap(int argc, char **argv)
     cli_progress progress;
     cli_progress_init(&progress, stderr, quiet);
     lmb_layout layout;
-    lmb_status st = lmb_layout_build(scene, &cfg, cli_progress_update, &progress, &layout, &err);
+    lmb_status st = lmb_layout_build(scene, &cfg, cli_progress_update, &progress, &log, &layout, &err);
     if (st == LMB_OK) {
         print_report(scene, &layout);
         for (uint32_t a = 0; a < layout.atlas_count && st == LMB_OK; a++) {

@@ -9,7 +9,9 @@
  */
 #define _POSIX_C_SOURCE 200809L
 #include "layout.h"
+#include "keep_uv1.h"
 #include "pack.h"
+#include "unwrap/metrics.h"
 #include "../util/mat4.h"
 
 #include <math.h>
@@ -224,7 +226,8 @@ static lmb_status pack_split(const lmb_scene *s, const lmb_config *cfg, lmb_layo
     return st == LMB_OK ? pack_split(s, cfg, l, list + n / 2, n - n / 2, err) : st;
 }
 
-static lmb_status unwrap_meshes(const lmb_scene *s, lmb_layout *l, lmb_progress_fn progress, void *user, lmb_error *err)
+static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, lmb_progress_fn progress,
+                                void *user, lmb_error *err)
 {
     uint64_t total = 0, done = 0;
     for (uint32_t m = 0; m < s->mesh_count; m++)
@@ -239,8 +242,10 @@ static lmb_status unwrap_meshes(const lmb_scene *s, lmb_layout *l, lmb_progress_
         double t0 = now();
         lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
                                lm->soup.skip};
+        lm->kept_uv1 = cfg->keep_uv1 && lmb_mesh_has_uv1(s, m);
         if (st == LMB_OK)
-            st = lmb_unwrap_mesh(&in, &opt, &lm->charts, err);
+            st = lm->kept_uv1 ? lmb_charts_from_uv1(s, m, &lm->soup, &lm->charts, err)
+                              : lmb_unwrap_mesh(&in, &opt, &lm->charts, err);
         lm->chart_seconds = now() - t0;
         if (st != LMB_OK)
             return st;
@@ -251,8 +256,50 @@ static lmb_status unwrap_meshes(const lmb_scene *s, lmb_layout *l, lmb_progress_
     return LMB_OK;
 }
 
+/* An instance of a kept-TEXCOORD_1 mesh: an atlas of its own, its UVs scaled to it, overlaps
+ * reported. */
+static lmb_status own_atlas(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, uint32_t i, const lmb_log *log,
+                            lmb_error *err)
+{
+    lmb_layout_instance *li = &l->instances[i];
+    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+    double q[9], world = 0;
+    for (uint32_t f = 0; f < c->triangle_count; f++)
+        if (c->chart_of[f] != UINT32_MAX) {
+            lmb_layout_world_triangle(s, l, i, f, q);
+            world += area3(q);
+        }
+    uint32_t size = lmb_uv1_atlas_size(world, c, li->texel_density, cfg->max_atlas_size);
+    uint32_t *w = realloc(l->width, (l->atlas_count + 1) * sizeof *w);
+    if (w) l->width = w;
+    uint32_t *h = realloc(l->height, (l->atlas_count + 1) * sizeof *h);
+    if (h) l->height = h;
+    if (!w || !h)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    li->atlas = l->atlas_count++;
+    l->width[li->atlas] = l->height[li->atlas] = size;
+    for (uint32_t k = 0; k < 6 * c->triangle_count; k++)
+        li->uv1[k] = c->chart_of[k / 6] == UINT32_MAX ? 0 : c->uv[k] * size;
+    /* validation: texel centres covered twice */
+    double *pos = malloc(sizeof(double) * 9 * c->triangle_count + 1);
+    if (!pos)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    for (uint32_t f = 0; f < c->triangle_count; f++)
+        lmb_layout_world_triangle(s, l, i, f, pos + 9 * f);
+    lmb_uv_layout lay = {c->triangle_count, pos, li->uv1, size, size};
+    lmb_uv_metrics m;
+    lmb_status st = lmb_uv_metrics_compute(&lay, &m, err);
+    free(pos);
+    if (st == LMB_OK && m.overlapping_texels)
+        lmb_warn(log, "instance '%s': its own TEXCOORD_1 (atlas.keep_uv1) overlaps itself on %llu texels of its %ux%u "
+                 "atlas: those texels mix light from two places",
+                 s->instances[i].name, (unsigned long long)m.overlapping_texels, size, size);
+    l->chart_total++;
+    return st;
+}
+
 lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progress_fn progress, void *user,
-                            lmb_layout *l, lmb_error *err)
+                            const lmb_log *log, lmb_layout *l, lmb_error *err)
 {
     memset(l, 0, sizeof *l);
     l->mesh_count = s->mesh_count;
@@ -269,7 +316,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             l->meshes[s->instances[i].mesh].used = 1;
             list[n++] = i;
         }
-    lmb_status st = unwrap_meshes(s, l, progress, user, err);
+    lmb_status st = unwrap_meshes(s, cfg, l, progress, user, err);
     for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
         lmb_layout_instance *li = &l->instances[list[j]];
         li->lightmapped = 1;
@@ -277,9 +324,18 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
         li->uv1 = calloc((size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6 + 1, sizeof *li->uv1);
         if (!li->uv1)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-        else
+        else if (!l->meshes[s->instances[list[j]].mesh].kept_uv1)
             scale_instance(s, l, list[j]);
     }
+    /* kept TEXCOORD_1: own atlases; the rest is packed */
+    uint32_t packed = 0;
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
+        if (l->meshes[s->instances[list[j]].mesh].kept_uv1)
+            st = own_atlas(s, cfg, l, list[j], log, err);
+        else
+            list[packed++] = list[j];
+    }
+    n = packed;
     double t0 = now();
     if (st == LMB_OK && n)
         st = pack_split(s, cfg, l, list, n, err);

@@ -24,7 +24,8 @@ typedef struct lmb_mesh_soup {
 typedef struct lmb_layout_mesh {
     int used;           /* some lightmapped instance uses it */
     lmb_mesh_soup soup;
-    lmb_charts charts;  /* chart-local UVs, isometric */
+    lmb_charts charts;  /* chart-local UVs, isometric; with kept_uv1 one chart of the mesh's TEXCOORD_1 */
+    int kept_uv1;       /* atlas.keep_uv1 and the mesh has TEXCOORD_1 everywhere */
     double chart_seconds;
 } lmb_layout_mesh;
 
@@ -46,9 +47,9 @@ typedef struct lmb_layout {
 } lmb_layout;
 
 /* Builds the layout for the lightmapped instances of scene (see lmb_scene_select_lightmapped).
- * progress may be NULL. Free with lmb_layout_free, also after an error. */
+ * progress and log may be NULL. Free with lmb_layout_free, also after an error. */
 lmb_status lmb_layout_build(const lmb_scene *scene, const lmb_config *cfg, lmb_progress_fn progress,
-                            void *progress_user, lmb_layout *out, lmb_error *err);
+                            void *progress_user, const lmb_log *log, lmb_layout *out, lmb_error *err);
 
 void lmb_layout_free(lmb_layout *l);
 
