@@ -5,9 +5,9 @@
  * place only when everything succeeded, so a failed bake leaves nothing behind; outdir may
  * not be the input's own folder (the input and its .bin files are never written over).
  */
-#define _POSIX_C_SOURCE 200809L
 #include <lmbake/lmbake.h>
 
+#include "util/clock.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
 #include "load/textures.h"
@@ -22,14 +22,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Tonemapped 8-bit preview of irradiance: exposure maps the 95th percentile of the valid
  * texels' luminance to 0.8 before Reinhard x/(1+x) and the sRGB curve. For a quick look
@@ -277,7 +269,7 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
 lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress, void *user,
                     lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
 {
-    double t0 = now();
+    double t0 = lmb_seconds();
     memset(stats, 0, sizeof *stats);
     lmb_output_dir od;
     lmb_status st = lmb_output_dir_open(&od, outdir, s->path, err);
@@ -296,7 +288,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
         st = lmb_textures_load_emissive(s, &tx, log, err);
     if (st == LMB_OK)
         st = lmb_emitters_build(s, cfg, &tx, &em, err);
-    double tl = now();
+    double tl = lmb_seconds();
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
         size_t n = (size_t)l.width[a] * l.height[a];
         float *rgb = calloc(3 * n + 1, sizeof *rgb);
@@ -310,7 +302,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
         free(rgb);
         free(valid);
     }
-    stats->light_seconds = now() - tl;
+    stats->light_seconds = lmb_seconds() - tl;
     stats->atlases = l.atlas_count;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
@@ -326,6 +318,6 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     lmb_textures_free(&tx);
     lmb_rt_free(&rt);
     lmb_layout_free(&l);
-    stats->seconds = now() - t0;
+    stats->seconds = lmb_seconds() - t0;
     return st;
 }

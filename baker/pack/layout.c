@@ -7,7 +7,7 @@
  * are grouped in scene order by estimated size and each group packed alone, halving a
  * group that still spills over, so that every instance sits whole in one atlas.
  */
-#define _POSIX_C_SOURCE 200809L
+#include "../util/clock.h"
 #include "layout.h"
 #include "keep_uv1.h"
 #include "pack.h"
@@ -17,14 +17,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Area-weighted face normals summed per vertex, for a primitive that has no NORMAL (glTF
  * says flat shading then; per vertex of an unwelded primitive this is the face normal). */
@@ -239,14 +231,14 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
         if (!lm->used)
             continue;
         lmb_status st = build_soup(s, m, &lm->soup, err);
-        double t0 = now();
+        double t0 = lmb_seconds();
         lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
                                lm->soup.skip};
         lm->kept_uv1 = cfg->keep_uv1 && lmb_mesh_has_uv1(s, m);
         if (st == LMB_OK)
             st = lm->kept_uv1 ? lmb_charts_from_uv1(s, m, &lm->soup, &lm->charts, err)
                               : lmb_unwrap_mesh(&in, &opt, &lm->charts, err);
-        lm->chart_seconds = now() - t0;
+        lm->chart_seconds = lmb_seconds() - t0;
         if (st != LMB_OK)
             return st;
         done += s->meshes[m].triangle_count;
@@ -336,10 +328,10 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             list[packed++] = list[j];
     }
     n = packed;
-    double t0 = now();
+    double t0 = lmb_seconds();
     if (st == LMB_OK && n)
         st = pack_split(s, cfg, l, list, n, err);
-    l->pack_seconds = now() - t0;
+    l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);
     free(list);

@@ -18,25 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint32_t find_local(const uint32_t *ids, uint32_t n, uint32_t key)
-{
-    uint32_t lo = 0, hi = n;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (ids[mid] < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /* Orthonormal basis (e1, e2) of the plane with normal n, chosen deterministically. */
 static void plane_basis(const double n[3], double e1[3], double e2[3])
 {
@@ -81,7 +62,7 @@ static int gather_vertices(const lmb_unwrap_input *in, const lmb_topology *t, co
     for (uint32_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
             c->ids[3 * i + k] = t->weld[in->indices[3 * tris[i] + k]];
-    qsort(c->ids, 3 * (size_t)n, sizeof *c->ids, cmp_u32);
+    qsort(c->ids, 3 * (size_t)n, sizeof *c->ids, lmb_cmp_u32);
     uint32_t m = 0;
     for (uint32_t i = 0; i < 3 * n; i++)
         if (i == 0 || c->ids[i] != c->ids[m - 1])
@@ -93,7 +74,7 @@ static int gather_vertices(const lmb_unwrap_input *in, const lmb_topology *t, co
         return 0;
     for (uint32_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) {
-            uint32_t v = in->indices[3 * tris[i] + k], l = find_local(c->ids, m, t->weld[v]);
+            uint32_t v = in->indices[3 * tris[i] + k], l = lmb_lower_bound(c->ids, m, t->weld[v]);
             c->local[3 * i + k] = l;
             for (int d = 0; d < 3; d++)
                 c->pos[3 * l + d] = in->positions[3 * v + d];

@@ -27,25 +27,6 @@ void lmb_charts_free(lmb_charts *c)
     memset(c, 0, sizeof *c);
 }
 
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-static uint32_t find_sorted(const uint32_t *ids, uint32_t n, uint32_t key)
-{
-    uint32_t lo = 0, hi = n;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (ids[mid] < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 static double orient(const double *a, const double *b, const double *c)
 {
     return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
@@ -180,7 +161,7 @@ static int has_hole(const lmb_unwrap_input *in, const lmb_topology *t, const uin
         ids[2 * e] = scratch[e].wa;
         ids[2 * e + 1] = scratch[e].wb;
     }
-    qsort(ids, 2 * (size_t)ne, sizeof *ids, cmp_u32);
+    qsort(ids, 2 * (size_t)ne, sizeof *ids, lmb_cmp_u32);
     uint32_t m = 0;
     for (uint32_t i = 0; i < 2 * ne; i++)
         if (i == 0 || ids[i] != ids[m - 1])
@@ -189,7 +170,7 @@ static int has_hole(const lmb_unwrap_input *in, const lmb_topology *t, const uin
         parent[i] = i;
     uint32_t pieces = m;
     for (uint32_t e = 0; e < ne; e++) {
-        uint32_t a = find_sorted(ids, m, scratch[e].wa), b = find_sorted(ids, m, scratch[e].wb);
+        uint32_t a = lmb_lower_bound(ids, m, scratch[e].wa), b = lmb_lower_bound(ids, m, scratch[e].wb);
         while (parent[a] != a)
             a = parent[a] = parent[parent[a]];
         while (parent[b] != b)

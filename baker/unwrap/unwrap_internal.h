@@ -6,6 +6,26 @@
 
 #define LMB_NONE UINT32_MAX
 
+/* qsort comparison of uint32_t, and the position of key in a sorted array (lower bound). */
+static inline int lmb_cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static inline uint32_t lmb_lower_bound(const uint32_t *ids, uint32_t n, uint32_t key)
+{
+    uint32_t lo = 0, hi = n;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (ids[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 /* Welded topology of one mesh: vertices merged by exact position, and for each triangle
  * corner k the triangle across edge (k, k+1), or LMB_NONE at a boundary, a non-manifold
  * edge (3+ triangles) or a winding flip (both triangles run the edge the same way). */

@@ -1,5 +1,5 @@
 /* Unwrap + pack a generated mesh into one ~size x size atlas (see unwrap_fit.h). */
-#define _POSIX_C_SOURCE 200809L
+#include "util/clock.h"
 #include "unwrap_fit.h"
 
 #include "pack/pack.h"
@@ -9,14 +9,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct packed {
     lmb_pack_result r;
@@ -59,9 +51,9 @@ static int try_pack(const lmb_charts *c, double d, uint32_t size, uint32_t paddi
 static int measure(const gen_mesh *g, const lmb_charts *c, double d, uint32_t size, uint32_t padding, fit_result *r)
 {
     packed p;
-    double t0 = now();
+    double t0 = lmb_seconds();
     int ok = try_pack(c, d, size, padding, &p);
-    double t = now() - t0;
+    double t = lmb_seconds() - t0;
     if (!ok) {
         packed_free(&p);
         return 0;
@@ -111,10 +103,10 @@ int fit_mesh(const gen_mesh *g, uint32_t size, uint32_t padding, fit_result *r)
     lmb_charts c;
     lmb_error err;
     lmb_unwrap_options_default(&o);
-    double t0 = now();
+    double t0 = lmb_seconds();
     if (lmb_unwrap_mesh(&in, &o, &c, &err) != LMB_OK)
         return -1;
-    double chart_seconds = now() - t0;
+    double chart_seconds = lmb_seconds() - t0;
     double area = 0;
     for (uint32_t f = 0; f < c.triangle_count; f++) {
         const double *u = c.uv + 6 * f;
