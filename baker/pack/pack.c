@@ -42,6 +42,7 @@ typedef struct atlas {
     uint64_t *rows;
     uint32_t *free_from; /* per row: every column before it is occupied */
     uint32_t used_w, used_h;
+    uint32_t open_row;   /* rows below it are full up to `width` (a chart's first row has texels) */
 } atlas;
 
 static int cmp_pt(const void *a, const void *b)
@@ -306,12 +307,20 @@ static int fits(const atlas *a, const mask *m, uint32_t x, uint32_t y)
 }
 
 /* Bottom-left first fit inside a->width; returns 1 with (x, y). */
-static int find(const atlas *a, const mask *m, uint32_t *ox, uint32_t *oy)
+/* (from_y, from_x): no position before it in (y, x) order can fit (the first fit of an
+ * identical mask found earlier: occupancy only grows). */
+static int find(atlas *a, const mask *m, uint32_t from_y, uint32_t from_x, uint32_t *ox, uint32_t *oy)
 {
     if (m->w > a->width || m->h > a->size)
         return 0;
-    for (uint32_t y = 0; y + m->h <= a->size; y++) {
-        uint32_t start = 0;
+    while (a->open_row < a->size && a->free_from[a->open_row] >= a->width)
+        a->open_row++;
+    if (from_y < a->open_row) {
+        from_y = a->open_row;
+        from_x = 0;
+    }
+    for (uint32_t y = from_y; y + m->h <= a->size; y++) {
+        uint32_t start = y == from_y ? from_x : 0;
         for (uint32_t r = 0; r < m->h; r++) /* columns before free_from are taken in that row */
             if (m->first[r] < m->w && a->free_from[y + r] > m->first[r] && a->free_from[y + r] - m->first[r] > start)
                 start = a->free_from[y + r] - m->first[r];
@@ -360,17 +369,42 @@ void lmb_pack_result_free(lmb_pack_result *r)
     memset(r, 0, sizeof *r);
 }
 
+/* Where each orientation of the previous chart first fitted in an atlas: a lower bound for
+ * the next chart when its masks are the same (many identical cube faces, say). */
+typedef struct hint {
+    const item *prev;
+    uint32_t atlas;
+    uint32_t y[4], x[4];
+    int valid[4];
+} hint;
+
+static int same_masks(const item *a, const item *b)
+{
+    for (int o = 0; o < 4; o++) {
+        const mask *p = &a->shape[o], *q = &b->shape[o];
+        if (p->w != q->w || p->h != q->h || memcmp(p->bits, q->bits, (size_t)p->words * p->h * sizeof *p->bits))
+            return 0;
+    }
+    return 1;
+}
+
 /* Tries the four orientations in atlas a; picks the one that keeps the used area smaller. */
-static int try_place(const atlas *a, const item *it, int *turn, uint32_t *x, uint32_t *y)
+static int try_place(atlas *a, uint32_t ai, const item *it, hint *h, int *turn, uint32_t *x, uint32_t *y)
 {
     uint32_t bx = 0, by = 0, best = UINT32_MAX;
+    int use = h->prev && h->atlas == ai && same_masks(h->prev, it);
     for (int o = 0; o < 4; o++) {
-        uint32_t px, py;
-        if (!find(a, &it->shape[o], &px, &py))
+        uint32_t px, py, fy = use && h->valid[o] ? h->y[o] : 0, fx = use && h->valid[o] ? h->x[o] : 0;
+        if (use && !h->valid[o])
+            continue; /* it did not fit before: it does not fit now */
+        h->valid[o] = find(a, &it->shape[o], fy, fx, &px, &py);
+        if (!h->valid[o])
             continue;
+        h->y[o] = py;
+        h->x[o] = px;
         uint32_t w = px + it->shape[o].w > a->used_w ? px + it->shape[o].w : a->used_w;
-        uint32_t h = py + it->shape[o].h > a->used_h ? py + it->shape[o].h : a->used_h;
-        uint32_t score = w > h ? w : h;
+        uint32_t hh = py + it->shape[o].h > a->used_h ? py + it->shape[o].h : a->used_h;
+        uint32_t score = w > hh ? w : hh;
         if (score < best) {
             best = score;
             *turn = o;
@@ -378,6 +412,8 @@ static int try_place(const atlas *a, const item *it, int *turn, uint32_t *x, uin
             by = py;
         }
     }
+    h->prev = it;
+    h->atlas = ai;
     *x = bx;
     *y = by;
     return best != UINT32_MAX;
@@ -412,15 +448,19 @@ static lmb_status place_all(const item *items, uint32_t count, uint32_t size, ui
     atlas *atlases = NULL;
     uint32_t na = 0;
     lmb_status st = LMB_OK;
+    hint h;
+    memset(&h, 0, sizeof h);
     for (uint32_t i = 0; st == LMB_OK && i < count; i++) {
         const item *it = &items[i];
         uint32_t x = 0, y = 0, a = 0;
         int turn = 0, placed = 0;
         for (a = 0; a < na && !placed; a++) {
-            placed = try_place(&atlases[a], it, &turn, &x, &y);
+            placed = try_place(&atlases[a], a, it, &h, &turn, &x, &y);
             if (!placed && atlases[a].width < size) { /* widen before giving up on it */
                 atlases[a].width = size;
-                placed = try_place(&atlases[a], it, &turn, &x, &y);
+                atlases[a].open_row = 0;
+                h.prev = NULL;
+                placed = try_place(&atlases[a], a, it, &h, &turn, &x, &y);
             }
             if (placed)
                 break;
@@ -437,9 +477,12 @@ static lmb_status place_all(const item *items, uint32_t count, uint32_t size, ui
             }
             atlases = g;
             a = na++;
-            if (!try_place(&atlases[a], it, &turn, &x, &y)) {
+            h.prev = NULL;
+            if (!try_place(&atlases[a], a, it, &h, &turn, &x, &y)) {
                 atlases[a].width = size;
-                try_place(&atlases[a], it, &turn, &x, &y);
+                atlases[a].open_row = 0;
+                h.prev = NULL;
+                try_place(&atlases[a], a, it, &h, &turn, &x, &y);
             }
         }
         occupy(&atlases[a], &it->occ[turn], x, y);
