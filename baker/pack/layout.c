@@ -15,6 +15,7 @@
 #include "../util/mat4.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -156,6 +157,16 @@ static lmb_status pack_group(const lmb_scene *s, const lmb_config *cfg, lmb_layo
     lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding};
     if (st == LMB_OK)
         st = lmb_pack_charts(charts, nc, &opt, &r, err);
+    unsigned bad;
+    if (st == LMB_ERR_INPUT && sscanf(err->message, "chart %u", &bad) == 1 && bad < nc) {
+        /* name the instance and mesh the chart belongs to: that is what a user can change */
+        char detail[sizeof err->message];
+        const char *rest = strstr(err->message, " is ");
+        snprintf(detail, sizeof detail, "%s", rest ? rest + 4 : err->message);
+        st = lmb_error_set(err, LMB_ERR_INPUT, "instance '%s' (mesh '%s'): a chart is %s (texel_density %g)",
+                           s->instances[owner[bad]].name, s->meshes[s->instances[owner[bad]].mesh].name, detail,
+                           l->instances[owner[bad]].texel_density);
+    }
     *spilled = 0;
     for (uint32_t c = 1; st == LMB_OK && c < nc; c++)
         if (owner[c] == owner[c - 1] && r.placements[c].atlas != r.placements[c - 1].atlas)

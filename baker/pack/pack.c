@@ -226,7 +226,10 @@ static int turn_mask(const mask *a, mask *b)
     return 1;
 }
 
-static int prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, item *it)
+/* Returns 1 when ready, 0 when out of memory, 2 when the chart's box (*bw x *bh) exceeds
+ * max_size: checked before any mask is allocated. */
+static int prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, uint32_t max_size, item *it,
+                   double *bw, double *bh)
 {
     uint32_t n = 3 * c->triangle_count;
     pt *p = malloc(((size_t)n + 1) * sizeof *p), *h = malloc(((size_t)n + 2) * sizeof *h);
@@ -240,8 +243,14 @@ static int prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, ite
             p[i].y = c->uv[2 * i + 1];
         }
         min_box(h, n ? hull(p, n, h) : 0, it->m, it->lo, hi);
-        uint32_t w = (uint32_t)(floor(hi[0] - it->lo[0]) + 1) + 2 * border;
-        uint32_t hh = (uint32_t)(floor(hi[1] - it->lo[1]) + 1) + 2 * border;
+        *bw = floor(hi[0] - it->lo[0]) + 1 + 2.0 * border;
+        *bh = floor(hi[1] - it->lo[1]) + 1 + 2.0 * border;
+        if (!(*bw <= max_size && *bh <= max_size)) {
+            free(p);
+            free(h);
+            return 2;
+        }
+        uint32_t w = (uint32_t)*bw, hh = (uint32_t)*bh;
         for (uint32_t i = 0; i < n; i++) { /* the chart in its box frame, lo at (border, border) */
             double u = c->uv[2 * i], v = c->uv[2 * i + 1];
             p[i].x = it->m[0] * u + it->m[1] * v - it->lo[0] + border;
@@ -527,13 +536,15 @@ lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const l
     lmb_status st = (items && out->placements) ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
     uint64_t total = 0;
     for (uint32_t i = 0; st == LMB_OK && i < count; i++, prepared++) {
-        if (!prepare(&charts[i], i, border, &items[i]))
+        double bw = 0, bh = 0;
+        int r = prepare(&charts[i], i, border, size, &items[i], &bw, &bh);
+        if (r == 0)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
-        else if (items[i].shape[0].w > size || items[i].shape[0].h > size)
+        else if (r == 2)
             st = lmb_error_set(err, LMB_ERR_INPUT,
-                               "chart %u is %u x %u texels with padding, larger than the maximum atlas size %u: lower "
-                               "texel_density",
-                               i, items[i].shape[0].w, items[i].shape[0].h, size);
+                               "chart %u is %.0f x %.0f texels with padding, larger than the maximum atlas size %u: "
+                               "lower texel_density",
+                               i, bw, bh, size);
         total += items[i].area;
     }
     /* orders and placement widths to try: squares holding the footprints with some slack (a
