@@ -1,0 +1,61 @@
+/*
+ * The final-gather estimators of irradiance at one gather point, independent of ray tracing:
+ * E = integral over the hemisphere of f(w) = L(w) max(0, w.n) dw, where L(w) is the radiance
+ * arriving from direction w (a callback: one traced ray per call).
+ *   classic:        cosine-weighted samples, E ~ 1/N sum f / p_cos.
+ *   AMIS:           the paper's adaptive multiple importance sampling (DESIGN.md section 4):
+ *                   T iterations of N_t samples from cosine-power lobes, every sample weighted by
+ *                   the balance heuristic over all lobes so far (deterministic mixture, eq. 3),
+ *                   the next lobe's axis by eq. 4 and exponent by the weighted MLE of eq. 2.
+ *   AMIS defensive: every iteration samples the mixture q_t = d p_cos + (1 - d) p_t, so every
+ *                   weight is bounded by f / (d N p_cos): at most 1/d times classic's variance
+ *                   (Hesterberg's defensive importance sampling); d = 0 is the paper exactly.
+ * A sample whose direction lies below the geometric normal has f = 0 and traces no ray.
+ * Random numbers: sample j of the point uses counter 4j.. of the caller's stream, so the
+ * same stream gives the same directions to every method (AMIS with T = 1 is classic
+ * gathering, bit for bit).
+ */
+#ifndef LMBAKE_ESTIMATOR_H
+#define LMBAKE_ESTIMATOR_H
+
+#include <lmbake/lmbake.h>
+
+#include "gather/lobe.h"
+#include "util/rng.h"
+
+#define LMB_AMIS_MAX_ITERATIONS 64
+#define LMB_AMIS_MAX_EXPONENT 1000.0 /* a lobe narrower than ~4 degrees (half width) is not learned */
+
+/* Radiance (RGB) arriving from unit direction w; `sample` is the sample's index at the point. */
+typedef void (*lmb_radiance_fn)(void *user, const double w[3], uint32_t sample, double out[3]);
+
+typedef struct lmb_estimator_options {
+    lmb_gather_method method;
+    uint32_t rays;       /* samples N (all iterations together) */
+    uint32_t iterations; /* T, AMIS only; 1..LMB_AMIS_MAX_ITERATIONS */
+    double defensive;    /* d, AMIS defensive only, in [0, 1) */
+} lmb_estimator_options;
+
+/* Per-thread memory for the AMIS samples (grows as needed; free with lmb_estimator_scratch_free). */
+typedef struct lmb_estimator_scratch {
+    uint32_t cap, count;
+    double *w, *f;        /* 3 each per kept sample: direction, integrand f (RGB) */
+    double *lum, *denom;  /* luminance of f; sum over lobes so far of N_k q_k(w) */
+} lmb_estimator_scratch;
+
+typedef struct lmb_estimate {
+    double e[3];       /* irradiance estimate */
+    uint32_t traced;   /* rays traced (samples above the surface) */
+    lmb_lobe last;     /* the last lobe used (AMIS), or the cosine lobe */
+    uint32_t adapted;  /* iterations that changed the lobe */
+} lmb_estimate;
+
+void lmb_estimator_scratch_free(lmb_estimator_scratch *s);
+
+/* Estimates E at a point with shading normal n and geometric normal ng (both unit). Returns
+ * LMB_ERR_INTERNAL only when the scratch cannot grow (out of memory). */
+lmb_status lmb_estimate_irradiance(const lmb_estimator_options *opt, const double n[3], const double ng[3],
+                                   lmb_rng rng, lmb_radiance_fn radiance, void *user, lmb_estimator_scratch *scratch,
+                                   lmb_estimate *out);
+
+#endif

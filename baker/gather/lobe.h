@@ -1,0 +1,60 @@
+/*
+ * The cosine-power lobe of the AMIS paper (eq. 1): p(w; n^, a) = (a + 1) / (2 pi) (w.n^)^a on
+ * the hemisphere around the unit axis n^, zero outside it. a = 1 is cosine sampling (the
+ * Lambertian pdf cos/pi), the starting lobe of every gather point. Sampling inverts the
+ * CDF of cos(theta): cos(theta) = u1^(1 / (a + 1)), phi = 2 pi u2. The tangent frame is
+ * Duff et al., "Building an Orthonormal Basis, Revisited" (JCGT 2017), branch-free and
+ * continuous except at n.z = -1.
+ */
+#ifndef LMBAKE_LOBE_H
+#define LMBAKE_LOBE_H
+
+#include "util/lmb_math.h"
+
+#include <math.h>
+
+typedef struct lmb_lobe {
+    double axis[3]; /* unit */
+    double a;       /* exponent, >= 0 */
+} lmb_lobe;
+
+static inline double lmb_dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* Two unit tangents t, b with (t, b, n) right-handed and orthonormal. */
+static inline void lmb_frame(const double n[3], double t[3], double b[3])
+{
+    double s = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (s + n[2]), c = n[0] * n[1] * a;
+    t[0] = 1.0 + s * n[0] * n[0] * a;
+    t[1] = s * c;
+    t[2] = -s * n[0];
+    b[0] = c;
+    b[1] = s + n[1] * n[1] * a;
+    b[2] = -n[1];
+}
+
+/* pdf of direction w (unit) under the lobe, per steradian. */
+static inline double lmb_lobe_pdf(const lmb_lobe *l, const double w[3])
+{
+    double c = lmb_dot3(w, l->axis);
+    if (c <= 0)
+        return 0;
+    return (l->a + 1.0) * (0.5 * LMB_INV_PI) * (l->a == 1.0 ? c : pow(c, l->a));
+}
+
+/* Direction drawn from the lobe with uniforms u1, u2 in [0, 1). */
+static inline void lmb_lobe_sample(const lmb_lobe *l, double u1, double u2, double w[3])
+{
+    double t[3], b[3];
+    lmb_frame(l->axis, t, b);
+    /* 1 - u1 is in (0, 1]: cos(theta) > 0, so the pdf of the sample is never 0 */
+    double ct = l->a == 1.0 ? sqrt(1.0 - u1) : pow(1.0 - u1, 1.0 / (l->a + 1.0));
+    double st = sqrt(fmax(0.0, 1.0 - ct * ct)), phi = 2.0 * LMB_PI * u2;
+    double x = st * cos(phi), y = st * sin(phi);
+    for (int k = 0; k < 3; k++)
+        w[k] = x * t[k] + y * b[k] + ct * l->axis[k];
+}
+
+#endif
