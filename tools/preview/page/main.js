@@ -1,0 +1,285 @@
+// lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
+// the view modes (lit, lightmap, checker, invalid, atlas). The URL query drives everything
+// (mode, ev, tonemap, view|cam, atlas, layer, zoom, at, ui) and the page exposes hooks for
+// tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { lightmapPlugin } from './lightmap-plugin.js';
+import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
+import { AtlasView } from './atlas-view.js';
+import { Fly } from './fly.js';
+
+const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas'];
+// "none" is three's LinearToneMapping: clamp(colour x 2^EV) (three applies no exposure at all
+// with NoToneMapping). Default: AgX, which keeps a bright hotspot from clipping.
+const TONEMAPS = { none: THREE.LinearToneMapping, agx: THREE.AgXToneMapping, aces: THREE.ACESFilmicToneMapping, neutral: THREE.NeutralToneMapping };
+const FOV = 45; // degrees, vertical
+
+const q = new URLSearchParams(location.search);
+const state = {
+  mode: q.get('mode') || 'lit', ev: Number(q.get('ev') ?? 0), tonemap: q.get('tonemap') || 'agx',
+  view: q.get('view') || 'front', cam: q.get('cam'), atlas: Number(q.get('atlas') ?? 0),
+  layer: q.get('layer') || 'lightmap', zoom: q.get('zoom') ? Number(q.get('zoom')) : null,
+  at: q.get('at') ? q.get('at').split(',').map(Number) : null, ui: q.get('ui') !== '0',
+};
+const info = (window.lmbInfo = { error: null });
+window.lmbReady = false;
+const $ = (id) => document.getElementById(id);
+
+function fail(msg) {
+  info.error = String(msg);
+  $('error').textContent = 'lmbake preview: ' + msg;
+  $('error').style.display = 'block';
+  console.error('lmbake preview: ' + msg);
+}
+addEventListener('error', (e) => fail(e.message));
+addEventListener('unhandledrejection', (e) => fail(e.reason && e.reason.stack ? e.reason.stack : e.reason));
+
+if (!MODES.includes(state.mode)) throw new Error(`unknown mode '${state.mode}' (one of ${MODES.join(', ')})`);
+if (!(state.tonemap in TONEMAPS)) throw new Error(`unknown tonemap '${state.tonemap}' (one of ${Object.keys(TONEMAPS).join(', ')})`);
+if (!Number.isFinite(state.ev)) throw new Error(`ev must be a number`);
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(devicePixelRatio);
+renderer.setSize(innerWidth, innerHeight);
+renderer.outputColorSpace = THREE.SRGBColorSpace;
+renderer.debug.onShaderError = (gl, program, vs, fs) => fail('shader error: ' + (gl.getShaderInfoLog(fs) || gl.getShaderInfoLog(vs) || gl.getProgramInfoLog(program)));
+document.body.prepend(renderer.domElement);
+
+const sceneInfo = await (await fetch('/scene.json')).json();
+document.title = `lmbake preview: ${sceneInfo.name}`;
+$('title').textContent = sceneInfo.name;
+const atlases = [];
+const loader = new GLTFLoader().register(lightmapPlugin(atlases));
+const gltf = await loader.loadAsync(sceneInfo.gltf);
+const root = gltf.scene;
+const lights = [];
+root.traverse((o) => { if (o.isLight) lights.push(o); });
+for (const l of lights) l.removeFromParent(); // lit = lightmap only, no other lights
+const scene = new THREE.Scene();
+scene.add(root);
+root.updateMatrixWorld(true);
+
+// Each mesh and its materials per mode
+const GREY = new THREE.MeshBasicMaterial({ color: 0x404040, toneMapped: false });
+const entries = [];
+const cache = new Map();
+const cached = (k, make) => (cache.has(k) ? cache.get(k) : cache.set(k, make()).get(k));
+let charts = 0;
+root.traverse((o) => {
+  if (!o.isMesh) return;
+  const lit = o.material, lm = lit.lightMap;
+  const e = { mesh: o, lit, geometry: o.geometry, atlas: lm && lm.userData.atlas !== undefined ? lm.userData.atlas : -1 };
+  if (lm) e.lightmap = cached(`lm:${lm.uuid}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(lightmapMaterial(lm, lit.lightMapIntensity), { side: lit.side }));
+  if (e.atlas >= 0 && o.geometry.attributes.uv1) {
+    const a = atlases[e.atlas];
+    e.invalid = cached(`inv:${e.atlas}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity), { side: lit.side }));
+    e.checker = cached(`chk:${e.atlas}:${lit.side}`, () => Object.assign(checkerMaterial(a), { side: lit.side }));
+    e.checkerGeometry = checkerGeometry(o.geometry, charts);
+    charts += e.checkerGeometry.userData.charts;
+  }
+  entries.push(e);
+});
+const chartMeshes = entries.filter((e) => e.checkerGeometry).map((e) => ({ atlas: e.atlas, checkerGeometry: e.checkerGeometry }));
+const atlasView = new AtlasView(atlases, chartMeshes);
+if (state.mode === 'atlas' && !atlases.length) throw new Error('the atlas view needs a MOZ_texture_rgbe (.hdr) lightmap; this glTF has none');
+if (atlases.length && !(state.atlas >= 0 && state.atlas < atlases.length)) throw new Error(`atlas ${state.atlas} does not exist (${atlases.length} atlases)`);
+if (!['lightmap', 'invalid', 'checker'].includes(state.layer)) throw new Error(`unknown layer '${state.layer}'`);
+
+// Camera: "front" looks along -Z at the centre of the scene's bounding box, from where the
+// box's +Z face fills 1/1.1 of the view height (or width, if narrower); fov 45 degrees.
+const box = new THREE.Box3().setFromObject(root);
+const size = box.getSize(new THREE.Vector3()), centre = box.getCenter(new THREE.Vector3());
+const extent = Math.max(size.length(), 1e-3);
+const camera = new THREE.PerspectiveCamera(FOV, innerWidth / innerHeight, extent * 1e-3, extent * 100);
+const controls = new OrbitControls(camera, renderer.domElement);
+const fly = new Fly(camera, renderer.domElement, extent * 0.3);
+
+function frontView() {
+  const tanHalf = Math.tan(THREE.MathUtils.degToRad(FOV / 2));
+  const half = 1.1 * Math.max(size.y / 2, size.x / 2 / camera.aspect);
+  camera.position.set(centre.x, centre.y, centre.z + size.z / 2 + half / tanHalf);
+  controls.target.copy(centre);
+  camera.lookAt(centre);
+}
+if (state.cam) {
+  const c = state.cam.split(',').map(Number);
+  if (c.length !== 6 || c.some((v) => !Number.isFinite(v))) throw new Error(`cam wants px,py,pz,tx,ty,tz`);
+  camera.position.set(c[0], c[1], c[2]); controls.target.set(c[3], c[4], c[5]); camera.lookAt(controls.target);
+} else if (state.view === 'front') frontView();
+else throw new Error(`unknown view '${state.view}' (front, or cam=px,py,pz,tx,ty,tz)`);
+controls.update();
+
+// Applying the state
+let dirty = true;
+const requestRender = () => { dirty = true; };
+controls.addEventListener('change', requestRender);
+
+function apply() {
+  const m = state.mode;
+  for (const e of entries) {
+    let mat = e.lit, geom = e.geometry;
+    if (m === 'lightmap') mat = e.lightmap || GREY;
+    else if (m === 'invalid') mat = e.invalid || GREY;
+    else if (m === 'checker') { mat = e.checker || GREY; geom = e.checkerGeometry || e.geometry; }
+    e.mesh.material = mat; e.mesh.geometry = geom;
+  }
+  renderer.toneMapping = TONEMAPS[state.tonemap];
+  renderer.toneMappingExposure = Math.pow(2, state.ev);
+  atlasView.atlas = state.atlas; atlasView.layer = state.layer;
+  if (m === 'atlas') atlasView.layout(innerWidth, innerHeight, state.zoom, state.at);
+  controls.enabled = m !== 'atlas' && !fly.enabled;
+  updateInfo();
+  requestRender();
+}
+
+function updateInfo() {
+  Object.assign(info, {
+    gltf: sceneInfo.name, mode: state.mode, ev: state.ev, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
+    camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
+    canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
+    atlases: atlases.map((a) => ({ index: a.index, uri: a.uri, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
+    meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
+    charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),
+    atlasView: { atlas: atlasView.atlas, layer: atlasView.layer, zoom: atlasView.zoom, originX: atlasView.originX, originY: atlasView.originY },
+  });
+}
+
+function render() {
+  if (state.mode === 'atlas') atlasView.render(renderer);
+  else renderer.render(scene, camera);
+}
+
+// UI
+$('panel').classList.toggle('hidden', !state.ui);
+$('hover').classList.toggle('hidden', !state.ui);
+$('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-5: views';
+$('atlas').innerHTML = atlases.map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
+const sync = () => {
+  $('mode').value = state.mode; $('ev').value = state.ev; $('evText').textContent = state.ev.toFixed(1);
+  $('tonemap').value = state.tonemap; $('atlas').value = state.atlas; $('layer').value = state.layer;
+  $('atlasControls').classList.toggle('hidden', state.mode !== 'atlas');
+  $('fly').checked = fly.enabled;
+  const u = new URL(location.href);
+  for (const k of ['mode', 'ev', 'tonemap', 'atlas', 'layer']) u.searchParams.set(k, state[k]);
+  history.replaceState(null, '', u);
+};
+const onInput = (id, f) => $(id).addEventListener('input', (e) => { f(e.target.value); sync(); apply(); });
+onInput('mode', (v) => { state.mode = v; });
+onInput('ev', (v) => { state.ev = Number(v); });
+onInput('tonemap', (v) => { state.tonemap = v; });
+onInput('atlas', (v) => { state.atlas = Number(v); state.zoom = null; state.at = null; });
+onInput('layer', (v) => { state.layer = v; });
+const setFly = (on) => {
+  if (!on && fly.enabled) { // orbit around the point in front of the camera
+    const d = camera.position.distanceTo(controls.target);
+    controls.target.copy(camera.position).add(new THREE.Vector3(0, 0, -d).applyQuaternion(camera.quaternion));
+  }
+  fly.enabled = on; sync(); apply();
+};
+$('fly').addEventListener('change', (e) => setFly(e.target.checked));
+$('reset').addEventListener('click', () => { setFly(false); frontView(); controls.update(); requestRender(); });
+addEventListener('keydown', (e) => {
+  if (['INPUT', 'SELECT'].includes(e.target.tagName)) return;
+  if (e.code === 'KeyF') setFly(!fly.enabled);
+  else if (e.code === 'KeyR') $('reset').click();
+  else if (/^Digit[1-5]$/.test(e.code)) { state.mode = MODES[Number(e.code[5]) - 1]; sync(); apply(); }
+});
+addEventListener('resize', () => {
+  renderer.setSize(innerWidth, innerHeight);
+  camera.aspect = innerWidth / innerHeight; camera.updateProjectionMatrix();
+  if (state.mode === 'atlas') atlasView.updateCamera(innerWidth, innerHeight);
+  updateInfo(); requestRender();
+});
+
+// Atlas view: drag pans, wheel zooms about the cursor
+let pan = null;
+renderer.domElement.addEventListener('pointerdown', (e) => { if (state.mode === 'atlas') pan = [e.clientX, e.clientY]; });
+addEventListener('pointerup', () => { pan = null; });
+renderer.domElement.addEventListener('wheel', (e) => {
+  if (state.mode !== 'atlas') return;
+  atlasView.zoomAt(e.deltaY < 0 ? 1.25 : 0.8, e.offsetX, e.offsetY, innerWidth, innerHeight);
+  updateInfo(); requestRender();
+}, { passive: true });
+
+// Hover: texel coordinates and the stored irradiance (from the .hdr data)
+const raycaster = new THREE.Raycaster();
+function pick(px, py) {
+  const ndc = new THREE.Vector2((px / innerWidth) * 2 - 1, -(py / innerHeight) * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  const hit = raycaster.intersectObject(root, true)[0];
+  if (!hit) return null;
+  const e = entries.find((x) => x.mesh === hit.object);
+  const r = { object: hit.object.name, point: hit.point.toArray(), distance: hit.distance, atlas: e ? e.atlas : -1 };
+  if (hit.uv1) {
+    r.uv1 = [hit.uv1.x, hit.uv1.y];
+    const a = atlases[r.atlas];
+    if (a) r.texel = [Math.min(a.width - 1, Math.floor(hit.uv1.x * a.width)), Math.min(a.height - 1, Math.floor(hit.uv1.y * a.height))];
+  }
+  return r;
+}
+addEventListener('pointermove', (e) => {
+  if (e.target !== renderer.domElement) return;
+  if (pan && state.mode === 'atlas') {
+    atlasView.pan(e.clientX - pan[0], e.clientY - pan[1], innerWidth, innerHeight); pan = [e.clientX, e.clientY];
+    updateInfo(); requestRender();
+  }
+  let t = null;
+  if (state.mode === 'atlas') t = atlasView.texelAt(e.offsetX, e.offsetY);
+  else { const h = pick(e.offsetX, e.offsetY); if (h && h.texel) t = { atlas: h.atlas, x: h.texel[0], y: h.texel[1], object: h.object }; }
+  if (t && !t.rgb) { const a = atlases[t.atlas], i = 4 * (t.y * a.width + t.x); t.rgb = Array.from(a.data.subarray(i, i + 3)); }
+  const f = (v) => v.toPrecision(4);
+  $('hover').textContent = t ? `atlas ${t.atlas} texel (${t.x}, ${t.y})${t.object ? '  ' + t.object : ''}\nE = ${t.rgb.map(f).join(' ')} lux   E/pi = ${t.rgb.map((v) => f(v / Math.PI)).join(' ')}` : '';
+});
+
+// Hooks for tests (pixel coordinates: CSS pixels from the canvas's top-left)
+window.lmbProject = (x, y, z) => {
+  const v = new THREE.Vector3(x, y, z).project(camera);
+  return { x: (v.x + 1) / 2 * innerWidth, y: (1 - v.y) / 2 * innerHeight, inFront: v.z < 1 };
+};
+// What the centre of pixel (px, py) sees: object, world point, uv1, atlas and texel.
+window.lmbPick = (px, py) => pick(px + 0.5, py + 0.5);
+// Where the centre of texel (x, y) of an atlas is drawn: in the atlas view, the pixel; in
+// the 3D views, the projection of the surface point with that UV1 (visible: a pick there
+// sees the same atlas within a texel).
+window.lmbTexelToScreen = (atlasIndex, x, y) => {
+  if (state.mode === 'atlas') return { ...atlasView.texelToScreen(x, y), visible: atlasIndex === atlasView.atlas };
+  const a = atlases[atlasIndex];
+  const p = new THREE.Vector2((x + 0.5) / a.width, (y + 0.5) / a.height);
+  for (const e of entries) {
+    if (e.atlas !== atlasIndex) continue;
+    const g = e.geometry, uv = g.attributes.uv1, pos = g.attributes.position;
+    const idx = g.index ? g.index.array : null, n = idx ? idx.length : pos.count;
+    const A = new THREE.Vector2(), B = new THREE.Vector2(), C = new THREE.Vector2(), bc = new THREE.Vector3();
+    for (let t = 0; t < n; t += 3) {
+      const i0 = idx ? idx[t] : t, i1 = idx ? idx[t + 1] : t + 1, i2 = idx ? idx[t + 2] : t + 2;
+      A.fromBufferAttribute(uv, i0); B.fromBufferAttribute(uv, i1); C.fromBufferAttribute(uv, i2);
+      if (!THREE.Triangle.containsPoint(new THREE.Vector3(p.x, p.y, 0), new THREE.Vector3(A.x, A.y, 0), new THREE.Vector3(B.x, B.y, 0), new THREE.Vector3(C.x, C.y, 0))) continue;
+      THREE.Triangle.getBarycoord(new THREE.Vector3(p.x, p.y, 0), new THREE.Vector3(A.x, A.y, 0), new THREE.Vector3(B.x, B.y, 0), new THREE.Vector3(C.x, C.y, 0), bc);
+      const w = new THREE.Vector3().fromBufferAttribute(pos, i0).multiplyScalar(bc.x)
+        .add(new THREE.Vector3().fromBufferAttribute(pos, i1).multiplyScalar(bc.y))
+        .add(new THREE.Vector3().fromBufferAttribute(pos, i2).multiplyScalar(bc.z))
+        .applyMatrix4(e.mesh.matrixWorld);
+      const s = window.lmbProject(w.x, w.y, w.z);
+      const h = pick(s.x, s.y);
+      const visible = s.inFront && s.x >= 0 && s.y >= 0 && s.x < innerWidth && s.y < innerHeight && !!h && h.atlas === atlasIndex &&
+        !!h.texel && Math.abs(h.texel[0] - x) <= 1 && Math.abs(h.texel[1] - y) <= 1;
+      return { x: s.x, y: s.y, visible, object: e.mesh.name, point: w.toArray() };
+    }
+  }
+  return null;
+};
+
+// Render loop: only when something changed (SwiftShader is slow); ready after the first frame
+sync();
+apply();
+let last = performance.now();
+function frame(now) {
+  if (fly.update((now - last) / 1000)) { dirty = true; updateInfo(); }
+  last = now;
+  if (dirty) { dirty = false; render(); }
+  requestAnimationFrame(frame);
+}
+render(); dirty = false;
+requestAnimationFrame((t) => { last = t; if (!info.error) window.lmbReady = true; requestAnimationFrame(frame); });

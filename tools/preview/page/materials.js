@@ -1,0 +1,170 @@
+// Materials of the view modes other than `lit`, and the de-indexed geometry the checker needs
+// (barycentrics, chart-boundary edge flags, a tint per chart).
+//   lightmap: colour = E x intensity / pi x 2^EV, then tone mapping, then sRGB (three's
+//             MeshBasicMaterial with a white colour does exactly E x intensity / pi; the
+//             renderer applies 2^EV = toneMappingExposure and the tone mapping).
+//   invalid:  the lightmap view, with texels whose stored irradiance is exactly 0 in magenta.
+//   checker:  a texel checkerboard of the UV1 atlas (tinted per chart, darker every other 8x8
+//             block), texel grid lines when zoomed in, chart borders in red-orange.
+import * as THREE from 'three';
+
+export const INVALID_COLOR = new THREE.Color(1, 0, 1);       // magenta, linear = sRGB
+export const BORDER_COLOR = new THREE.Color(1, 0.1, 0.0);    // linear; sRGB (255, 89, 0)
+
+const VERT = /* glsl */`
+varying vec2 vUv1;
+#ifdef CHECKER
+attribute vec3 bary;
+attribute vec3 edge;
+attribute vec3 tint;
+varying vec3 vBary;
+varying vec3 vEdge;
+varying vec3 vTint;
+#endif
+void main() {
+  vUv1 = uv1;
+#ifdef CHECKER
+  vBary = bary; vEdge = edge; vTint = tint;
+#endif
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+}`;
+
+// ATLAS_NEAREST: the 2D atlas view reads the texel itself (texelFetch), no filtering.
+const INVALID_FRAG = /* glsl */`
+uniform sampler2D lightMap;
+uniform sampler2D invalidMask;
+uniform float intensity;
+uniform vec2 atlasSize;
+uniform bool showInvalid;
+varying vec2 vUv1;
+void main() {
+  ivec2 texel = ivec2(clamp(floor(vUv1 * atlasSize), vec2(0.0), atlasSize - 1.0));
+#ifdef ATLAS_NEAREST
+  vec3 e = texelFetch(lightMap, texel, 0).rgb;
+#else
+  vec3 e = texture2D(lightMap, vUv1).rgb;
+#endif
+  gl_FragColor = vec4(e * intensity * 0.3183098861837907, 1.0); // E / pi
+  #include <tonemapping_fragment>
+  if (showInvalid && texelFetch(invalidMask, texel, 0).r > 0.5) gl_FragColor.rgb = vec3(1.0, 0.0, 1.0);
+  #include <colorspace_fragment>
+}`;
+
+const CHECKER_FRAG = /* glsl */`
+uniform vec2 atlasSize;
+uniform vec3 borderColor;
+varying vec2 vUv1;
+varying vec3 vBary;
+varying vec3 vEdge;
+varying vec3 vTint;
+void main() {
+  vec2 t = vUv1 * atlasSize;                 // texel coordinates, x right, y down the image
+  vec2 cell = floor(t);
+  bool odd = mod(cell.x + cell.y, 2.0) > 0.5;
+  vec3 c = vTint * (odd ? 0.30 : 0.80);
+  vec2 block = floor(cell / 8.0);            // 8 x 8 texel blocks: density visible from afar
+  if (mod(block.x + block.y, 2.0) > 0.5) c *= 0.8;
+  vec2 tpp = fwidth(t);                      // texels per pixel
+  vec2 distPx = fract(t) / max(tpp, vec2(1e-6)); // pixels past the texel's top-left edge
+  if (max(tpp.x, tpp.y) < 0.25 && min(distPx.x, distPx.y) < 1.0) c *= 0.4; // texel grid, 1 px
+  vec3 d = vBary / max(fwidth(vBary), vec3(1e-6)); // distance to each edge, in pixels
+  float db = 1e9;
+  if (vEdge.x > 0.5) db = min(db, d.x);
+  if (vEdge.y > 0.5) db = min(db, d.y);
+  if (vEdge.z > 0.5) db = min(db, d.z);
+  if (db < 1.5) c = borderColor;             // chart border
+  gl_FragColor = vec4(c, 1.0);
+  #include <colorspace_fragment>
+}`;
+
+export function lightmapMaterial(tex, intensity) {
+  return new THREE.MeshBasicMaterial({ color: 0xffffff, lightMap: tex, lightMapIntensity: intensity, side: THREE.FrontSide });
+}
+
+export function invalidMaterial(atlas, intensity, { nearest = false, showInvalid = true } = {}) {
+  return new THREE.ShaderMaterial({
+    defines: nearest ? { USE_UV1: '', ATLAS_NEAREST: '' } : { USE_UV1: '' },
+    uniforms: {
+      lightMap: { value: atlas.texture }, invalidMask: { value: atlas.maskTexture },
+      intensity: { value: intensity }, atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) },
+      showInvalid: { value: showInvalid },
+    },
+    vertexShader: VERT, fragmentShader: INVALID_FRAG,
+  });
+}
+
+export function checkerMaterial(atlas) {
+  return new THREE.ShaderMaterial({
+    defines: { USE_UV1: '', CHECKER: '' },
+    uniforms: { atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) }, borderColor: { value: BORDER_COLOR } },
+    vertexShader: VERT, fragmentShader: CHECKER_FRAG, toneMapped: false, side: THREE.DoubleSide,
+  });
+}
+
+// Non-indexed copy of a geometry with uv1, plus the checker attributes. Corners are welded
+// by (position, uv1) value (lmbake writes every corner as its own vertex); an edge is a chart
+// border when only one triangle uses it, and charts are the connected components.
+export function checkerGeometry(geom, firstChart = 0) {
+  const pos = geom.attributes.position, uv = geom.attributes.uv1;
+  const n = pos.count;
+  const raw = geom.index ? Array.from(geom.index.array) : Array.from({ length: n }, (_, i) => i);
+  const weld = new Map(), id = new Int32Array(n);
+  for (let i = 0; i < n; i++) {
+    const k = [pos.getX(i), pos.getY(i), pos.getZ(i), uv.getX(i), uv.getY(i)].map((v) => Math.round(v * 1e6)).join(',');
+    if (!weld.has(k)) weld.set(k, weld.size);
+    id[i] = weld.get(k);
+  }
+  const index = raw.map((i) => id[i]);
+  const w = weld.size;
+  const edgeUse = new Map();
+  const key = (a, b) => (a < b ? a * w + b : b * w + a);
+  for (let t = 0; t < index.length; t += 3) {
+    for (let k = 0; k < 3; k++) {
+      const e = key(index[t + k], index[t + (k + 1) % 3]);
+      edgeUse.set(e, (edgeUse.get(e) || 0) + 1);
+    }
+  }
+  const parent = Int32Array.from({ length: w }, (_, i) => i);
+  const find = (x) => { while (parent[x] !== x) x = parent[x] = parent[parent[x]]; return x; };
+  for (let t = 0; t < index.length; t += 3) {
+    parent[find(index[t + 1])] = find(index[t]);
+    parent[find(index[t + 2])] = find(index[t]);
+  }
+  const chartOf = new Map();
+  const out = geom.index ? geom.toNonIndexed() : geom.clone();
+  const m = index.length;
+  const bary = new Float32Array(m * 3), edge = new Float32Array(m * 3), tint = new Float32Array(m * 3);
+  const col = new THREE.Color();
+  for (let t = 0; t < m; t += 3) {
+    const root = find(index[t]);
+    if (!chartOf.has(root)) chartOf.set(root, chartOf.size);
+    col.setHSL(((firstChart + chartOf.get(root)) * 0.618034 + 0.25) % 1, 0.55, 0.72, THREE.SRGBColorSpace);
+    // edge opposite vertex k joins vertices k+1 and k+2
+    const flags = [0, 1, 2].map((k) => (edgeUse.get(key(index[t + (k + 1) % 3], index[t + (k + 2) % 3])) === 1 ? 1 : 0));
+    for (let k = 0; k < 3; k++) {
+      const o = 3 * (t + k);
+      bary[o + k] = 1;
+      edge.set(flags, o);
+      tint[o] = col.r; tint[o + 1] = col.g; tint[o + 2] = col.b;
+    }
+  }
+  out.setAttribute('bary', new THREE.BufferAttribute(bary, 3));
+  out.setAttribute('edge', new THREE.BufferAttribute(edge, 3));
+  out.setAttribute('tint', new THREE.BufferAttribute(tint, 3));
+  out.userData.charts = chartOf.size;
+  return out;
+}
+
+// The same triangles laid out flat in the atlas: x = u * width, y = -v * height (texel units).
+export function atlasLayoutGeometry(checkerGeom, atlas) {
+  const g = checkerGeom.clone();
+  const uv = g.attributes.uv1;
+  const pos = new Float32Array(uv.count * 3);
+  for (let i = 0; i < uv.count; i++) {
+    pos[3 * i] = uv.getX(i) * atlas.width;
+    pos[3 * i + 1] = -uv.getY(i) * atlas.height;
+  }
+  g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+  g.deleteAttribute('normal');
+  return g;
+}
