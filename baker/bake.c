@@ -1,13 +1,14 @@
 /*
- * The bake pipeline driver: layout (unwrap + pack) -> ray-tracing scene -> per atlas:
- * texels -> direct light -> dilation -> images; then the glTF with TEXCOORD_1 and
- * MOZ_lightmap. Output is written into a staging folder inside outdir and moved into
+ * The bake pipeline driver: layout (unwrap + pack) -> ray-tracing scene, textures, lights ->
+ * lighting (lighting.h: texels, direct light, bounce passes, final gather, dilation) ->
+ * images; then the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written into a staging folder inside outdir and moved into
  * place only when everything succeeded, so a failed bake leaves nothing behind; outdir may
  * not be the input's own folder (the input and its .bin files are never written over).
  */
 #include <lmbake/lmbake.h>
 
 #include "util/clock.h"
+#include "lighting.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
 #include "load/textures.h"
@@ -79,36 +80,6 @@ static lmb_status write_atlas_images(const lmb_config *cfg, const char *dir, con
         st = lmb_image_write_u8(path, w, h, 3, png, err);
         free(png);
     }
-    return st;
-}
-
-/* Lights one atlas into rgb (w*h*3, dilated) and valid (w*h). */
-static lmb_status light_atlas(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
-                              const lmb_emitters *em, uint32_t a, lmb_progress_fn progress, void *user, float *rgb,
-                              uint8_t *valid, lmb_bake_stats *stats, lmb_error *err)
-{
-    lmb_texels t;
-    lmb_status st = lmb_texels_build(s, l, a, cfg->texel_samples, &t, err);
-    if (st != LMB_OK)
-        return st;
-    float *e = calloc((size_t)t.count * 3 + 1, sizeof *e);
-    if (!e) {
-        lmb_texels_free(&t);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory");
-    }
-    lmb_direct_job job = {s, cfg, rt, em, a, progress, user};
-    st = lmb_direct_compute(&job, &t, e, &stats->rays, err);
-    for (uint32_t i = 0; st == LMB_OK && i < t.count; i++) {
-        valid[t.texel[i]] = t.valid[i] ? LMB_TEXEL_VALID : LMB_TEXEL_INSIDE;
-        for (int c = 0; c < 3; c++)
-            rgb[3 * (size_t)t.texel[i] + c] = e[3 * (size_t)i + c];
-        stats->texels++;
-        stats->valid_texels += t.valid[i];
-    }
-    if (st == LMB_OK)
-        st = lmb_dilate(rgb, valid, l->width[a], l->height[a], err);
-    free(e);
-    lmb_texels_free(&t);
     return st;
 }
 
@@ -278,30 +249,29 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     lmb_layout l;
     lmb_rt rt;
     lmb_emitters *em = NULL;
+    lmb_direct *direct = NULL;
     lmb_textures tx;
+    lmb_cache cache;
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
+    memset(&cache, 0, sizeof cache);
     st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
     if (st == LMB_OK)
-        st = lmb_textures_load_emissive(s, &tx, log, err);
+        st = lmb_textures_load(s, &tx, log, err);
     if (st == LMB_OK)
         st = lmb_emitters_build(s, cfg, &tx, &em, err);
+    if (st == LMB_OK)
+        st = lmb_direct_create(s, cfg, &rt, em, &direct, err);
+    if (st == LMB_OK)
+        st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     double tl = lmb_seconds();
-    for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
-        size_t n = (size_t)l.width[a] * l.height[a];
-        float *rgb = calloc(3 * n + 1, sizeof *rgb);
-        uint8_t *valid = calloc(n + 1, 1);
-        if (!rgb || !valid)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "bake: out of memory for atlas %u", a);
-        if (st == LMB_OK)
-            st = light_atlas(s, cfg, &l, &rt, em, a, progress, user, rgb, valid, stats, err);
-        if (st == LMB_OK)
-            st = write_atlas_images(cfg, od.staging, od.stem, a, rgb, valid, l.width[a], l.height[a], err);
-        free(rgb);
-        free(valid);
-    }
+    if (st == LMB_OK)
+        st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, err);
+    for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
+        st = write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
+                                l.height[a], err);
     stats->light_seconds = lmb_seconds() - tl;
     stats->atlases = l.atlas_count;
     if (st == LMB_OK) {
@@ -314,6 +284,8 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
         lmb_output_dir_abort(&od);
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
+    lmb_cache_free(&cache);
+    lmb_direct_free(direct);
     lmb_emitters_free(em);
     lmb_textures_free(&tx);
     lmb_rt_free(&rt);

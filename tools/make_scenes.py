@@ -12,6 +12,12 @@ usage: make_scenes.py OUTDIR
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
   sealed-room.gltf    closed 2 m room (inward faces), point light outside it
   box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
+  furnace.gltf        closed 2 m box, every face albedo 0.5 and emitting 1 nit (the furnace test;
+                      also the benchmark's "light from everywhere" scene)
+  two-spots.gltf      the Cornell room without blocks, two point lights 3 cm from the left and
+                      right walls: two bright spots in opposite directions (benchmark)
+  grazing.gltf        a 4 m x 1 m x 0.6 m corridor, a point light 3 cm above the floor near one
+                      end: the floor sees its spot at grazing angles (benchmark)
 
 The analytic values the tests compare with are in tests/bake/check_analytic.py.
 """
@@ -226,8 +232,29 @@ def analytic(out):
     s.write(os.path.join(out, "box-floor.gltf"))
 
 
+def indirect(out):
+    s = Scene()
+    mat = s.material("furnace", (0.5, 0.5, 0.5), emissive=(1, 1, 1))
+    s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), mat)
+    s.write(os.path.join(out, "furnace.gltf"))
+
+    s = Scene()
+    white = s.material("white", (0.73, 0.73, 0.73))
+    s.mesh("room", box(0, 0, 0, 1, 1, 1, inward=True), white)
+    s.light("left_spot", "point", 5.0, translation=(0.03, 0.5, 0.5))
+    s.light("right_spot", "point", 5.0, translation=(0.97, 0.5, 0.5))
+    s.write(os.path.join(out, "two-spots.gltf"))
+
+    s = Scene()
+    white = s.material("white", (0.73, 0.73, 0.73))
+    s.mesh("corridor", box(0, 0, 0, 4, 0.6, 1, inward=True), white)
+    s.light("floor_spot", "point", 5.0, translation=(0.5, 0.03, 0.5))
+    s.write(os.path.join(out, "grazing.gltf"))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     cornell(out)
     analytic(out)
+    indirect(out)

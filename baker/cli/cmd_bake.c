@@ -1,8 +1,8 @@
 /*
  * `lmbake bake SCENE [-c CONFIG] [-o OUTDIR]`: the whole pipeline on one level.
  * Command-line values override the config file, which overrides the defaults.
- * Stages: load, select, then lmb_bake (unwrap, pack, texels, direct light, dilation, write).
- * Indirect light (bounce cache, final gather) is not in yet: the lightmaps hold direct light.
+ * Stages: load, select, then lmb_bake (unwrap, pack, texels, direct light, bounce passes,
+ * final gather or the path-traced reference, dilation, write).
  */
 #include "cli_common.h"
 #include "commands.h"
@@ -19,6 +19,10 @@ static const char help[] =
     "  -o, --output DIR    output folder (default: ./lmbake-out)\n"
     "      --threads N     worker threads, 0 = all cores (overrides the config)\n"
     "      --seed N        random seed (overrides the config)\n"
+    "      --method M      final gather: cosine, amis or amis_defensive (overrides gather.method)\n"
+    "      --rays N        final gather rays per texel (overrides samples.gather)\n"
+    "      --reference     path-trace indirect light with no cache (ground truth for error\n"
+    "                      measurement; --rays paths per texel: use many)\n"
     "  -q, --quiet         no progress or warnings\n"
     "  -h, --help          this help\n"
     "\n"
@@ -26,15 +30,15 @@ static const char help[] =
 
 typedef struct bake_args {
     const char *scene, *config, *outdir;
-    long long threads, seed; /* -1: from the config */
-    int quiet;
+    long long threads, seed, rays, method; /* -1: from the config */
+    int quiet, reference;
 } bake_args;
 
 static int parse_args(int argc, char **argv, bake_args *a)
 {
     memset(a, 0, sizeof *a);
     a->outdir = "lmbake-out";
-    a->threads = a->seed = -1;
+    a->threads = a->seed = a->rays = a->method = -1;
     for (int i = 1; i < argc; i++) {
         const char *v;
         int r;
@@ -58,6 +62,20 @@ static int parse_args(int argc, char **argv, bake_args *a)
             if (r < 0 || !cli_parse_uint(v, (1ULL << 63) - 1, &n))
                 return cli_usage_error("bake", "--seed needs a non-negative integer");
             a->seed = (long long)n;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--rays", NULL, &v)) != 0) {
+            if (r < 0 || !cli_parse_uint(v, 1048576, &n) || n == 0)
+                return cli_usage_error("bake", "--rays needs a number 1..1048576");
+            a->rays = (long long)n;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--method", NULL, &v)) != 0) {
+            static const char *const names[] = {"cosine", "amis", "amis_defensive"};
+            a->method = -2;
+            for (int k = 0; r > 0 && k < 3; k++)
+                if (!strcmp(v, names[k]))
+                    a->method = k;
+            if (a->method < 0)
+                return cli_usage_error("bake", "--method needs cosine, amis or amis_defensive");
+        } else if (cli_is_flag(argv[i], "--reference", NULL)) {
+            a->reference = 1;
         } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
             a->quiet = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
@@ -88,6 +106,11 @@ int cmd_bake(int argc, char **argv)
         cfg.threads = (uint32_t)a.threads;
     if (a.seed >= 0)
         cfg.seed = (uint64_t)a.seed;
+    if (a.rays > 0)
+        cfg.gather_rays = (uint32_t)a.rays;
+    if (a.method >= 0)
+        cfg.gather_method = (lmb_gather_method)a.method;
+    cfg.reference = a.reference;
     cli_warnings warnings = {0, a.quiet};
     lmb_log log = cli_log(&warnings);
     double t0 = cli_now();
@@ -117,6 +140,10 @@ int cmd_bake(int argc, char **argv)
     lmb_scene_free(scene);
     if (rc != LMB_OK)
         return cli_fail(&err);
+    if (!a.quiet && cfg.bounces > 0)
+        printf("%s: %.3f s, %llu rays, %.4g rays/s, %u rays per texel, %u bounce(s)\n",
+               cfg.reference ? "reference" : "final gather", bs.gather_seconds, (unsigned long long)bs.gather_rays,
+               bs.gather_seconds > 0 ? (double)bs.gather_rays / bs.gather_seconds : 0.0, cfg.gather_rays, cfg.bounces);
     if (!a.quiet)
         printf("bake: %.2f s (lighting %.2f s), %u atlas(es), %llu texels (%llu valid), %llu rays, %.3g rays/s\n"
                "output: %s (lightmaps beside it)\n",

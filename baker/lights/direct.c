@@ -44,6 +44,7 @@ typedef struct emitter {
     int two_sided;
     const lmb_texture *tex; /* emissive texture or NULL */
     float uv[6];   /* its texture coordinates at the corners */
+    uint32_t instance, primitive, triangle; /* where it is in the scene (primitive: lmb_scene index) */
 } emitter;
 
 struct lmb_emitters {
@@ -136,6 +137,9 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const l
                     x.le[k] = (float)(mat->emissive[k] * cfg->emissive_scale);
                 x.two_sided = mat->double_sided;
                 x.tex = emitter_texture(tx, mat, pr, f, x.uv);
+                x.instance = i;
+                x.primitive = m->first_primitive + p;
+                x.triangle = f;
                 st = add_emitter(es, &cap, &x, err);
             }
         }
@@ -178,9 +182,17 @@ static uint32_t pick(const lmb_emitters *es, double u, double *prob)
     return lo;
 }
 
+struct lmb_direct {
+    const lmb_scene *scene;
+    const lmb_config *cfg;
+    const lmb_rt *rt;
+    const lmb_emitters *emitters;
+    light_set lights;
+    uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
+};
+
 typedef struct point_ctx {
-    const lmb_direct_job *job;
-    const light_set *lights;
+    const lmb_direct *d;
     double o[3];    /* offset origin */
     double p[3], n[3], ng[3];
     double eps;
@@ -192,10 +204,22 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
+/* Two unit tangents completing the unit normal n (Duff et al. 2017). */
+static void lmb_basis(const double n[3], double t[3], double b[3])
+{
+    double sg = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (sg + n[2]), c = n[0] * n[1] * a;
+    t[0] = 1.0 + sg * n[0] * n[0] * a;
+    t[1] = sg * c;
+    t[2] = -sg * n[0];
+    b[0] = c;
+    b[1] = sg + n[1] * n[1] * a;
+    b[2] = -n[1];
+}
+
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
-    double scale = c->job->cfg->light_intensity_scale, d[3], dist = 1e300, cosang, w = 1.0;
+    double scale = c->d->cfg->light_intensity_scale, d[3], dist = 1e300, cosang, w = 1.0;
     if (l->type == LMB_LIGHT_DIRECTIONAL) {
         for (int k = 0; k < 3; k++)
             d[k] = -l->direction[k];
@@ -224,7 +248,7 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     if (w <= 0 || cosang <= 0 || dot3(c->ng, d) <= 0)
         return;
     c->rays++;
-    if (lmb_rt_occluded(c->job->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
+    if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
         return;
     for (int k = 0; k < 3; k++)
         e[k] += weight * scale * l->intensity * l->color[k] * cosang * w;
@@ -233,14 +257,14 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
 /* Point and spot lights: all of them when few, else power-proportional samples. */
 static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
 {
-    const light_set *ls = c->lights;
-    const lmb_light *all = c->job->scene->lights;
+    const light_set *ls = &c->d->lights;
+    const lmb_light *all = c->d->scene->lights;
     if (ls->local_count <= EXACT_LOCAL_LIGHTS) {
         for (uint32_t i = 0; i < ls->local_count; i++)
             punctual(c, &all[ls->local[i]], 1.0, e);
         return;
     }
-    uint32_t n = c->job->cfg->direct_samples;
+    uint32_t n = c->d->cfg->direct_samples;
     double total = ls->cdf[ls->local_count];
     for (uint32_t s = 0; s < n; s++) {
         double target = lmb_rng_next(rng) * total;
@@ -257,38 +281,84 @@ static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
     }
 }
 
+/* Emitted radiance of emitter x at barycentrics (b1, b2) seen from direction d (unit, toward
+ * the emitter), or 0 when seen from its back and one-sided. */
+static int emitted(const emitter *x, double b1, double b2, const double d[3], double *cos_y, double le[3])
+{
+    double cy = -dot3(x->n, d);
+    if (x->two_sided)
+        cy = fabs(cy);
+    if (cy <= 0)
+        return 0;
+    float t[3] = {1, 1, 1};
+    double b0 = 1 - b1 - b2;
+    if (x->tex)
+        lmb_texture_sample(x->tex, b0 * x->uv[0] + b1 * x->uv[2] + b2 * x->uv[4],
+                           b0 * x->uv[1] + b1 * x->uv[3] + b2 * x->uv[5], t);
+    for (int k = 0; k < 3; k++)
+        le[k] = x->le[k] * t[k];
+    *cos_y = cy;
+    return 1;
+}
+
+/* Area lights by multiple importance sampling (Veach 1997, balance heuristic, one sample of
+ * each technique per round): a point on an emitter chosen by power (pdf in solid angle
+ * p_l = P(tri) / A_tri x d^2 / cos_y) and a cosine-distributed direction (p_b = cos_x / pi)
+ * that counts when its first hit is an emitter. Light sampling alone has unbounded variance
+ * where an emitter meets the surface (corners of an emissive room); the cosine rays cover it. */
 static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
 {
-    const lmb_emitters *es = c->job->emitters;
-    uint32_t n = c->job->cfg->direct_samples;
+    const lmb_emitters *es = c->d->emitters;
+    uint32_t n = c->d->cfg->direct_samples;
+    double total = es->cdf[es->count];
     for (uint32_t s = 0; s < n; s++) {
+        /* light sample */
         double prob, u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), u3 = lmb_rng_next(rng);
         const emitter *x = &es->e[pick(es, u1, &prob)];
-        double su = sqrt(u2), b0 = 1 - su, b1 = su * (1 - u3), b2 = su * u3, y[3], d[3];
+        double su = sqrt(u2), b1 = su * (1 - u3), b2 = su * u3, y[3], d[3], le[3], cy;
         for (int k = 0; k < 3; k++) {
-            y[k] = b0 * x->p[k] + b1 * x->p[3 + k] + b2 * x->p[6 + k];
+            y[k] = (1 - b1 - b2) * x->p[k] + b1 * x->p[3 + k] + b2 * x->p[6 + k];
             d[k] = y[k] - c->p[k];
         }
         double dist2 = dot3(d, d), dist = sqrt(dist2);
-        if (!(dist > 0))
-            continue;
+        if (dist > 0) {
+            for (int k = 0; k < 3; k++)
+                d[k] /= dist;
+            double cx = dot3(c->n, d);
+            if (cx > 0 && dot3(c->ng, d) > 0 && emitted(x, b1, b2, d, &cy, le)) {
+                c->rays++;
+                if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
+                    double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
+                    double g = cx / (pl + pb) / n;
+                    for (int k = 0; k < 3; k++)
+                        e[k] += le[k] * g;
+                }
+            }
+        }
+        /* cosine sample */
+        double v1 = lmb_rng_next(rng), v2 = lmb_rng_next(rng), t1[3], t2[3], w[3];
+        double r = sqrt(v1), phi = 2 * LMB_PI * v2, cz = sqrt(fmax(0, 1 - v1));
+        lmb_basis(c->n, t1, t2);
         for (int k = 0; k < 3; k++)
-            d[k] /= dist;
-        double cx = dot3(c->n, d), cy = -dot3(x->n, d);
-        if (x->two_sided)
-            cy = fabs(cy);
-        if (cx <= 0 || cy <= 0 || dot3(c->ng, d) <= 0)
+            w[k] = r * cos(phi) * t1[k] + r * sin(phi) * t2[k] + cz * c->n[k];
+        if (!(cz > 0) || dot3(c->ng, w) <= 0)
             continue;
+        lmb_rt_hit h;
         c->rays++;
-        if (lmb_rt_occluded(c->job->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps))
+        if (!lmb_rt_intersect(c->d->rt, c->o, w, c->eps, 1e300, &h))
             continue;
-        double g = cx * cy / dist2 * x->area / prob / n;
-        float t[3] = {1, 1, 1};
-        if (x->tex)
-            lmb_texture_sample(x->tex, b0 * x->uv[0] + b1 * x->uv[2] + b2 * x->uv[4],
-                               b0 * x->uv[1] + b1 * x->uv[3] + b2 * x->uv[5], t);
+        const uint32_t *map = c->d->emitter_of[h.geom];
+        uint32_t k1 = map ? map[h.prim] : 0;
+        if (!k1)
+            continue;
+        x = &es->e[k1 - 1];
+        if (!emitted(x, h.u, h.v, w, &cy, le))
+            continue;
+        double pt = (es->cdf[k1] - es->cdf[k1 - 1]) / total;
+        double pl = pt / x->area * h.t * h.t / cy, pb = cz * LMB_INV_PI;
+        double g = cz / (pl + pb) / n;
         for (int k = 0; k < 3; k++)
-            e[k] += x->le[k] * t[k] * g;
+            e[k] += le[k] * g;
     }
 }
 
@@ -313,41 +383,74 @@ static int inside_geometry(point_ctx *c, lmb_rng *rng)
             d[k] = x * t1[k] + y * t2[k] + z * c->ng[k];
         lmb_rt_hit h;
         c->rays++;
-        if (lmb_rt_intersect(c->job->rt, c->o, d, c->eps, 1e300, &h) && h.backface)
+        if (lmb_rt_intersect(c->d->rt, c->o, d, c->eps, 1e300, &h) && h.backface)
             back++;
     }
     return 2 * back > VALIDITY_RAYS;
 }
 
-static void texel_direct(const lmb_direct_job *job, const light_set *lights, lmb_texels *t, uint32_t i, float *out,
-                         uint64_t *rays)
+static void point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp)
+{
+    memset(c, 0, sizeof *c);
+    c->d = d;
+    for (int k = 0; k < 3; k++) {
+        c->p[k] = sp->p[k];
+        c->n[k] = sp->n[k];
+        c->ng[k] = sp->ng[k];
+        c->o[k] = sp->p[k] + sp->ng[k] * sp->eps;
+    }
+    c->eps = sp->eps;
+}
+
+uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, double e[3])
+{
+    point_ctx c;
+    point_init(&c, d, sp);
+    e[0] = e[1] = e[2] = 0;
+    for (uint32_t l = 0; l < d->lights.directional_count; l++)
+        punctual(&c, &d->scene->lights[d->lights.directional[l]], 1.0, e);
+    local_lights(&c, rng, e);
+    if (lmb_emitters_count(d->emitters))
+        area_lights(&c, rng, e);
+    return (uint32_t)c.rays;
+}
+
+int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays)
+{
+    point_ctx c;
+    point_init(&c, d, sp);
+    int inside = inside_geometry(&c, rng);
+    *rays += (uint32_t)c.rays;
+    return inside;
+}
+
+void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp)
+{
+    const lmb_gather_point *g = &t->points[(size_t)i * t->samples + k];
+    for (int r = 0; r < 3; r++) {
+        sp->p[r] = g->p[r];
+        sp->n[r] = g->n[r];
+        sp->ng[r] = g->ng[r];
+    }
+    sp->eps = d->rt->eps + 1e-4 * t->texel_size[i];
+}
+
+static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, float *out, uint64_t *rays)
 {
     double sum[3] = {0, 0, 0};
-    uint32_t used = 0;
+    uint32_t used = 0, r = 0;
     uint64_t key = ((uint64_t)job->atlas << 32) | t->texel[i];
-    point_ctx c;
-    memset(&c, 0, sizeof c);
-    c.job = job;
-    c.lights = lights;
+    t->gather_at[i] = 0;
     for (uint32_t k = 0; k < t->points_in[i]; k++) {
-        const lmb_gather_point *g = &t->points[(size_t)i * t->samples + k];
-        lmb_rng rng = lmb_rng_make(job->cfg->seed, key, k);
-        for (int d = 0; d < 3; d++) {
-            c.p[d] = g->p[d];
-            c.n[d] = g->n[d];
-            c.ng[d] = g->ng[d];
-        }
-        c.eps = job->rt->eps + 1e-4 * t->texel_size[i];
-        for (int d = 0; d < 3; d++)
-            c.o[d] = c.p[d] + c.ng[d] * c.eps;
-        if (inside_geometry(&c, &rng))
+        lmb_shading_point sp;
+        lmb_texel_shading_point(job->direct, t, i, k, &sp);
+        lmb_rng rng = lmb_rng_make(job->direct->cfg->seed, key, k);
+        if (lmb_point_inside_geometry(job->direct, &sp, &rng, &r))
             continue;
-        double e[3] = {0, 0, 0};
-        for (uint32_t l = 0; l < c.lights->directional_count; l++)
-            punctual(&c, &job->scene->lights[c.lights->directional[l]], 1.0, e);
-        local_lights(&c, &rng, e);
-        if (lmb_emitters_count(job->emitters))
-            area_lights(&c, &rng, e);
+        if (!used)
+            t->gather_at[i] = (uint8_t)k;
+        double e[3];
+        r += lmb_direct_at(job->direct, &sp, &rng, e);
         for (int d = 0; d < 3; d++)
             sum[d] += e[d];
         used++;
@@ -355,7 +458,7 @@ static void texel_direct(const lmb_direct_job *job, const light_set *lights, lmb
     t->valid[i] = used > 0;
     for (int d = 0; d < 3; d++)
         out[3 * i + d] = used ? (float)(sum[d] / used) : 0.0f;
-    *rays += c.rays;
+    *rays += r;
 }
 
 /* Splits the scene's lights into directional and local, with the local lights' power CDF
@@ -391,31 +494,80 @@ static void light_set_free(light_set *ls)
     free(ls->cdf);
 }
 
-lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays, lmb_error *err)
+lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, const lmb_rt *rt,
+                             const lmb_emitters *emitters, lmb_direct **out, lmb_error *err)
 {
-    light_set lights;
-    if (!light_set_build(job->scene, &lights)) {
-        light_set_free(&lights);
+    lmb_direct *d = calloc(1, sizeof *d);
+    if (!d || !light_set_build(scene, &d->lights)) {
+        if (d)
+            light_set_free(&d->lights);
+        free(d);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory");
     }
+    d->scene = scene;
+    d->cfg = cfg;
+    d->rt = rt;
+    d->emitters = emitters;
+    d->emitter_of = calloc((size_t)rt->geom_count + 1, sizeof *d->emitter_of);
+    lmb_status st = d->emitter_of ? LMB_OK : LMB_ERR_INTERNAL;
+    /* emitters come grouped by (instance, primitive); geometries in the same order */
+    uint32_t g = 0;
+    for (uint32_t k = 0; st == LMB_OK && emitters && k < emitters->count; k++) {
+        const emitter *x = &emitters->e[k];
+        while (g < rt->geom_count && (rt->geoms[g].instance != x->instance || rt->geoms[g].primitive != x->primitive))
+            g++;
+        if (g == rt->geom_count) {
+            st = LMB_ERR_INTERNAL;
+            break;
+        }
+        if (!d->emitter_of[g]) {
+            d->emitter_of[g] = calloc((size_t)scene->primitives[x->primitive].triangle_count + 1, sizeof **d->emitter_of);
+            if (!d->emitter_of[g]) {
+                st = LMB_ERR_INTERNAL;
+                break;
+            }
+        }
+        d->emitter_of[g][x->triangle] = k + 1;
+    }
+    if (st != LMB_OK) {
+        lmb_direct_free(d);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory (emitter map)");
+    }
+    *out = d;
+    return LMB_OK;
+}
+
+void lmb_direct_free(lmb_direct *d)
+{
+    if (!d)
+        return;
+    light_set_free(&d->lights);
+    for (uint32_t g = 0; d->emitter_of && g < d->rt->geom_count; g++)
+        free(d->emitter_of[g]);
+    free(d->emitter_of);
+    free(d);
+}
+
+lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays, lmb_error *err)
+{
     const uint32_t block = 1024;
     uint64_t total = 0;
-    int threads = job->cfg->threads ? (int)job->cfg->threads : 0;
+    int threads = job->direct->cfg->threads ? (int)job->direct->cfg->threads : omp_get_max_threads();
     for (uint32_t start = 0; start < t->count; start += block) {
         uint32_t end = start + block < t->count ? start + block : t->count;
         uint64_t block_rays = 0;
-#pragma omp parallel num_threads(threads ? threads : omp_get_max_threads()) reduction(+ : block_rays)
+#pragma omp parallel num_threads(threads) reduction(+ : block_rays)
         {
             lmb_rt_thread_init();
 #pragma omp for schedule(dynamic, 16)
             for (uint32_t i = start; i < end; i++)
-                texel_direct(job, &lights, t, i, irradiance, &block_rays);
+                texel_direct(job, t, i, irradiance, &block_rays);
         }
         total += block_rays;
         if (job->progress)
             job->progress(job->progress_user, "direct", end, t->count);
     }
     *rays += total;
-    light_set_free(&lights);
+    (void)err;
     return LMB_OK;
 }

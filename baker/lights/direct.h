@@ -12,6 +12,7 @@
 #include "rt_scene.h"
 #include "load/textures.h"
 #include "texels/texels.h"
+#include "util/rng.h"
 
 typedef struct lmb_emitters lmb_emitters; /* opaque: emissive triangles and their power CDF */
 
@@ -22,17 +23,39 @@ lmb_status lmb_emitters_build(const lmb_scene *scene, const lmb_config *cfg, con
 void lmb_emitters_free(lmb_emitters *e);
 uint32_t lmb_emitters_count(const lmb_emitters *e);
 
+typedef struct lmb_direct lmb_direct; /* opaque: a scene's lights ready to evaluate at any point */
+
+/* The lights of scene (punctual from scene->lights, area from emitters), for any number of
+ * threads at once. Borrows everything it is given; free with lmb_direct_free. */
+lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, const lmb_rt *rt,
+                             const lmb_emitters *emitters, lmb_direct **out, lmb_error *err);
+void lmb_direct_free(lmb_direct *d);
+
+/* A point on a surface: position, shading and geometric normals (unit, front side) and the
+ * offset along ng that rays start from (so they do not hit the surface itself). */
+typedef struct lmb_shading_point {
+    double p[3], n[3], ng[3];
+    double eps;
+} lmb_shading_point;
+
+/* Direct irradiance at sp (lux, RGB) from every light with shadow rays; rng drives area-light
+ * and many-light sampling. Returns the rays traced. */
+uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, double e[3]);
+
+/* 1 when sp lies inside geometry (most of its hemisphere rays hit back faces); adds to *rays. */
+int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays);
+
+/* Gather point k of listed texel i of t as a shading point (offset scaled to the texel). */
+void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp);
+
 typedef struct lmb_direct_job {
-    const lmb_scene *scene;
-    const lmb_config *cfg;
-    const lmb_rt *rt;
-    const lmb_emitters *emitters;
+    const lmb_direct *direct;
     uint32_t atlas;      /* keys the random streams */
     lmb_progress_fn progress;
     void *progress_user;
 } lmb_direct_job;
 
-/* Fills irradiance (3 floats per listed texel of t) and t->valid. Counts rays traced. */
+/* Fills irradiance (3 floats per listed texel of t), t->valid and t->gather_at. Counts rays. */
 lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays,
                               lmb_error *err);
 

@@ -96,6 +96,7 @@ static const key_spec config_keys[] = {
     U32("samples.texel", OFF(texel_samples), 1, 256),
     U32("samples.direct", OFF(direct_samples), 1, 65536),
     U32("samples.gather", OFF(gather_rays), 1, 1048576),
+    U32("samples.bounce", OFF(bounce_rays), 1, 1048576),
     U32("samples.amis_iterations", OFF(amis_iterations), 1, 64),
     U32("bounces", OFF(bounces), 0, 64),
     ENUM("gather.method", OFF(gather_method), gather_methods),
@@ -129,6 +130,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->texel_samples = 4;
     cfg->direct_samples = 16;
     cfg->gather_rays = 256;
+    cfg->bounce_rays = 64;
     cfg->amis_iterations = 4;
     cfg->bounces = 2;
     cfg->gather_method = LMB_GATHER_AMIS_DEFENSIVE;

@@ -64,7 +64,25 @@ static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t 
     return LMB_OK;
 }
 
-lmb_status lmb_textures_load_emissive(const lmb_scene *s, lmb_textures *out, const lmb_log *log, lmb_error *err)
+/* Loads texture `tex` for `role` of material m once; a texture that cannot be read is a warning. */
+static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_material *m, int32_t tex, const char *role,
+                     lmb_textures *out, const lmb_log *log)
+{
+    if (tex < 0)
+        return;
+    if ((uint32_t)tex >= v->texture_count) {
+        lmb_warn(log, "%s: material '%s' names %s texture %d, which does not exist; using its factor", s->path,
+                 m->name, role, tex);
+        return;
+    }
+    if (out->t[tex].rgb)
+        return;
+    lmb_error e;
+    if (load_one(s, v, (uint32_t)tex, &out->t[tex], &e) != LMB_OK)
+        lmb_warn(log, "material '%s': %s texture not used: %s", m->name, role, e.message);
+}
+
+lmb_status lmb_textures_load(const lmb_scene *s, lmb_textures *out, const lmb_log *log, lmb_error *err)
 {
     const lmb_gltf_view *v = lmb_gltf_get_view(s->doc);
     memset(out, 0, sizeof *out);
@@ -73,21 +91,12 @@ lmb_status lmb_textures_load_emissive(const lmb_scene *s, lmb_textures *out, con
     if (!out->t)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "textures: out of memory");
     for (uint32_t m = 0; m < s->material_count; m++) {
-        int32_t tex = s->materials[m].emissive_texture;
-        if (tex < 0 || !lmb_material_is_emissive(&s->materials[m]))
-            continue;
-        if ((uint32_t)tex >= v->texture_count) {
-            lmb_warn(log, "%s: material '%s' names emissive texture %d, which does not exist; using its factor",
-                     s->path, s->materials[m].name, tex);
-            continue;
-        }
-        if (out->t[tex].rgb)
-            continue;
-        lmb_error e;
-        if (load_one(s, v, (uint32_t)tex, &out->t[tex], &e) != LMB_OK)
-            lmb_warn(log, "material '%s': emissive texture not used: %s", s->materials[m].name, e.message);
+        const lmb_material *mat = &s->materials[m];
+        if (lmb_material_is_emissive(mat))
+            load_for(s, v, mat, mat->emissive_texture, "emissive", out, log);
+        if (mat->metallic < 1)
+            load_for(s, v, mat, mat->base_color_texture, "base colour", out, log);
     }
-    (void)err;
     return LMB_OK;
 }
 

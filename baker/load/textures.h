@@ -1,5 +1,5 @@
 /*
- * Material textures the baker needs (emissive now, base colour for bounces later), decoded
+ * Material textures the baker needs (emissive for area lights, base colour for the albedo of bounces), decoded
  * once through the OpenImageIO adapter from the glTF's external files, buffer views or
  * data URIs, converted from sRGB to linear (glTF colour textures are sRGB), and sampled
  * bilinearly with repeat wrapping (glTF's default sampler; samplers are not read yet).
@@ -20,9 +20,10 @@ typedef struct lmb_textures {
     lmb_texture *t; /* indexed like the glTF's textures */
 } lmb_textures;
 
-/* Loads every texture used as an emissive texture by a material of scene. A texture that
- * cannot be read is a warning (the material then emits its factor alone). */
-lmb_status lmb_textures_load_emissive(const lmb_scene *scene, lmb_textures *out, const lmb_log *log, lmb_error *err);
+/* Loads every texture a material of scene uses as its emissive texture (when it emits) or its
+ * base colour texture (when it reflects diffusely: metallic < 1). A texture that cannot be
+ * read is a warning (the material then uses its factor alone). */
+lmb_status lmb_textures_load(const lmb_scene *scene, lmb_textures *out, const lmb_log *log, lmb_error *err);
 
 /* Bilinear lookup at glTF UV (u, v), (0, 0) = the image's top-left corner. */
 void lmb_texture_sample(const lmb_texture *t, double u, double v, float out[3]);

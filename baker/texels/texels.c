@@ -33,6 +33,7 @@ void lmb_texels_free(lmb_texels *t)
     free(t->texel_size);
     free(t->points);
     free(t->valid);
+    free(t->gather_at);
     memset(t, 0, sizeof *t);
 }
 
@@ -208,7 +209,8 @@ lmb_status lmb_texels_build(const lmb_scene *s, const lmb_layout *l, uint32_t at
     out->texel_size = malloc(((size_t)out->count + 1) * sizeof *out->texel_size);
     out->points = calloc((size_t)out->count * samples + 1, sizeof *out->points);
     out->valid = malloc((size_t)out->count + 1);
-    if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->valid) {
+    out->gather_at = calloc((size_t)out->count + 1, 1);
+    if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->valid || !out->gather_at) {
         free(b);
         lmb_texels_free(out);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", out->count);

@@ -29,6 +29,8 @@ typedef struct lmb_texels {
     float *texel_size;         /* per listed texel: world units per texel */
     lmb_gather_point *points;  /* count * samples; the first points_in[i] of each are set */
     uint8_t *valid;            /* per listed texel: 1, or 0 when inside geometry (set by the lights stage) */
+    uint8_t *gather_at;        /* per listed texel: its first point outside geometry, where indirect
+                                  light is gathered (set by the lights stage) */
 } lmb_texels;
 
 /* Gather points for atlas `atlas` of layout l. `samples` per texel, 1..256. */

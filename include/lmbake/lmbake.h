@@ -184,11 +184,13 @@ typedef struct lmb_config {
     /* samples */
     uint32_t texel_samples;        /* gather points per texel (stratified) */
     uint32_t direct_samples;       /* shadow rays per area-light evaluation */
-    uint32_t gather_rays;          /* final gather rays per gather point */
+    uint32_t gather_rays;          /* final gather rays per texel (reference: paths per texel) */
+    uint32_t bounce_rays;          /* rays per texel of each bounce pass before the final gather */
     uint32_t amis_iterations;
     uint32_t bounces;
     lmb_gather_method gather_method;
     double defensive_fraction;     /* share of cosine samples, AMIS defensive */
+    int reference;                 /* path-trace indirect light with no cache (ground truth) */
     uint64_t seed;
     uint32_t threads;              /* 0: all cores */
     unsigned output_formats;       /* LMB_OUTPUT_* bits */
@@ -257,6 +259,9 @@ typedef struct lmb_bake_stats {
     uint64_t rays;          /* shadow and validity rays traced */
     double seconds;         /* wall time of the bake (layout to last file) */
     double light_seconds;   /* wall time of the lighting stages */
+    double gather_seconds;  /* wall time of the final gather (or the reference) */
+    uint64_t gather_rays;   /* rays of the final gather (or the reference) */
+    uint64_t amis_adapted;  /* AMIS lobe updates that changed a lobe */
     char gltf_path[8600];   /* the output glTF */
 } lmb_bake_stats;
 

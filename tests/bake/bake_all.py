@@ -10,7 +10,7 @@ import os
 import subprocess
 import sys
 
-CONFIG = "texel_density: 4\natlas: {max_size: 2048}\nsamples: {texel: 1, direct: 2}\n"
+CONFIG = "texel_density: 4\natlas: {max_size: 2048}\nbounces: 2\nsamples: {texel: 1, direct: 2, gather: 16, bounce: 8}\n"
 
 
 def main():

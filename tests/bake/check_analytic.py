@@ -25,6 +25,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 SAMPLES = 4  # samples.texel in the configs below
 
 CONFIG = """texel_density: 8
+bounces: 0        # direct light only: the formulas are direct irradiance
 samples:
   texel: %d
   direct: %d

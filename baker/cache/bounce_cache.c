@@ -1,0 +1,121 @@
+/* The bounce cache (see bounce_cache.h). */
+#include "bounce_cache.h"
+
+#include "post/dilate.h"
+#include "util/lmb_math.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void lmb_cache_free(lmb_cache *c)
+{
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        if (c->irradiance)
+            free(c->irradiance[a]);
+        if (c->state)
+            free(c->state[a]);
+    }
+    free(c->irradiance);
+    free(c->state);
+    memset(c, 0, sizeof *c);
+}
+
+lmb_status lmb_cache_init(lmb_cache *c, const lmb_scene *scene, const lmb_layout *layout, const lmb_rt *rt,
+                          const lmb_textures *textures, lmb_error *err)
+{
+    memset(c, 0, sizeof *c);
+    c->scene = scene;
+    c->layout = layout;
+    c->rt = rt;
+    c->textures = textures;
+    c->atlas_count = layout->atlas_count;
+    c->irradiance = calloc((size_t)c->atlas_count + 1, sizeof *c->irradiance);
+    c->state = calloc((size_t)c->atlas_count + 1, sizeof *c->state);
+    if (!c->irradiance || !c->state)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory");
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        size_t n = (size_t)layout->width[a] * layout->height[a];
+        c->irradiance[a] = calloc(3 * n + 1, sizeof **c->irradiance);
+        c->state[a] = calloc(n + 1, 1);
+        if (!c->irradiance[a] || !c->state[a])
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u", a);
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err)
+{
+    uint32_t w = c->layout->width[a], h = c->layout->height[a];
+    float *img = c->irradiance[a];
+    uint8_t *st = c->state[a];
+    memset(img, 0, (size_t)w * h * 3 * sizeof *img);
+    memset(st, LMB_TEXEL_EMPTY, (size_t)w * h);
+    for (uint32_t i = 0; i < t->count; i++) {
+        st[t->texel[i]] = t->valid[i] ? LMB_TEXEL_VALID : LMB_TEXEL_INSIDE;
+        for (int k = 0; k < 3; k++)
+            img[3 * (size_t)t->texel[i] + k] = t->valid[i] ? e[3 * (size_t)i + k] : 0.0f;
+    }
+    return lmb_dilate(img, st, w, h, err);
+}
+
+/* Diffuse albedo / pi of primitive pr's material at barycentrics (b1, b2) of triangle f. */
+static void albedo_at(const lmb_cache *c, const lmb_primitive *pr, uint32_t f, double b1, double b2, double out[3])
+{
+    if (pr->material < 0) { /* glTF default material: white, fully metallic, so no diffuse */
+        out[0] = out[1] = out[2] = 0;
+        return;
+    }
+    const lmb_material *m = &c->scene->materials[pr->material];
+    double k = (1.0 - m->metallic) * LMB_INV_PI;
+    float tex[3] = {1, 1, 1};
+    const float *uv = m->base_color_texcoord == 0 ? pr->uv0 : m->base_color_texcoord == 1 ? pr->uv1 : NULL;
+    if (c->textures && uv && m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < c->textures->count &&
+        c->textures->t[m->base_color_texture].rgb) {
+        const uint32_t *ix = pr->indices + 3 * (size_t)f;
+        double b0 = 1.0 - b1 - b2;
+        double u = b0 * uv[2 * ix[0]] + b1 * uv[2 * ix[1]] + b2 * uv[2 * ix[2]];
+        double v = b0 * uv[2 * ix[0] + 1] + b1 * uv[2 * ix[1] + 1] + b2 * uv[2 * ix[2] + 1];
+        lmb_texture_sample(&c->textures->t[m->base_color_texture], u, v, tex);
+    }
+    for (int j = 0; j < 3; j++)
+        out[j] = k * m->base_color[j] * tex[j];
+}
+
+/* Bilinear lookup at atlas texel coordinates (x, y) (texel centres at half integers), clamped. */
+static void bilinear(const float *img, uint32_t w, uint32_t h, double x, double y, double out[3])
+{
+    x -= 0.5;
+    y -= 0.5;
+    double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
+    long x0 = (long)fx, y0 = (long)fy;
+    long xs[2] = {x0 < 0 ? 0 : x0 >= (long)w ? (long)w - 1 : x0, x0 + 1 < 0 ? 0 : x0 + 1 >= (long)w ? (long)w - 1 : x0 + 1};
+    long ys[2] = {y0 < 0 ? 0 : y0 >= (long)h ? (long)h - 1 : y0, y0 + 1 < 0 ? 0 : y0 + 1 >= (long)h ? (long)h - 1 : y0 + 1};
+    double wx[2] = {1 - ax, ax}, wy[2] = {1 - ay, ay};
+    out[0] = out[1] = out[2] = 0;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            const float *p = img + 3 * ((size_t)ys[j] * w + (size_t)xs[i]);
+            for (int k = 0; k < 3; k++)
+                out[k] += wx[i] * wy[j] * p[k];
+        }
+}
+
+lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double albedo_over_pi[3], double e[3])
+{
+    e[0] = e[1] = e[2] = 0;
+    albedo_over_pi[0] = albedo_over_pi[1] = albedo_over_pi[2] = 0;
+    if (hit->backface)
+        return LMB_HIT_DARK;
+    const lmb_rt_geom *g = &c->rt->geoms[hit->geom];
+    const lmb_primitive *pr = &c->scene->primitives[g->primitive];
+    albedo_at(c, pr, hit->prim, hit->u, hit->v, albedo_over_pi);
+    const lmb_layout_instance *li = &c->layout->instances[g->instance];
+    if (!li->lightmapped)
+        return LMB_HIT_UNMAPPED;
+    const double *uv = li->uv1 + 6 * ((size_t)g->first_triangle + hit->prim);
+    double b1 = hit->u, b2 = hit->v, b0 = 1.0 - b1 - b2;
+    double x = b0 * uv[0] + b1 * uv[2] + b2 * uv[4], y = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
+    bilinear(c->irradiance[li->atlas], c->layout->width[li->atlas], c->layout->height[li->atlas], x, y, e);
+    return LMB_HIT_CACHED;
+}

@@ -1,0 +1,54 @@
+/*
+ * The bounce cache (DESIGN.md section 2, step 6): per atlas, the irradiance E of the last pass
+ * as a dilated image, which gather rays read. A gather ray's hit maps through the Embree
+ * geometry (instance, primitive) and triangle to the instance's lightmap UV (TEXCOORD_1) and a
+ * bilinear lookup; the outgoing diffuse radiance there is B = albedo / pi x E, with albedo =
+ * baseColorFactor x baseColorTexture (at the hit's UV, sRGB decoded) x (1 - metallic), the
+ * diffuse part a glTF viewer shows.
+ * Emission Le is not in the cache: emitters reach every point through the direct stage's
+ * area-light sampling, so a gather ray that hits an emitter counts only its reflected light
+ * (no light is counted twice).
+ * A hit on the back of a surface returns nothing (no lightmap holds the back side; a single-
+ * sided glTF surface is seen from behind only from inside geometry). A hit on a surface with
+ * no lightmap (excluded by the config, or a GPU-instanced copy) is reported as such: the
+ * gather stage then computes direct light at the hit with shadow rays, so those surfaces
+ * still bounce their direct light (one bounce; their own indirect light is left out).
+ */
+#ifndef LMBAKE_BOUNCE_CACHE_H
+#define LMBAKE_BOUNCE_CACHE_H
+
+#include <lmbake/lmbake.h>
+
+#include "lights/rt_scene.h"
+#include "load/textures.h"
+#include "pack/layout.h"
+#include "texels/texels.h"
+
+typedef struct lmb_cache {
+    const lmb_scene *scene;       /* borrowed */
+    const lmb_layout *layout;     /* borrowed */
+    const lmb_rt *rt;             /* borrowed */
+    const lmb_textures *textures; /* borrowed, may be NULL */
+    uint32_t atlas_count;
+    float **irradiance; /* owned: per atlas width x height x 3, dilated */
+    uint8_t **state;    /* owned: per atlas width x height LMB_TEXEL_* */
+} lmb_cache;
+
+typedef enum lmb_hit_kind {
+    LMB_HIT_DARK = 0,     /* back face: B = 0 */
+    LMB_HIT_CACHED = 1,   /* e holds the cached irradiance */
+    LMB_HIT_UNMAPPED = 2  /* a surface without a lightmap: the caller computes E */
+} lmb_hit_kind;
+
+/* Empty images for every atlas of layout. Free with lmb_cache_free, also after an error. */
+lmb_status lmb_cache_init(lmb_cache *c, const lmb_scene *scene, const lmb_layout *layout, const lmb_rt *rt,
+                          const lmb_textures *textures, lmb_error *err);
+void lmb_cache_free(lmb_cache *c);
+
+/* Atlas a's image := e (3 floats per listed texel of t, the texels of atlas a), dilated. */
+lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err);
+
+/* At a ray hit: albedo / pi (RGB) and, for LMB_HIT_CACHED, the irradiance E (RGB). */
+lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double albedo_over_pi[3], double e[3]);
+
+#endif

@@ -1,0 +1,159 @@
+/* The gather stage (see gather.h): cache passes, the path-traced reference, threads. */
+#include "gather.h"
+
+#include <omp.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+/* One gather point's context for the estimator's radiance callback. */
+typedef struct point_rays {
+    const lmb_gather_job *job;
+    lmb_shading_point sp;
+    double o[3];
+    uint64_t key;
+    uint64_t rays;
+} point_rays;
+
+/* A hit as a shading point (its geometric normal, front side) for direct light there. */
+static void hit_point(const lmb_rt *rt, const double o[3], const double w[3], const lmb_rt_hit *h, lmb_shading_point *y)
+{
+    for (int k = 0; k < 3; k++) {
+        y->p[k] = o[k] + h->t * w[k];
+        y->n[k] = y->ng[k] = h->ng[k];
+    }
+    y->eps = 4 * rt->eps;
+}
+
+/* Radiance arriving from w: B at the first hit, from the cache or (no lightmap) direct light. */
+static void cached_radiance(void *user, const double w[3], uint32_t sample, double out[3])
+{
+    point_rays *pr = user;
+    const lmb_gather_job *job = pr->job;
+    lmb_rt_hit h;
+    out[0] = out[1] = out[2] = 0;
+    pr->rays++;
+    if (!lmb_rt_intersect(job->rt, pr->o, w, pr->sp.eps, 1e300, &h))
+        return;
+    double albedo[3], e[3];
+    lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
+    if (kind == LMB_HIT_DARK)
+        return;
+    if (kind == LMB_HIT_UNMAPPED) {
+        lmb_shading_point y;
+        hit_point(job->rt, pr->o, w, &h, &y);
+        lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
+        pr->rays += lmb_direct_at(job->direct, &y, &rng, e);
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = albedo[k] * e[k];
+}
+
+/* Path-traced indirect irradiance at sp: paths x depth cosine bounces, direct light at each hit. */
+static void reference(point_rays *pr, double out[3])
+{
+    const lmb_gather_job *job = pr->job;
+    uint32_t paths = job->estimator.rays;
+    double sum[3] = {0, 0, 0};
+    for (uint32_t j = 0; j < paths; j++) {
+        lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | j);
+        lmb_shading_point x = pr->sp;
+        double o[3] = {pr->o[0], pr->o[1], pr->o[2]}, beta[3] = {1, 1, 1};
+        for (uint32_t d = 0; d < job->depth; d++) {
+            lmb_lobe cosine = {{x.n[0], x.n[1], x.n[2]}, 1.0};
+            double w[3], u1 = lmb_rng_next(&rng), u2 = lmb_rng_next(&rng);
+            lmb_lobe_sample(&cosine, u1, u2, w);
+            if (lmb_dot3(w, x.ng) <= 0)
+                break;
+            lmb_rt_hit h;
+            pr->rays++;
+            if (!lmb_rt_intersect(job->rt, o, w, x.eps, 1e300, &h))
+                break;
+            double albedo[3], unused[3];
+            if (lmb_cache_lookup(job->cache, &h, albedo, unused) == LMB_HIT_DARK)
+                break;
+            lmb_shading_point y;
+            hit_point(job->rt, o, w, &h, &y);
+            double e[3];
+            pr->rays += lmb_direct_at(job->direct, &y, &rng, e);
+            /* cosine sampling: f / p = pi B = pi albedo/pi E, so the path weight gains rho = pi albedo/pi */
+            for (int k = 0; k < 3; k++) {
+                beta[k] *= LMB_PI * albedo[k];
+                sum[k] += beta[k] * e[k];
+            }
+            if (!(beta[0] + beta[1] + beta[2] > 0))
+                break;
+            x = y;
+            for (int k = 0; k < 3; k++)
+                o[k] = y.p[k] + y.ng[k] * y.eps;
+        }
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = sum[k] / paths;
+}
+
+static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
+                               lmb_estimator_scratch *scratch, float *out, lmb_gather_stats *st)
+{
+    out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0;
+    if (!t->valid[i])
+        return LMB_OK;
+    point_rays pr;
+    memset(&pr, 0, sizeof pr);
+    pr.job = job;
+    pr.key = ((uint64_t)atlas << 32) | t->texel[i];
+    lmb_texel_shading_point(job->direct, t, i, t->gather_at[i], &pr.sp);
+    for (int k = 0; k < 3; k++)
+        pr.o[k] = pr.sp.p[k] + pr.sp.ng[k] * pr.sp.eps;
+    double e[3];
+    if (job->reference) {
+        reference(&pr, e);
+    } else {
+        lmb_estimate est;
+        /* stream b = pass << 32 | 0xFFFFFFFF: apart from the per-sample streams of hits */
+        lmb_rng rng = lmb_rng_make(job->seed, pr.key, ((uint64_t)job->pass << 32) | 0xFFFFFFFFu);
+        if (lmb_estimate_irradiance(&job->estimator, pr.sp.n, pr.sp.ng, rng, cached_radiance, &pr, scratch, &est) != LMB_OK)
+            return LMB_ERR_INTERNAL;
+        memcpy(e, est.e, sizeof e);
+        st->adapted += est.adapted;
+    }
+    for (int k = 0; k < 3; k++)
+        out[3 * (size_t)i + k] = (float)e[k];
+    st->rays += pr.rays;
+    st->texels++;
+    return LMB_OK;
+}
+
+lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,
+                            lmb_gather_stats *stats, lmb_error *err)
+{
+    const uint32_t block = 256;
+    int threads = job->threads ? (int)job->threads : omp_get_max_threads(), failed = 0;
+    for (uint32_t start = 0; start < t->count && !failed; start += block) {
+        uint32_t end = start + block < t->count ? start + block : t->count;
+        uint64_t rays = 0, texels = 0, adapted = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : rays, texels, adapted, failed)
+        {
+            lmb_rt_thread_init();
+            lmb_estimator_scratch scratch = {0};
+            lmb_gather_stats st = {0, 0, 0};
+#pragma omp for schedule(dynamic, 4)
+            for (uint32_t i = start; i < end; i++)
+                if (gather_texel(job, atlas, t, i, &scratch, out, &st) != LMB_OK)
+                    failed = 1;
+            lmb_estimator_scratch_free(&scratch);
+            rays += st.rays;
+            texels += st.texels;
+            adapted += st.adapted;
+        }
+        stats->rays += rays;
+        stats->texels += texels;
+        stats->adapted += adapted;
+        if (job->progress)
+            job->progress(job->progress_user, job->stage, job->progress_done + end, job->progress_total);
+    }
+    if (failed)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", job->stage,
+                             job->estimator.rays);
+    return LMB_OK;
+}

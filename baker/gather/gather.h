@@ -1,0 +1,51 @@
+/*
+ * The gather stage: indirect irradiance at every valid texel of an atlas, at the texel's first
+ * point outside geometry (indirect light varies slowly; direct light keeps all the texel's
+ * points). Two kinds of pass:
+ *   - a cache pass (bounce passes and the final gather): one estimator per texel (classic,
+ *     AMIS or defensive AMIS, estimator.h) whose rays read the bounce cache (bounce_cache.h);
+ *   - the reference (`lmbake bake --reference`): brute-force path tracing with no cache. Each
+ *     path samples the cosine lobe at every vertex and adds next-event estimates of direct
+ *     light (lmb_direct_at) at each hit, depth = bounces: E_ind = sum_k (rho_1 ... rho_k) E_d(y_k),
+ *     the estimator pi L(y_1) under cosine sampling unrolled (path vertices use their geometric
+ *     normal).
+ * Random numbers are keyed by (seed, atlas and texel, pass, sample): results do not depend on
+ * the thread count.
+ */
+#ifndef LMBAKE_GATHER_H
+#define LMBAKE_GATHER_H
+
+#include <lmbake/lmbake.h>
+
+#include "cache/bounce_cache.h"
+#include "gather/estimator.h"
+#include "lights/direct.h"
+
+typedef struct lmb_gather_job {
+    const lmb_direct *direct;   /* lights, for hits on surfaces without a lightmap and the reference */
+    const lmb_cache *cache;     /* the previous pass (unused by the reference) */
+    const lmb_rt *rt;
+    uint64_t seed;
+    uint32_t threads;           /* 0: all cores */
+    lmb_estimator_options estimator;
+    int reference;              /* path tracing, estimator.rays paths per texel */
+    uint32_t depth;             /* reference: bounces */
+    uint32_t pass;              /* keys the random streams */
+    const char *stage;          /* progress stage name */
+    lmb_progress_fn progress;
+    void *progress_user;
+    uint64_t progress_done, progress_total; /* texels before this atlas, texels of the whole pass */
+} lmb_gather_job;
+
+typedef struct lmb_gather_stats {
+    uint64_t rays;      /* rays traced (gather rays, and shadow rays at hits) */
+    uint64_t texels;    /* texels gathered */
+    uint64_t adapted;   /* AMIS: lobe updates that changed the lobe */
+} lmb_gather_stats;
+
+/* Indirect irradiance of every listed texel of t (atlas `atlas`) into out (3 floats per texel;
+ * 0 for invalid texels). */
+lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,
+                            lmb_gather_stats *stats, lmb_error *err);
+
+#endif

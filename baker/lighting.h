@@ -1,0 +1,25 @@
+/*
+ * The lighting half of the pipeline, over every atlas of a layout (DESIGN.md section 2,
+ * steps 4-7): gather points per texel -> direct light -> bounce passes -> final gather (or
+ * the path-traced reference). Bounces need every atlas's direct light before any gather,
+ * so all atlases' texels stay in memory through the passes.
+ *   bounces = 0: E = E_direct.
+ *   bounces = k: the cache starts as E_direct; k - 1 cheap passes (classic gathering,
+ *                samples.bounce rays) each set the cache to E_direct + gather(previous cache);
+ *                the final gather (gather.method, samples.gather rays) gives
+ *                E = E_direct + gather(cache): k bounces of indirect light in all.
+ *   --reference: E = E_direct + path-traced indirect light of depth k, no cache.
+ * The result is left in the cache (its images, dilated), which the writer saves.
+ */
+#ifndef LMBAKE_LIGHTING_H
+#define LMBAKE_LIGHTING_H
+
+#include <lmbake/lmbake.h>
+
+#include "cache/bounce_cache.h"
+#include "lights/direct.h"
+
+lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
+                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats, lmb_error *err);
+
+#endif
