@@ -19,7 +19,7 @@ export async function launchBrowser() {
 
 // Opens the preview at baseUrl with the query params; waits for window.lmbReady. Throws with
 // the page's error (window.lmbInfo.error, page errors, console errors) if it never gets ready.
-export async function openPreview(browser, baseUrl, params = {}, { timeout = 60000 } = {}) {
+export async function openPreview(browser, baseUrl, params = {}, { timeout = 30000 } = {}) {
   const context = await browser.newContext({ viewport: VIEWPORT, deviceScaleFactor: 1 });
   const page = await context.newPage();
   const errors = [];
@@ -31,13 +31,16 @@ export async function openPreview(browser, baseUrl, params = {}, { timeout = 600
     else if (process.env.LMB_PREVIEW_VERBOSE) console.error(`note: ${r.url()}: ${r.failure().errorText} after HTTP ${resp.status()}`);
   });
   page.on('response', (r) => { if (r.status() >= 400) errors.push(`HTTP ${r.status()}: ${r.url()}`); });
+  let onError; // a page error ends the wait at once (a broken module never sets lmbReady)
+  const failed = new Promise((resolve) => { onError = resolve; page.on('pageerror', () => resolve()); });
   const url = baseUrl + '?' + new URLSearchParams({ ui: '0', ...params }).toString();
   await page.goto(url);
   try {
-    await page.waitForFunction(() => window.lmbReady === true || (window.lmbInfo && window.lmbInfo.error), null, { timeout, polling: 100 });
+    await Promise.race([failed, page.waitForFunction(() => window.lmbReady === true || (window.lmbInfo && window.lmbInfo.error), null, { timeout, polling: 100 })]);
   } catch {
     errors.push(`not ready after ${timeout / 1000} s`);
   }
+  onError();
   const info = await page.evaluate(() => window.lmbInfo || null).catch(() => null);
   if (info && info.error) errors.unshift('lmbInfo.error: ' + info.error);
   if (errors.length) {

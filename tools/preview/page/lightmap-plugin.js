@@ -17,6 +17,10 @@ class LightmapPlugin {
     this.atlases = atlases;
     this.name = 'MOZ_lightmap';
     this.byTexture = new Map(); // texture index -> Promise<THREE.Texture>
+    // Atlas numbers follow the lightmap texture indices in increasing order (not load order)
+    const used = new Set();
+    for (const m of parser.json.materials || []) if (m.extensions && m.extensions.MOZ_lightmap) used.add(m.extensions.MOZ_lightmap.index);
+    this.order = [...used].sort((a, b) => a - b);
   }
 
   extendMaterialParams(materialIndex, params) {
@@ -87,8 +91,8 @@ class LightmapPlugin {
     maskTex.magFilter = maskTex.minFilter = THREE.NearestFilter;
     maskTex.needsUpdate = true;
 
-    const atlas = { index: this.atlases.length, textureIndex, uri, width, height, data, texture: tex, maskTexture: maskTex, zeroTexels: zero };
-    this.atlases.push(atlas);
+    const atlas = { index: this.order.indexOf(textureIndex), textureIndex, uri, width, height, data, texture: tex, maskTexture: maskTex, zeroTexels: zero };
+    this.atlases[atlas.index] = atlas;
     tex.userData.atlas = atlas.index;
     return tex;
   }

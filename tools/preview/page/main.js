@@ -83,8 +83,8 @@ root.traverse((o) => {
 });
 const chartMeshes = entries.filter((e) => e.checkerGeometry).map((e) => ({ atlas: e.atlas, checkerGeometry: e.checkerGeometry }));
 const atlasView = new AtlasView(atlases, chartMeshes);
-if (state.mode === 'atlas' && !atlases.length) throw new Error('the atlas view needs a MOZ_texture_rgbe (.hdr) lightmap; this glTF has none');
-if (atlases.length && !(state.atlas >= 0 && state.atlas < atlases.length)) throw new Error(`atlas ${state.atlas} does not exist (${atlases.length} atlases)`);
+// atlases[i] is undefined for a lightmap without its .hdr (PNG only): no data to show
+if (state.mode === 'atlas' && !atlases[state.atlas]) throw new Error(`atlas ${state.atlas} does not exist or has no MOZ_texture_rgbe .hdr (${atlases.filter(Boolean).length} atlases)`);
 if (!['lightmap', 'invalid', 'checker'].includes(state.layer)) throw new Error(`unknown layer '${state.layer}'`);
 
 // Camera: "front" looks along -Z at the centre of the scene's bounding box, from where the
@@ -138,8 +138,9 @@ function updateInfo() {
   Object.assign(info, {
     gltf: sceneInfo.name, mode: state.mode, ev: state.ev, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
     camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
+    bounds: { min: box.min.toArray(), max: box.max.toArray() },
     canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
-    atlases: atlases.map((a) => ({ index: a.index, uri: a.uri, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
+    atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
     meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
     charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),
     atlasView: { atlas: atlasView.atlas, layer: atlasView.layer, zoom: atlasView.zoom, originX: atlasView.originX, originY: atlasView.originY },
@@ -155,7 +156,7 @@ function render() {
 $('panel').classList.toggle('hidden', !state.ui);
 $('hover').classList.toggle('hidden', !state.ui);
 $('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-5: views';
-$('atlas').innerHTML = atlases.map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
+$('atlas').innerHTML = atlases.filter(Boolean).map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
 const sync = () => {
   $('mode').value = state.mode; $('ev').value = state.ev; $('evText').textContent = state.ev.toFixed(1);
   $('tonemap').value = state.tonemap; $('atlas').value = state.atlas; $('layer').value = state.layer;
