@@ -19,6 +19,7 @@ packages=(
   libopenmesh-dev                   # half-edge mesh library (found by CMake; see README)
   libsuitesparse-dev                # CHOLMOD sparse Cholesky for the LSCM flattening
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
+  chromium                          # headless browser for the preview's shots and e2e test (playwright-core drives it)
 )
 
 # node and npm: the machine's own if it has them, else Debian's
@@ -40,7 +41,7 @@ if ((${#missing[@]})); then
 fi
 
 # npm pieces (package.json): the Khronos glTF validator for the tests
-if [ ! -d node_modules/gltf-validator ]; then
+if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ]; then
   echo "setup: installing npm packages (package.json)"
   npm install --no-audit --no-fund --silent >/dev/null 2>&1 || { echo "setup: npm install failed"; exit 1; }
 fi
