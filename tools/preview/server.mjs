@@ -31,7 +31,7 @@ export function checkGltf(file) {
   if (abs.toLowerCase().endsWith('.glb')) {
     if (bytes.length < 12 || bytes.toString('latin1', 0, 4) !== 'glTF') throw new InputError(`'${file}' is not a .glb file`);
   } else {
-    try { JSON.parse(bytes.toString('utf8')); } catch (e) { throw new InputError(`'${file}' is not JSON: ${e.message}`); }
+    try { JSON.parse(bytes.toString('utf8')); } catch (e) { throw new InputError(`'${file}' is not JSON: ${e.message.replace(/\s+/g, ' ')}`); }
   }
   return abs;
 }
