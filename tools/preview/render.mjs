@@ -1,6 +1,6 @@
 #!/usr/bin/env node
 // Renders the preview's view modes of a bake headless: `node tools/preview/render.mjs
-// OUT.gltf OUTDIR [--ev N] [--tonemap none|agx|aces|neutral] [--modes lit,lightmap,...]`
+// OUT.gltf OUTDIR [--ev N|auto] [--tonemap none|agx|aces|neutral] [--modes lit,lightmap,...]`
 // writes OUTDIR/preview-<mode>.png (960 x 720, the "front" camera; the atlas view shows atlas 0).
 // Exit 1: usage; 2: the glTF is missing or unreadable; 3: the browser or the page failed.
 import fs from 'node:fs';
@@ -9,9 +9,9 @@ import { startServer, InputError } from './server.mjs';
 import { launchBrowser, openPreview } from './browser.mjs';
 
 const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas'];
-const usage = 'usage: node tools/preview/render.mjs OUT.gltf OUTDIR [--ev N] [--tonemap none|agx|aces|neutral] [--modes m1,m2,...]';
+const usage = 'usage: node tools/preview/render.mjs OUT.gltf OUTDIR [--ev N|auto] [--tonemap none|agx|aces|neutral] [--modes m1,m2,...]';
 const args = process.argv.slice(2), pos = [];
-const opt = { ev: '0', tonemap: 'agx', modes: MODES };
+const opt = { ev: 'auto', tonemap: 'agx', modes: MODES };
 for (let i = 0; i < args.length; i++) {
   const a = args[i];
   if (a === '-h' || a === '--help') { console.log(usage); process.exit(0); }
@@ -25,7 +25,7 @@ for (let i = 0; i < args.length; i++) {
 if (pos.length !== 2) { console.error(usage); process.exit(1); }
 const bad = opt.modes.filter((m) => !MODES.includes(m));
 if (bad.length) { console.error(`render: unknown mode '${bad[0]}' (one of ${MODES.join(', ')})`); process.exit(1); }
-if (!Number.isFinite(Number(opt.ev))) { console.error(`render: --ev wants a number, got '${opt.ev}'`); process.exit(1); }
+if (opt.ev !== 'auto' && !Number.isFinite(Number(opt.ev))) { console.error(`render: --ev wants a number or auto, got '${opt.ev}'`); process.exit(1); }
 
 let srv;
 try { srv = await startServer(pos[0]); } catch (e) {

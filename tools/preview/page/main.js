@@ -18,7 +18,7 @@ const FOV = 45; // degrees, vertical
 
 const q = new URLSearchParams(location.search);
 const state = {
-  mode: q.get('mode') || 'lit', ev: Number(q.get('ev') ?? 0), tonemap: q.get('tonemap') || 'agx',
+  mode: q.get('mode') || 'lit', ev: q.get('ev') ?? 'auto', tonemap: q.get('tonemap') || 'agx',
   view: q.get('view') || 'front', cam: q.get('cam'), atlas: Number(q.get('atlas') ?? 0),
   layer: q.get('layer') || 'lightmap', zoom: q.get('zoom') ? Number(q.get('zoom')) : null,
   at: q.get('at') ? q.get('at').split(',').map(Number) : null, ui: q.get('ui') !== '0',
@@ -38,7 +38,7 @@ addEventListener('unhandledrejection', (e) => fail(e.reason && e.reason.stack ? 
 
 if (!MODES.includes(state.mode)) throw new Error(`unknown mode '${state.mode}' (one of ${MODES.join(', ')})`);
 if (!(state.tonemap in TONEMAPS)) throw new Error(`unknown tonemap '${state.tonemap}' (one of ${Object.keys(TONEMAPS).join(', ')})`);
-if (!Number.isFinite(state.ev)) throw new Error(`ev must be a number`);
+if (state.ev !== 'auto' && !Number.isFinite((state.ev = Number(state.ev)))) throw new Error(`ev must be a number or auto`);
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(devicePixelRatio);
@@ -60,6 +60,19 @@ for (const l of lights) l.removeFromParent(); // lit = lightmap only, no other l
 const scene = new THREE.Scene();
 scene.add(root);
 root.updateMatrixWorld(true);
+
+// ev=auto (the default): the median E/pi of the non-zero texels maps to 0.18 (middle grey),
+// rounded to half an EV. Measured on every 7th texel of every atlas.
+const evAuto = state.ev === 'auto';
+if (evAuto) {
+  const v = [];
+  for (const a of atlases) if (a) for (let i = 0; i < a.data.length; i += 28) {
+    const l = (0.2126 * a.data[i] + 0.7152 * a.data[i + 1] + 0.0722 * a.data[i + 2]) / Math.PI;
+    if (l > 0) v.push(l);
+  }
+  v.sort((x, y) => x - y);
+  state.ev = v.length ? Math.max(-12, Math.min(12, Math.round(2 * Math.log2(0.18 / v[v.length >> 1])) / 2)) : 0;
+}
 
 // Each mesh and its materials per mode
 const GREY = new THREE.MeshBasicMaterial({ color: 0x404040, toneMapped: false });
@@ -136,7 +149,7 @@ function apply() {
 
 function updateInfo() {
   Object.assign(info, {
-    gltf: sceneInfo.name, mode: state.mode, ev: state.ev, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
+    gltf: sceneInfo.name, mode: state.mode, ev: state.ev, evAuto, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
     camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
     bounds: { min: box.min.toArray(), max: box.max.toArray() },
     canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
