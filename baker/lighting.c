@@ -86,7 +86,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     char stage[64];
     for (uint32_t b = 1; b < cfg->bounces && !cfg->reference && st == LMB_OK; b++) {
         lmb_gather_stats gs = {0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0};
+        lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0, 0};
         job.estimator = e;
         job.pass = b;
         snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
@@ -96,7 +96,8 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     /* the final gather, or the reference */
     if (cfg->bounces > 0 && st == LMB_OK) {
         lmb_gather_stats gs = {0, 0, 0};
-        lmb_estimator_options e = {cfg->gather_method, cfg->gather_rays, cfg->amis_iterations, cfg->defensive_fraction};
+        lmb_estimator_options e = {cfg->gather_method, cfg->gather_rays, cfg->amis_iterations, cfg->defensive_fraction,
+                                   cfg->amis_weights == LMB_AMIS_UNBIASED};
         job.estimator = e;
         job.pass = 1000;
         job.reference = cfg->reference;

@@ -19,6 +19,7 @@ void lmb_estimator_scratch_free(lmb_estimator_scratch *s)
     free(s->f);
     free(s->lum);
     free(s->denom);
+    free(s->own);
     memset(s, 0, sizeof *s);
 }
 
@@ -38,7 +39,10 @@ static int scratch_reserve(lmb_estimator_scratch *s, uint32_t n)
     double *den = realloc(s->denom, (size_t)n * sizeof *den);
     if (den)
         s->denom = den;
-    if (!w || !f || !lum || !den)
+    double *own = realloc(s->own, (size_t)n * sizeof *own);
+    if (own)
+        s->own = own;
+    if (!w || !f || !lum || !den || !own)
         return 0;
     s->cap = n;
     return 1;
@@ -124,13 +128,30 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
     s->count = 0;
     lobes[0] = *cosine;
     uint32_t j = 0;
+    double share_sum = 0;
+    for (uint32_t t = 0; t < T; t++)
+        share_sum += (double)(opt->rays / T + (t < opt->rays % T)) * (t + 1);
+    double s_t = 0; /* S_t = N_0 + ... + N_t */
     for (uint32_t t = 0; t < T; t++) {
         uint32_t n_t = opt->rays / T + (t < opt->rays % T);
         nk[t] = (double)n_t;
+        s_t += nk[t];
+        /* the unbiased estimate without a defensive share samples the mixture of lobes 0..t */
+        int past_mixture = opt->unbiased && !(d > 0);
         for (uint32_t i = 0; i < n_t; i++, j++) {
             double u[3], w[3], l[3];
             sample_uniforms(rng, j, u);
-            lmb_lobe_sample(d > 0 && u[2] < d ? cosine : &lobes[t], u[0], u[1], w);
+            const lmb_lobe *lobe = &lobes[t];
+            if (past_mixture) {
+                double pick = u[2] * s_t, acc = 0;
+                uint32_t k = 0;
+                while (k < t && pick >= (acc += nk[k]))
+                    k++;
+                lobe = &lobes[k];
+            } else if (d > 0 && u[2] < d) {
+                lobe = cosine;
+            }
+            lmb_lobe_sample(lobe, u[0], u[1], w);
             double c = lmb_dot3(w, cosine->axis);
             if (c <= 0 || lmb_dot3(w, ng) <= 0)
                 continue;
@@ -146,6 +167,11 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
             s->denom[q] = 0;
             for (uint32_t k = 0; k < t; k++) /* a new sample sees every earlier lobe once */
                 s->denom[q] += nk[k] * mixture_pdf(cosine, &lobes[k], d, w);
+            double own = nk[t] * mixture_pdf(cosine, &lobes[t], d, w); /* N_t q_t(w) */
+            if (past_mixture) /* N_t x the mixture's pdf D_t(w) / S_t */
+                own = (s->denom[q] + own) * (nk[t] / s_t);
+            /* divided by the share a_t, as a ratio so that T = 1 gives classic's N p exactly */
+            s->own[q] = own * (share_sum / (nk[t] * (t + 1)));
         }
         for (uint32_t q = 0; q < s->count; q++) /* ... and every sample the lobe of iteration t */
             s->denom[q] += nk[t] * mixture_pdf(cosine, &lobes[t], d, s->w + 3 * q);
@@ -157,7 +183,7 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
     }
     for (uint32_t q = 0; q < s->count; q++)
         for (int k = 0; k < 3; k++)
-            out->e[k] += s->f[3 * q + k] / s->denom[q];
+            out->e[k] += s->f[3 * q + k] / (opt->unbiased ? s->own[q] : s->denom[q]);
     out->last = lobes[T - 1];
     return LMB_OK;
 }

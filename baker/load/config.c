@@ -83,6 +83,7 @@ static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node
 
 /* Index = lmb_gather_method value; bit i = 1 << i = LMB_OUTPUT_* */
 static const char *const gather_methods[] = {"cosine", "amis", "amis_defensive", NULL};
+static const char *const amis_weights[] = {"unbiased", "balance", NULL};
 static const char *const output_formats[] = {"exr", "hdr", "png", NULL};
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
 _Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4, "output_formats");
@@ -100,6 +101,7 @@ static const key_spec config_keys[] = {
     U32("samples.amis_iterations", OFF(amis_iterations), 1, 64),
     U32("bounces", OFF(bounces), 0, 64),
     ENUM("gather.method", OFF(gather_method), gather_methods),
+    ENUM("gather.amis_weights", OFF(amis_weights), amis_weights),
     FLOAT("gather.defensive", OFF(defensive_fraction), 0, 1, OPEN_HI),
     U64("seed", OFF(seed), 0, 9223372036854775807LL),
     U32("threads", OFF(threads), 0, 1024),
@@ -335,7 +337,8 @@ static lmb_status bad_name(parse_ctx *c, const key_spec *k, const yaml_node_t *n
     return bad_value(c, k, n, want);
 }
 
-/* The only enum key is gather.method, so the value is stored as an lmb_gather_method. */
+/* Enum keys (gather.method, gather.amis_weights) are C enums of the same size. */
+_Static_assert(sizeof(lmb_gather_method) == sizeof(lmb_amis_weights), "enum keys share set_enum");
 static lmb_status set_enum(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
     int i = name_index(k, n);

@@ -163,6 +163,11 @@ typedef enum lmb_gather_method {
     LMB_GATHER_AMIS_DEFENSIVE = 2  /* AMIS with a share of cosine samples in every pdf */
 } lmb_gather_method;
 
+typedef enum lmb_amis_weights {
+    LMB_AMIS_UNBIASED = 0, /* each iteration's samples by their own pdf, fixed shares: unbiased */
+    LMB_AMIS_BALANCE = 1   /* the paper: every sample by the balance heuristic over all lobes (biased, consistent) */
+} lmb_amis_weights;
+
 enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4 };
 
 #define LMB_MAX_PATTERNS 64
@@ -190,6 +195,7 @@ typedef struct lmb_config {
     uint32_t bounces;
     lmb_gather_method gather_method;
     double defensive_fraction;     /* share of cosine samples, AMIS defensive */
+    lmb_amis_weights amis_weights; /* how AMIS weights its samples in the estimate */
     int reference;                 /* path-trace indirect light with no cache (ground truth) */
     uint64_t seed;
     uint32_t threads;              /* 0: all cores */
