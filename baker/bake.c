@@ -80,6 +80,16 @@ static lmb_status write_atlas_images(const lmb_config *cfg, const char *dir, con
         st = lmb_image_write_u8(path, w, h, 3, png, err);
         free(png);
     }
+    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_MASK)) {
+        uint8_t *mask = malloc((size_t)w * h + 1);
+        if (!mask)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "mask: out of memory");
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            mask[i] = valid[i] == LMB_TEXEL_VALID ? 255 : valid[i] == LMB_TEXEL_INSIDE ? 128 : 0;
+        snprintf(path, sizeof path, "%s/%s-lightmap-%u-mask.png", dir, stem, a);
+        st = lmb_image_write_u8(path, w, h, 1, mask, err);
+        free(mask);
+    }
     return st;
 }
 

@@ -6,8 +6,10 @@
  */
 #include "cli_common.h"
 #include "commands.h"
+#include "node_tool.h"
 #include "progress.h"
 
+#include <limits.h>
 #include <string.h>
 
 static const char help[] =
@@ -21,6 +23,8 @@ static const char help[] =
     "      --seed N        random seed (overrides the config)\n"
     "      --method M      final gather: cosine, amis or amis_defensive (overrides gather.method)\n"
     "      --rays N        final gather rays per texel (overrides samples.gather)\n"
+    "      --preview       also render the views of `lmbake preview` (lit, lightmap, checker,\n"
+    "                      invalid, atlases) headless to OUTDIR/preview-<view>.png\n"
     "      --reference     path-trace indirect light with no cache (ground truth for error\n"
     "                      measurement; --rays paths per texel: use many)\n"
     "  -q, --quiet         no progress or warnings\n"
@@ -31,7 +35,7 @@ static const char help[] =
 typedef struct bake_args {
     const char *scene, *config, *outdir;
     long long threads, seed, rays, method; /* -1: from the config */
-    int quiet, reference;
+    int quiet, reference, preview;
 } bake_args;
 
 static int parse_args(int argc, char **argv, bake_args *a)
@@ -74,6 +78,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
                     a->method = k;
             if (a->method < 0)
                 return cli_usage_error("bake", "--method needs cosine, amis or amis_defensive");
+        } else if (cli_is_flag(argv[i], "--preview", NULL)) {
+            a->preview = 1;
         } else if (cli_is_flag(argv[i], "--reference", NULL)) {
             a->reference = 1;
         } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
@@ -140,6 +146,10 @@ int cmd_bake(int argc, char **argv)
     lmb_scene_free(scene);
     if (rc != LMB_OK)
         return cli_fail(&err);
+    char script[PATH_MAX + 64];
+    /* the preview script is looked up before the bake's summary, so a missing one is said first */
+    if (a.preview && !node_tool_path("render.mjs", script, sizeof script))
+        return LMB_ERR_INTERNAL;
     if (!a.quiet && cfg.bounces > 0)
         printf("%s: %.3f s, %llu rays, %.4g rays/s, %u rays per texel, %u bounce(s)\n",
                cfg.reference ? "reference" : "final gather", bs.gather_seconds, (unsigned long long)bs.gather_rays,
@@ -150,5 +160,16 @@ int cmd_bake(int argc, char **argv)
                bs.seconds, bs.light_seconds, bs.atlases, (unsigned long long)bs.texels,
                (unsigned long long)bs.valid_texels, (unsigned long long)bs.rays,
                bs.light_seconds > 0 ? (double)bs.rays / bs.light_seconds : 0.0, bs.gltf_path);
+    if (a.preview) {
+        char *args[] = {bs.gltf_path, (char *)a.outdir, NULL};
+        int code = node_tool_run(script, args);
+        if (code != 0) {
+            lmb_error_set(&err, LMB_ERR_INTERNAL, "the bake in %s is complete, but its preview images were not "
+                          "rendered (tools/preview/render.mjs exit %d)", a.outdir, code);
+            return cli_fail(&err);
+        }
+        if (!a.quiet)
+            printf("preview: %s/preview-<view>.png\n", a.outdir);
+    }
     return LMB_OK;
 }

@@ -6,5 +6,6 @@
 int cmd_inspect(int argc, char **argv);
 int cmd_bake(int argc, char **argv);
 int cmd_unwrap(int argc, char **argv);
+int cmd_preview(int argc, char **argv);
 
 #endif

@@ -19,6 +19,7 @@ static const char usage[] =
     "  inspect SCENE [-c CONFIG] [--json]   list meshes, instances, materials, lights and\n"
     "                                       what will be lightmapped (and why not)\n"
     "  unwrap SCENE [-c CONFIG] [--png DIR] lightmap UV layout and its quality report\n"
+    "  preview OUT.gltf [--port N]          look at a bake in a browser (127.0.0.1 only)\n"
     "\n"
     "options:\n"
     "  -h, --help      this help; 'lmbake <command> --help' for a command's options\n"
@@ -45,6 +46,8 @@ int main(int argc, char **argv)
         return cmd_inspect(argc - 1, argv + 1);
     if (!strcmp(cmd, "unwrap"))
         return cmd_unwrap(argc - 1, argv + 1);
+    if (!strcmp(cmd, "preview"))
+        return cmd_preview(argc - 1, argv + 1);
     if (!strcmp(cmd, "bake"))
         return cmd_bake(argc - 1, argv + 1);
     fprintf(stderr, "lmbake: unknown command '%s'\n\n%s", cmd, usage);

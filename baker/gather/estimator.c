@@ -20,6 +20,7 @@ void lmb_estimator_scratch_free(lmb_estimator_scratch *s)
     free(s->lum);
     free(s->denom);
     free(s->own);
+    free(s->si);
     memset(s, 0, sizeof *s);
 }
 
@@ -42,7 +43,10 @@ static int scratch_reserve(lmb_estimator_scratch *s, uint32_t n)
     double *own = realloc(s->own, (size_t)n * sizeof *own);
     if (own)
         s->own = own;
-    if (!w || !f || !lum || !den || !own)
+    double *si = realloc(s->si, (size_t)n * sizeof *si);
+    if (si)
+        s->si = si;
+    if (!w || !f || !lum || !den || !own || !si)
         return 0;
     s->cap = n;
     return 1;
@@ -94,6 +98,7 @@ static int next_lobe(const lmb_estimator_scratch *s, lmb_lobe *next)
     double sum = 0, v[3] = {0, 0, 0};
     for (uint32_t i = 0; i < s->count; i++) {
         double si = s->lum[i] / s->denom[i];
+        s->si[i] = si;
         sum += si;
         for (int k = 0; k < 3; k++)
             v[k] += si * s->w[3 * i + k];
@@ -104,7 +109,7 @@ static int next_lobe(const lmb_estimator_scratch *s, lmb_lobe *next)
     double axis[3] = {v[0] / len, v[1] / len, v[2] / len}, lsum = 0;
     for (uint32_t i = 0; i < s->count; i++) {
         double c = fabs(lmb_dot3(s->w + 3 * i, axis));
-        lsum += s->lum[i] / s->denom[i] * log(c > 1e-6 ? c : 1e-6);
+        lsum += s->si[i] * (double)logf((float)(c > 1e-6 ? c : 1e-6));
     }
     double a = lsum < 0 ? -1.0 - sum / lsum : LMB_AMIS_MAX_EXPONENT;
     if (!(a >= 0))
@@ -133,7 +138,7 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
         share_sum += (double)(opt->rays / T + (t < opt->rays % T)) * (t + 1);
     double s_t = 0; /* S_t = N_0 + ... + N_t */
     for (uint32_t t = 0; t < T; t++) {
-        uint32_t n_t = opt->rays / T + (t < opt->rays % T);
+        uint32_t n_t = opt->rays / T + (t < opt->rays % T), first_new = s->count;
         nk[t] = (double)n_t;
         s_t += nk[t];
         /* the unbiased estimate without a defensive share samples the mixture of lobes 0..t */
@@ -168,12 +173,13 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
             for (uint32_t k = 0; k < t; k++) /* a new sample sees every earlier lobe once */
                 s->denom[q] += nk[k] * mixture_pdf(cosine, &lobes[k], d, w);
             double own = nk[t] * mixture_pdf(cosine, &lobes[t], d, w); /* N_t q_t(w) */
+            s->denom[q] += own;
             if (past_mixture) /* N_t x the mixture's pdf D_t(w) / S_t */
-                own = (s->denom[q] + own) * (nk[t] / s_t);
+                own = s->denom[q] * (nk[t] / s_t);
             /* divided by the share a_t, as a ratio so that T = 1 gives classic's N p exactly */
             s->own[q] = own * (share_sum / (nk[t] * (t + 1)));
         }
-        for (uint32_t q = 0; q < s->count; q++) /* ... and every sample the lobe of iteration t */
+        for (uint32_t q = 0; q < first_new; q++) /* ... and every earlier sample the lobe of iteration t */
             s->denom[q] += nk[t] * mixture_pdf(cosine, &lobes[t], d, s->w + 3 * q);
         if (t + 1 < T) {
             lobes[t + 1] = lobes[t];

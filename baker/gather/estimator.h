@@ -54,6 +54,7 @@ typedef struct lmb_estimator_scratch {
     double *w, *f;        /* 3 each per kept sample: direction, integrand f (RGB) */
     double *lum, *denom;  /* luminance of f; sum over lobes so far of N_k q_k(w) */
     double *own;          /* N_t q_t(w) / a_t: the unbiased estimate's denominator */
+    double *si;           /* eq. 3's s_i of the current lobe update */
 } lmb_estimator_scratch;
 
 typedef struct lmb_estimate {

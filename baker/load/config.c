@@ -84,9 +84,10 @@ static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node
 /* Index = lmb_gather_method value; bit i = 1 << i = LMB_OUTPUT_* */
 static const char *const gather_methods[] = {"cosine", "amis", "amis_defensive", NULL};
 static const char *const amis_weights[] = {"unbiased", "balance", NULL};
-static const char *const output_formats[] = {"exr", "hdr", "png", NULL};
+static const char *const output_formats[] = {"exr", "hdr", "png", "mask", NULL};
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
-_Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4, "output_formats");
+_Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4 && LMB_OUTPUT_MASK == 8,
+               "output_formats");
 
 static const key_spec config_keys[] = {
     FLOAT("texel_density", OFF(texel_density), 0, 100000, OPEN_LO),

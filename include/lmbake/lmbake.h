@@ -168,7 +168,8 @@ typedef enum lmb_amis_weights {
     LMB_AMIS_BALANCE = 1   /* the paper: every sample by the balance heuristic over all lobes (biased, consistent) */
 } lmb_amis_weights;
 
-enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4 };
+/* MASK: <stem>-lightmap-N-mask.png, per texel 255 = lit (valid), 128 = inside geometry, 0 = padding */
+enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8 };
 
 #define LMB_MAX_PATTERNS 64
 #define LMB_PATTERN_LEN 128

@@ -182,7 +182,7 @@ static void test_value_errors(void)
     expect_error("atlas:\n  keep_uv1: maybe\n", "level.yaml:2: ",
                  "key 'atlas.keep_uv1': expected true or false, got 'maybe'");
     expect_error("output:\n  formats:\n    - exr\n    - tiff\n", "level.yaml:4: ",
-                 "key 'output.formats': expected one of exr, hdr, png, got 'tiff'");
+                 "key 'output.formats': expected one of exr, hdr, png, mask, got 'tiff'");
     expect_error("output:\n  formats: []\n", "level.yaml:2: ", "key 'output.formats': expected at least one of exr");
     expect_error("lightmap:\n  extras_key: \"\"\n", "level.yaml:2: ",
                  "key 'lightmap.extras_key': expected a non-empty string");
