@@ -43,7 +43,7 @@ static void cached_radiance(void *user, const double w[3], uint32_t sample, doub
         lmb_shading_point y;
         hit_point(job->rt, pr->o, w, &h, &y);
         lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
-        pr->rays += lmb_direct_at(job->direct, &y, &rng, e);
+        pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e);
     }
     for (int k = 0; k < 3; k++)
         out[k] = albedo[k] * e[k];
@@ -75,7 +75,7 @@ static void reference(point_rays *pr, double out[3])
             lmb_shading_point y;
             hit_point(job->rt, o, w, &h, &y);
             double e[3];
-            pr->rays += lmb_direct_at(job->direct, &y, &rng, e);
+            pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e);
             /* cosine sampling: f / p = pi B = pi albedo/pi E, so the path weight gains rho = pi albedo/pi */
             for (int k = 0; k < 3; k++) {
                 beta[k] *= LMB_PI * albedo[k];

@@ -196,6 +196,7 @@ typedef struct point_ctx {
     double o[3];    /* offset origin */
     double p[3], n[3], ng[3];
     double eps;
+    uint32_t samples; /* area-light and many-light samples */
     uint64_t rays;
 } point_ctx;
 
@@ -264,7 +265,7 @@ static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
             punctual(c, &all[ls->local[i]], 1.0, e);
         return;
     }
-    uint32_t n = c->d->cfg->direct_samples;
+    uint32_t n = c->samples;
     double total = ls->cdf[ls->local_count];
     for (uint32_t s = 0; s < n; s++) {
         double target = lmb_rng_next(rng) * total;
@@ -309,7 +310,7 @@ static int emitted(const emitter *x, double b1, double b2, const double d[3], do
 static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
 {
     const lmb_emitters *es = c->d->emitters;
-    uint32_t n = c->d->cfg->direct_samples;
+    uint32_t n = c->samples;
     double total = es->cdf[es->count];
     for (uint32_t s = 0; s < n; s++) {
         /* light sample */
@@ -402,10 +403,11 @@ static void point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_poin
     c->eps = sp->eps;
 }
 
-uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, double e[3])
+uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3])
 {
     point_ctx c;
     point_init(&c, d, sp);
+    c.samples = samples ? samples : d->cfg->direct_samples;
     e[0] = e[1] = e[2] = 0;
     for (uint32_t l = 0; l < d->lights.directional_count; l++)
         punctual(&c, &d->scene->lights[d->lights.directional[l]], 1.0, e);
@@ -450,7 +452,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, f
         if (!used)
             t->gather_at[i] = (uint8_t)k;
         double e[3];
-        r += lmb_direct_at(job->direct, &sp, &rng, e);
+        r += lmb_direct_at(job->direct, &sp, 0, &rng, e);
         for (int d = 0; d < 3; d++)
             sum[d] += e[d];
         used++;

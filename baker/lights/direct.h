@@ -39,8 +39,9 @@ typedef struct lmb_shading_point {
 } lmb_shading_point;
 
 /* Direct irradiance at sp (lux, RGB) from every light with shadow rays; rng drives area-light
- * and many-light sampling. Returns the rays traced. */
-uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, double e[3]);
+ * and many-light sampling, `samples` of each (0: samples.direct; a caller that averages many
+ * evaluations, as gather rays and reference paths do, passes 1). Returns the rays traced. */
+uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3]);
 
 /* 1 when sp lies inside geometry (most of its hemisphere rays hit back faces); adds to *rays. */
 int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays);

@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""Final-gather benchmark (issue 5): error against time for classic gathering, AMIS and
+defensive AMIS (both with lmbake's unbiased estimate) and the paper's AMIS (balance weights),
+at 64, 256 and 1024 rays per texel, on four generated scenes (tools/make_scenes.py):
+  cornell-point  the paper's Figure 1: Cornell box, point light 3 cm under the ceiling
+  two-spots      two bright spots on opposite walls (one lobe cannot fit both)
+  furnace        light from everywhere alike (nothing to adapt to)
+  grazing        a spot on a corridor floor, seen at grazing angles from the floor
+Errors: relative RMSE over valid texels (the mask output) against
+  - the reference: `lmbake bake --reference` (path tracing, no cache, BENCH_REF_PATHS paths);
+  - the converged gather: classic gathering with BENCH_CONVERGED_RAYS rays through the same
+    cache, so the difference is the estimator's noise alone (the cache's own resolution error
+    is the gap between the two references, also reported).
+Time: the final gather's wall time as lmbake prints it (2 threads).
+usage: bench_gather.py LMBAKE OUTDIR   (writes gather.csv, gather.md, gather.png, gather-<scene>.png)
+"""
+import csv
+import math
+import os
+import re
+import subprocess
+import sys
+
+import matplotlib
+import numpy as np
+import OpenImageIO as oiio
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCENES = [("cornell-point", 32), ("two-spots", 32), ("furnace", 16), ("grazing", 24)]
+METHODS = [("classic", ["--method", "cosine"], ""),
+           ("AMIS", ["--method", "amis"], ""),
+           ("AMIS defensive", ["--method", "amis_defensive"], ""),
+           ("AMIS paper", ["--method", "amis"], "  amis_weights: balance\n")]
+RAYS = [64, 256, 1024]
+REF_PATHS = int(os.environ.get("BENCH_REF_PATHS", "8192"))
+CONVERGED = int(os.environ.get("BENCH_CONVERGED_RAYS", "16384"))
+THREADS = os.environ.get("BENCH_THREADS", "2")
+
+
+def bake(lmbake, out, scene, density, extra_cfg, args):
+    cfg = out + ".yaml"
+    with open(cfg, "w") as f:
+        f.write("texel_density: %d\nbounces: 1\nsamples: {texel: 4, direct: 16, amis_iterations: 4}\n"
+                "output: {formats: [exr, mask]}\ngather:\n  defensive: 0.1\n%s" % (density, extra_cfg))
+    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "--threads", THREADS] + args,
+                       capture_output=True, text=True)
+    if p.returncode:
+        sys.exit("bake failed: %s" % p.stderr)
+    m = re.search(r"(final gather|reference): ([0-9.]+) s, ([0-9]+) rays", p.stdout)
+    stem = os.path.splitext(os.path.basename(scene))[0]
+    img = oiio.ImageBuf(os.path.join(out, stem + "-lightmap-0.exr")).get_pixels(oiio.FLOAT)[..., :3]
+    mask = oiio.ImageBuf(os.path.join(out, stem + "-lightmap-0-mask.png")).get_pixels(oiio.FLOAT)[..., 0] > 0.9
+    return img.astype(np.float64), mask, float(m.group(2)), int(m.group(3))
+
+
+def rel_rmse(x, ref, mask):
+    d = (x - ref)[mask]
+    return math.sqrt((d ** 2).mean()) / ref[mask].mean()
+
+
+def tonemap(img, scale):
+    x = img * scale
+    y = x / (1 + x)
+    return np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(np.maximum(y, 0), 1 / 2.4) - 0.055).clip(0, 1)
+
+
+def loglog_at(ts, es, t):
+    """Error of a method at time t by log-log interpolation over its (time, error) points."""
+    lt, le = np.log(ts), np.log(es)
+    if t <= ts[0]:
+        return float(np.exp(le[0] + (np.log(t) - lt[0]) * (le[1] - le[0]) / (lt[1] - lt[0])))
+    if t >= ts[-1]:
+        return float(np.exp(le[-1] + (np.log(t) - lt[-1]) * (le[-1] - le[-2]) / (lt[-1] - lt[-2])))
+    return float(np.exp(np.interp(np.log(t), lt, le)))
+
+
+def main():
+    lmbake, outdir = sys.argv[1], os.path.abspath(sys.argv[2])
+    work = os.path.join(outdir, "gather-work")
+    os.makedirs(work, exist_ok=True)
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
+                   check=True, stdout=subprocess.DEVNULL)
+    rows, md = [], ["# Final gather benchmark", "",
+                    "Relative RMSE over valid texels; `vs ref` against the path-traced reference (%d paths), "
+                    "`noise` against the converged gather (classic, %d rays, same cache). One bounce, 4 AMIS "
+                    "iterations, defensive share 0.1, %s threads." % (REF_PATHS, CONVERGED, THREADS), ""]
+    fig, axes = plt.subplots(2, 4, figsize=(18, 8))
+    for col, (name, density) in enumerate(SCENES):
+        scene = os.path.join(work, "scenes", name + ".gltf")
+        print("bench: %s: reference (%d paths)" % (name, REF_PATHS), flush=True)
+        ref, mask, ref_s, ref_rays = bake(lmbake, os.path.join(work, name + "-ref"), scene, density, "",
+                                          ["--reference", "--rays", str(REF_PATHS)])
+        conv, _, _, _ = bake(lmbake, os.path.join(work, name + "-conv"), scene, density, "",
+                             ["--method", "cosine", "--rays", str(CONVERGED)])
+        cache_err = rel_rmse(conv, ref, mask)
+        results, images = {}, {}
+        for label, args, extra in METHODS:
+            for rays in RAYS:
+                img, _, secs, nrays = bake(lmbake, os.path.join(work, "%s-%s-%d" % (name, label.replace(" ", "_"), rays)),
+                                           scene, density, extra, args + ["--rays", str(rays)])
+                e_ref, e_noise = rel_rmse(img, ref, mask), rel_rmse(img, conv, mask)
+                results[(label, rays)] = (secs, e_ref, e_noise, nrays)
+                if rays == 1024:
+                    images[label] = img
+                rows.append({"scene": name, "method": label, "rays_per_texel": rays, "gather_s": "%.4f" % secs,
+                             "rays": nrays, "rays_per_s": "%.4g" % (nrays / secs if secs > 0 else 0),
+                             "rmse_vs_reference": "%.5f" % e_ref, "rmse_noise": "%.5f" % e_noise,
+                             "cache_error": "%.5f" % cache_err, "valid_texels": int(mask.sum())})
+                print("bench: %-14s %-15s %5d rays: %.3f s, %.3g rays/s, RMSE vs ref %.4f, noise %.4f"
+                      % (name, label, rays, secs, nrays / max(secs, 1e-9), e_ref, e_noise), flush=True)
+        # tables
+        md += ["## %s (%d valid texels; cache error vs reference %.4f)" % (name, int(mask.sum()), cache_err), "",
+               "| method | rays | gather s | rays/s | time vs classic | RMSE vs ref | noise RMSE | noise at classic's time |",
+               "|---|---|---|---|---|---|---|---|"]
+        for label, _, _ in METHODS:
+            ts = np.array([results[(label, r)][0] for r in RAYS])
+            ns = np.array([results[(label, r)][2] for r in RAYS])
+            for k, r in enumerate(RAYS):
+                secs, e_ref, e_noise, nrays = results[(label, r)]
+                tc = results[("classic", r)][0]
+                md.append("| %s | %d | %.3f | %.3g | %+.0f%% | %.4f | %.4f | %.4f |"
+                          % (label, r, secs, nrays / max(secs, 1e-9), 100 * (secs / tc - 1), e_ref, e_noise,
+                             loglog_at(ts, ns, tc)))
+        md.append("")
+        for row, key, title in ((0, 2, "noise RMSE (vs converged gather)"), (1, 1, "RMSE vs path-traced reference")):
+            ax = axes[row][col]
+            for label, _, _ in METHODS:
+                ax.plot([results[(label, r)][0] for r in RAYS], [results[(label, r)][key] for r in RAYS], "o-",
+                        label=label)
+                for r in RAYS:
+                    ax.annotate(str(r), (results[(label, r)][0], results[(label, r)][key]), fontsize=6)
+            if row == 1:
+                ax.axhline(cache_err, color="grey", ls="--", lw=0.8, label="cache error")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_title("%s: %s" % (name, title), fontsize=9)
+            ax.set_xlabel("final gather wall time (s)")
+            ax.set_ylabel("relative RMSE")
+            ax.grid(True, which="both", lw=0.3)
+            if col == 0:
+                ax.legend(fontsize=7)
+        # side-by-side images at 1024 rays, one exposure (the reference's 95th percentile at 0.8)
+        lum = ref[mask].mean(axis=1)
+        scale = 0.8 / max(np.percentile(lum, 95), 1e-9)
+        panels = [("reference", ref)] + [(l, images[l]) for l, _, _ in METHODS]
+        f2, ax2 = plt.subplots(1, len(panels), figsize=(4 * len(panels), 4 * ref.shape[0] / ref.shape[1] + 0.6))
+        for a, (label, img) in zip(ax2, panels):
+            a.imshow(tonemap(img, scale), interpolation="nearest")
+            a.set_title("%s%s" % (label, "" if label == "reference" else ", 1024 rays, noise %.3f"
+                                  % results[(label, 1024)][2]), fontsize=9)
+            a.axis("off")
+        f2.tight_layout()
+        f2.savefig(os.path.join(outdir, "gather-%s.png" % name), dpi=100)
+        plt.close(f2)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "gather.png"), dpi=100)
+    with open(os.path.join(outdir, "gather.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    with open(os.path.join(outdir, "gather.md"), "w") as f:
+        f.write("\n".join(md) + "\n")
+    print("bench: wrote %s/gather.csv, gather.md, gather.png and gather-<scene>.png" % outdir)
+
+
+if __name__ == "__main__":
+    main()
