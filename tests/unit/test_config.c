@@ -114,6 +114,8 @@ static void test_full(void)
 }
 
 /* Keys not named keep what cfg held; values at the edges of their ranges are accepted. */
+static void expect_error(const char *text, const char *where, const char *what);
+
 static void test_partial_and_edges(void)
 {
     lmb_config c;
@@ -132,6 +134,16 @@ static void test_partial_and_edges(void)
     CHECK_INT(c.gather_method, LMB_GATHER_AMIS);
     CHECK_NEAR(c.defensive_fraction, 0.9995, 0);
     CHECK_NEAR(c.light_intensity_scale, 0, 0);
+
+    CHECK_INT(c.amis_weights, LMB_AMIS_UNBIASED);
+    CHECK_INT(c.bounce_rays, 64);
+    CHECK_INT(parse("gather: {amis_weights: balance}\nsamples: {bounce: 7}\noutput: {formats: [exr, mask]}\n", &c, &err),
+              LMB_OK);
+    CHECK_INT(c.amis_weights, LMB_AMIS_BALANCE);
+    CHECK_INT(c.bounce_rays, 7);
+    CHECK_INT(c.output_formats, LMB_OUTPUT_EXR | LMB_OUTPUT_MASK);
+    expect_error("gather:\n  amis_weights: paper\n", "level.yaml:2: ",
+                 "key 'gather.amis_weights': expected one of unbiased, balance, got 'paper'");
 
     CHECK_INT(parse("atlas: {keep_uv1: On}\noutput: {formats: hdr}\nlightmap: {include: []}\n", &c, &err), LMB_OK);
     CHECK_INT(c.keep_uv1, 1);
