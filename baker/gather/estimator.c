@@ -24,32 +24,24 @@ void lmb_estimator_scratch_free(lmb_estimator_scratch *s)
     memset(s, 0, sizeof *s);
 }
 
+static int grow(double **p, size_t n)
+{
+    double *q = realloc(*p, n * sizeof *q);
+    if (!q)
+        return 0;
+    *p = q;
+    return 1;
+}
+
 static int scratch_reserve(lmb_estimator_scratch *s, uint32_t n)
 {
     if (n <= s->cap)
         return 1;
-    double *w = realloc(s->w, (size_t)n * 3 * sizeof *w);
-    if (w)
-        s->w = w;
-    double *f = realloc(s->f, (size_t)n * 3 * sizeof *f);
-    if (f)
-        s->f = f;
-    double *lum = realloc(s->lum, (size_t)n * sizeof *lum);
-    if (lum)
-        s->lum = lum;
-    double *den = realloc(s->denom, (size_t)n * sizeof *den);
-    if (den)
-        s->denom = den;
-    double *own = realloc(s->own, (size_t)n * sizeof *own);
-    if (own)
-        s->own = own;
-    double *si = realloc(s->si, (size_t)n * sizeof *si);
-    if (si)
-        s->si = si;
-    if (!w || !f || !lum || !den || !own || !si)
-        return 0;
-    s->cap = n;
-    return 1;
+    int ok = grow(&s->w, 3 * (size_t)n) & grow(&s->f, 3 * (size_t)n) & grow(&s->lum, n) & grow(&s->denom, n) &
+             grow(&s->own, n) & grow(&s->si, n);
+    if (ok)
+        s->cap = n;
+    return ok;
 }
 
 static double luminance(const double c[3])

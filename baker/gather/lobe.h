@@ -2,13 +2,13 @@
  * The cosine-power lobe of the AMIS paper (eq. 1): p(w; n^, a) = (a + 1) / (2 pi) (w.n^)^a on
  * the hemisphere around the unit axis n^, zero outside it. a = 1 is cosine sampling (the
  * Lambertian pdf cos/pi), the starting lobe of every gather point. Sampling inverts the
- * CDF of cos(theta): cos(theta) = u1^(1 / (a + 1)), phi = 2 pi u2. The tangent frame is
- * Duff et al., "Building an Orthonormal Basis, Revisited" (JCGT 2017), branch-free and
- * continuous except at n.z = -1.
+ * CDF of cos(theta): cos(theta) = u1^(1 / (a + 1)), phi = 2 pi u2, in the frame of
+ * util/frame.h.
  */
 #ifndef LMBAKE_LOBE_H
 #define LMBAKE_LOBE_H
 
+#include "util/frame.h"
 #include "util/lmb_math.h"
 
 #include <math.h>
@@ -17,23 +17,6 @@ typedef struct lmb_lobe {
     double axis[3]; /* unit */
     double a;       /* exponent, >= 0 */
 } lmb_lobe;
-
-static inline double lmb_dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-/* Two unit tangents t, b with (t, b, n) right-handed and orthonormal. */
-static inline void lmb_frame(const double n[3], double t[3], double b[3])
-{
-    double s = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (s + n[2]), c = n[0] * n[1] * a;
-    t[0] = 1.0 + s * n[0] * n[0] * a;
-    t[1] = s * c;
-    t[2] = -s * n[0];
-    b[0] = c;
-    b[1] = s + n[1] * n[1] * a;
-    b[2] = -n[1];
-}
 
 /* pdf of direction w (unit) under the lobe, per steradian. */
 static inline double lmb_lobe_pdf(const lmb_lobe *l, const double w[3])

@@ -15,6 +15,7 @@
  */
 #include "direct.h"
 
+#include "../util/frame.h"
 #include "../util/lmb_math.h"
 #include "../util/rng.h"
 
@@ -205,18 +206,6 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Two unit tangents completing the unit normal n (Duff et al. 2017). */
-static void lmb_basis(const double n[3], double t[3], double b[3])
-{
-    double sg = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (sg + n[2]), c = n[0] * n[1] * a;
-    t[0] = 1.0 + sg * n[0] * n[0] * a;
-    t[1] = sg * c;
-    t[2] = -sg * n[0];
-    b[0] = c;
-    b[1] = sg + n[1] * n[1] * a;
-    b[2] = -n[1];
-}
-
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
@@ -302,8 +291,9 @@ static int emitted(const emitter *x, double b1, double b2, const double d[3], do
     return 1;
 }
 
-/* Area lights by multiple importance sampling (Veach 1997, balance heuristic, one sample of
- * each technique per round): a point on an emitter chosen by power (pdf in solid angle
+/* Area lights by multiple importance sampling (Veach 1997, power heuristic with beta = 2, one
+ * sample of each technique per round; the balance heuristic left 4x the variance under a disk
+ * light, where light sampling alone is nearly exact): a point on an emitter chosen by power (pdf in solid angle
  * p_l = P(tri) / A_tri x d^2 / cos_y) and a cosine-distributed direction (p_b = cos_x / pi)
  * that counts when its first hit is an emitter. Light sampling alone has unbounded variance
  * where an emitter meets the surface (corners of an emissive room); the cosine rays cover it. */
@@ -330,7 +320,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
                 c->rays++;
                 if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
                     double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
-                    double g = cx / (pl + pb) / n;
+                    double g = cx * pl / (pl * pl + pb * pb) / n; /* (cx / pl) x power weight */
                     for (int k = 0; k < 3; k++)
                         e[k] += le[k] * g;
                 }
@@ -339,7 +329,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
         /* cosine sample */
         double v1 = lmb_rng_next(rng), v2 = lmb_rng_next(rng), t1[3], t2[3], w[3];
         double r = sqrt(v1), phi = 2 * LMB_PI * v2, cz = sqrt(fmax(0, 1 - v1));
-        lmb_basis(c->n, t1, t2);
+        lmb_frame(c->n, t1, t2);
         for (int k = 0; k < 3; k++)
             w[k] = r * cos(phi) * t1[k] + r * sin(phi) * t2[k] + cz * c->n[k];
         if (!(cz > 0) || dot3(c->ng, w) <= 0)
@@ -357,7 +347,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
             continue;
         double pt = (es->cdf[k1] - es->cdf[k1 - 1]) / total;
         double pl = pt / x->area * h.t * h.t / cy, pb = cz * LMB_INV_PI;
-        double g = cz / (pl + pb) / n;
+        double g = cz * pb / (pl * pl + pb * pb) / n; /* (cz / pb) x power weight */
         for (int k = 0; k < 3; k++)
             e[k] += le[k] * g;
     }
