@@ -11,7 +11,8 @@ Errors: relative RMSE over valid texels (the mask output) against
   - the converged gather: classic gathering with BENCH_CONVERGED_RAYS rays through the same
     cache, so the difference is the estimator's noise alone (the cache's own resolution error
     is the gap between the two references, also reported).
-Time: the final gather's wall time as lmbake prints it (2 threads).
+Time: the final gather's wall time as lmbake prints it (2 threads), the fastest of BENCH_REPEAT
+(3) runs: the machine is shared and single runs move by tens of percent.
 usage: bench_gather.py LMBAKE OUTDIR   (writes gather.csv, gather.md, gather.png, gather-<scene>.png)
 """
 import csv
@@ -38,22 +39,26 @@ RAYS = [64, 256, 1024]
 REF_PATHS = int(os.environ.get("BENCH_REF_PATHS", "8192"))
 CONVERGED = int(os.environ.get("BENCH_CONVERGED_RAYS", "16384"))
 THREADS = os.environ.get("BENCH_THREADS", "2")
+REPEAT = int(os.environ.get("BENCH_REPEAT", "3"))  # timed runs per setting; the fastest counts
 
 
-def bake(lmbake, out, scene, density, extra_cfg, args):
+def bake(lmbake, out, scene, density, extra_cfg, args, repeat=1):
     cfg = out + ".yaml"
     with open(cfg, "w") as f:
         f.write("texel_density: %d\nbounces: 1\nsamples: {texel: 4, direct: 16, amis_iterations: 4}\n"
                 "output: {formats: [exr, mask]}\ngather:\n  defensive: 0.1\n%s" % (density, extra_cfg))
-    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "--threads", THREADS] + args,
-                       capture_output=True, text=True)
-    if p.returncode:
-        sys.exit("bake failed: %s" % p.stderr)
-    m = re.search(r"(final gather|reference): ([0-9.]+) s, ([0-9]+) rays", p.stdout)
+    secs = []
+    for _ in range(repeat):  # same seed, same files: only the time differs (this machine is shared)
+        p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "--threads", THREADS] + args,
+                           capture_output=True, text=True)
+        if p.returncode:
+            sys.exit("bake failed: %s" % p.stderr)
+        m = re.search(r"(final gather|reference): ([0-9.]+) s, ([0-9]+) rays", p.stdout)
+        secs.append(float(m.group(2)))
     stem = os.path.splitext(os.path.basename(scene))[0]
     img = oiio.ImageBuf(os.path.join(out, stem + "-lightmap-0.exr")).get_pixels(oiio.FLOAT)[..., :3]
     mask = oiio.ImageBuf(os.path.join(out, stem + "-lightmap-0-mask.png")).get_pixels(oiio.FLOAT)[..., 0] > 0.9
-    return img.astype(np.float64), mask, float(m.group(2)), int(m.group(3))
+    return img.astype(np.float64), mask, min(secs), int(m.group(3))
 
 
 def rel_rmse(x, ref, mask):
@@ -86,7 +91,7 @@ def main():
     rows, md = [], ["# Final gather benchmark", "",
                     "Relative RMSE over valid texels; `vs ref` against the path-traced reference (%d paths), "
                     "`noise` against the converged gather (classic, %d rays, same cache). One bounce, 4 AMIS "
-                    "iterations, defensive share 0.1, %s threads." % (REF_PATHS, CONVERGED, THREADS), ""]
+                    "iterations, defensive share 0.1, %s threads, fastest of %d timed runs." % (REF_PATHS, CONVERGED, THREADS, REPEAT), ""]
     fig, axes = plt.subplots(2, 4, figsize=(18, 8))
     for col, (name, density) in enumerate(SCENES):
         scene = os.path.join(work, "scenes", name + ".gltf")
@@ -100,7 +105,7 @@ def main():
         for label, args, extra in METHODS:
             for rays in RAYS:
                 img, _, secs, nrays = bake(lmbake, os.path.join(work, "%s-%s-%d" % (name, label.replace(" ", "_"), rays)),
-                                           scene, density, extra, args + ["--rays", str(rays)])
+                                           scene, density, extra, args + ["--rays", str(rays)], REPEAT)
                 e_ref, e_noise = rel_rmse(img, ref, mask), rel_rmse(img, conv, mask)
                 results[(label, rays)] = (secs, e_ref, e_noise, nrays)
                 if rays == 1024:
