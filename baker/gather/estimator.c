@@ -58,19 +58,31 @@ static void sample_uniforms(lmb_rng rng, uint32_t j, double u[3])
     u[2] = lmb_rng_next(&rng);
 }
 
+/* Sample j's direction from `lobe` into w; when it lies above the surface (shading and
+ * geometric normals) traces it: l = radiance, *c = w.n, returns 1. Shared by both methods so
+ * that the same stream gives the same rays. */
+static int draw_and_trace(const lmb_lobe *lobe, const lmb_lobe *cosine, const double ng[3], const double u[3],
+                          uint32_t j, lmb_radiance_fn radiance, void *user, double w[3], double l[3], double *c,
+                          lmb_estimate *out)
+{
+    lmb_lobe_sample(lobe, u[0], u[1], w);
+    *c = lmb_dot3(w, cosine->axis);
+    if (*c <= 0 || lmb_dot3(w, ng) <= 0)
+        return 0;
+    radiance(user, w, j, l);
+    out->traced++;
+    return 1;
+}
+
 /* Classic final gathering: E = 1/N sum f(w_j) / p_cos(w_j). */
 static void classic(const lmb_estimator_options *opt, const lmb_lobe *cosine, const double ng[3], lmb_rng rng,
                     lmb_radiance_fn radiance, void *user, lmb_estimate *out)
 {
     for (uint32_t j = 0; j < opt->rays; j++) {
-        double u[3], w[3], l[3];
+        double u[3], w[3], l[3], c;
         sample_uniforms(rng, j, u);
-        lmb_lobe_sample(cosine, u[0], u[1], w);
-        double c = lmb_dot3(w, cosine->axis);
-        if (c <= 0 || lmb_dot3(w, ng) <= 0)
+        if (!draw_and_trace(cosine, cosine, ng, u, j, radiance, user, w, l, &c, out))
             continue;
-        radiance(user, w, j, l);
-        out->traced++;
         double denom = (double)opt->rays * lmb_lobe_pdf(cosine, w);
         for (int k = 0; k < 3; k++)
             out->e[k] += l[k] * c / denom;
@@ -148,12 +160,9 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
             } else if (d > 0 && u[2] < d) {
                 lobe = cosine;
             }
-            lmb_lobe_sample(lobe, u[0], u[1], w);
-            double c = lmb_dot3(w, cosine->axis);
-            if (c <= 0 || lmb_dot3(w, ng) <= 0)
+            double c;
+            if (!draw_and_trace(lobe, cosine, ng, u, j, radiance, user, w, l, &c, out))
                 continue;
-            radiance(user, w, j, l);
-            out->traced++;
             double f[3] = {l[0] * c, l[1] * c, l[2] * c}, lum = luminance(f);
             if (!(lum > 0))
                 continue;

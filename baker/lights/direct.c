@@ -201,11 +201,6 @@ typedef struct point_ctx {
     uint64_t rays;
 } point_ctx;
 
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
@@ -216,7 +211,7 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     } else {
         for (int k = 0; k < 3; k++)
             d[k] = l->position[k] - c->p[k];
-        dist = sqrt(dot3(d, d));
+        dist = sqrt(lmb_dot3(d, d));
         if (!(dist > 0))
             return;
         for (int k = 0; k < 3; k++)
@@ -228,14 +223,14 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
             w *= f * f;
         }
         if (l->type == LMB_LIGHT_SPOT) {
-            double cd = -dot3(d, l->direction), co = cos(l->outer_cone), ci = cos(l->inner_cone);
+            double cd = -lmb_dot3(d, l->direction), co = cos(l->outer_cone), ci = cos(l->inner_cone);
             double t = (cd - co) / fmax(1e-3, ci - co);
             t = t < 0 ? 0 : (t > 1 ? 1 : t);
             w *= t * t;
         }
     }
-    cosang = dot3(c->n, d);
-    if (w <= 0 || cosang <= 0 || dot3(c->ng, d) <= 0)
+    cosang = lmb_dot3(c->n, d);
+    if (w <= 0 || cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
         return;
     c->rays++;
     if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
@@ -275,7 +270,7 @@ static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
  * the emitter), or 0 when seen from its back and one-sided. */
 static int emitted(const emitter *x, double b1, double b2, const double d[3], double *cos_y, double le[3])
 {
-    double cy = -dot3(x->n, d);
+    double cy = -lmb_dot3(x->n, d);
     if (x->two_sided)
         cy = fabs(cy);
     if (cy <= 0)
@@ -311,12 +306,12 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
             y[k] = (1 - b1 - b2) * x->p[k] + b1 * x->p[3 + k] + b2 * x->p[6 + k];
             d[k] = y[k] - c->p[k];
         }
-        double dist2 = dot3(d, d), dist = sqrt(dist2);
+        double dist2 = lmb_dot3(d, d), dist = sqrt(dist2);
         if (dist > 0) {
             for (int k = 0; k < 3; k++)
                 d[k] /= dist;
-            double cx = dot3(c->n, d);
-            if (cx > 0 && dot3(c->ng, d) > 0 && emitted(x, b1, b2, d, &cy, le)) {
+            double cx = lmb_dot3(c->n, d);
+            if (cx > 0 && lmb_dot3(c->ng, d) > 0 && emitted(x, b1, b2, d, &cy, le)) {
                 c->rays++;
                 if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
                     double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
@@ -332,7 +327,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
         lmb_frame(c->n, t1, t2);
         for (int k = 0; k < 3; k++)
             w[k] = r * cos(phi) * t1[k] + r * sin(phi) * t2[k] + cz * c->n[k];
-        if (!(cz > 0) || dot3(c->ng, w) <= 0)
+        if (!(cz > 0) || lmb_dot3(c->ng, w) <= 0)
             continue;
         lmb_rt_hit h;
         c->rays++;
@@ -360,7 +355,7 @@ static int inside_geometry(point_ctx *c, lmb_rng *rng)
     t1[0] = a[1] * c->ng[2] - a[2] * c->ng[1];
     t1[1] = a[2] * c->ng[0] - a[0] * c->ng[2];
     t1[2] = a[0] * c->ng[1] - a[1] * c->ng[0];
-    double l = sqrt(dot3(t1, t1));
+    double l = sqrt(lmb_dot3(t1, t1));
     for (int k = 0; k < 3; k++)
         t1[k] /= l;
     t2[0] = c->ng[1] * t1[2] - c->ng[2] * t1[1];
