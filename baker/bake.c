@@ -284,6 +284,9 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
                                 l.height[a], err);
     stats->light_seconds = lmb_seconds() - tl;
     stats->atlases = l.atlas_count;
+    stats->texel_density = l.density.scene_density;
+    stats->density_auto = l.density.automatic;
+    stats->density_capped = l.density.capped;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
         st = write_gltf(s, &l, od.staging, od.stem, stats, err);

@@ -4,6 +4,8 @@
 #include "gather/gather.h"
 #include "util/clock.h"
 
+#include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,6 +14,7 @@ typedef struct atlas_work {
     lmb_texels t;
     float *direct;   /* 3 per listed texel */
     float *result;   /* 3 per listed texel: the pass being computed */
+    float *prev;     /* 3 per listed texel: the pass before (bounces: auto) */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -20,6 +23,7 @@ static void work_free(atlas_work *w, uint32_t n)
         lmb_texels_free(&w[a].t);
         free(w[a].direct);
         free(w[a].result);
+        free(w[a].prev);
     }
     free(w);
 }
@@ -39,6 +43,122 @@ static lmb_status gather_pass(lmb_gather_job *job, atlas_work *w, lmb_cache *cac
     for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
         st = lmb_cache_store(cache, a, &w[a].t, w[a].result, err);
     stats->rays += gs->rays;
+    return st;
+}
+
+/* Mean of each channel over the valid texels of every atlas (field: direct, result or prev). */
+static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3])
+{
+    double sum[3] = {0, 0, 0};
+    uint64_t count = 0;
+    for (uint32_t a = 0; a < n; a++) {
+        const float *e = *(float *const *)(const void *)((const char *)&w[a] + field);
+        for (uint32_t i = 0; i < w[a].t.count; i++)
+            if (w[a].t.valid[i]) {
+                count++;
+                for (int c = 0; c < 3; c++)
+                    sum[c] += e[3 * (size_t)i + c];
+            }
+    }
+    for (int c = 0; c < 3; c++)
+        out[c] = count ? sum[c] / (double)count : 0;
+}
+
+static double luminance(const double c[3])
+{
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
+
+/*
+ * bounces: auto (README "Bounces"). Pass b sets the cache to E_b = E_direct + gather(E_{b-1});
+ * what it added, D_b = mean(E_b - E_{b-1}), shrinks by the scene's bounce ratio r = D_b / D_{b-1}
+ * (the mean albedo seen, weighted by where light goes; per channel). The bounces no pass
+ * computes form a geometric tail: after pass b the final gather adds bounce b + 1 and the
+ * rest is D_b (r^2 + r^3 + ...). Passes go on until the tail the cache is missing,
+ * T = D_b r / (1 - r), is below bounces_auto.tail of the total, with two ratios in a row
+ * agreeing (the tail is an extrapolation: it needs a settled ratio), or bounces_auto.max.
+ * Then the tail is added to the cache texel by texel, T_x = (E_b - E_{b-1})_x r / (1 - r),
+ * so the final gather reads converged light and adds what the passes left out: a closed
+ * room of albedo rho gets pi Le / (1 - rho), not the series cut after b + 1 terms.
+ * Why extrapolate rather than run until the tail is negligible: at rho = 0.8 a 1% tail takes
+ * ~20 passes; the ratio settles after 3-4, and the extrapolation is exact for a furnace and
+ * within the ratio's error times the tail elsewhere.
+ */
+static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas_work *w, lmb_cache *cache,
+                               lmb_bake_stats *stats, uint32_t *passes, lmb_error *err)
+{
+    uint32_t n = cache->atlas_count, max_passes = cfg->bounces_max - 1;
+    double before[3], after[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+        w[a].prev = malloc((3 * (size_t)w[a].t.count + 1) * sizeof *w[a].prev);
+        if (!w[a].prev)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
+        else
+            memcpy(w[a].prev, w[a].direct, 3 * (size_t)w[a].t.count * sizeof *w[a].prev);
+    }
+    mean_rgb(w, n, offsetof(atlas_work, direct), before);
+    stats->bounce_energy[0] = luminance(before);
+    char stage[64];
+    int converged = 0;
+    uint32_t done = 0;
+    for (uint32_t b = 1; b <= max_passes && !converged && st == LMB_OK; b++) {
+        lmb_gather_stats gs = {0, 0, 0};
+        lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0, 0};
+        job->estimator = e;
+        job->pass = b;
+        snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
+        job->stage = stage;
+        st = gather_pass(job, w, cache, stats, &gs, err);
+        if (st != LMB_OK)
+            break;
+        mean_rgb(w, n, offsetof(atlas_work, result), after);
+        for (int c = 0; c < 3; c++) {
+            added[c] = after[c] - before[c];
+            ratio[c] = last[c] > 0 ? added[c] / last[c] : 0;
+            ratio[c] = ratio[c] < 0 ? 0 : ratio[c] > 0.98 ? 0.98 : ratio[c];
+        }
+        if (b < LMB_MAX_REPORTED_BOUNCES)
+            stats->bounce_energy[b] = luminance(added);
+        double r = luminance(ratio), total = luminance(after), tail[3];
+        for (int c = 0; c < 3; c++)
+            tail[c] = added[c] * ratio[c] / (1 - ratio[c]);
+        double tail_share = total + luminance(tail) > 0 ? luminance(tail) / (total + luminance(tail)) : 0;
+        int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
+        int negligible = luminance(added) <= 1e-6 * total; /* nothing bounces: no tail to speak of */
+        converged = negligible || (settled && tail_share < cfg->bounces_tail);
+        stats->tail_share = b >= 2 ? tail_share : 0;
+        stats->bounce_ratio = b >= 2 ? r : 0;
+        prev_ratio = b >= 2 ? r : -1;
+        done = b;
+        for (int c = 0; c < 3; c++) {
+            last[c] = added[c];
+            before[c] = after[c];
+        }
+        if (converged || b == max_passes) {
+            if (negligible || b < 2) {
+                stats->tail_share = 0;
+                break;
+            }
+            /* the geometric tail, texel by texel, into the cache the final gather reads */
+            for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+                for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
+                    double f = ratio[k % 3] / (1 - ratio[k % 3]);
+                    double v = w[a].result[k] + (w[a].result[k] - w[a].prev[k]) * f;
+                    w[a].result[k] = (float)(v > 0 ? v : 0);
+                }
+                st = lmb_cache_store(cache, a, &w[a].t, w[a].result, err);
+            }
+            stats->tail_added = 1;
+            break;
+        }
+        for (uint32_t a = 0; a < n; a++) {
+            float *t = w[a].prev;
+            w[a].prev = w[a].result;
+            w[a].result = t;
+        }
+    }
+    *passes = done;
     return st;
 }
 
@@ -82,9 +202,12 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.progress = progress;
     job.progress_user = user;
     job.progress_total = total;
-    /* bounce passes: classic gathering with few rays */
+    /* bounce passes: classic gathering with few rays, a fixed number or until converged */
+    uint32_t passes = 0;
+    if (st == LMB_OK && !cfg->reference && cfg->bounces == LMB_AUTO)
+        st = auto_bounces(cfg, &job, w, cache, stats, &passes, err);
     char stage[64];
-    for (uint32_t b = 1; b < cfg->bounces && !cfg->reference && st == LMB_OK; b++) {
+    for (uint32_t b = 1; cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK; b++) {
         lmb_gather_stats gs = {0, 0, 0};
         lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0, 0};
         job.estimator = e;
@@ -92,16 +215,19 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
         job.stage = stage;
         st = gather_pass(&job, w, cache, stats, &gs, err);
+        passes = b;
     }
+    uint32_t bounces = cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
+    stats->bounces = bounces;
     /* the final gather, or the reference */
-    if (cfg->bounces > 0 && st == LMB_OK) {
+    if (bounces > 0 && st == LMB_OK) {
         lmb_gather_stats gs = {0, 0, 0};
         lmb_estimator_options e = {cfg->gather_method, cfg->gather_rays, cfg->amis_iterations, cfg->defensive_fraction,
                                    cfg->amis_weights == LMB_AMIS_UNBIASED};
         job.estimator = e;
         job.pass = 1000;
         job.reference = cfg->reference;
-        job.depth = cfg->bounces;
+        job.depth = bounces;
         job.stage = cfg->reference ? "reference" : "final gather";
         double t0 = lmb_seconds();
         st = gather_pass(&job, w, cache, stats, &gs, err);

@@ -1,14 +1,13 @@
 /*
- * Scene lightmap layout (see layout.h). Texel density per instance: the first
- * density_overrides glob matching the instance's node or mesh name, else texel_density.
- * Each chart of an instance is scaled by density * sqrt(world area / UV area), so texels
+ * Scene lightmap layout (see layout.h). Texel density per instance: density.h (an
+ * override, the explicit texel_density, or auto from the texel budget). Each chart of an instance is scaled by density * sqrt(world area / UV area), so texels
  * are square in world units whatever the instance's (even non-uniform) scale.
- * Atlases: everything is packed together first; if that needs several atlases, instances
- * are grouped in scene order by estimated size and each group packed alone, halving a
- * group that still spills over, so that every instance sits whole in one atlas.
+ * Atlases: everything is packed in one run, every instance whole in one atlas (pack.h's
+ * groups); kept TEXCOORD_1 instances get atlases of their own first.
  */
 #include "../util/clock.h"
 #include "layout.h"
+#include "density.h"
 #include "keep_uv1.h"
 #include "pack.h"
 #include "unwrap/metrics.h"
@@ -83,16 +82,6 @@ static double area3(const double *q)
     return 0.5 * sqrt(x * x + y * y + z * z);
 }
 
-static double density_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i)
-{
-    const lmb_instance *in = &s->instances[i];
-    for (uint32_t k = 0; k < cfg->density_override_count; k++)
-        if (lmb_glob_match(cfg->density_overrides[k].pattern, in->name) ||
-            lmb_glob_match(cfg->density_overrides[k].pattern, s->meshes[in->mesh].name))
-            return cfg->density_overrides[k].texel_density;
-    return cfg->texel_density;
-}
-
 /* Scales instance i's charts into uv1 (texel units, chart-local) and returns its texel area. */
 static double scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
 {
@@ -120,12 +109,13 @@ static double scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
     return texels;
 }
 
-/* Packs the charts of instances list[0..n) into their own atlases (appended to l). Returns
- * LMB_OK, or 1 in *spilled if one instance's charts ended in different atlases. */
-static lmb_status pack_group(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list, uint32_t n,
-                             int *spilled, lmb_error *err)
+/* Packs the charts of instances list[0..n) together, each instance whole in one atlas (a
+ * group of the packer). Returns the instance that did not fit in *failed (or UINT32_MAX). */
+static lmb_status pack_instances(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                                 uint32_t n, uint32_t *failed, lmb_error *err)
 {
     uint32_t nc = 0;
+    *failed = UINT32_MAX;
     for (uint32_t j = 0; j < n; j++)
         nc += l->meshes[s->instances[list[j]].mesh].charts.chart_count;
     lmb_pack_chart *charts = calloc((size_t)nc + 1, sizeof *charts);
@@ -150,28 +140,35 @@ static lmb_status pack_group(const lmb_scene *s, const lmb_config *cfg, lmb_layo
                 memcpy(bufs[q] + 6 * t, uv1 + 6 * c->order[c->first[k] + t], 6 * sizeof(double));
             charts[q].triangle_count = len;
             charts[q].uv = bufs[q];
+            charts[q].group = j;
             owner[q] = list[j];
             chart_id[q] = k;
         }
     }
-    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding};
+    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1};
     if (st == LMB_OK)
         st = lmb_pack_charts(charts, nc, &opt, &r, err);
-    unsigned bad;
-    if (st == LMB_ERR_INPUT && sscanf(err->message, "chart %u", &bad) == 1 && bad < nc) {
-        /* name the instance and mesh the chart belongs to: that is what a user can change */
-        char detail[sizeof err->message];
-        const char *rest = strstr(err->message, " is ");
-        snprintf(detail, sizeof detail, "%s", rest ? rest + 4 : err->message);
-        st = lmb_error_set(err, LMB_ERR_INPUT, "instance '%s' (mesh '%s'): a chart is %s (texel_density %g)",
-                           s->instances[owner[bad]].name, s->meshes[s->instances[owner[bad]].mesh].name, detail,
-                           l->instances[owner[bad]].texel_density);
+    if (st == LMB_ERR_INPUT && r.failed_group < n) {
+        uint32_t i = list[r.failed_group];
+        *failed = i;
+        if (r.failed_chart != UINT32_MAX) {
+            /* name the instance and mesh the chart belongs to: that is what a user can change */
+            char detail[sizeof err->message];
+            const char *rest = strstr(err->message, " is ");
+            snprintf(detail, sizeof detail, "%s", rest ? rest + 4 : err->message);
+            st = lmb_error_set(err, LMB_ERR_INPUT, "instance '%s' (mesh '%s'): a chart is %s (texel_density %g)",
+                               s->instances[i].name, s->meshes[s->instances[i].mesh].name, detail,
+                               l->instances[i].texel_density);
+        } else {
+            st = lmb_error_set(err, LMB_ERR_INPUT,
+                               "instance '%s' (mesh '%s') does not fit in one %ux%u atlas at %g texels per unit: "
+                               "lower texel_density (or a density_overrides entry), use texel_density: auto, or "
+                               "raise atlas.max_size",
+                               s->instances[i].name, s->meshes[s->instances[i].mesh].name, cfg->max_atlas_size,
+                               cfg->max_atlas_size, l->instances[i].texel_density);
+        }
     }
-    *spilled = 0;
-    for (uint32_t c = 1; st == LMB_OK && c < nc; c++)
-        if (owner[c] == owner[c - 1] && r.placements[c].atlas != r.placements[c - 1].atlas)
-            *spilled = 1;
-    if (st == LMB_OK && !*spilled) {
+    if (st == LMB_OK) {
         uint32_t base = l->atlas_count;
         uint32_t *w = realloc(l->width, (base + r.atlas_count + 1) * sizeof *w);
         if (w) l->width = w;
@@ -211,22 +208,36 @@ static lmb_status pack_group(const lmb_scene *s, const lmb_config *cfg, lmb_layo
     return st;
 }
 
-/* Packs list[0..n) whole, halving on spill-over. */
-static lmb_status pack_split(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list, uint32_t n,
-                             lmb_error *err)
+/* Packs; with texel_density auto, an instance the estimate let through but the packer could
+ * not fit is lowered (x 0.85, a warning names it) and the packing redone. */
+static lmb_status pack_level(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                             uint32_t n, const lmb_log *log, lmb_error *err)
 {
-    int spilled;
-    lmb_status st = pack_group(s, cfg, l, list, n, &spilled, err);
-    if (st != LMB_OK || !spilled)
-        return st;
-    if (n == 1)
-        return lmb_error_set(err, LMB_ERR_INPUT,
-                             "instance '%s' does not fit in one %ux%u atlas at %g texels per unit: lower "
-                             "texel_density (or a density_overrides entry) or raise atlas.max_size",
-                             s->instances[list[0]].name, cfg->max_atlas_size, cfg->max_atlas_size,
-                             l->instances[list[0]].texel_density);
-    st = pack_split(s, cfg, l, list, n / 2, err);
-    return st == LMB_OK ? pack_split(s, cfg, l, list + n / 2, n - n / 2, err) : st;
+    for (int attempt = 0;; attempt++) {
+        uint32_t failed;
+        lmb_status st = pack_instances(s, cfg, l, list, n, &failed, err);
+        if (st != LMB_ERR_INPUT || !l->density.automatic || failed == UINT32_MAX || attempt >= 24 ||
+            l->meshes[s->instances[failed].mesh].kept_uv1)
+            return st;
+        int overridden = 0;
+        for (uint32_t k = 0; k < cfg->density_override_count; k++)
+            overridden |= lmb_glob_match(cfg->density_overrides[k].pattern, s->instances[failed].name) ||
+                          lmb_glob_match(cfg->density_overrides[k].pattern, s->meshes[s->instances[failed].mesh].name);
+        if (overridden)
+            return st;
+        lmb_layout_instance *li = &l->instances[failed];
+        li->texel_density *= 0.85;
+        lmb_warn(log, "instance '%s' (mesh '%s') lowered to %.4g texels per unit to fit one %ux%u atlas",
+                 s->instances[failed].name, s->meshes[s->instances[failed].mesh].name, li->texel_density,
+                 cfg->max_atlas_size, cfg->max_atlas_size);
+        /* start again from chart-local UVs */
+        for (uint32_t a = 0; a < l->atlas_count; a++)
+            l->width[a] = l->height[a] = 0;
+        l->atlas_count = l->kept_atlases;
+        l->chart_total = l->kept_atlases;
+        for (uint32_t j = 0; j < n; j++)
+            scale_instance(s, l, list[j]);
+    }
 }
 
 static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, lmb_progress_fn progress,
@@ -320,10 +331,11 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             list[n++] = i;
         }
     lmb_status st = unwrap_meshes(s, cfg, l, progress, user, err);
+    if (st == LMB_OK)
+        st = lmb_density_choose(s, cfg, l, list, n, log, &l->density, err);
     for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
         lmb_layout_instance *li = &l->instances[list[j]];
         li->lightmapped = 1;
-        li->texel_density = density_for(s, cfg, list[j]);
         li->uv1 = calloc((size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6 + 1, sizeof *li->uv1);
         if (!li->uv1)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
@@ -339,9 +351,10 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             list[packed++] = list[j];
     }
     n = packed;
+    l->kept_atlases = l->atlas_count;
     double t0 = lmb_seconds();
     if (st == LMB_OK && n)
-        st = pack_split(s, cfg, l, list, n, err);
+        st = pack_level(s, cfg, l, list, n, log, err);
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);

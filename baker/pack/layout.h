@@ -12,6 +12,14 @@
 
 #include "unwrap/unwrap.h"
 
+/* How texel densities were chosen (density.h), for reports. */
+typedef struct lmb_density_report {
+    int automatic;          /* texel_density: auto */
+    double scene_density;   /* the density instances without an override got (before any fit cap) */
+    uint64_t budget;        /* auto: the texel budget */
+    uint32_t capped;        /* auto: instances lowered to fit one atlas */
+} lmb_density_report;
+
 /* One mesh's primitives as a single triangle list (vertex ids offset per primitive). */
 typedef struct lmb_mesh_soup {
     uint32_t vertex_count, triangle_count;
@@ -42,7 +50,9 @@ typedef struct lmb_layout {
     lmb_layout_instance *instances;
     uint32_t atlas_count;
     uint32_t *width, *height;
+    uint32_t kept_atlases; /* the first atlases: one per kept-TEXCOORD_1 instance */
     uint32_t chart_total;  /* charts placed, over all instances */
+    lmb_density_report density;    /* how densities were chosen */
     double pack_seconds;
 } lmb_layout;
 

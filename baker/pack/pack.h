@@ -13,11 +13,13 @@
 typedef struct lmb_pack_chart {
     uint32_t triangle_count;
     const double *uv; /* 6 per triangle: chart-local coordinates in texel units */
+    uint32_t group;   /* with lmb_pack_options.grouped: charts of one group share an atlas (an instance) */
 } lmb_pack_chart;
 
 typedef struct lmb_pack_options {
     uint32_t max_size; /* atlas side limit, texels */
     uint32_t padding;  /* texels between footprints */
+    int grouped;       /* every group lands whole in one atlas; a group that cannot is an error */
 } lmb_pack_options;
 
 /* Chart-local uv -> atlas texel coordinates: x = m[0] u + m[1] v + m[2], y = m[3] u + m[4] v + m[5]
@@ -31,13 +33,22 @@ typedef struct lmb_pack_result {
     uint32_t atlas_count;
     uint32_t *width, *height; /* per atlas, each <= max_size, cropped to what is used */
     lmb_pack_placement *placements; /* one per input chart */
+    uint32_t failed_group;          /* after LMB_ERR_INPUT: the group that does not fit one atlas */
+    uint32_t failed_chart;          /* after LMB_ERR_INPUT: a chart of it (too large alone), or UINT32_MAX */
 } lmb_pack_result;
 
 /* Fills out (caller frees with lmb_pack_result_free). A chart whose footprint cannot fit in
- * max_size x max_size is LMB_ERR_INPUT naming its index and size (lower the density). */
+ * max_size x max_size is LMB_ERR_INPUT naming its index and size (lower the density); so is,
+ * when grouped, a group whose footprints cannot share one atlas: found before placing
+ * anything when their area exceeds it, else as soon as the group fails in an empty atlas.
+ * out->failed_group / failed_chart say which. Time grows with charts and the area they
+ * cover, not with the empty area searched or the number of atlases. */
 lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const lmb_pack_options *opt,
                            lmb_pack_result *out, lmb_error *err);
 
 void lmb_pack_result_free(lmb_pack_result *r);
+
+/* The chart's minimal-area bounding box (the orientation the packer uses), in its units. */
+void lmb_pack_chart_box(const lmb_pack_chart *c, double *w, double *h);
 
 #endif

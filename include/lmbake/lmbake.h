@@ -171,6 +171,9 @@ typedef enum lmb_amis_weights {
 /* MASK: <stem>-lightmap-N-mask.png, per texel 255 = lit (valid), 128 = inside geometry, 0 = padding */
 enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8 };
 
+/* A u32 key set to "auto" (bounces). */
+#define LMB_AUTO UINT32_MAX
+
 #define LMB_MAX_PATTERNS 64
 #define LMB_PATTERN_LEN 128
 
@@ -181,9 +184,10 @@ typedef struct lmb_density_override {
 
 typedef struct lmb_config {
     /* unwrap / pack */
-    double texel_density;          /* texels per world unit */
+    double texel_density;          /* texels per world unit; 0 = auto: the lightmapped surface fills atlas_texels */
     lmb_density_override density_overrides[LMB_MAX_PATTERNS];
     uint32_t density_override_count;
+    uint64_t atlas_texels;         /* auto density's budget of lightmapped texels; 0 = auto (lmb_config_atlas_texels) */
     uint32_t max_atlas_size;       /* texels per side */
     uint32_t padding;              /* texels between charts */
     int keep_uv1;                  /* keep a mesh's own TEXCOORD_1 */
@@ -193,7 +197,9 @@ typedef struct lmb_config {
     uint32_t gather_rays;          /* final gather rays per texel (reference: paths per texel) */
     uint32_t bounce_rays;          /* rays per texel of each bounce pass before the final gather */
     uint32_t amis_iterations;
-    uint32_t bounces;
+    uint32_t bounces;              /* indirect bounces, or LMB_AUTO: bounce passes until the tail is small, tail added */
+    uint32_t bounces_max;          /* auto: at most this many bounces */
+    double bounces_tail;           /* auto: stop when the estimated tail beyond the last pass is below this share */
     lmb_gather_method gather_method;
     double defensive_fraction;     /* share of cosine samples, AMIS defensive */
     lmb_amis_weights amis_weights; /* how AMIS weights its samples in the estimate */
@@ -214,6 +220,10 @@ typedef struct lmb_config {
 
 /* Fills cfg with the documented defaults (README: "Bake config"). */
 void lmb_config_default(lmb_config *cfg);
+
+/* The auto density's texel budget: cfg->atlas_texels, or when 0 the texels of one
+ * max_size atlas at the coverage the packer typically reaches on real levels. */
+uint64_t lmb_config_atlas_texels(const lmb_config *cfg);
 
 /* Reads a YAML bake config over the defaults already in cfg. Unknown keys, wrong
  * types and out-of-range values are LMB_ERR_INPUT naming file, line and key. */
@@ -259,6 +269,8 @@ void lmb_scene_stats_compute(const lmb_scene *scene, lmb_scene_stats *out);
 
 /* ---- baking -------------------------------------------------------------- */
 
+#define LMB_MAX_REPORTED_BOUNCES 65
+
 typedef struct lmb_bake_stats {
     uint32_t atlases;
     uint64_t texels;        /* texels holding gather points */
@@ -269,6 +281,14 @@ typedef struct lmb_bake_stats {
     double gather_seconds;  /* wall time of the final gather (or the reference) */
     uint64_t gather_rays;   /* rays of the final gather (or the reference) */
     uint64_t amis_adapted;  /* AMIS lobe updates that changed a lobe */
+    uint32_t bounces;       /* bounces of indirect light computed (passes + the final gather) */
+    double bounce_energy[LMB_MAX_REPORTED_BOUNCES]; /* mean luminance: [0] direct, [b] what pass b added */
+    double bounce_ratio;    /* bounces: auto: the last ratio of what two passes added */
+    double tail_share;      /* bounces: auto: the estimated tail's share of the total */
+    int tail_added;         /* bounces: auto: the geometric tail was added to the cache */
+    double texel_density;   /* the scene's density (auto: what the budget gave) */
+    int density_auto;       /* texel_density: auto */
+    uint32_t density_capped; /* auto: instances lowered to fit one atlas */
     char gltf_path[8600];   /* the output glTF */
 } lmb_bake_stats;
 

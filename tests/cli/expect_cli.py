@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Runs one lmbake command and asserts its exit code and messages.
 
-usage: expect_cli.py --exit N [--stderr RE]... [--stdout RE]... [--absent PATH]...
+usage: expect_cli.py --exit N [--stderr RE]... [--no-stderr RE]... [--stdout RE]... [--absent PATH]...
                      [--unchanged PATH]... -- COMMAND ARGS...
 
 --stderr/--stdout: a regular expression that must match somewhere in that stream.
+--no-stderr: a regular expression that must match nowhere in stderr (a stage that must not run).
 --absent: a path that must not exist afterwards (nothing written on failure).
 --unchanged: a file whose bytes must be the same after the command (input never touched);
   one that did not exist must still not exist.
@@ -24,6 +25,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exit", type=int, required=True)
     ap.add_argument("--stderr", action="append", default=[])
+    ap.add_argument("--no-stderr", action="append", default=[])
     ap.add_argument("--stdout", action="append", default=[])
     ap.add_argument("--absent", action="append", default=[])
     ap.add_argument("--unchanged", action="append", default=[])
@@ -37,6 +39,9 @@ def main():
     for rx in opts.stderr:
         if not re.search(rx, proc.stderr):
             failures.append(f"stderr does not match /{rx}/")
+    for rx in opts.no_stderr:
+        if re.search(rx, proc.stderr):
+            failures.append(f"stderr matches /{rx}/, which it must not")
     for rx in opts.stdout:
         if not re.search(rx, proc.stdout):
             failures.append(f"stdout does not match /{rx}/")

@@ -31,7 +31,9 @@ static void test_defaults(void)
 {
     lmb_config c;
     lmb_config_default(&c);
-    CHECK_NEAR(c.texel_density, 8.0, 0);
+    CHECK_NEAR(c.texel_density, 0, 0); /* auto */
+    CHECK(c.atlas_texels == 0);        /* auto: 0.6 x max_size^2 */
+    CHECK(lmb_config_atlas_texels(&c) == 629145);
     CHECK_INT(c.density_override_count, 0);
     CHECK_INT(c.max_atlas_size, 1024);
     CHECK_INT(c.padding, 2);
@@ -40,7 +42,9 @@ static void test_defaults(void)
     CHECK_INT(c.direct_samples, 16);
     CHECK_INT(c.gather_rays, 256);
     CHECK_INT(c.amis_iterations, 4);
-    CHECK_INT(c.bounces, 2);
+    CHECK(c.bounces == LMB_AUTO);
+    CHECK_INT(c.bounces_max, 32);
+    CHECK_NEAR(c.bounces_tail, 0.2, 0);
     CHECK_INT(c.gather_method, LMB_GATHER_AMIS_DEFENSIVE);
     CHECK_NEAR(c.defensive_fraction, 0.1, 0);
     CHECK(c.seed == 1);
@@ -123,7 +127,29 @@ static void test_partial_and_edges(void)
     CHECK_INT(parse("atlas:\n  padding: 0\n", &c, &err), LMB_OK);
     CHECK_INT(c.padding, 0);
     CHECK_INT(c.max_atlas_size, 1024);
-    CHECK_INT(c.bounces, 2);
+    CHECK(c.bounces == LMB_AUTO);
+
+    /* auto and explicit values of the keys that take both */
+    CHECK_INT(parse("texel_density: auto\nbounces: auto\natlas: {texels: auto}\n", &c, &err), LMB_OK);
+    CHECK_NEAR(c.texel_density, 0, 0);
+    CHECK(c.bounces == LMB_AUTO);
+    CHECK(c.atlas_texels == 0);
+    CHECK_INT(parse("texel_density: 12\nbounces: 3\natlas: {texels: 2000000, max_size: 2048}\n"
+                    "bounces_auto: {max: 8, tail: 0.05}\n", &c, &err), LMB_OK);
+    CHECK_NEAR(c.texel_density, 12, 0);
+    CHECK_INT(c.bounces, 3);
+    CHECK(c.atlas_texels == 2000000 && lmb_config_atlas_texels(&c) == 2000000);
+    CHECK_INT(c.bounces_max, 8);
+    CHECK_NEAR(c.bounces_tail, 0.05, 0);
+    CHECK_INT(parse("atlas: {max_size: 2048}\n", &c, &err), LMB_OK);
+    CHECK(lmb_config_atlas_texels(&c) == (uint64_t)(0.6 * 2048 * 2048));
+    expect_error("texel_density: 'auto'\n", "level.yaml:1: ",
+                 "key 'texel_density': expected auto or a number > 0 and <= 100000, got 'auto'");
+    expect_error("bounces: Auto\n", "level.yaml:1: ", "key 'bounces': expected auto or an integer in 0..64, got 'Auto'");
+    expect_error("bounces: 65\n", "level.yaml:1: ", "expected auto or an integer in 0..64, got '65'");
+    expect_error("atlas:\n  texels: 10\n", "level.yaml:2: ", "key 'atlas.texels': expected auto or an integer in 256..");
+    expect_error("bounces_auto:\n  tail: 0\n", "level.yaml:2: ", "key 'bounces_auto.tail': expected a number > 0 and < 1");
+    expect_error("bounces_auto:\n  max: 0\n", "level.yaml:2: ", "key 'bounces_auto.max': expected an integer in 1..64");
 
     CHECK_INT(parse("seed: 9223372036854775807\nthreads: 1024\ntexel_density: 100000\n", &c, &err), LMB_OK);
     CHECK(c.seed == 9223372036854775807ULL);
@@ -181,8 +207,8 @@ static void test_value_errors(void)
     expect_error("atlas:\n  max_size: 8\n", "level.yaml:2: ", "key 'atlas.max_size': expected an integer in 16..16384");
     expect_error("threads: [1]\n", "level.yaml:1: ", "key 'threads': expected an integer in 0..1024, got a list");
     expect_error("texel_density: 0\n", "level.yaml:1: ",
-                 "key 'texel_density': expected a number > 0 and <= 100000, got '0'");
-    expect_error("texel_density: .nan\n", "level.yaml:1: ", "key 'texel_density': expected a number");
+                 "key 'texel_density': expected auto or a number > 0 and <= 100000, got '0'");
+    expect_error("texel_density: .nan\n", "level.yaml:1: ", "key 'texel_density': expected auto or a number");
     expect_error("texel_density: .inf\n", "level.yaml:1: ", "got '.inf'");
     expect_error("texel_density: 0x10\n", "level.yaml:1: ", "got '0x10'");
     expect_error("texel_density:\n", "level.yaml:1: ", "got an empty value");
@@ -203,7 +229,7 @@ static void test_value_errors(void)
 static void test_structure_errors(void)
 {
     expect_error("texel_density: 8\natlas:\n  maxsize: 512\n", "level.yaml:3: ",
-                 "unknown key 'atlas.maxsize' (known keys under 'atlas': max_size, padding, keep_uv1)");
+                 "unknown key 'atlas.maxsize' (known keys under 'atlas': texels, max_size, padding, keep_uv1)");
     expect_error("bouncez: 3\n", "level.yaml:1: ",
                  "unknown key 'bouncez' (known keys: texel_density, density_overrides, atlas");
     expect_error("seed: 1\nthreads: 2\nseed: 2\n", "level.yaml:3: ", "key 'seed' is given twice (first on line 1)");

@@ -1,0 +1,202 @@
+/* Texel density per instance (see density.h). */
+#include "density.h"
+
+#include "pack.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define FIT_AREA_SHARE 0.8
+
+static double area3(const double *q)
+{
+    double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
+    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    return 0.5 * sqrt(x * x + y * y + z * z);
+}
+
+double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t i)
+{
+    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+    double q[9], a = 0;
+    for (uint32_t f = 0; f < c->triangle_count; f++)
+        if (c->chart_of[f] != UINT32_MAX) {
+            lmb_layout_world_triangle(s, l, i, f, q);
+            a += area3(q);
+        }
+    return a;
+}
+
+/* Per chart of instance i: its box sides in world units (chart box x world/uv scale). */
+static int chart_boxes(const lmb_scene *s, const lmb_layout *l, uint32_t i, double *bw, double *bh)
+{
+    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+    for (uint32_t k = 0; k < c->chart_count; k++) {
+        uint32_t len = c->first[k + 1] - c->first[k];
+        double *uv = malloc(sizeof(double) * 6 * len + 1), aw = 0, auv = 0, q[9];
+        if (!uv)
+            return 0;
+        for (uint32_t t = 0; t < len; t++) {
+            uint32_t f = c->order[c->first[k] + t];
+            const double *u = c->uv + 6 * f;
+            memcpy(uv + 6 * t, u, 6 * sizeof(double));
+            lmb_layout_world_triangle(s, l, i, f, q);
+            aw += area3(q);
+            auv += 0.5 * fabs((u[2] - u[0]) * (u[5] - u[1]) - (u[4] - u[0]) * (u[3] - u[1]));
+        }
+        lmb_pack_chart pc = {len, uv, 0};
+        double w, h, scale = auv > 0 ? sqrt(aw / auv) : 0;
+        lmb_pack_chart_box(&pc, &w, &h);
+        bw[k] = w * scale;
+        bh[k] = h * scale;
+        free(uv);
+    }
+    return 1;
+}
+
+/* Charts' footprints at density d: boxes with half the padding each side (neighbours share
+ * the gap) and the conservative raster's texel. */
+static double footprint_area(const double *bw, const double *bh, uint32_t nc, double d, uint32_t padding)
+{
+    double pad = padding + 3.0, area = 0;
+    for (uint32_t k = 0; k < nc; k++)
+        area += (d * bw[k] + pad) * (d * bh[k] + pad);
+    return area;
+}
+
+double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t i)
+{
+    const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
+    uint32_t nc = lm->charts.chart_count;
+    if (lm->kept_uv1 || nc == 0)
+        return INFINITY;
+    double *bw = malloc(sizeof(double) * nc + 1), *bh = malloc(sizeof(double) * nc + 1);
+    if (!bw || !bh || !chart_boxes(s, l, i, bw, bh)) {
+        free(bw);
+        free(bh);
+        return INFINITY; /* out of memory: the packer will say */
+    }
+    /* a chart's footprint: its box + 1 (conservative raster) + 2 x (padding + 1) per side */
+    double border = 2.0 * (cfg->padding + 1) + 1 + 2 /* margin for rounding */, longest = 0;
+    for (uint32_t k = 0; k < nc; k++)
+        longest = fmax(longest, fmax(bw[k], bh[k]));
+    double atlas = FIT_AREA_SHARE * (double)cfg->max_atlas_size * cfg->max_atlas_size;
+    double d_side = longest > 0 ? (cfg->max_atlas_size - border) / longest : INFINITY;
+    double result = d_side > 0 ? d_side : 0;
+    if (isfinite(d_side) && footprint_area(bw, bh, nc, d_side, cfg->padding) > atlas) {
+        double lo = 0, hi = d_side; /* the footprints' area grows with d: bisect */
+        for (int it = 0; it < 60 && hi - lo > 1e-6 * hi; it++) {
+            double mid = 0.5 * (lo + hi);
+            if (footprint_area(bw, bh, nc, mid, cfg->padding) <= atlas)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        result = lo;
+    }
+    free(bw);
+    free(bh);
+    return result;
+}
+
+/* The first density_overrides entry matching the instance's node or mesh name, or 0. */
+static double override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i)
+{
+    const lmb_instance *in = &s->instances[i];
+    for (uint32_t k = 0; k < cfg->density_override_count; k++)
+        if (lmb_glob_match(cfg->density_overrides[k].pattern, in->name) ||
+            lmb_glob_match(cfg->density_overrides[k].pattern, s->meshes[in->mesh].name))
+            return cfg->density_overrides[k].texel_density;
+    return 0;
+}
+
+/* An explicit density that will not fit: say so now, with what would. */
+static lmb_status explicit_too_high(const lmb_scene *s, const lmb_config *cfg, uint32_t i, double d, double fit,
+                                    int from_override, lmb_error *err)
+{
+    return lmb_error_set(err, LMB_ERR_INPUT,
+                         "instance '%s' (mesh '%s') does not fit in one %ux%u atlas at %s %g texels per unit: at most "
+                         "about %.3g fits (or use texel_density: auto, or raise atlas.max_size)",
+                         s->instances[i].name, s->meshes[s->instances[i].mesh].name, cfg->max_atlas_size,
+                         cfg->max_atlas_size, from_override ? "its density_overrides entry's" : "texel_density", d,
+                         0.97 * fit);
+}
+
+lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                              uint32_t n, const lmb_log *log, lmb_density_report *rep, lmb_error *err)
+{
+    memset(rep, 0, sizeof *rep);
+    rep->automatic = !(cfg->texel_density > 0);
+    rep->budget = lmb_config_atlas_texels(cfg);
+    double *fit = malloc(sizeof(double) * n + 1), *area = malloc(sizeof(double) * n + 1);
+    uint8_t *fixed = calloc((size_t)n + 1, 1);
+    lmb_status st = fit && area && fixed ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    double fixed_texels = 0, free_area = 0;
+    for (uint32_t k = 0; st == LMB_OK && k < n; k++) {
+        uint32_t i = list[k];
+        double o = override_for(s, cfg, i), d = o > 0 ? o : cfg->texel_density;
+        fit[k] = lmb_density_fit(s, l, cfg, i);
+        area[k] = lmb_instance_world_area(s, l, i);
+        if (!(fit[k] > 0)) {
+            st = lmb_error_set(err, LMB_ERR_INPUT,
+                               "instance '%s' (mesh '%s') has %u charts: their padding alone (atlas.padding %u) "
+                               "covers more than one %ux%u atlas at any density; raise atlas.max_size or lower "
+                               "atlas.padding",
+                               s->instances[i].name, s->meshes[s->instances[i].mesh].name,
+                               l->meshes[s->instances[i].mesh].charts.chart_count, cfg->padding, cfg->max_atlas_size,
+                               cfg->max_atlas_size);
+            break;
+        }
+        if (d > 0) { /* explicit: it wins, or it is refused now */
+            if (d > fit[k])
+                st = explicit_too_high(s, cfg, i, d, fit[k], o > 0, err);
+            l->instances[i].texel_density = d;
+            fixed[k] = 1;
+            fixed_texels += area[k] * d * d;
+        } else {
+            free_area += area[k];
+        }
+    }
+    if (st == LMB_OK && !rep->automatic)
+        rep->scene_density = cfg->texel_density;
+    if (st == LMB_OK && rep->automatic && free_area > 0) {
+        /* water filling: instances that cannot take d keep their fit, the rest share what is left */
+        double left = (double)rep->budget - fixed_texels, d;
+        if (left < 0.1 * (double)rep->budget)
+            left = 0.1 * (double)rep->budget; /* overrides took the budget: the rest still gets some */
+        d = sqrt(left / free_area);
+        for (int round = 0; round < 32; round++) {
+            double capped_texels = 0, open_area = 0;
+            for (uint32_t k = 0; k < n; k++)
+                if (!fixed[k] && fit[k] < d)
+                    capped_texels += area[k] * fit[k] * fit[k];
+                else if (!fixed[k])
+                    open_area += area[k];
+            double next = open_area > 0 ? sqrt(fmax(left - capped_texels, 0) / open_area) : d;
+            if (!(next > d * 1.001))
+                break;
+            d = next;
+        }
+        rep->scene_density = d;
+        for (uint32_t k = 0; k < n; k++) {
+            if (fixed[k])
+                continue;
+            uint32_t i = list[k];
+            double di = fit[k] < d ? fit[k] : d;
+            l->instances[i].texel_density = di > 0 ? di : d;
+            if (fit[k] < d) {
+                rep->capped++;
+                lmb_warn(log,
+                         "instance '%s' (mesh '%s') gets %.4g texels per unit, less than the scene's %.4g, so that it "
+                         "fits one %ux%u atlas (raise atlas.max_size for more)",
+                         s->instances[i].name, s->meshes[s->instances[i].mesh].name, di, d, cfg->max_atlas_size,
+                         cfg->max_atlas_size);
+            }
+        }
+    }
+    free(fit);
+    free(area);
+    free(fixed);
+    return st;
+}

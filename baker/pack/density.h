@@ -1,0 +1,32 @@
+/*
+ * Texel density per instance (issue 10: defaults that bake any level). The density is
+ * texels per world unit. An explicit `texel_density` or a `density_overrides` entry wins;
+ * `texel_density: auto` (the default) picks one scene-wide density so that the lightmapped
+ * surface fills the texel budget (`atlas.texels`):
+ *     d = sqrt(budget / sum of world areas),
+ * scale-free by construction (a level in millimetres and the same in metres get the same
+ * texels). Every instance must sit whole in one atlas, so each also has a fit density (an
+ * estimate from its charts' boxes and padding, below); an instance whose fit is lower than d
+ * gets its fit (a warning names it) and the texels it leaves go to the others.
+ */
+#ifndef LMBAKE_DENSITY_H
+#define LMBAKE_DENSITY_H
+
+#include "layout.h"
+
+/* The largest density at which instance i is expected to fit one max_size atlas: its
+ * largest chart's box plus padding within max_size, and its charts' boxes with padding
+ * within 80% of the atlas area (what the packer reaches with many charts). Infinite for an
+ * instance that keeps its TEXCOORD_1 (it gets its own atlas, clamped). */
+double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t instance);
+
+/* Sets l->instances[list[k]].texel_density for the lightmapped instances list[0..n).
+ * Explicit densities that are not expected to fit one atlas are LMB_ERR_INPUT naming the
+ * instance and the density that would fit, before anything is packed. */
+lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                              uint32_t n, const lmb_log *log, lmb_density_report *report, lmb_error *err);
+
+/* World area of instance i's lightmapped triangles. */
+double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t instance);
+
+#endif
