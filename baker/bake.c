@@ -253,7 +253,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     double t0 = lmb_seconds();
     memset(stats, 0, sizeof *stats);
     lmb_output_dir od;
-    lmb_status st = lmb_output_dir_open(&od, outdir, s->path, err);
+    lmb_status st = lmb_output_dir_open(&od, outdir, s->path, log, err);
     if (st != LMB_OK)
         return st;
     lmb_layout l;

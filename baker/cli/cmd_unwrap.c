@@ -156,6 +156,14 @@ static void print_report(const lmb_scene *s, const lmb_layout *l)
     }
     printf("total: charting %.3f s, packing %.3f s, %u charts in %u atlas(es)\n", chart_total, l->pack_seconds,
            l->chart_total, l->atlas_count);
+    if (l->density.automatic)
+        printf("texel density: auto, %.4g texels per unit (budget %llu texels)", l->density.scene_density,
+               (unsigned long long)l->density.budget);
+    else
+        printf("texel density: %.4g texels per unit", l->density.scene_density);
+    if (l->density.capped)
+        printf("; %u instance(s) lowered to fit one atlas", l->density.capped);
+    printf("\n");
 }
 
 int cmd_unwrap(int argc, char **argv)
@@ -205,6 +213,7 @@ int cmd_unwrap(int argc, char **argv)
     cli_progress_init(&progress, stderr, quiet);
     lmb_layout layout;
     lmb_status st = lmb_layout_build(scene, &cfg, cli_progress_update, &progress, &log, &layout, &err);
+    double texels = 0;
     if (st == LMB_OK) {
         print_report(scene, &layout);
         for (uint32_t a = 0; a < layout.atlas_count && st == LMB_OK; a++) {
@@ -216,9 +225,13 @@ int cmd_unwrap(int argc, char **argv)
                        "%.3f/%.3f/%.3f, overlapping texels %llu\n",
                        a, layout.width[a], layout.height[a], charts, m.coverage, m.l2_stretch, m.density_p1,
                        m.density_p50, m.density_p99, (unsigned long long)m.overlapping_texels);
+            texels += m.coverage * layout.width[a] * layout.height[a];
             if (st == LMB_OK && png_dir)
                 st = write_png(scene, &layout, a, png_dir, &err);
         }
+        if (st == LMB_OK)
+            printf("texels: %.0f covered (texel centres inside a triangle) in %u atlas(es)\n", texels,
+                   layout.atlas_count);
     }
     lmb_layout_free(&layout);
     lmb_scene_free(scene);

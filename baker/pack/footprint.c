@@ -252,6 +252,13 @@ int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, u
         for (uint32_t y = 0; ok && y < hh; y++)
             for (uint32_t x = 0; x < w; x++)
                 it->area += (uint64_t)lmb_mask_bit(&it->shape[0], x, y), it->occ_area += (uint64_t)lmb_mask_bit(&it->occ[0], x, y);
+        if (ok) { /* FNV-1a over the size and the bit rows */
+            const lmb_mask *m = &it->shape[0];
+            uint64_t hsh = 1469598103934665603ull ^ ((uint64_t)m->w << 32 | m->h);
+            for (size_t k = 0; k < (size_t)m->words * m->h; k++)
+                hsh = (hsh ^ m->bits[k]) * 1099511628211ull;
+            it->shape_hash = hsh;
+        }
     }
     free(p);
     free(h);

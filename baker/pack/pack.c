@@ -33,6 +33,7 @@ typedef struct atlas {
     uint32_t used_w, used_h;
     uint32_t open_row;   /* rows below it are full up to `width` */
     uint64_t free_area;  /* texels not recorded by any footprint */
+    uint32_t generation; /* bumped when occupancy shrinks or the width grows: older hints are void */
 } atlas;
 
 static uint32_t longest_side(const lmb_pack_item *x)
@@ -112,6 +113,66 @@ static uint32_t collides(const atlas *a, const lmb_mask *m, uint32_t x, uint32_t
     return 0;
 }
 
+/* The first column p >= from where row y has `len` free texels [p, p + len) before `limit`,
+ * or UINT32_MAX: alternately skips occupied and free runs a word at a time. */
+static uint32_t next_free_run(const atlas *a, uint32_t y, uint32_t from, uint32_t len, uint32_t limit)
+{
+    const uint64_t *row = a->rows + (size_t)y * a->words;
+    uint32_t p = from;
+    while (p + len <= limit) {
+        /* skip occupied texels: the first zero bit at or after p */
+        uint64_t inv = ~row[p / 64] >> (p % 64);
+        while (!inv) {
+            p = (p / 64 + 1) * 64;
+            if (p + len > limit)
+                return UINT32_MAX;
+            inv = ~row[p / 64];
+        }
+        p += (uint32_t)__builtin_ctzll(inv);
+        if (p + len > limit)
+            return UINT32_MAX;
+        /* the free run from p: up to the next set bit */
+        uint32_t e = p;
+        uint64_t bits = row[e / 64] >> (e % 64);
+        while (!bits) {
+            e = (e / 64 + 1) * 64;
+            if (e >= p + len)
+                return p;
+            bits = row[e / 64];
+        }
+        e += (uint32_t)__builtin_ctzll(bits);
+        if (e >= p + len)
+            return p;
+        p = e;
+    }
+    return UINT32_MAX;
+}
+
+/* Moves *x right to the first column where every solid row of m lies on a free run of its
+ * atlas row (each row's constraint only pushes x right, so alternating them converges).
+ * Returns 0 when some row has no such run before the width. */
+static int align_runs(const atlas *a, const lmb_mask *m, uint32_t y, uint32_t *x)
+{
+    for (int moved = 1; moved;) {
+        moved = 0;
+        for (uint32_t k = 0; k < m->h; k++) {
+            uint32_t r = k == 0 ? m->widest_row : k == m->widest_row ? 0 : k;
+            if (!m->solid[r])
+                continue;
+            uint32_t len = m->last[r] - m->first[r] + 1;
+            uint32_t limit = a->width - (m->w - 1 - m->last[r]);
+            uint32_t p = next_free_run(a, y + r, *x + m->first[r], len, limit);
+            if (p == UINT32_MAX)
+                return 0;
+            if (p - m->first[r] > *x) {
+                *x = p - m->first[r];
+                moved = 1;
+            }
+        }
+    }
+    return 1;
+}
+
 /* Rows y..y+h-1 have the free runs the mask's rows need (a necessary condition). */
 static int rows_can_hold(const atlas *a, const lmb_mask *m, uint32_t y)
 {
@@ -143,6 +204,8 @@ static int find(atlas *a, const lmb_mask *m, uint32_t from_y, uint32_t from_x, u
             if (m->first[r] < m->w && a->free_from[y + r] > m->first[r] && a->free_from[y + r] - m->first[r] > x)
                 x = a->free_from[y + r] - m->first[r];
         while (x + m->w <= a->width) {
+            if (!align_runs(a, m, y, &x))
+                break; /* some row has no free run long enough to the right: next y */
             uint32_t next = collides(a, m, x, y);
             if (!next) {
                 *ox = x;
@@ -193,6 +256,7 @@ static void vacate(atlas *a, const lmb_mask *m, uint32_t x, uint32_t y, uint64_t
     refresh_rows(a, y, m->h);
     a->open_row = y < a->open_row ? y : a->open_row;
     a->free_area += area;
+    a->generation++;
 }
 
 static int atlas_open(atlas *a, uint32_t size, uint32_t width)
@@ -214,6 +278,7 @@ static int atlas_open(atlas *a, uint32_t size, uint32_t width)
 
 static void atlas_widen(atlas *a)
 {
+    a->generation++;
     a->width = a->size;
     a->open_row = 0;
     refresh_rows(a, 0, a->size);
@@ -234,36 +299,88 @@ void lmb_pack_result_free(lmb_pack_result *r)
     memset(r, 0, sizeof *r);
 }
 
-/* Where each orientation of the previous chart first fitted in an atlas: a lower bound for
- * the next chart when its masks are the same (many identical cube faces, say). Valid only
- * while occupancy grows: cleared when a group is moved. */
+/* Where each orientation of a mask first fitted in an atlas, for every distinct mask seen:
+ * a lower bound in (y, x) order for a later identical mask (many identical box faces in a
+ * modular level), valid while the atlas's occupancy only grows: void once a group leaves it
+ * or it widens (its generation). Open addressing on (mask hash, atlas); identical masks are compared bit for bit. */
 typedef struct hint {
-    const lmb_pack_item *prev;
-    uint32_t atlas;
+    const lmb_pack_item *item; /* NULL: empty slot */
+    uint32_t atlas, generation;
     uint32_t y[4], x[4];
     int valid[4];
 } hint;
 
+typedef struct hints {
+    hint *slot;
+    uint32_t cap, count; /* cap: a power of two */
+} hints;
+
 static int same_masks(const lmb_pack_item *a, const lmb_pack_item *b)
 {
-    for (int o = 0; o < 4; o++) {
-        const lmb_mask *p = &a->shape[o], *q = &b->shape[o];
-        if (p->w != q->w || p->h != q->h || memcmp(p->bits, q->bits, (size_t)p->words * p->h * sizeof *p->bits))
-            return 0;
+    const lmb_mask *p = &a->shape[0], *q = &b->shape[0]; /* the other turns follow from it */
+    return a->shape_hash == b->shape_hash && p->w == q->w && p->h == q->h &&
+           !memcmp(p->bits, q->bits, (size_t)p->words * p->h * sizeof *p->bits);
+}
+
+static uint32_t hint_index(const hints *h, uint64_t hash, uint32_t atlas)
+{
+    uint64_t k = hash ^ (atlas * 0x9E3779B97F4A7C15ull);
+    k ^= k >> 29;
+    return (uint32_t)(k & (h->cap - 1));
+}
+
+/* The entry for (it's mask, atlas): an existing one of the atlas's generation, or a new
+ * empty one (NULL without memory). */
+static hint *hint_for(hints *h, const lmb_pack_item *it, uint32_t atlas, uint32_t generation, int *found)
+{
+    if (2 * (h->count + 1) > h->cap) {
+        uint32_t cap = h->cap ? 2 * h->cap : 1024;
+        hint *slot = calloc(cap, sizeof *slot), *old = h->slot;
+        if (!slot)
+            return NULL;
+        uint32_t old_cap = h->cap;
+        h->slot = slot;
+        h->cap = cap;
+        for (uint32_t i = 0; i < old_cap; i++)
+            if (old[i].item) {
+                uint32_t j = hint_index(h, old[i].item->shape_hash, old[i].atlas);
+                while (h->slot[j].item)
+                    j = (j + 1) & (cap - 1);
+                h->slot[j] = old[i];
+            }
+        free(old);
     }
-    return 1;
+    uint32_t j = hint_index(h, it->shape_hash, atlas);
+    while (h->slot[j].item) {
+        if (h->slot[j].atlas == atlas && same_masks(h->slot[j].item, it)) {
+            *found = h->slot[j].generation == generation;
+            h->slot[j].generation = generation;
+            return &h->slot[j];
+        }
+        j = (j + 1) & (h->cap - 1);
+    }
+    *found = 0;
+    h->count++;
+    h->slot[j].item = it;
+    h->slot[j].atlas = atlas;
+    h->slot[j].generation = generation;
+    return &h->slot[j];
 }
 
 /* Tries the four orientations in atlas a; picks the one that keeps the used area smaller. */
-static int try_orientations(atlas *a, uint32_t ai, const lmb_pack_item *it, hint *h, int *turn, uint32_t *x,
+static int try_orientations(atlas *a, uint32_t ai, const lmb_pack_item *it, hints *hs, int *turn, uint32_t *x,
                             uint32_t *y)
 {
     uint32_t bx = 0, by = 0, best = UINT32_MAX;
-    if (it->occ_area > a->free_area) {
-        h->prev = NULL;
+    if (it->occ_area > a->free_area)
         return 0;
+    int use;
+    hint none, *h = hint_for(hs, it, ai, a->generation, &use);
+    if (!h) { /* no memory for the table: search from the start */
+        memset(&none, 0, sizeof none);
+        h = &none;
+        use = 0;
     }
-    int use = h->prev && h->atlas == ai && same_masks(h->prev, it);
     for (int o = 0; o < 4; o++) {
         uint32_t px, py, fy = use && h->valid[o] ? h->y[o] : 0, fx = use && h->valid[o] ? h->x[o] : 0;
         if (use && !h->valid[o])
@@ -283,22 +400,19 @@ static int try_orientations(atlas *a, uint32_t ai, const lmb_pack_item *it, hint
             by = py;
         }
     }
-    h->prev = it;
-    h->atlas = ai;
     *x = bx;
     *y = by;
     return best != UINT32_MAX;
 }
 
 /* In atlas a, widening it to max_size before giving up. */
-static int try_place(atlas *a, uint32_t ai, const lmb_pack_item *it, hint *h, int *turn, uint32_t *x, uint32_t *y)
+static int try_place(atlas *a, uint32_t ai, const lmb_pack_item *it, hints *h, int *turn, uint32_t *x, uint32_t *y)
 {
     if (try_orientations(a, ai, it, h, turn, x, y))
         return 1;
     if (a->width >= a->size)
         return 0;
     atlas_widen(a);
-    h->prev = NULL;
     return try_orientations(a, ai, it, h, turn, x, y);
 }
 
@@ -334,7 +448,7 @@ typedef struct placer {
     int *turn;
     uint32_t *group_atlas;     /* per group: its atlas or NONE */
     uint32_t *group_first, *group_items; /* items of group g: group_items[group_first[g] .. group_first[g+1]) */
-    hint h;
+    hints h;
 } placer;
 
 static int open_atlas(placer *p)
@@ -348,7 +462,6 @@ static int open_atlas(placer *p)
         return 0;
     }
     p->atlas_count++;
-    p->h.prev = NULL;
     return 1;
 }
 
@@ -367,7 +480,6 @@ static void unplace(placer *p, uint32_t i)
     const lmb_pack_item *it = &p->items[i];
     vacate(&p->atlases[p->where[i]], &it->occ[p->turn[i]], p->px[i], p->py[i], it->occ_area);
     p->where[i] = NONE;
-    p->h.prev = NULL;
 }
 
 /* Group g whole into atlas a, or nothing of it (returns 0 and leaves a as it was). */
@@ -504,6 +616,7 @@ static lmb_status place_all(const lmb_pack_item *items, uint32_t count, uint32_t
     free(p.group_atlas);
     free(p.group_first);
     free(p.group_items);
+    free(p.h.slot);
     return st;
 }
 

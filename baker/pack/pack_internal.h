@@ -26,6 +26,7 @@ typedef struct lmb_pack_item {
     lmb_mask shape[4]; /* footprint dilated by padding + 1, tested against the atlas; k: turned k x 90 degrees */
     lmb_mask occ[4];   /* footprint dilated by 1 (the bilinear reach), what the atlas records */
     uint64_t area;     /* set texels of shape[0] */
+    uint64_t shape_hash; /* of shape[0]'s size and bits: identical masks share it */
     uint64_t occ_area; /* set texels of occ[0]: footprints never share one, so their sum bounds an atlas */
 } lmb_pack_item;
 

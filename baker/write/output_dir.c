@@ -5,6 +5,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,7 +24,52 @@ static void dirname_of(const char *path, char *out, size_t size)
         *slash = '\0';
 }
 
-lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, lmb_error *err)
+static void remove_tree(const char *path);
+
+/* This host's name, as staging folders carry it ('-' and '/' would confuse the parse). */
+static void host_name(char *out, size_t size)
+{
+    if (gethostname(out, size) != 0 || !out[0])
+        snprintf(out, size, "localhost");
+    out[size - 1] = '\0';
+    for (char *p = out; *p; p++)
+        if (*p == '-' || *p == '/')
+            *p = '_';
+}
+
+/* Removes dir/.lmbake-staging-HOST-PID folders of this host whose process is gone (and the
+ * older .lmbake-staging-PID form), naming each in a warning. */
+static void remove_stale_staging(const char *dir, const lmb_log *log)
+{
+    char host[256], prefix[300];
+    host_name(host, sizeof host);
+    snprintf(prefix, sizeof prefix, ".lmbake-staging-%s-", host);
+    DIR *d = opendir(dir);
+    if (!d)
+        return;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        const char *pid_text = NULL;
+        if (!strncmp(e->d_name, prefix, strlen(prefix)))
+            pid_text = e->d_name + strlen(prefix);
+        else if (!strncmp(e->d_name, ".lmbake-staging-", 16) && strspn(e->d_name + 16, "0123456789") == strlen(e->d_name + 16))
+            pid_text = e->d_name + 16;
+        if (!pid_text || !*pid_text || strspn(pid_text, "0123456789") != strlen(pid_text))
+            continue;
+        long pid = strtol(pid_text, NULL, 10);
+        if (pid <= 0 || pid == (long)getpid() || kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue; /* running (or not ours to judge) */
+        char path[8400];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        remove_tree(path);
+        lmb_warn(log, "removed '%s', left by a bake that was stopped (process %ld is gone); its files were never "
+                 "part of the output", path, pid);
+    }
+    closedir(d);
+}
+
+lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, const lmb_log *log,
+                               lmb_error *err)
 {
     memset(od, 0, sizeof *od);
     snprintf(od->dir, sizeof od->dir, "%s", dir);
@@ -50,7 +96,11 @@ lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *
                              "input and its files are never written over",
                              dir, input_path);
     }
-    snprintf(od->staging, sizeof od->staging, "%s/.lmbake-staging-%ld", dir, (long)getpid());
+    if (!od->created_dir)
+        remove_stale_staging(dir, log);
+    char host[256];
+    host_name(host, sizeof host);
+    snprintf(od->staging, sizeof od->staging, "%s/.lmbake-staging-%s-%ld", dir, host, (long)getpid());
     if (mkdir(od->staging, 0777) != 0) {
         lmb_status st = lmb_error_set(err, LMB_ERR_INTERNAL, "cannot create '%s': %s", od->staging, strerror(errno));
         od->staging[0] = '\0';

@@ -7,6 +7,10 @@ usage: check_indirect.py LMBAKE WORKDIR CHECK
                E = pi Le (1 + rho + ... + rho^k). The mean over valid texels is within 1% for
                k = 1, 2, 3 (final gather by the default defensive AMIS) and for the path-traced
                --reference at k = 2; 98% of texels within 6%.
+  furnace_auto closed box of albedo 0.8 emitting 1 nit (tools/make_levels.py furnace-08.glb):
+               with bounces: auto the mean is within 1% of pi Le / (1 - rho) = 15.708; with
+               bounces: 2 it is pi Le (1 + rho + rho^2) = 7.665 (the gap auto closes: the check
+               fails if auto stops early or leaves the tail out); the log names the passes run.
   identity     AMIS with one iteration and classic gathering: byte-identical EXR for the same seed.
   determinism  AMIS bake at --threads 1 and --threads 2: byte-identical EXR.
   unbiased     bright-spot Cornell box (point light 3 cm under the ceiling), one bounce, 1024 rays:
@@ -72,6 +76,39 @@ def furnace(lmbake, work):
     return ok
 
 
+def furnace_auto(lmbake, work):
+    d = os.path.join(work, "levels")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_levels.py"), d, "furnace"], check=True,
+                   stdout=subprocess.DEVNULL)
+    s = os.path.join(d, "furnace-08.glb")
+    rho, ok = 0.8, True
+    limit = math.pi / (1 - rho)
+    for name, bounces, expected, tol in (("auto", "auto", limit, 0.01),
+                                         ("fixed-2", "2", math.pi * (1 + rho + rho ** 2), 0.01)):
+        cfg = "texel_density: 8\nbounces: %s\nsamples: {direct: 64, gather: 256}\n" % bounces
+        cfgp = os.path.join(work, name + ".yaml")
+        with open(cfgp, "w") as f:
+            f.write(cfg)
+        out = os.path.join(work, name)
+        p = subprocess.run([lmbake, "bake", s, "-c", cfgp, "-o", out], capture_output=True, text=True)
+        if p.returncode != 0:
+            sys.exit("bake %s failed (%d): %s" % (name, p.returncode, p.stderr))
+        log = [l for l in p.stdout.splitlines() if l.startswith("bounces:")]
+        e = read(glob.glob(os.path.join(out, "*-lightmap-0.exr"))[0])[..., 0]
+        v = e[e > 0]
+        good = abs(v.mean() / expected - 1) <= tol
+        ok &= good
+        print("furnace rho 0.8, bounces %-5s: %d texels, mean %.4f, expected %.4f (ratio %.4f), pi Le / (1 - rho) = "
+              "%.4f (ratio %.4f)  %s" % (bounces, v.size, v.mean(), expected, v.mean() / expected, limit,
+                                         v.mean() / limit, "ok" if good else "FAIL"))
+        if log:
+            print("  " + log[0])
+        if bounces == "auto" and not (log and "geometric tail" in log[0]):
+            print("  FAIL: the log does not say what the passes added and the tail")
+            ok = False
+    return ok
+
+
 CORNELL = "texel_density: %d\nbounces: 1\nsamples: {texel: 4, direct: 16, amis_iterations: %d}\n"
 
 
@@ -134,7 +171,7 @@ def unbiased(lmbake, work):
 def main():
     lmbake, work, check = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
-    ok = {"furnace": furnace, "identity": identity, "determinism": determinism, "unbiased": unbiased}[check](lmbake, work)
+    ok = {"furnace": furnace, "furnace_auto": furnace_auto, "identity": identity, "determinism": determinism, "unbiased": unbiased}[check](lmbake, work)
     sys.exit(0 if ok else 1)
 
 
