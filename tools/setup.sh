@@ -16,7 +16,7 @@ packages=(
   libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
   libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
   libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
-  libopenmesh-dev                   # half-edge mesh library (found by CMake; see README)
+  libopenmesh-dev                   # the unwrapper's half-edge mesh (OpenMesh, behind baker/unwrap/halfedge_adapter.cpp)
   libsuitesparse-dev                # CHOLMOD sparse Cholesky for the LSCM flattening
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
   chromium                          # headless browser for the preview's shots and e2e test (playwright-core drives it)

@@ -139,6 +139,20 @@ static lmb_status write_png(const lmb_scene *s, const lmb_layout *l, uint32_t a,
     return st;
 }
 
+/* What the half-edge mesh refused and made seams of (nothing when the mesh is manifold and
+ * consistently wound). */
+static void print_topology(const lmb_topology_counts *t)
+{
+    uint32_t refused = t->complex_edge_faces + t->flipped_faces + t->vertex_faces;
+    if (refused || t->nonmanifold_edges || t->bowtie_vertices)
+        printf("  topology: %u non-manifold edges, %u bowtie vertices; %u triangles re-added on %u duplicated "
+               "vertices (%u on a complex edge, %u flipped, %u at a vertex); OpenMesh warnings: %u complex edge, "
+               "%u complex vertex, %u re-linking, %u other\n",
+               t->nonmanifold_edges, t->bowtie_vertices, refused, t->duplicated_vertices, t->complex_edge_faces,
+               t->flipped_faces, t->vertex_faces, t->om_complex_edge, t->om_complex_vertex, t->om_relink_failed,
+               t->om_other);
+}
+
 static void print_report(const lmb_scene *s, const lmb_layout *l)
 {
     double chart_total = 0;
@@ -153,6 +167,7 @@ static void print_report(const lmb_scene *s, const lmb_layout *l)
                "charting %.3f s\n",
                s->meshes[m].name, lm->soup.triangle_count, s->meshes[m].degenerate_count, lm->charts.chart_count,
                lm->charts.planar_charts, lm->charts.splits, um.l2_stretch, lm->chart_seconds);
+        print_topology(&lm->charts.topology);
     }
     printf("total: charting %.3f s, packing %.3f s, %u charts in %u atlas(es)\n", chart_total, l->pack_seconds,
            l->chart_total, l->atlas_count);

@@ -37,7 +37,7 @@ static void plane_basis(const double n[3], double e1[3], double e2[3])
 
 typedef struct chart_verts {
     uint32_t count;
-    uint32_t *ids;   /* sorted welded ids */
+    uint32_t *ids;   /* sorted mesh vertex ids (lmb_topology.corner) */
     uint32_t *local; /* 3 per chart triangle: index into ids */
     double *pos;     /* 3 per local vertex */
     double *uv;      /* 2 per local vertex */
@@ -61,7 +61,7 @@ static int gather_vertices(const lmb_unwrap_input *in, const lmb_topology *t, co
         return 0;
     for (uint32_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
-            c->ids[3 * i + k] = t->weld[in->indices[3 * tris[i] + k]];
+            c->ids[3 * i + k] = t->corner[3 * tris[i] + k];
     qsort(c->ids, 3 * (size_t)n, sizeof *c->ids, lmb_cmp_u32);
     uint32_t m = 0;
     for (uint32_t i = 0; i < 3 * n; i++)
@@ -74,7 +74,7 @@ static int gather_vertices(const lmb_unwrap_input *in, const lmb_topology *t, co
         return 0;
     for (uint32_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) {
-            uint32_t v = in->indices[3 * tris[i] + k], l = lmb_lower_bound(c->ids, m, t->weld[v]);
+            uint32_t v = in->indices[3 * tris[i] + k], l = lmb_lower_bound(c->ids, m, t->corner[3 * tris[i] + k]);
             c->local[3 * i + k] = l;
             for (int d = 0; d < 3; d++)
                 c->pos[3 * l + d] = in->positions[3 * v + d];

@@ -1,10 +1,12 @@
 /*
  * Welding and adjacency for the unwrapper. Vertices are merged when their positions are
- * bit-identical (sorted, so the result does not depend on hashing); edges are matched by
- * sorting (welded a, welded b) keys. Two triangles are neighbours only across an edge
- * that exactly two triangles share, in opposite directions: a non-manifold edge or a
- * winding flip becomes a chart seam instead of a crash or a fold.
+ * equal (sorted, so the result does not depend on hashing); the welded triangles then go
+ * into a half-edge mesh (OpenMesh, behind halfedge_adapter.h), which keeps every triangle
+ * and gives, per corner, the triangle across its edge. Two triangles are neighbours only
+ * across an edge that exactly two triangles share, in opposite directions: a non-manifold
+ * edge or a winding flip becomes a chart seam instead of a crash or a fold.
  */
+#include "halfedge_adapter.h"
 #include "unwrap_internal.h"
 
 #include <math.h>
@@ -16,29 +18,19 @@ typedef struct vkey {
     uint32_t v;
 } vkey;
 
+static int cmp_position(const float *x, const float *y)
+{
+    for (int i = 0; i < 3; i++)
+        if (x[i] != y[i])
+            return x[i] < y[i] ? -1 : 1;
+    return 0;
+}
+
 static int cmp_vkey(const void *a, const void *b)
 {
     const vkey *x = a, *y = b;
-    for (int i = 0; i < 3; i++)
-        if (x->p[i] != y->p[i])
-            return x->p[i] < y->p[i] ? -1 : 1;
-    return (x->v > y->v) - (x->v < y->v);
-}
-
-typedef struct ekey {
-    uint32_t lo, hi; /* welded ids, lo < hi */
-    uint32_t corner; /* 3 * triangle + k */
-    int forward;     /* the triangle runs lo -> hi */
-} ekey;
-
-static int cmp_ekey(const void *a, const void *b)
-{
-    const ekey *x = a, *y = b;
-    if (x->lo != y->lo)
-        return x->lo < y->lo ? -1 : 1;
-    if (x->hi != y->hi)
-        return x->hi < y->hi ? -1 : 1;
-    return (x->corner > y->corner) - (x->corner < y->corner);
+    int c = cmp_position(x->p, y->p);
+    return c ? c : (x->v > y->v) - (x->v < y->v);
 }
 
 static void geometry(const lmb_unwrap_input *in, uint32_t f, lmb_topology *t)
@@ -60,77 +52,66 @@ static void geometry(const lmb_unwrap_input *in, uint32_t f, lmb_topology *t)
         t->normal[3 * f + i] = len > 0 ? n[i] / len : 0.0;
 }
 
-static int skipped(const lmb_unwrap_input *in, const lmb_topology *t, uint32_t f)
+/* Welded id per input vertex (ids in order of position) and one position per welded id. */
+static uint32_t weld(const lmb_unwrap_input *in, vkey *vk, uint32_t *id, float *welded)
 {
-    return (in->skip && in->skip[f]) || !(t->area[f] > 0);
-}
-
-lmb_status lmb_topology_build(const lmb_unwrap_input *in, lmb_topology *t, lmb_error *err)
-{
-    memset(t, 0, sizeof *t);
-    uint32_t nv = in->vertex_count, nt = in->triangle_count;
-    vkey *vk = malloc(((size_t)nv + 1) * sizeof *vk);
-    ekey *ek = malloc(((size_t)nt * 3 + 1) * sizeof *ek);
-    t->weld = malloc(((size_t)nv + 1) * sizeof *t->weld);
-    t->neighbor = malloc(((size_t)nt * 3 + 1) * sizeof *t->neighbor);
-    t->normal = calloc((size_t)nt * 3 + 1, sizeof *t->normal);
-    t->area = calloc((size_t)nt + 1, sizeof *t->area);
-    t->centroid = calloc((size_t)nt * 3 + 1, sizeof *t->centroid);
-    if (!vk || !ek || !t->weld || !t->neighbor || !t->normal || !t->area || !t->centroid) {
-        free(vk);
-        free(ek);
-        lmb_topology_free(t);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "unwrap: out of memory for %u triangles", nt);
-    }
+    uint32_t nv = in->vertex_count, count = 0;
     for (uint32_t v = 0; v < nv; v++) {
         memcpy(vk[v].p, in->positions + 3 * v, sizeof vk[v].p);
         vk[v].v = v;
     }
     qsort(vk, nv, sizeof *vk, cmp_vkey);
     for (uint32_t i = 0; i < nv; i++) {
-        if (i > 0 && memcmp(vk[i].p, vk[i - 1].p, sizeof vk[i].p) != 0)
-            t->welded_count++;
-        t->weld[vk[i].v] = t->welded_count;
+        if (i > 0 && cmp_position(vk[i].p, vk[i - 1].p) != 0)
+            count++;
+        id[vk[i].v] = count;
+        memcpy(welded + 3 * (size_t)count, vk[i].p, sizeof vk[i].p);
     }
-    t->welded_count += nv > 0;
-    uint32_t ne = 0;
-    for (uint32_t f = 0; f < nt; f++) {
-        geometry(in, f, t);
-        for (int k = 0; k < 3; k++) {
-            t->neighbor[3 * f + k] = LMB_NONE;
-            if (skipped(in, t, f))
-                continue;
-            uint32_t a = t->weld[in->indices[3 * f + k]], b = t->weld[in->indices[3 * f + (k + 1) % 3]];
-            if (a == b)
-                continue;
-            ek[ne].lo = a < b ? a : b;
-            ek[ne].hi = a < b ? b : a;
-            ek[ne].corner = 3 * f + (uint32_t)k;
-            ek[ne].forward = a < b;
-            ne++;
+    return count + (nv > 0);
+}
+
+lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_topology *t, lmb_error *err)
+{
+    memset(t, 0, sizeof *t);
+    uint32_t nv = in->vertex_count, nt = in->triangle_count;
+    vkey *vk = malloc(((size_t)nv + 1) * sizeof *vk);
+    uint32_t *id = malloc(((size_t)nv + 1) * sizeof *id), *faces = malloc(((size_t)nt * 3 + 1) * sizeof *faces);
+    float *welded = malloc(((size_t)nv * 3 + 1) * sizeof *welded);
+    uint8_t *skip = malloc((size_t)nt + 1);
+    t->corner = malloc(((size_t)nt * 3 + 1) * sizeof *t->corner);
+    t->neighbor = malloc(((size_t)nt * 3 + 1) * sizeof *t->neighbor);
+    t->normal = calloc((size_t)nt * 3 + 1, sizeof *t->normal);
+    t->area = calloc((size_t)nt + 1, sizeof *t->area);
+    t->centroid = calloc((size_t)nt * 3 + 1, sizeof *t->centroid);
+    lmb_status st = LMB_OK;
+    if (!vk || !id || !faces || !welded || !skip || !t->corner || !t->neighbor || !t->normal || !t->area ||
+        !t->centroid) {
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "unwrap: mesh '%s': out of memory for %u triangles",
+                           name ? name : "mesh", nt);
+    } else {
+        uint32_t nw = weld(in, vk, id, welded);
+        for (uint32_t f = 0; f < nt; f++) {
+            geometry(in, f, t);
+            skip[f] = (in->skip && in->skip[f]) || !(t->area[f] > 0);
+            for (int k = 0; k < 3; k++)
+                faces[3 * f + k] = id[in->indices[3 * f + k]];
         }
-    }
-    qsort(ek, ne, sizeof *ek, cmp_ekey);
-    for (uint32_t i = 0; i < ne;) {
-        uint32_t j = i;
-        while (j < ne && ek[j].lo == ek[i].lo && ek[j].hi == ek[i].hi)
-            j++;
-        if (j - i == 2 && ek[i].forward != ek[i + 1].forward) {
-            t->neighbor[ek[i].corner] = ek[i + 1].corner / 3;
-            t->neighbor[ek[i + 1].corner] = ek[i].corner / 3;
-        } else if (j - i > 2) {
-            t->nonmanifold_edges++;
-        }
-        i = j;
+        lmb_halfedge_input h = {name, nw, welded, nt, faces, skip};
+        st = lmb_halfedge_build(&h, t->corner, t->neighbor, &t->vertex_count, &t->counts, err);
     }
     free(vk);
-    free(ek);
-    return LMB_OK;
+    free(id);
+    free(faces);
+    free(welded);
+    free(skip);
+    if (st != LMB_OK)
+        lmb_topology_free(t);
+    return st;
 }
 
 void lmb_topology_free(lmb_topology *t)
 {
-    free(t->weld);
+    free(t->corner);
     free(t->neighbor);
     free(t->normal);
     free(t->area);

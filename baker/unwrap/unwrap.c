@@ -10,12 +10,14 @@
 #include "unwrap_internal.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 void lmb_unwrap_options_default(lmb_unwrap_options *o)
 {
     o->max_chart_angle = 30.0 * 3.14159265358979323846 / 180.0;
+    o->name = NULL;
 }
 
 void lmb_charts_free(lmb_charts *c)
@@ -41,7 +43,7 @@ static int crosses(const double *p, const double *q, const double *r, const doub
 
 typedef struct bedge {
     const double *a, *b;
-    uint32_t wa, wb; /* welded end points */
+    uint32_t wa, wb; /* end points' mesh vertex ids */
 } bedge;
 
 /* Boundary self-intersection over a uniform grid of the chart's UV bounding box. */
@@ -110,7 +112,7 @@ static int boundary_crosses(const bedge *e, uint32_t ne)
 }
 
 /* Valid: no flipped or collapsed triangle, boundary does not cross itself. */
-static int chart_valid(const lmb_unwrap_input *in, const lmb_topology *t, const uint32_t *tris, uint32_t n,
+static int chart_valid(const lmb_topology *t, const uint32_t *tris, uint32_t n,
                        const uint32_t *chart_of, const double *uv, bedge *scratch)
 {
     uint32_t ne = 0, id = chart_of[tris[0]];
@@ -125,8 +127,8 @@ static int chart_valid(const lmb_unwrap_input *in, const lmb_topology *t, const 
             bedge *b = &scratch[ne++];
             b->a = p + 2 * k;
             b->b = p + 2 * ((k + 1) % 3);
-            b->wa = t->weld[in->indices[3 * tris[i] + k]];
-            b->wb = t->weld[in->indices[3 * tris[i] + (k + 1) % 3]];
+            b->wa = t->corner[3 * tris[i] + k];
+            b->wb = t->corner[3 * tris[i] + (k + 1) % 3];
         }
     }
     return !boundary_crosses(scratch, ne);
@@ -134,8 +136,8 @@ static int chart_valid(const lmb_unwrap_input *in, const lmb_topology *t, const 
 
 /* A chart whose boundary falls into more than one connected piece has a hole (a ring,
  * such as the flat top of a torus): valid, but its hole wastes atlas space, so it is cut.
- * Boundary end points are merged with union-find over the chart's welded vertex ids. */
-static int has_hole(const lmb_unwrap_input *in, const lmb_topology *t, const uint32_t *tris, uint32_t n,
+ * Boundary end points are merged with union-find over the chart's mesh vertex ids. */
+static int has_hole(const lmb_topology *t, const uint32_t *tris, uint32_t n,
                     const uint32_t *chart_of, bedge *scratch)
 {
     uint32_t ne = 0, id = chart_of[tris[0]];
@@ -144,8 +146,8 @@ static int has_hole(const lmb_unwrap_input *in, const lmb_topology *t, const uin
             uint32_t g = t->neighbor[3 * tris[i] + k];
             if (g != LMB_NONE && chart_of[g] == id)
                 continue;
-            scratch[ne].wa = t->weld[in->indices[3 * tris[i] + k]];
-            scratch[ne].wb = t->weld[in->indices[3 * tris[i] + (k + 1) % 3]];
+            scratch[ne].wa = t->corner[3 * tris[i] + k];
+            scratch[ne].wb = t->corner[3 * tris[i] + (k + 1) % 3];
             ne++;
         }
     if (ne < 6)
@@ -323,14 +325,29 @@ static lmb_status finish(lmb_charts *out, const pool *p, uint32_t nt, lmb_error 
     return LMB_OK;
 }
 
+/* "unwrap: X" from a stage that does not know the mesh -> "unwrap: mesh 'NAME': X". */
+static void name_mesh(lmb_error *err, const char *name)
+{
+    const char *prefix = "unwrap: ";
+    size_t n = strlen(prefix);
+    if (!err || strncmp(err->message, prefix, n) != 0 || strncmp(err->message + n, "mesh '", 6) == 0)
+        return;
+    char rest[sizeof err->message];
+    memcpy(rest, err->message + n, sizeof rest - n);
+    rest[sizeof rest - n - 1] = 0;
+    snprintf(err->message, sizeof err->message, "unwrap: mesh '%.200s': %.800s", name, rest);
+}
+
 lmb_status lmb_unwrap_mesh(const lmb_unwrap_input *in, const lmb_unwrap_options *opt, lmb_charts *out,
                            lmb_error *err)
 {
     memset(out, 0, sizeof *out);
     lmb_topology t;
-    lmb_status st = lmb_topology_build(in, &t, err);
+    const char *name = opt->name ? opt->name : "mesh";
+    lmb_status st = lmb_topology_build(in, name, &t, err);
     if (st != LMB_OK)
         return st;
+    out->topology = t.counts;
     uint32_t nt = in->triangle_count, n = 0, next = 0;
     pool p;
     memset(&p, 0, sizeof p);
@@ -356,8 +373,8 @@ lmb_status lmb_unwrap_mesh(const lmb_unwrap_input *in, const lmb_unwrap_options 
         int planar = 0;
         st = lmb_flatten(in, &t, members, len, out->uv, &planar, err);
         if (st != LMB_OK || len == 1 ||
-            (chart_valid(in, &t, members, len, out->chart_of, out->uv, scratch) &&
-             !has_hole(in, &t, members, len, out->chart_of, scratch))) {
+            (chart_valid(&t, members, len, out->chart_of, out->uv, scratch) &&
+             !has_hole(&t, members, len, out->chart_of, scratch))) {
             out->planar_charts += planar;
             continue;
         }
@@ -392,7 +409,9 @@ lmb_status lmb_unwrap_mesh(const lmb_unwrap_input *in, const lmb_unwrap_options 
     free(p.len);
     free(p.angle);
     lmb_topology_free(&t);
-    if (st != LMB_OK)
+    if (st != LMB_OK) {
         lmb_charts_free(out);
+        name_mesh(err, name);
+    }
     return st;
 }

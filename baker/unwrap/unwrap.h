@@ -2,7 +2,8 @@
  * The unwrap stage: one mesh (object space) -> charts with flattened, chart-local UVs in
  * world-ish units (each chart's UV area equals its 3D area), ready for the pack stage to
  * scale to a texel density and place. Pipeline, each in its own file:
- *   topology.c  weld by position, triangle adjacency across manifold, consistently wound edges
+ *   topology.c  weld by position into a half-edge mesh (OpenMesh, through halfedge_adapter.cpp);
+ *               triangle adjacency across manifold, consistently wound edges
  *   segment.c   greedy chart growth from seeds under a normal-cone and roundness cost
  *   flatten.c   planar projection where exact, else LSCM (Levy et al. 2002) solved with CHOLMOD
  *   unwrap.c    validity (no flips, no boundary self-intersection) and splitting until valid
@@ -22,7 +23,21 @@ typedef struct lmb_unwrap_input {
 
 typedef struct lmb_unwrap_options {
     double max_chart_angle; /* radians: a chart's normals stay within this cone of its mean */
+    const char *name;       /* the mesh, named in error messages; NULL: "mesh" */
 } lmb_unwrap_options;
+
+/* What welding into the half-edge mesh found. Every triangle is kept whatever it found:
+ * a refused triangle is added again on duplicated vertices and its edges become seams. */
+typedef struct lmb_topology_counts {
+    uint32_t complex_edge_faces;  /* refused: an edge of theirs already had two triangles */
+    uint32_t flipped_faces;       /* refused: a neighbour runs the shared edge the same way */
+    uint32_t vertex_faces;        /* refused at a vertex: a closed fan, or fans OpenMesh could not relink */
+    uint32_t duplicated_vertices; /* vertices added at an existing position to re-add refused triangles */
+    uint32_t nonmanifold_edges;   /* edges that 3+ triangles share: seams for all of them */
+    uint32_t bowtie_vertices;     /* vertices where 2+ fans meet (accepted and kept as they are) */
+    /* OpenMesh's own ::omerr() warnings, captured and counted by message (not printed) */
+    uint32_t om_complex_vertex, om_complex_edge, om_relink_failed, om_other;
+} lmb_topology_counts;
 
 void lmb_unwrap_options_default(lmb_unwrap_options *o);
 
@@ -35,6 +50,7 @@ typedef struct lmb_charts {
     uint32_t *order;      /* triangles sorted by chart */
     uint32_t planar_charts;   /* flattened by projection */
     uint32_t splits;          /* charts split because their flattening was invalid */
+    lmb_topology_counts topology;
 } lmb_charts;
 
 /* Charts one mesh. The result is deterministic. Free with lmb_charts_free. */

@@ -26,20 +26,23 @@ static inline uint32_t lmb_lower_bound(const uint32_t *ids, uint32_t n, uint32_t
     return lo;
 }
 
-/* Welded topology of one mesh: vertices merged by exact position, and for each triangle
- * corner k the triangle across edge (k, k+1), or LMB_NONE at a boundary, a non-manifold
- * edge (3+ triangles) or a winding flip (both triangles run the edge the same way). */
+/* Welded topology of one mesh: vertices merged by exact position into a half-edge mesh
+ * (OpenMesh; a triangle it refuses gets duplicated vertices), and for each triangle corner
+ * k its mesh vertex and the triangle across edge (k, k+1), or LMB_NONE at a boundary, a
+ * non-manifold edge (3+ triangles), a winding flip (both triangles run the edge the same
+ * way) or a skipped triangle. */
 typedef struct lmb_topology {
-    uint32_t welded_count;
-    uint32_t *weld;      /* per input vertex -> welded id */
-    uint32_t *neighbor;  /* 3 per triangle */
-    double *normal;      /* 3 per triangle, unit (0 for skipped) */
-    double *area;        /* per triangle */
-    double *centroid;    /* 3 per triangle */
-    uint32_t nonmanifold_edges;
+    uint32_t vertex_count; /* welded vertices and their duplicates */
+    uint32_t *corner;      /* 3 per triangle: vertex id, shared by the corners of one chart vertex */
+    uint32_t *neighbor;    /* 3 per triangle */
+    double *normal;        /* 3 per triangle, unit (0 for skipped) */
+    double *area;          /* per triangle */
+    double *centroid;      /* 3 per triangle */
+    lmb_topology_counts counts;
 } lmb_topology;
 
-lmb_status lmb_topology_build(const lmb_unwrap_input *in, lmb_topology *t, lmb_error *err);
+/* name: the mesh, for messages (NULL: "mesh"). */
+lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_topology *t, lmb_error *err);
 void lmb_topology_free(lmb_topology *t);
 
 /* Grows charts over the triangles listed in tris[0..n) (all unassigned in chart_of, which
