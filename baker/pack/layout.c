@@ -18,21 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Area-weighted face normals summed per vertex, for a primitive that has no NORMAL (glTF
- * says flat shading then; per vertex of an unwelded primitive this is the face normal). */
-static void smooth_normals(lmb_mesh_soup *soup, uint32_t tbase, uint32_t tcount)
-{
-    for (uint32_t f = tbase; f < tbase + tcount; f++) {
-        const uint32_t *t = soup->indices + 3 * (size_t)f;
-        const float *a = soup->positions + 3 * t[0], *b = soup->positions + 3 * t[1], *c = soup->positions + 3 * t[2];
-        float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-        for (int k = 0; k < 3; k++)
-            for (int d = 0; d < 3; d++)
-                soup->normals[3 * t[k] + d] += n[d];
-    }
-}
-
 static lmb_status build_soup(const lmb_scene *s, uint32_t mesh, lmb_mesh_soup *soup, lmb_error *err)
 {
     const lmb_mesh *m = &s->meshes[mesh];
@@ -44,8 +29,9 @@ static lmb_status build_soup(const lmb_scene *s, uint32_t mesh, lmb_mesh_soup *s
     soup->positions = malloc(((size_t)soup->vertex_count * 3 + 1) * sizeof *soup->positions);
     soup->indices = malloc(((size_t)soup->triangle_count * 3 + 1) * sizeof *soup->indices);
     soup->skip = malloc((size_t)soup->triangle_count + 1);
+    soup->flat = calloc((size_t)soup->triangle_count + 1, 1);
     soup->normals = calloc((size_t)soup->vertex_count * 3 + 1, sizeof *soup->normals);
-    if (!soup->positions || !soup->indices || !soup->skip || !soup->normals)
+    if (!soup->positions || !soup->indices || !soup->skip || !soup->normals || !soup->flat)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "mesh '%s': out of memory", m->name);
     uint32_t vbase = 0, tbase = 0;
     for (uint32_t p = 0; p < m->primitive_count; p++) {
@@ -56,8 +42,8 @@ static lmb_status build_soup(const lmb_scene *s, uint32_t mesh, lmb_mesh_soup *s
         memcpy(soup->skip + tbase, pr->degenerate, pr->triangle_count);
         if (pr->normals)
             memcpy(soup->normals + 3 * (size_t)vbase, pr->normals, (size_t)pr->vertex_count * 3 * sizeof(float));
-        else
-            smooth_normals(soup, tbase, pr->triangle_count);
+        else /* glTF 3.7.2.1: no NORMAL means flat normals, whatever vertices the faces share */
+            memset(soup->flat + tbase, 1, pr->triangle_count);
         vbase += pr->vertex_count;
         tbase += pr->triangle_count;
     }
@@ -252,6 +238,7 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
         lmb_layout_mesh *lm = &l->meshes[m];
         if (!lm->used)
             continue;
+        opt.name = s->meshes[m].name;
         lmb_status st = build_soup(s, m, &lm->soup, err);
         double t0 = lmb_seconds();
         lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
@@ -369,6 +356,7 @@ void lmb_layout_free(lmb_layout *l)
         free(l->meshes[m].soup.normals);
         free(l->meshes[m].soup.indices);
         free(l->meshes[m].soup.skip);
+        free(l->meshes[m].soup.flat);
         lmb_charts_free(&l->meshes[m].charts);
     }
     for (uint32_t i = 0; l->instances && i < l->instance_count; i++)

@@ -24,9 +24,10 @@ typedef struct lmb_density_report {
 typedef struct lmb_mesh_soup {
     uint32_t vertex_count, triangle_count;
     float *positions;  /* 3 per vertex, object space */
-    float *normals;    /* 3 per vertex, object space; a primitive without NORMAL gets its face normals' average */
+    float *normals;    /* 3 per vertex, object space; 0 for a primitive without NORMAL (see flat) */
     uint32_t *indices; /* 3 per triangle */
     uint8_t *skip;     /* per triangle: zero area */
+    uint8_t *flat;     /* per triangle: its primitive has no NORMAL, so it is shaded flat (glTF) */
 } lmb_mesh_soup;
 
 typedef struct lmb_layout_mesh {

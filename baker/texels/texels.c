@@ -177,6 +177,8 @@ static void make_point(const lmb_scene *s, const lmb_layout *l, const best *b, l
     memcpy(out->p, p, sizeof p);
     normalize3f(g, out->ng);
     normalize3f(n, out->n);
+    if (soup->flat[b->triangle])
+        memcpy(out->n, out->ng, sizeof out->n);
     if (!(fabsf(out->n[0]) + fabsf(out->n[1]) + fabsf(out->n[2]) > 0) || !isfinite(out->n[0]))
         memcpy(out->n, out->ng, sizeof out->n);
     out->instance = b->instance;
