@@ -7,6 +7,7 @@
 #include "cli_common.h"
 #include "commands.h"
 
+#include <math.h>
 #include <string.h>
 
 static const char help[] =
@@ -50,6 +51,9 @@ static void print_material(uint32_t m, const lmb_material *mat)
                mat->name, mat->base_color[0], mat->base_color[1], mat->base_color[2],
                mat->base_color_texture.texture >= 0 ? " x texture" : "", mat->specular[0], mat->specular[1],
                mat->specular[2], mat->specular_texture.texture >= 0 ? " x texture" : "");
+        if (mat->specular_texture.texture < 0 &&
+            fmaxf(mat->specular[0], fmaxf(mat->specular[1], mat->specular[2])) >= 1.0f)
+            printf(" (specular 1, the extension's default: no diffuse, so a lightmap shows black on it in viewers)");
     } else {
         printf("  [%u] '%s': base colour (%.3g, %.3g, %.3g)%s, metallic %.3g%s", m, mat->name, mat->base_color[0],
                mat->base_color[1], mat->base_color[2], mat->base_color_texture.texture >= 0 ? " x texture" : "",
