@@ -10,10 +10,17 @@ usage: make_scenes.py OUTDIR
   disk.gltf           plane, emissive disk (64 segments, R = 0.5, L = 10 nits) facing down at h = 1
   many-lights.gltf    10 x 10 plane under 20 point lights (sampled by power, not looped)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
+  disk-transform.gltf the same disk with a 2 x 1 emissive texture (black | white, NEAREST,
+                      CLAMP_TO_EDGE) whose KHR_texture_transform (offset, rotation, scale and a
+                      texCoord override to TEXCOORD_1 = (x, z)) lights the part of the disk where
+                      x + 0.433 z >= -0.1 (DISK_TRANSFORM)
   sealed-room.gltf    closed 2 m room (inward faces), point light outside it
   box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
   furnace.gltf        closed 2 m box, every face albedo 0.5 and emitting 1 nit (the furnace test;
                       also the benchmark's "light from everywhere" scene)
+  furnace-*.gltf      the same box with other materials (FURNACE_MATERIALS: spec-gloss, a
+                      metallicRoughness texture's blue channel, a mirrored base colour texture);
+                      each states the albedo rho it must bounce with
   two-spots.gltf      the Cornell room without blocks, two point lights 3 cm from the left and
                       right walls: two bright spots in opposite directions (benchmark)
   grazing.gltf        a 4 m x 1 m x 0.6 m corridor, a point light 3 cm above the floor near one
@@ -72,14 +79,23 @@ class Scene:
 
     def texture_png(self, rgb, size=2):
         """A size x size PNG of one 8-bit sRGB colour, as a data-URI image; returns the texture."""
-        raw = b"".join(b"\0" + bytes(rgb) * size for _ in range(size))
+        return self.texture_pixels([[tuple(rgb)] * size] * size)
+
+    def texture_pixels(self, rows, sampler=None):
+        """A PNG of 8-bit RGB pixels (rows top to bottom) as a data-URI image, with an optional
+        sampler (a glTF sampler object); returns the texture."""
+        raw = b"".join(b"\0" + b"".join(bytes(p) for p in row) for row in rows)
         def chunk(kind, data):
             return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
-        png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", size, size, 8, 2, 0, 0, 0)) +
-               chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+        ihdr = struct.pack(">IIBBBBB", len(rows[0]), len(rows), 8, 2, 0, 0, 0)
+        png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
         self.doc.setdefault("images", []).append(
             {"uri": "data:image/png;base64," + base64.b64encode(png).decode(), "mimeType": "image/png"})
-        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1})
+        tex = {"source": len(self.doc["images"]) - 1}
+        if sampler is not None:
+            self.doc.setdefault("samplers", []).append(sampler)
+            tex["sampler"] = len(self.doc["samplers"]) - 1
+        self.doc.setdefault("textures", []).append(tex)
         return len(self.doc["textures"]) - 1
 
     def _use(self, ext):
@@ -87,9 +103,16 @@ class Scene:
         if ext not in used:
             used.append(ext)
 
-    def mesh(self, name, tris, material, translation=(0, 0, 0), uv=False):
+    def require(self, ext):
+        self._use(ext)
+        req = self.doc.setdefault("extensionsRequired", [])
+        if ext not in req:
+            req.append(ext)
+
+    def mesh(self, name, tris, material, translation=(0, 0, 0), uv=False, uv_sets=None):
         """tris: list of ((p0, p1, p2)) counter-clockwise seen from the front; flat normals;
-        uv: TEXCOORD_0 = (x, z) of each corner."""
+        uv: TEXCOORD_0 = (x, z) of each corner; uv_sets: functions of a corner's position
+        giving TEXCOORD_0, TEXCOORD_1, ... instead."""
         pos, nrm, idx = [], [], []
         for a, b, c in tris:
             e1 = [b[i] - a[i] for i in range(3)]
@@ -104,7 +127,9 @@ class Scene:
         prim = {"attributes": {"POSITION": self._accessor(pos, 3), "NORMAL": self._accessor(nrm, 3)},
                 "indices": self._accessor(idx, 1, True), "material": material}
         if uv:
-            prim["attributes"]["TEXCOORD_0"] = self._accessor([(p[0], p[2]) for p in pos], 2)
+            uv_sets = [lambda p: (p[0], p[2])]
+        for k, f in enumerate(uv_sets or []):
+            prim["attributes"]["TEXCOORD_%d" % k] = self._accessor([tuple(f(p)) for p in pos], 2)
         self.doc["meshes"].append({"name": name, "primitives": [prim]})
         self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1,
                                   "translation": list(translation)})
@@ -130,6 +155,29 @@ class Scene:
         with open(path, "w") as f:
             json.dump(self.doc, f, indent=1)
 
+
+# The emissive disk with a texture transform: TEXCOORD_1 = (x, z), the transform's texCoord picks it
+# over TEXCOORD_0 (constant 0.1, 0.1); u' = 2 cos(r) x + 0.5 sin(r) z + 0.6 (r = 60 degrees) >= 0.5
+# selects the white texel.
+DISK_TRANSFORM = {"offset": [0.6, 0.25], "rotation": math.pi / 3, "scale": [2.0, 0.5], "texCoord": 1}
+NEAREST_CLAMP = {"magFilter": 9728, "minFilter": 9728, "wrapS": 33071, "wrapT": 33071}
+
+
+def srgb_to_linear(c8):
+    c = c8 / 255.0
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+# Furnace boxes (name -> albedo rho every face must bounce with): spec-gloss c_diff = diffuse x
+# (1 - max specular); metalness = metallicFactor x the metallicRoughness texture's blue (linear);
+# a base colour texture read through a transform and MIRRORED_REPEAT.
+FURNACE_MATERIALS = {
+    "specgloss": 0.625 * (1 - 0.2),
+    "metal-blue0": 0.5,
+    "metal-blue128": 0.5 * (1 - 128 / 255.0),
+    "metal-blue255": 0.0,
+    "basecolor-mirror": srgb_to_linear(188),
+}
 
 # 20 point lights 2 m above the plane (x, z, candela): more than lmbake evaluates exactly
 MANY_LIGHTS = [(-4 + 2 * (k % 5), -3 + 2 * (k // 5), 10.0 + 7.0 * k) for k in range(20)]
@@ -214,6 +262,16 @@ def analytic(out):
     s.write(os.path.join(out, "disk-textured.gltf"))
 
     s = Scene()
+    s.mesh("plane", plane(6), s.material("grey", (0.5, 0.5, 0.5)))
+    mat = s.material("emitter", (0.0, 0.0, 0.0), emissive=(1, 1, 1), strength=10.0)
+    tex = s.texture_pixels([[(0, 0, 0), (255, 255, 255)]], NEAREST_CLAMP)
+    s.doc["materials"][mat]["emissiveTexture"] = {"index": tex, "texCoord": 0,
+                                                  "extensions": {"KHR_texture_transform": DISK_TRANSFORM}}
+    s.require("KHR_texture_transform")
+    s.mesh("disk", disk, mat, uv_sets=[lambda p: (0.1, 0.1), lambda p: (p[0], p[2])])
+    s.write(os.path.join(out, "disk-transform.gltf"))
+
+    s = Scene()
     s.mesh("plane", plane(10), s.material("grey", (0.5, 0.5, 0.5)))
     for k, (x, z, i) in enumerate(MANY_LIGHTS):
         s.light("lamp%d" % k, "point", i, translation=(x, 2, z))
@@ -232,11 +290,53 @@ def analytic(out):
     s.write(os.path.join(out, "box-floor.gltf"))
 
 
+def furnace_variant(out, name):
+    """The furnace box (Le = 1 nit) with material `name` of FURNACE_MATERIALS; TEXCOORD_0 = (x, z)."""
+    s = Scene()
+    mat = s.material("furnace-" + name, (0.5, 0.5, 0.5), emissive=(1, 1, 1))
+    m = s.doc["materials"][mat]
+    pbr = m["pbrMetallicRoughness"]
+    if name == "specgloss":
+        # the fallback metal-rough material would bounce nothing: spec-gloss must win
+        pbr.update({"baseColorFactor": [0.1, 0.1, 0.1, 1.0], "metallicFactor": 1.0})
+        m["extensions"] = {"KHR_materials_pbrSpecularGlossiness": {
+            "diffuseFactor": [0.625, 0.625, 0.625, 1.0], "specularFactor": [0.2, 0.2, 0.2], "glossinessFactor": 0.5}}
+        s.require("KHR_materials_pbrSpecularGlossiness")
+    elif name == "metal-blue0":
+        # texel 0 says metal (blue 255), texel 1 dielectric (blue 0; red and green 255); the
+        # transform maps (x, z) in [-1, 1]^2 to u' = 0.1 z + 1 in [0.9, 1.1]: texel 1 with
+        # CLAMP_TO_EDGE (REPEAT would read texel 0 above u' = 1, and no transform texel 0 for x < 0.5)
+        tex = s.texture_pixels([[(0, 0, 255), (255, 255, 0)]], NEAREST_CLAMP)
+        pbr["metallicFactor"] = 1.0
+        pbr["metallicRoughnessTexture"] = {"index": tex, "extensions": {"KHR_texture_transform": {
+            "offset": [1.0, 0.5], "rotation": math.pi / 2, "scale": [0.1, 0.1]}}}
+        s.require("KHR_texture_transform")
+    elif name in ("metal-blue128", "metal-blue255"):
+        blue = 128 if name == "metal-blue128" else 255
+        rg = 255 if blue == 128 else 0  # red and green unlike blue: reading the wrong channel shows
+        pbr["metallicFactor"] = 1.0
+        pbr["metallicRoughnessTexture"] = {"index": s.texture_pixels([[(rg, rg, blue)] * 2] * 2)}
+    elif name == "basecolor-mirror":
+        # u' = 0.1 x - 0.75 in [-0.85, -0.65], texel index floor(2 u') = -2: MIRRORED_REPEAT reads
+        # texel 1 (sRGB 188) there; REPEAT and CLAMP_TO_EDGE would read texel 0 (white)
+        tex = s.texture_pixels([[(255, 255, 255), (188, 188, 188)]],
+                               {"magFilter": 9728, "wrapS": 33648, "wrapT": 10497})
+        pbr["baseColorFactor"] = [1.0, 1.0, 1.0, 1.0]
+        pbr["baseColorTexture"] = {"index": tex, "extensions": {"KHR_texture_transform": {
+            "offset": [-0.75, 0.0], "scale": [0.1, 0.1]}}}
+        s.require("KHR_texture_transform")
+    s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), mat, uv=True)
+    s.write(os.path.join(out, "furnace-%s.gltf" % name))
+
+
 def indirect(out):
     s = Scene()
     mat = s.material("furnace", (0.5, 0.5, 0.5), emissive=(1, 1, 1))
     s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), mat)
     s.write(os.path.join(out, "furnace.gltf"))
+
+    for name in FURNACE_MATERIALS:
+        furnace_variant(out, name)
 
     s = Scene()
     white = s.material("white", (0.73, 0.73, 0.73))

@@ -66,20 +66,9 @@ static void albedo_at(const lmb_cache *c, const lmb_primitive *pr, uint32_t f, d
         out[0] = out[1] = out[2] = 0;
         return;
     }
-    const lmb_material *m = &c->scene->materials[pr->material];
-    double k = (1.0 - m->metallic) * LMB_INV_PI;
-    float tex[3] = {1, 1, 1};
-    const float *uv = m->base_color_texcoord == 0 ? pr->uv0 : m->base_color_texcoord == 1 ? pr->uv1 : NULL;
-    if (c->textures && uv && m->base_color_texture >= 0 && (uint32_t)m->base_color_texture < c->textures->count &&
-        c->textures->t[m->base_color_texture].rgb) {
-        const uint32_t *ix = pr->indices + 3 * (size_t)f;
-        double b0 = 1.0 - b1 - b2;
-        double u = b0 * uv[2 * ix[0]] + b1 * uv[2 * ix[1]] + b2 * uv[2 * ix[2]];
-        double v = b0 * uv[2 * ix[0] + 1] + b1 * uv[2 * ix[1] + 1] + b2 * uv[2 * ix[2] + 1];
-        lmb_texture_sample(&c->textures->t[m->base_color_texture], u, v, tex);
-    }
+    lmb_material_albedo(c->textures, &c->scene->materials[pr->material], pr, f, b1, b2, out);
     for (int j = 0; j < 3; j++)
-        out[j] = k * m->base_color[j] * tex[j];
+        out[j] *= LMB_INV_PI;
 }
 
 /* Bilinear lookup at atlas texel coordinates (x, y) (texel centres at half integers), clamped. */

@@ -7,6 +7,7 @@
 #include "cli_common.h"
 #include "commands.h"
 
+#include <math.h>
 #include <string.h>
 
 static const char help[] =
@@ -40,6 +41,32 @@ static void json_str(const char *s)
             putchar(c);
     }
     putchar('"');
+}
+
+/* One material line: what its diffuse albedo is made of (textures.h lmb_material_albedo) and its emission. */
+static void print_material(uint32_t m, const lmb_material *mat)
+{
+    if (mat->spec_gloss) {
+        printf("  [%u] '%s': spec-gloss, diffuse (%.3g, %.3g, %.3g)%s x (1 - max specular (%.3g, %.3g, %.3g)%s)", m,
+               mat->name, mat->base_color[0], mat->base_color[1], mat->base_color[2],
+               mat->base_color_texture.texture >= 0 ? " x texture" : "", mat->specular[0], mat->specular[1],
+               mat->specular[2], mat->specular_texture.texture >= 0 ? " x texture" : "");
+        if (mat->specular_texture.texture < 0 &&
+            fmaxf(mat->specular[0], fmaxf(mat->specular[1], mat->specular[2])) >= 1.0f)
+            printf(" (specular 1, the extension's default: no diffuse, so a lightmap shows black on it in viewers)");
+    } else {
+        printf("  [%u] '%s': base colour (%.3g, %.3g, %.3g)%s, metallic %.3g%s", m, mat->name, mat->base_color[0],
+               mat->base_color[1], mat->base_color[2], mat->base_color_texture.texture >= 0 ? " x texture" : "",
+               mat->metallic, mat->metallic_texture.texture >= 0 && mat->metallic > 0 ? " x texture (blue)" : "");
+        if (mat->metallic >= 1.0f && mat->metallic_texture.texture < 0)
+            printf(" (fully metallic: no diffuse, so a lightmap shows black on it in viewers)");
+    }
+    if (mat->unlit)
+        printf(", unlit (reflects no light in the bake)");
+    if (lmb_material_is_emissive(mat))
+        printf(", emissive (%.4g, %.4g, %.4g) nits (strength %.4g)%s -> area light", mat->emissive[0],
+               mat->emissive[1], mat->emissive[2], mat->emissive_strength,
+               mat->emissive_texture.texture >= 0 ? " x texture" : "");
 }
 
 static void print_text(const lmb_scene *s, const lmb_scene_stats *st)
@@ -79,13 +106,7 @@ static void print_text(const lmb_scene *s, const lmb_scene_stats *st)
     printf("materials:\n");
     for (uint32_t m = 0; m < s->material_count; m++) {
         const lmb_material *mat = &s->materials[m];
-        printf("  [%u] '%s': base colour (%.3g, %.3g, %.3g)%s, metallic %.3g", m, mat->name, mat->base_color[0],
-               mat->base_color[1], mat->base_color[2], mat->base_color_texture >= 0 ? " x texture" : "", mat->metallic);
-        if (mat->metallic >= 1.0f)
-            printf(" (fully metallic: no diffuse, so a lightmap shows black on it in viewers)");
-        if (lmb_material_is_emissive(mat))
-            printf(", emissive (%.4g, %.4g, %.4g) nits (strength %.4g)%s -> area light", mat->emissive[0],
-                   mat->emissive[1], mat->emissive[2], mat->emissive_strength, mat->emissive_texture >= 0 ? " x texture" : "");
+        print_material(m, mat);
         printf("\n");
     }
     printf("lights:\n");
@@ -139,8 +160,10 @@ static void print_json(const lmb_scene *s, const lmb_scene_stats *st)
         const lmb_material *mat = &s->materials[m];
         printf("%s\n  {\"name\": ", m ? "," : "");
         json_str(mat->name);
-        printf(", \"base_color\": [%.6g, %.6g, %.6g, %.6g], \"emissive\": [%.6g, %.6g, %.6g], \"emissive_strength\": %.6g}",
-               mat->base_color[0], mat->base_color[1], mat->base_color[2], mat->base_color[3], mat->emissive[0],
+        printf(", \"model\": \"%s\", \"base_color\": [%.6g, %.6g, %.6g, %.6g], \"metallic\": %.6g, "
+               "\"emissive\": [%.6g, %.6g, %.6g], \"emissive_strength\": %.6g}",
+               mat->unlit ? "unlit" : mat->spec_gloss ? "spec-gloss" : "metal-rough", mat->base_color[0],
+               mat->base_color[1], mat->base_color[2], mat->base_color[3], mat->metallic, mat->emissive[0],
                mat->emissive[1], mat->emissive[2], mat->emissive_strength);
     }
     printf("],\n \"light_list\": [");

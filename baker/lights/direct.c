@@ -44,7 +44,7 @@ typedef struct emitter {
     float le[3];   /* radiance, nits (times the texture when there is one) */
     int two_sided;
     const lmb_texture *tex; /* emissive texture or NULL */
-    float uv[6];   /* its texture coordinates at the corners */
+    double uv[6];  /* its texture coordinates at the corners (KHR_texture_transform applied) */
     uint32_t instance, primitive, triangle; /* where it is in the scene (primitive: lmb_scene index) */
 } emitter;
 
@@ -88,21 +88,20 @@ static void world_point(const double m[16], const float *p, double *out)
         out[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
 }
 
-/* The emissive texture of material `mat` on primitive pr, and its corner UVs for face f. */
+/* The emissive texture of material `mat` on primitive pr, and its corner UVs for face f with
+ * the slot's KHR_texture_transform applied (an affine map commutes with barycentric interpolation). */
 static const lmb_texture *emitter_texture(const lmb_textures *tx, const lmb_material *mat, const lmb_primitive *pr,
-                                          uint32_t f, float uv[6])
+                                          uint32_t f, double uv[6])
 {
-    if (!tx || mat->emissive_texture < 0 || (uint32_t)mat->emissive_texture >= tx->count ||
-        !tx->t[mat->emissive_texture].rgb)
-        return NULL;
-    const float *set = mat->emissive_texcoord == 1 ? pr->uv1 : mat->emissive_texcoord == 0 ? pr->uv0 : NULL;
-    if (!set)
+    const lmb_texture *t = lmb_textures_get(tx, &mat->emissive_texture, LMB_TEX_COLOUR);
+    const float *set = mat->emissive_texture.texcoord == 1 ? pr->uv1 : mat->emissive_texture.texcoord == 0 ? pr->uv0 : NULL;
+    if (!t || !set)
         return NULL;
     for (int k = 0; k < 3; k++) {
-        uv[2 * k] = set[2 * pr->indices[3 * f + k]];
-        uv[2 * k + 1] = set[2 * pr->indices[3 * f + k] + 1];
+        lmb_texture_ref_apply(&mat->emissive_texture, set[2 * pr->indices[3 * f + k]],
+                              set[2 * pr->indices[3 * f + k] + 1], &uv[2 * k], &uv[2 * k + 1]);
     }
-    return &tx->t[mat->emissive_texture];
+    return t;
 }
 
 lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const lmb_textures *tx, lmb_emitters **out,
@@ -278,7 +277,7 @@ static int emitted(const emitter *x, double b1, double b2, const double d[3], do
     float t[3] = {1, 1, 1};
     double b0 = 1 - b1 - b2;
     if (x->tex)
-        lmb_texture_sample(x->tex, b0 * x->uv[0] + b1 * x->uv[2] + b2 * x->uv[4],
+        lmb_texture_sample(x->tex, LMB_TEX_COLOUR, b0 * x->uv[0] + b1 * x->uv[2] + b2 * x->uv[4],
                            b0 * x->uv[1] + b1 * x->uv[3] + b2 * x->uv[5], t);
     for (int k = 0; k < 3; k++)
         le[k] = x->le[k] * t[k];

@@ -157,6 +157,54 @@ void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
     c.gpu_scale = int_member(attrs, "SCALE", -1);
 }
 
+double number_member(const tinygltf::Value *obj, const char *key, double fallback)
+{
+    const tinygltf::Value *v = obj ? member(*obj, key) : nullptr;
+    return (v && v->IsNumber()) ? v->GetNumberAsDouble() : fallback;
+}
+
+/* Copies up to n numbers of the array obj[key] into dst (what is missing keeps its default). */
+void number_array(const tinygltf::Value *obj, const char *key, double *dst, int n)
+{
+    const tinygltf::Value *v = obj ? member(*obj, key) : nullptr;
+    if (!v || !v->IsArray())
+        return;
+    for (int i = 0; i < n && i < (int)v->ArrayLen(); i++)
+        if (v->Get(i).IsNumber())
+            dst[i] = v->Get(i).GetNumberAsDouble();
+}
+
+/* A textureInfo's fields and its KHR_texture_transform object `t` (may be null), as written. */
+lmb_gltf_texture_info texture_info(int32_t index, int32_t texcoord, const tinygltf::Value *t)
+{
+    lmb_gltf_texture_info c{};
+    c.index = index;
+    c.texcoord = texcoord;
+    c.scale[0] = c.scale[1] = 1.0;
+    c.transform_texcoord = -1;
+    if (t && t->IsObject()) {
+        c.has_transform = 1;
+        number_array(t, "offset", c.offset, 2);
+        number_array(t, "scale", c.scale, 2);
+        c.rotation = number_member(t, "rotation", 0.0);
+        c.transform_texcoord = int_member(t, "texCoord", -1);
+    }
+    return c;
+}
+
+lmb_gltf_texture_info texture_info(const tinygltf::TextureInfo &t)
+{
+    return texture_info(t.index, t.texCoord, extension(t.extensions, "KHR_texture_transform"));
+}
+
+/* A textureInfo held as a JSON object inside an extension (spec-gloss's textures). */
+lmb_gltf_texture_info texture_info(const tinygltf::Value *obj)
+{
+    const tinygltf::Value *ext = obj ? member(*obj, "extensions") : nullptr;
+    return texture_info(int_member(obj, "index", -1), int_member(obj, "texCoord", 0),
+                        ext ? member(*ext, "KHR_texture_transform") : nullptr);
+}
+
 void fill_materials(lmb_gltf_doc &d)
 {
     for (const auto &m : d.model.materials) {
@@ -165,19 +213,42 @@ void fill_materials(lmb_gltf_doc &d)
         const auto &pbr = m.pbrMetallicRoughness;
         c.base_color[0] = c.base_color[1] = c.base_color[2] = c.base_color[3] = 1.0;
         copy_doubles(c.base_color, pbr.baseColorFactor, 4);
-        c.base_color_texture = pbr.baseColorTexture.index;
-        c.base_color_texcoord = pbr.baseColorTexture.texCoord;
+        c.base_color_texture = texture_info(pbr.baseColorTexture);
         c.metallic = pbr.metallicFactor;
+        c.metallic_roughness_texture = texture_info(pbr.metallicRoughnessTexture);
         copy_doubles(c.emissive, m.emissiveFactor, 3);
-        c.emissive_strength = 1.0;
-        const tinygltf::Value *es = extension(m.extensions, "KHR_materials_emissive_strength");
-        const tinygltf::Value *s = es ? member(*es, "emissiveStrength") : nullptr;
-        if (s && s->IsNumber())
-            c.emissive_strength = s->GetNumberAsDouble();
-        c.emissive_texture = m.emissiveTexture.index;
-        c.emissive_texcoord = m.emissiveTexture.texCoord;
+        c.emissive_strength = number_member(extension(m.extensions, "KHR_materials_emissive_strength"),
+                                            "emissiveStrength", 1.0);
+        c.emissive_texture = texture_info(m.emissiveTexture);
         c.double_sided = m.doubleSided;
+        const tinygltf::Value *sg = extension(m.extensions, "KHR_materials_pbrSpecularGlossiness");
+        c.spec_gloss = sg && sg->IsObject();
+        c.diffuse[0] = c.diffuse[1] = c.diffuse[2] = c.diffuse[3] = 1.0;
+        c.specular[0] = c.specular[1] = c.specular[2] = 1.0;
+        c.glossiness = 1.0;
+        c.diffuse_texture = texture_info(c.spec_gloss ? member(*sg, "diffuseTexture") : nullptr);
+        c.specular_glossiness_texture = texture_info(c.spec_gloss ? member(*sg, "specularGlossinessTexture") : nullptr);
+        if (c.spec_gloss) {
+            number_array(sg, "diffuseFactor", c.diffuse, 4);
+            number_array(sg, "specularFactor", c.specular, 3);
+            c.glossiness = number_member(sg, "glossinessFactor", 1.0);
+        }
+        c.unlit = extension(m.extensions, "KHR_materials_unlit") != nullptr;
         d.materials.push_back(c);
+    }
+}
+
+void fill_textures(lmb_gltf_doc &d)
+{
+    for (const auto &t : d.model.textures) {
+        lmb_gltf_texture c{t.source, t.sampler, TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT, -1};
+        if (t.sampler >= 0 && (size_t)t.sampler < d.model.samplers.size()) {
+            const auto &s = d.model.samplers[(size_t)t.sampler];
+            c.wrap_s = s.wrapS;
+            c.wrap_t = s.wrapT;
+            c.mag_filter = s.magFilter;
+        }
+        d.textures.push_back(c);
     }
 }
 
@@ -253,8 +324,7 @@ void build_view(lmb_gltf_doc &d)
         }
         d.images.push_back(g);
     }
-    for (const auto &t : d.model.textures)
-        d.texture_source.push_back(t.source);
+    fill_textures(d);
     lmb_gltf_view &v = d.view;
     expose(d.buffers, v.buffers, v.buffer_count);
     expose(d.buffer_views, v.buffer_views, v.buffer_view_count);
@@ -270,7 +340,7 @@ void build_view(lmb_gltf_doc &d)
     expose(d.ext_used, v.extensions_used, v.extensions_used_count);
     expose(d.image_uris, v.image_uris, v.image_count);
     v.images = d.images.empty() ? nullptr : d.images.data();
-    expose(d.texture_source, v.texture_source, v.texture_count);
+    expose(d.textures, v.textures, v.texture_count);
 }
 
 /* tinygltf's messages end in newlines and may hold several lines: keep the first one. */

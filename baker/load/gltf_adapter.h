@@ -65,16 +65,39 @@ typedef struct lmb_gltf_node {
     int has_gpu_instancing;
 } lmb_gltf_node;
 
+/* A glTF textureInfo with its KHR_texture_transform, as written (defaults filled in). */
+typedef struct lmb_gltf_texture_info {
+    int32_t index;    /* texture, -1: none */
+    int32_t texcoord; /* textureInfo.texCoord */
+    int has_transform;
+    double offset[2], rotation, scale[2]; /* KHR_texture_transform (0, 0), 0, (1, 1) by default */
+    int32_t transform_texcoord;           /* its texCoord override, -1 if not given */
+} lmb_gltf_texture_info;
+
 typedef struct lmb_gltf_material {
     const char *name;
     double base_color[4];
-    int32_t base_color_texture, base_color_texcoord;
+    lmb_gltf_texture_info base_color_texture;
     double metallic;
+    lmb_gltf_texture_info metallic_roughness_texture;
     double emissive[3];
     double emissive_strength; /* 1 if KHR_materials_emissive_strength is absent */
-    int32_t emissive_texture, emissive_texcoord;
+    lmb_gltf_texture_info emissive_texture;
     int double_sided;
+    /* KHR_materials_pbrSpecularGlossiness (when spec_gloss): defaults 1, 1, 1 */
+    int spec_gloss;
+    double diffuse[4], specular[3], glossiness;
+    lmb_gltf_texture_info diffuse_texture, specular_glossiness_texture;
+    int unlit; /* KHR_materials_unlit */
 } lmb_gltf_material;
+
+/* A glTF texture and its sampler (glTF defaults when it has none). */
+typedef struct lmb_gltf_texture {
+    int32_t source;           /* image, -1: none */
+    int32_t sampler;          /* -1: none */
+    int32_t wrap_s, wrap_t;   /* 10497 REPEAT, 33648 MIRRORED_REPEAT, 33071 CLAMP_TO_EDGE (or anything written) */
+    int32_t mag_filter;       /* 9728 NEAREST, 9729 LINEAR, -1 not given */
+} lmb_gltf_texture;
 
 typedef struct lmb_gltf_light {
     const char *name;
@@ -108,7 +131,7 @@ typedef struct lmb_gltf_view {
     const char *const *extensions_used;         uint32_t extensions_used_count;
     const char *const *image_uris;              uint32_t image_count; /* "" when in a buffer view */
     const lmb_gltf_image *images;               /* image_count of them */
-    const int32_t *texture_source;              uint32_t texture_count; /* image index or -1 */
+    const lmb_gltf_texture *textures;           uint32_t texture_count;
 } lmb_gltf_view;
 
 /* Parses path (.gltf or .glb by content). `extras_key` names the node extras bool read

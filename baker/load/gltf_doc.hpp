@@ -30,7 +30,7 @@ struct lmb_gltf_doc {
     std::vector<int32_t> scene_roots;
     std::vector<const char *> ext_required, ext_used, image_uris;
     std::vector<lmb_gltf_image> images;
-    std::vector<int32_t> texture_source;
+    std::vector<lmb_gltf_texture> textures;
     lmb_gltf_view view;
     /* writer: (original material, lightmap texture) -> lightmapped material copy */
     std::map<std::pair<int, int>, int> lightmap_materials;

@@ -21,6 +21,9 @@ void lmb_primitive_release(lmb_primitive *p);
 lmb_status lmb_load_nodes(const lmb_accessor_ctx *ctx, lmb_scene *scene, const lmb_log *log,
                           lmb_error *err);
 
+/* Fills scene->materials from the glTF's materials (materials.c). */
+lmb_status lmb_load_materials(const char *path, const lmb_gltf_view *v, lmb_scene *scene, lmb_error *err);
+
 /* "name" or "<kind> N" when the glTF object has no name; buf must hold 160 bytes. */
 const char *lmb_object_label(char *buf, const char *kind, uint32_t index, const char *name);
 

@@ -3,12 +3,15 @@
  * files lmbake cannot bake fail with a message naming the reason rather than with the
  * symptom tinygltf would report later ("'uri' is missing", "invalid bufferView"):
  *   - asset.version must be 2.x (and minVersion, if any, <= 2.0);
- *   - extensionsRequired must only name extensions lmbake implements;
+ *   - extensionsRequired must only name extensions lmbake implements or can bake without
+ *     (extensions.c); an alternative image format (KHR_texture_basisu, EXT_texture_webp, ...)
+ *     only if every texture lmbake reads keeps a fallback `source` image;
  *   - compressed geometry (KHR_draco_mesh_compression on a primitive,
  *     EXT_meshopt_compression on a buffer view) is refused, naming the mesh or view.
  * For .glb the JSON chunk is read from the container (glTF 2.0 spec section 4.4).
  */
 #include "preflight.h"
+#include "extensions.h"
 #include "load_internal.h"
 #include "../util/file.h"
 
@@ -16,12 +19,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Extensions lmbake implements fully; a file may require these. */
-static const char *const supported_required[] = {
-    "KHR_lights_punctual", "KHR_materials_emissive_strength", "EXT_mesh_gpu_instancing",
-    "KHR_mesh_quantization",
-};
 
 static uint32_t le32(const unsigned char *p)
 {
@@ -66,18 +63,79 @@ static lmb_status check_version(const char *path, const cJSON *root, lmb_error *
     return LMB_OK;
 }
 
+static int texture_index(const cJSON *info)
+{
+    const cJSON *i = cJSON_GetObjectItemCaseSensitive(info, "index");
+    return cJSON_IsNumber(i) && i->valuedouble >= 0 && i->valuedouble < 1e9 ? (int)i->valuedouble : -1;
+}
+
+/* Textures lmbake reads (textures.c): base colour, metallicRoughness, emissive, spec-gloss diffuse
+ * and specular. Returns the material that reads texture `tex` through `slot`, or -1. */
+static int material_reading(const cJSON *root, int tex, const char **slot)
+{
+    static const char *const pbr_slots[] = {"baseColorTexture", "metallicRoughnessTexture"};
+    static const char *const sg_slots[] = {"diffuseTexture", "specularGlossinessTexture"};
+    const cJSON *m;
+    int mi = 0;
+    cJSON_ArrayForEach(m, cJSON_GetObjectItemCaseSensitive(root, "materials"))
+    {
+        const cJSON *pbr = cJSON_GetObjectItemCaseSensitive(m, "pbrMetallicRoughness");
+        const cJSON *sg = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(m, "extensions"),
+                                                           "KHR_materials_pbrSpecularGlossiness");
+        for (int k = 0; k < 2; k++) {
+            if (texture_index(cJSON_GetObjectItemCaseSensitive(pbr, pbr_slots[k])) == tex)
+                return *slot = pbr_slots[k], mi;
+            if (texture_index(cJSON_GetObjectItemCaseSensitive(sg, sg_slots[k])) == tex)
+                return *slot = sg_slots[k], mi;
+        }
+        if (texture_index(cJSON_GetObjectItemCaseSensitive(m, "emissiveTexture")) == tex)
+            return *slot = "emissiveTexture", mi;
+        mi++;
+    }
+    return -1;
+}
+
+/* A required image-format extension (KHR_texture_basisu, ...): every texture lmbake reads that
+ * carries it must also have a core `source` (PNG or JPEG), which is what lmbake decodes. */
+static lmb_status check_image_fallback(const char *path, const cJSON *root, const char *ext, lmb_error *err)
+{
+    const cJSON *t;
+    int ti = 0;
+    cJSON_ArrayForEach(t, cJSON_GetObjectItemCaseSensitive(root, "textures"))
+    {
+        const cJSON *e = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(t, "extensions"), ext);
+        const char *slot = NULL;
+        int m;
+        if (e && !cJSON_IsNumber(cJSON_GetObjectItemCaseSensitive(t, "source")) &&
+            (m = material_reading(root, ti, &slot)) >= 0) {
+            const cJSON *name = cJSON_GetObjectItemCaseSensitive(
+                cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(root, "materials"), m), "name");
+            char label[160];
+            return lmb_error_set(err, LMB_ERR_INPUT,
+                                 "%s: requires %s, and texture %d (the %s of %s) has no fallback image (`source`) "
+                                 "lmbake can decode; export PNG or JPEG fallbacks",
+                                 path, ext, ti, slot,
+                                 lmb_object_label(label, "material", (uint32_t)m, cJSON_IsString(name) ? name->valuestring : NULL));
+        }
+        ti++;
+    }
+    return LMB_OK;
+}
+
 static lmb_status check_required(const char *path, const cJSON *root, lmb_error *err)
 {
     char missing[512] = "";
     const cJSON *e;
     cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(root, "extensionsRequired"))
     {
-        int known = 0;
         if (!cJSON_IsString(e))
             continue;
-        for (size_t k = 0; k < sizeof supported_required / sizeof *supported_required; k++)
-            known |= !strcmp(e->valuestring, supported_required[k]);
-        if (!known) {
+        const lmb_extension_info *info = lmb_extension_find(e->valuestring);
+        if (info && info->support == LMB_EXT_IMAGE) {
+            lmb_status st = check_image_fallback(path, root, e->valuestring, err);
+            if (st != LMB_OK)
+                return st;
+        } else if (!info) {
             size_t len = strlen(missing);
             snprintf(missing + len, sizeof missing - len, "%s%s", len ? ", " : "", e->valuestring);
         }

@@ -5,20 +5,13 @@
  * Draco accessors without data, cycles, out-of-range indices). On error nothing leaks and
  * *out stays NULL.
  */
+#include "extensions.h"
 #include "load_internal.h"
 #include "preflight.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Extensions lmbake knows it ignores when they are only used: what a user should expect. */
-static const struct { const char *name, *effect; } ignored_used[] = {
-    {"KHR_texture_transform", "texture transforms are ignored for bounce albedo"},
-    {"KHR_materials_transmission", "transmissive surfaces are baked as opaque"},
-    {"KHR_materials_volume", "volumes are baked as opaque surfaces"},
-    {"KHR_materials_pbrSpecularGlossiness", "spec-gloss materials use their diffuse factor only"},
-};
 
 char *lmb_strdup(const char *s)
 {
@@ -38,45 +31,31 @@ const char *lmb_object_label(char *buf, const char *kind, uint32_t index, const 
     return buf;
 }
 
+static int listed(const char *const *names, uint32_t count, const char *name)
+{
+    for (uint32_t k = 0; k < count; k++)
+        if (!strcmp(names[k], name))
+            return 1;
+    return 0;
+}
+
+static void warn_one(const char *path, const char *name, int required, const lmb_log *log)
+{
+    const lmb_extension_info *info = lmb_extension_find(name);
+    if (info && info->support != LMB_EXT_SUPPORTED)
+        lmb_warn(log, "%s: %s %s: %s", path, required ? "requires" : "uses", name, info->effect);
+}
+
+/* One warning per extension the file uses or requires whose effect the bake leaves out
+ * (extensions.c), naming the file and the extension. */
 static void warn_ignored_extensions(const char *path, const lmb_gltf_view *v, const lmb_log *log)
 {
     for (uint32_t i = 0; i < v->extensions_used_count; i++)
-        for (size_t k = 0; k < sizeof ignored_used / sizeof *ignored_used; k++)
-            if (!strcmp(v->extensions_used[i], ignored_used[k].name))
-                lmb_warn(log, "%s: uses %s: %s", path, ignored_used[k].name, ignored_used[k].effect);
-}
-
-static lmb_status load_materials(const char *path, const lmb_gltf_view *v, lmb_scene *s, lmb_error *err)
-{
-    s->materials = calloc(v->material_count + 1, sizeof *s->materials);
-    if (!s->materials)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
-    for (uint32_t i = 0; i < v->material_count; i++) {
-        const lmb_gltf_material *g = &v->materials[i];
-        lmb_material *m = &s->materials[i];
-        char label[160];
-        lmb_object_label(label, "material", i, g->name);
-        m->name = lmb_strdup(g->name && *g->name ? g->name : label);
-        if (!m->name)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
-        s->material_count = i + 1;
-        if (!(g->emissive_strength >= 0.0) || g->emissive_strength > 1e30)
-            return lmb_error_set(err, LMB_ERR_INPUT,
-                                 "%s: %s: KHR_materials_emissive_strength %g must be a finite number >= 0",
-                                 path, label, g->emissive_strength);
-        for (int c = 0; c < 4; c++)
-            m->base_color[c] = (float)g->base_color[c];
-        for (int c = 0; c < 3; c++)
-            m->emissive[c] = (float)(g->emissive[c] * g->emissive_strength);
-        m->emissive_strength = (float)g->emissive_strength;
-        m->base_color_texture = g->base_color_texture;
-        m->base_color_texcoord = g->base_color_texcoord;
-        m->emissive_texture = g->emissive_texture;
-        m->emissive_texcoord = g->emissive_texcoord;
-        m->metallic = (float)g->metallic;
-        m->double_sided = g->double_sided;
-    }
-    return LMB_OK;
+        warn_one(path, v->extensions_used[i],
+                 listed(v->extensions_required, v->extensions_required_count, v->extensions_used[i]), log);
+    for (uint32_t i = 0; i < v->extensions_required_count; i++) /* required but (wrongly) not in extensionsUsed */
+        if (!listed(v->extensions_used, v->extensions_used_count, v->extensions_required[i]))
+            warn_one(path, v->extensions_required[i], 1, log);
 }
 
 static lmb_status load_meshes(const lmb_accessor_ctx *ctx, lmb_scene *s, const lmb_log *log, lmb_error *err)
@@ -140,7 +119,7 @@ lmb_status lmb_scene_load(const char *path, const lmb_config *cfg, lmb_scene **o
         lmb_accessor_ctx ctx = {v, path};
         s->node_count = v->node_count;
         warn_ignored_extensions(path, v, log);
-        st = load_materials(path, v, s, err);
+        st = lmb_load_materials(path, v, s, err);
         if (st == LMB_OK)
             st = load_meshes(&ctx, s, log, err);
         if (st == LMB_OK)

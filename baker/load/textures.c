@@ -1,4 +1,5 @@
-/* Decoded material textures (see textures.h). sRGB decode: IEC 61966-2-1. */
+/* Material textures: decoding, sampling, UV transforms and the albedo they give (see textures.h).
+ * sRGB decode: IEC 61966-2-1. */
 #include "textures.h"
 
 #include "gltf_adapter.h"
@@ -11,8 +12,10 @@
 
 void lmb_textures_free(lmb_textures *t)
 {
-    for (uint32_t i = 0; t->t && i < t->count; i++)
-        free(t->t[i].rgb);
+    for (uint32_t i = 0; t->t && i < t->count; i++) {
+        free(t->t[i].pixels[LMB_TEX_COLOUR]);
+        free(t->t[i].pixels[LMB_TEX_DATA]);
+    }
     free(t->t);
     memset(t, 0, sizeof *t);
 }
@@ -32,42 +35,68 @@ static const char *mem_name(const char *mime)
     return "embedded.png";
 }
 
-static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, lmb_texture *out, lmb_error *err)
+/* Reads texture tex's image as stored (8-bit values come back in [0, 1], still encoded). */
+static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, uint32_t *w, uint32_t *h,
+                              float **rgb, lmb_error *err)
 {
-    int32_t src = v->texture_source[tex];
+    int32_t src = v->textures[tex].source;
     if (src < 0 || (uint32_t)src >= v->image_count)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: texture %u has no usable image", s->path, tex);
     const lmb_gltf_image *img = &v->images[src];
-    float *rgb = NULL;
-    lmb_status st;
-    if (img->bytes) {
-        st = lmb_image_read_rgb(mem_name(img->mime), img->bytes, img->size, &out->width, &out->height, &rgb, err);
-    } else {
-        char path[8192];
-        const char *slash = strrchr(s->path, '/');
-        int dir = slash ? (int)(slash - s->path) : 1;
-        snprintf(path, sizeof path, "%.*s/%s", dir, slash ? s->path : ".", img->uri);
-        st = lmb_image_read_rgb(path, NULL, 0, &out->width, &out->height, &rgb, err);
-    }
+    if (img->bytes)
+        return lmb_image_read_rgb(mem_name(img->mime), img->bytes, img->size, w, h, rgb, err);
+    char path[8192];
+    const char *slash = strrchr(s->path, '/');
+    int dir = slash ? (int)(slash - s->path) : 1;
+    snprintf(path, sizeof path, "%.*s/%s", dir, slash ? s->path : ".", img->uri);
+    return lmb_image_read_rgb(path, NULL, 0, w, h, rgb, err);
+}
+
+static int wrap_mode(int32_t gl, const char *axis, const lmb_scene *s, uint32_t tex, const lmb_log *log)
+{
+    if (gl == LMB_WRAP_REPEAT || gl == LMB_WRAP_MIRRORED_REPEAT || gl == LMB_WRAP_CLAMP_TO_EDGE)
+        return gl;
+    lmb_warn(log, "%s: texture %u: sampler %s %d is not a glTF wrap mode; using REPEAT", s->path, tex, axis, gl);
+    return LMB_WRAP_REPEAT;
+}
+
+/* Makes texture tex available in `space` (decoding the image once per space). */
+static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, lmb_tex_space space,
+                           lmb_texture *out, const lmb_log *log, lmb_error *err)
+{
+    if (out->pixels[space])
+        return LMB_OK;
+    float *px = NULL;
+    uint32_t w, h;
+    lmb_status st = read_pixels(s, v, tex, &w, &h, &px, err);
     if (st != LMB_OK)
         return st;
-    size_t n = (size_t)out->width * out->height;
-    for (size_t i = 0; i < 3 * n; i++)
-        rgb[i] = srgb_to_linear(rgb[i]);
-    for (int c = 0; c < 3; c++) {
-        double sum = 0;
-        for (size_t i = 0; i < n; i++)
-            sum += rgb[3 * i + c];
-        out->mean[c] = n ? sum / (double)n : 0;
+    size_t n = (size_t)w * h;
+    if (space == LMB_TEX_COLOUR) {
+        for (size_t i = 0; i < 3 * n; i++)
+            px[i] = srgb_to_linear(px[i]);
+        for (int c = 0; c < 3; c++) {
+            double sum = 0;
+            for (size_t i = 0; i < n; i++)
+                sum += px[3 * i + c];
+            out->mean[c] = n ? sum / (double)n : 0;
+        }
     }
-    out->rgb = rgb;
+    out->width = w;
+    out->height = h;
+    out->pixels[space] = px;
+    const lmb_gltf_texture *gt = &v->textures[tex];
+    out->wrap_s = wrap_mode(gt->wrap_s, "wrapS", s, tex, log);
+    out->wrap_t = wrap_mode(gt->wrap_t, "wrapT", s, tex, log);
+    out->nearest = gt->mag_filter == LMB_FILTER_NEAREST;
     return LMB_OK;
 }
 
-/* Loads texture `tex` for `role` of material m once; a texture that cannot be read is a warning. */
-static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_material *m, int32_t tex, const char *role,
-                     lmb_textures *out, const lmb_log *log)
+/* Loads the texture of slot `ref` for `role` of material m; a texture that cannot be read is a warning. */
+static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_material *m, const lmb_texture_ref *ref,
+                     lmb_tex_space space, const char *role, lmb_textures *out, const lmb_log *log)
 {
+    int32_t tex = ref->texture;
     if (tex < 0)
         return;
     if ((uint32_t)tex >= v->texture_count) {
@@ -75,10 +104,8 @@ static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_mater
                  m->name, role, tex);
         return;
     }
-    if (out->t[tex].rgb)
-        return;
     lmb_error e;
-    if (load_one(s, v, (uint32_t)tex, &out->t[tex], &e) != LMB_OK)
+    if (load_one(s, v, (uint32_t)tex, space, &out->t[tex], log, &e) != LMB_OK)
         lmb_warn(log, "material '%s': %s texture not used: %s", m->name, role, e.message);
 }
 
@@ -90,32 +117,164 @@ lmb_status lmb_textures_load(const lmb_scene *s, lmb_textures *out, const lmb_lo
     out->t = calloc((size_t)v->texture_count + 1, sizeof *out->t);
     if (!out->t)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "textures: out of memory");
-    for (uint32_t m = 0; m < s->material_count; m++) {
-        const lmb_material *mat = &s->materials[m];
-        if (lmb_material_is_emissive(mat))
-            load_for(s, v, mat, mat->emissive_texture, "emissive", out, log);
-        if (mat->metallic < 1)
-            load_for(s, v, mat, mat->base_color_texture, "base colour", out, log);
+    for (uint32_t i = 0; i < s->material_count; i++) {
+        const lmb_material *m = &s->materials[i];
+        if (lmb_material_is_emissive(m))
+            load_for(s, v, m, &m->emissive_texture, LMB_TEX_COLOUR, "emissive", out, log);
+        if (m->unlit)
+            continue;
+        if (m->spec_gloss) {
+            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "diffuse", out, log);
+            load_for(s, v, m, &m->specular_texture, LMB_TEX_COLOUR, "specular-glossiness", out, log);
+            continue;
+        }
+        /* metalness = metallicFactor x texture blue <= metallicFactor: a texture can only lower it */
+        if (m->metallic < 1 || (m->metallic_texture.texture >= 0 && m->metallic > 0))
+            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "base colour", out, log);
+        if (m->metallic > 0)
+            load_for(s, v, m, &m->metallic_texture, LMB_TEX_DATA, "metallicRoughness", out, log);
     }
     return LMB_OK;
 }
 
-static const float *texel(const lmb_texture *t, long x, long y)
+const lmb_texture *lmb_textures_get(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space)
 {
-    long w = (long)t->width, h = (long)t->height;
-    x %= w;
-    y %= h;
-    x += x < 0 ? w : 0;
-    y += y < 0 ? h : 0;
-    return t->rgb + 3 * ((size_t)y * t->width + (size_t)x);
+    if (!tx || ref->texture < 0 || (uint32_t)ref->texture >= tx->count || !tx->t[ref->texture].pixels[space])
+        return NULL;
+    return &tx->t[ref->texture];
 }
 
-void lmb_texture_sample(const lmb_texture *t, double u, double v, float out[3])
+/* Texel index i of an axis of n texels under a wrap mode (glTF 2.0 section 3.8.4.3, as OpenGL). */
+static long wrap(long i, long n, int mode)
 {
-    double x = u * t->width - 0.5, y = v * t->height - 0.5;
+    if (mode == LMB_WRAP_CLAMP_TO_EDGE)
+        return i < 0 ? 0 : i >= n ? n - 1 : i;
+    if (mode == LMB_WRAP_MIRRORED_REPEAT) {
+        long m = i % (2 * n);
+        m += m < 0 ? 2 * n : 0;
+        return m < n ? m : 2 * n - 1 - m;
+    }
+    long m = i % n;
+    return m + (m < 0 ? n : 0);
+}
+
+static const float *texel(const lmb_texture *t, const float *px, long x, long y)
+{
+    x = wrap(x, (long)t->width, t->wrap_s);
+    y = wrap(y, (long)t->height, t->wrap_t);
+    return px + 3 * ((size_t)y * t->width + (size_t)x);
+}
+
+/* Texel coordinates beyond this are folded back by whole periods first (REPEAT and
+ * MIRRORED_REPEAT repeat every 2 texture sizes; CLAMP does not care), so a huge UV cannot
+ * overflow the integer texel index. */
+static double fold(double x, long n)
+{
+    double period = 2.0 * (double)n, limit = 1e9;
+    if (fabs(x) < limit)
+        return x;
+    return fmod(x, period);
+}
+
+void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3])
+{
+    const float *px = t->pixels[space];
+    double x = u * t->width, y = v * t->height;
+    if (!isfinite(x) || !isfinite(y)) /* a broken UV or transform reads texel (0, 0) */
+        x = y = 0;
+    if (t->wrap_s == LMB_WRAP_CLAMP_TO_EDGE)
+        x = fmax(-1.0, fmin(x, (double)t->width + 1.0));
+    else
+        x = fold(x, (long)t->width);
+    if (t->wrap_t == LMB_WRAP_CLAMP_TO_EDGE)
+        y = fmax(-1.0, fmin(y, (double)t->height + 1.0));
+    else
+        y = fold(y, (long)t->height);
+    if (t->nearest) {
+        const float *a = texel(t, px, (long)floor(x), (long)floor(y));
+        out[0] = a[0];
+        out[1] = a[1];
+        out[2] = a[2];
+        return;
+    }
+    x -= 0.5;
+    y -= 0.5;
     double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
     long x0 = (long)fx, y0 = (long)fy;
-    const float *a = texel(t, x0, y0), *b = texel(t, x0 + 1, y0), *c = texel(t, x0, y0 + 1), *d = texel(t, x0 + 1, y0 + 1);
+    const float *a = texel(t, px, x0, y0), *b = texel(t, px, x0 + 1, y0), *c = texel(t, px, x0, y0 + 1),
+                *d = texel(t, px, x0 + 1, y0 + 1);
     for (int k = 0; k < 3; k++)
         out[k] = (float)((1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]));
+}
+
+/*
+ * KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv, which gives
+ *   u' =  sx cos(r) u + sy sin(r) v + ox
+ *   v' = -sx sin(r) u + sy cos(r) v + oy
+ * The rotation turns the UVs counter-clockwise in UV space (u right, v down), as the
+ * extension's text says and its worked example shows (offset (0, 1), rotation pi/2, scale 0.5
+ * maps the unit square onto the image's lower-left quadrant, [0, 0.5] x [0.5, 1]); three.js,
+ * Babylon.js, Blender and the TextureTransformTest sample model agree. The GLSL listing in the
+ * extension, read as column-major GLSL, turns the other way (KhronosGroup/glTF issue #1563).
+ */
+void lmb_texture_transform_matrix(const double offset[2], double rotation, const double scale[2], double uv[6])
+{
+    double c = cos(rotation), s = sin(rotation);
+    uv[0] = scale[0] * c;
+    uv[1] = scale[1] * s;
+    uv[2] = offset[0];
+    uv[3] = -scale[0] * s;
+    uv[4] = scale[1] * c;
+    uv[5] = offset[1];
+}
+
+void lmb_texture_ref_apply(const lmb_texture_ref *ref, double u, double v, double *tu, double *tv)
+{
+    *tu = ref->uv[0] * u + ref->uv[1] * v + ref->uv[2];
+    *tv = ref->uv[3] * u + ref->uv[4] * v + ref->uv[5];
+}
+
+/* Looks slot ref up at barycentrics (b0, b1, b2) of triangle tri of pr; 0 when it cannot (out left as is). */
+static int sample_slot(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space,
+                       const lmb_primitive *pr, uint32_t tri, const double b[3], float out[3])
+{
+    const lmb_texture *t = lmb_textures_get(tx, ref, space);
+    const float *uv = ref->texcoord == 0 ? pr->uv0 : ref->texcoord == 1 ? pr->uv1 : NULL;
+    if (!t || !uv)
+        return 0;
+    const uint32_t *ix = pr->indices + 3 * (size_t)tri;
+    double u = 0, v = 0, tu, tv;
+    for (int k = 0; k < 3; k++) {
+        u += b[k] * uv[2 * ix[k]];
+        v += b[k] * uv[2 * ix[k] + 1];
+    }
+    lmb_texture_ref_apply(ref, u, v, &tu, &tv);
+    lmb_texture_sample(t, space, tu, tv, out);
+    return 1;
+}
+
+void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                         double b1, double b2, double albedo[3])
+{
+    double b[3] = {1.0 - b1 - b2, b1, b2};
+    albedo[0] = albedo[1] = albedo[2] = 0;
+    if (m->unlit)
+        return;
+    float base[3] = {1, 1, 1};
+    sample_slot(tx, &m->base_color_texture, LMB_TEX_COLOUR, pr, tri, b, base);
+    double keep; /* the share of base colour that is diffuse */
+    if (m->spec_gloss) {
+        float sp[3] = {1, 1, 1};
+        sample_slot(tx, &m->specular_texture, LMB_TEX_COLOUR, pr, tri, b, sp);
+        double mx = fmax(m->specular[0] * sp[0], fmax(m->specular[1] * sp[1], m->specular[2] * sp[2]));
+        keep = 1.0 - mx;
+    } else {
+        float mr[3] = {1, 1, 1};
+        if (m->metallic > 0)
+            sample_slot(tx, &m->metallic_texture, LMB_TEX_DATA, pr, tri, b, mr);
+        keep = 1.0 - m->metallic * mr[2];
+    }
+    keep = keep < 0 ? 0 : keep > 1 ? 1 : keep;
+    for (int k = 0; k < 3; k++)
+        albedo[k] = keep * m->base_color[k] * base[k];
 }

@@ -1,18 +1,36 @@
 /*
- * Material textures the baker needs (emissive for area lights, base colour for the albedo of bounces), decoded
- * once through the OpenImageIO adapter from the glTF's external files, buffer views or
- * data URIs, converted from sRGB to linear (glTF colour textures are sRGB), and sampled
- * bilinearly with repeat wrapping (glTF's default sampler; samplers are not read yet).
+ * Material textures the baker reads (emissive for area lights; base colour, metalness and
+ * spec-gloss diffuse/specular for the albedo of bounces), decoded once through the
+ * OpenImageIO adapter from the glTF's external files, buffer views or data URIs.
+ *   - Colour textures (base colour, emissive, spec-gloss diffuse and specular) are sRGB
+ *     encoded and converted to linear; data textures (metallicRoughness) are linear and kept
+ *     as stored (glTF 2.0 section 3.9.2 / 3.9.3; KHR_materials_pbrSpecularGlossiness).
+ *   - Lookups follow the texture's sampler: wrapS / wrapT (REPEAT, MIRRORED_REPEAT,
+ *     CLAMP_TO_EDGE; glTF 2.0 section 3.8.4), and magFilter NEAREST picks the nearest texel
+ *     (otherwise bilinear). Minification filters and mipmaps do not apply: the baker looks a
+ *     texture up at points, not over a pixel's footprint.
+ *   - KHR_texture_transform is an affine map of the UVs before the lookup (lmb_texture_ref.uv).
  */
 #ifndef LMBAKE_TEXTURES_H
 #define LMBAKE_TEXTURES_H
 
 #include <lmbake/lmbake.h>
 
+typedef enum lmb_tex_space {
+    LMB_TEX_COLOUR = 0, /* sRGB-encoded colour, decoded to linear */
+    LMB_TEX_DATA = 1    /* linear data, as stored */
+} lmb_tex_space;
+
+/* glTF sampler wrap modes (GL enums) and the NEAREST magnification filter. */
+enum { LMB_WRAP_REPEAT = 10497, LMB_WRAP_MIRRORED_REPEAT = 33648, LMB_WRAP_CLAMP_TO_EDGE = 33071 };
+enum { LMB_FILTER_NEAREST = 9728 };
+
 typedef struct lmb_texture {
     uint32_t width, height;
-    float *rgb;     /* linear, rows top to bottom; NULL when not loaded */
-    double mean[3]; /* average texel, for importance */
+    float *pixels[2]; /* per lmb_tex_space: RGB, rows top to bottom; NULL when not loaded in that space */
+    double mean[3];   /* average colour texel, for importance */
+    int wrap_s, wrap_t; /* LMB_WRAP_* */
+    int nearest;        /* magFilter NEAREST: nearest texel; else bilinear */
 } lmb_texture;
 
 typedef struct lmb_textures {
@@ -20,14 +38,35 @@ typedef struct lmb_textures {
     lmb_texture *t; /* indexed like the glTF's textures */
 } lmb_textures;
 
-/* Loads every texture a material of scene uses as its emissive texture (when it emits) or its
- * base colour texture (when it reflects diffusely: metallic < 1). A texture that cannot be
- * read is a warning (the material then uses its factor alone). */
+/* Loads every texture the baker will read: a material's emissive texture when it emits, and,
+ * when it reflects diffusely, its base colour (or spec-gloss diffuse) texture, its
+ * metallicRoughness texture (when metallicFactor > 0) or its specularGlossiness texture. A
+ * texture that cannot be read is a warning (the material then uses its factor alone). */
 lmb_status lmb_textures_load(const lmb_scene *scene, lmb_textures *out, const lmb_log *log, lmb_error *err);
 
-/* Bilinear lookup at glTF UV (u, v), (0, 0) = the image's top-left corner. */
-void lmb_texture_sample(const lmb_texture *t, double u, double v, float out[3]);
-
 void lmb_textures_free(lmb_textures *t);
+
+/* The texture a slot reads, if it was loaded in `space`; else NULL. */
+const lmb_texture *lmb_textures_get(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space);
+
+/* Lookup at glTF UV (u, v) ((0, 0) = the image's top-left corner, (1, 1) its bottom-right),
+ * with the texture's wrap modes and filter, in `space` (which must be loaded). */
+void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3]);
+
+/* KHR_texture_transform's matrix T(offset) x R(rotation) x S(scale) as the 2 x 3 affine map
+ * of lmb_texture_ref.uv (see textures.c for the rotation's direction). */
+void lmb_texture_transform_matrix(const double offset[2], double rotation, const double scale[2], double uv[6]);
+
+/* Applies ref's UV map to (u, v). */
+void lmb_texture_ref_apply(const lmb_texture_ref *ref, double u, double v, double *tu, double *tv);
+
+/* The diffuse albedo (linear RGB, what a viewer multiplies the lightmap by, times pi) of
+ * material m on primitive pr at barycentrics (b1, b2) of triangle tri:
+ *   metal-rough:  baseColorFactor x baseColorTexture x (1 - metallicFactor x metallicTexture.b)
+ *   spec-gloss:   diffuseFactor x diffuseTexture x (1 - max(specularFactor x specularTexture.rgb))
+ *   unlit:        0 (its colour does not depend on light; it reflects none)
+ * A texture that is missing, not loaded or whose TEXCOORD set the primitive lacks counts as 1. */
+void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                         double b1, double b2, double albedo[3]);
 
 #endif

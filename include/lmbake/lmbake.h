@@ -110,16 +110,30 @@ typedef struct lmb_instance {
     int extras_lightmap;   /* node extras flag: -1 absent, 0 false, 1 true */
 } lmb_instance;
 
+/* A material's texture slot: which glTF texture, read through which TEXCOORD_n set, and the
+ * KHR_texture_transform affine map applied to that set's UVs before the lookup. */
+typedef struct lmb_texture_ref {
+    int32_t texture;  /* glTF texture index, -1: none */
+    int32_t texcoord; /* TEXCOORD_n (KHR_texture_transform's texCoord when it gives one) */
+    double uv[6];     /* u' = uv[0] u + uv[1] v + uv[2], v' = uv[3] u + uv[4] v + uv[5]; identity without a transform */
+} lmb_texture_ref;
+
+/* What the baker reads of a glTF material. A KHR_materials_pbrSpecularGlossiness material is
+ * mapped onto the same fields: base_color = diffuseFactor, base_color_texture = diffuseTexture,
+ * metallic = 0, and its specular part in spec_gloss / specular / specular_texture. */
 typedef struct lmb_material {
     char *name;
-    float base_color[4];        /* linear RGBA factor */
-    int32_t base_color_texture; /* glTF texture index or -1 */
-    int32_t base_color_texcoord;
-    float metallic;
-    float emissive[3];          /* emissiveFactor x KHR_materials_emissive_strength */
-    float emissive_strength;    /* the strength alone (1 if absent) */
-    int32_t emissive_texture;   /* glTF texture index or -1 */
-    int32_t emissive_texcoord;
+    float base_color[4];                /* linear RGBA factor (spec-gloss: diffuseFactor) */
+    lmb_texture_ref base_color_texture; /* sRGB (spec-gloss: diffuseTexture) */
+    float metallic;                     /* metallicFactor (spec-gloss: 0) */
+    lmb_texture_ref metallic_texture;   /* metallicRoughnessTexture: metalness in blue, linear */
+    int spec_gloss;                     /* KHR_materials_pbrSpecularGlossiness */
+    float specular[3];                  /* its specularFactor */
+    lmb_texture_ref specular_texture;   /* its specularGlossinessTexture: specular in RGB, sRGB */
+    int unlit;                          /* KHR_materials_unlit: reflects no light in the bake */
+    float emissive[3];                  /* emissiveFactor x KHR_materials_emissive_strength */
+    float emissive_strength;            /* the strength alone (1 if absent) */
+    lmb_texture_ref emissive_texture;   /* sRGB */
     int double_sided;
 } lmb_material;
 

@@ -3,7 +3,7 @@
 EXR lightmaps with the formulas of ../shared/DESIGN.md section 3.
 
 usage: check_analytic.py LMBAKE WORKDIR CASE
-  CASE: point-plane | many-lights | sun-box | disk | disk-textured | sealed-room | box-floor
+  CASE: point-plane | many-lights | sun-box | disk | disk-textured | disk-transform | sealed-room | box-floor
 
 For each texel the expected value is computed at the same points the baker uses: the
 stratum centres of the texel (samples.texel), each clamped onto the closest triangle of
@@ -29,7 +29,9 @@ bounces: 0        # direct light only: the formulas are direct irradiance
 samples:
   texel: %d
   direct: %d
-""" % (SAMPLES, 256)
+"""
+# area-light samples per point: 256, more where a third of the emitter is black (per-texel bounds)
+DIRECT = {"disk-transform": 1024}
 
 
 def bake(lmbake, work, case):
@@ -37,7 +39,7 @@ def bake(lmbake, work, case):
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True)
     cfg = os.path.join(work, "analytic.yaml")
     with open(cfg, "w") as f:
-        f.write(CONFIG)
+        f.write(CONFIG % (SAMPLES, DIRECT.get(case, 256)))
     out = os.path.join(work, "out-" + case)
     p = subprocess.run([lmbake, "bake", os.path.join(scenes, case + ".gltf"), "-c", cfg, "-o", out, "-q",
                         "--threads", "2"], capture_output=True, text=True)
@@ -265,6 +267,80 @@ def disk_textured(charts, images):
     return disk(charts, images, L=10.0 * ((srgb + 0.055) / 1.055) ** 2.4)
 
 
+def polygon_e(L, poly, p):
+    """Irradiance at p (normal +y) from a uniform polygon emitter of radiance L seen from its
+    front: Lambert's formula, E = L/2 sum_i angle(r_i, r_i+1) (n . unit(r_i x r_i+1)), exact."""
+    r = [np.subtract(v, p) for v in poly]
+    total = 0.0
+    for i in range(len(r)):
+        a, b = r[i], r[(i + 1) % len(r)]
+        c = np.cross(a, b)
+        ln = np.linalg.norm(c)
+        if ln > 0:
+            ang = math.atan2(ln, float(np.dot(a, b)))
+            total += ang * c[1] / ln
+    return abs(L / 2 * total)
+
+
+def clip(poly, keep):
+    """Sutherland-Hodgman: the part of convex polygon poly where keep(v) = a . (x, z) + b >= 0."""
+    out = []
+    for i in range(len(poly)):
+        a, b = poly[i], poly[(i + 1) % len(poly)]
+        fa, fb = keep(a), keep(b)
+        if fa >= 0:
+            out.append(a)
+        if (fa >= 0) != (fb >= 0):
+            t = fa / (fa - fb)
+            out.append(tuple(a[c] + t * (b[c] - a[c]) for c in range(3)))
+    return out
+
+
+def disk_transform(charts, images):
+    """The 64-gon emitter lit only where KHR_texture_transform maps TEXCOORD_1 = (x, z) onto the
+    white texel: u' = sx cos(r) x + sy sin(r) z + ox >= 0.5 (counter-clockwise in UV space, the
+    extension's convention; textures.c). Every floor texel within 1.5 m of the axis is compared
+    with the exact polygon irradiance at its points: the mean ratio within 1%, 95% of texels
+    within 6% (1024 area-light samples per point, a third landing on the black part). The
+    rotation's sign flipped (how the extension's GLSL listing reads) and no transform at all
+    (TEXCOORD_1 read as is: u = x >= 0.5) must each move over 20% of those texels by more than
+    6%, so the test tells them apart."""
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    from make_scenes import DISK_TRANSFORM as T
+    L, n, R, h = 10.0, 64, 0.5, 1.0
+    ring = [(R * math.cos(2 * math.pi * k / n), h, R * math.sin(2 * math.pi * k / n)) for k in range(n)]
+    c, sn = math.cos(T["rotation"]), math.sin(T["rotation"])
+    sx, sy, ox = T["scale"][0], T["scale"][1], T["offset"][0]
+    lit = {"spec": clip(ring, lambda v: sx * c * v[0] + sy * sn * v[2] + ox - 0.5),
+           "flipped": clip(ring, lambda v: sx * c * v[0] - sy * sn * v[2] + ox - 0.5),
+           "none": clip(ring, lambda v: v[0] - 0.5)}
+    full = polygon_e(L, ring, (0, 0, 0))
+    ratios, others = [], {"flipped": [], "none": []}
+    for node, v, pts, x, y, _ in texels(charts, images):
+        if node != "plane" or any(math.hypot(q[0], q[2]) > 1.5 for q in pts):
+            continue
+        want = np.mean([polygon_e(L, lit["spec"], q) for q in pts])
+        ratios.append(float(v[0]) / want)
+        for k in others:
+            others[k].append(np.mean([polygon_e(L, lit[k], q) for q in pts]) / want)
+    r = np.array(ratios)
+    mean, worst, within = float(np.mean(r)), float(np.max(np.abs(r - 1))), float(np.mean(np.abs(r - 1) <= 0.06))
+    # how many texels a wrong convention would move by more than the 6% tolerance
+    off = {k: float(np.mean(np.abs(np.array(o) - 1) > 0.06)) for k, o in others.items()}
+    print("disk-transform: %d floor texels within 1.5 m of the axis; E / exact polygon irradiance of the lit part "
+          "(%.1f%% of the 64-gon's area): mean %.4f (bound 1 +- 1%%), worst %.2f%%, %.1f%% of texels within 6%% "
+          "(bound 95%%); full 64-gon at the centre %.4f lux vs disk formula %.4f. Texels whose value a wrong "
+          "convention moves by more than 6%%: rotation sign flipped %.0f%%, no transform %.0f%% (both must exceed "
+          "20%%)" % (len(r), 100 * polygon_area(lit["spec"]) / polygon_area(ring), mean, 100 * worst, 100 * within,
+                     full, disk_e(L, R, h, 0.0), 100 * off["flipped"], 100 * off["none"]))
+    return (len(r) > 300 and abs(mean - 1) <= 0.01 and within >= 0.95 and off["flipped"] > 0.2
+            and off["none"] > 0.2)
+
+
+def polygon_area(poly):
+    return 0.5 * abs(sum(a[0] * b[2] - b[0] * a[2] for a, b in zip(poly, poly[1:] + poly[:1])))
+
+
 def sealed_room(charts, images):
     m = max(float(np.max(img)) for img in images.values())
     n = sum(1 for _ in texels(charts, images))
@@ -301,7 +377,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     out = bake(lmbake, work, case)
     charts, images = load_output(out)
-    check = {"point-plane": point_plane, "many-lights": many_lights, "sun-box": sun_box, "disk": disk, "disk-textured": disk_textured, "sealed-room": sealed_room,
+    check = {"point-plane": point_plane, "many-lights": many_lights, "sun-box": sun_box, "disk": disk, "disk-textured": disk_textured, "disk-transform": disk_transform, "sealed-room": sealed_room,
              "box-floor": box_floor}[case]
     return 0 if check(charts, images) else 1
 

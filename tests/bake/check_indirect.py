@@ -11,6 +11,14 @@ usage: check_indirect.py LMBAKE WORKDIR CHECK
                with bounces: auto the mean is within 1% of pi Le / (1 - rho) = 15.708; with
                bounces: 2 it is pi Le (1 + rho + rho^2) = 7.665 (the gap auto closes: the check
                fails if auto stops early or leaves the tail out); the log names the passes run.
+  materials    furnace boxes (tools/make_scenes.py FURNACE_MATERIALS) whose albedo rho comes from
+               KHR_materials_pbrSpecularGlossiness (diffuse 0.625 x (1 - specular 0.2) = 0.5, over a
+               metal-rough fallback that would bounce nothing), metallicFactor 1 x a metallicRoughness
+               texture's blue channel of 0 (through KHR_texture_transform and CLAMP_TO_EDGE), 128
+               (linear: rho = 0.5 x (1 - 128/255) = 0.249; sRGB-decoded it would be 0.392) and 255
+               (no bounce: E = pi Le), and a base colour texture read through a transform and
+               MIRRORED_REPEAT (sRGB 188 = 0.5029). k = 2: the mean over texels is within 1% of
+               pi Le (1 + rho + rho^2), 98% of texels within 6%.
   identity     AMIS with one iteration and classic gathering: byte-identical EXR for the same seed.
   determinism  AMIS bake at --threads 1 and --threads 2: byte-identical EXR.
   unbiased     bright-spot Cornell box (point light 3 cm under the ceiling), one bounce, 1024 rays:
@@ -106,6 +114,23 @@ def furnace_auto(lmbake, work):
         if bounces == "auto" and not (log and "geometric tail" in log[0]):
             print("  FAIL: the log does not say what the passes added and the tail")
             ok = False
+def materials(lmbake, work):
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    from make_scenes import FURNACE_MATERIALS
+    d = scenes(work)
+    ok = True
+    cfg = "texel_density: 8\nbounces: 2\nsamples: {direct: 64, gather: 256, bounce: 256}\n"
+    for name, rho in FURNACE_MATERIALS.items():
+        e = read(bake(lmbake, work, os.path.join(d, "furnace-%s.gltf" % name), name, cfg))[..., 0]
+        v = e[e > 0]
+        expected = math.pi * (1 + rho + rho * rho)
+        mean = v.mean() / expected
+        within = np.mean(np.abs(v / expected - 1) <= 0.06)
+        good = abs(mean - 1) <= 0.01 and within >= 0.98
+        ok &= good
+        print("furnace-%-17s rho %.4f: %d texels, mean E %.5f = %.4f x pi Le (1 + rho + rho^2) = %.5f; %.1f%% of "
+              "texels within 6%%  %s" % (name, rho, v.size, v.mean(), mean, expected, 100 * within,
+                                          "ok" if good else "FAIL"))
     return ok
 
 
@@ -171,7 +196,8 @@ def unbiased(lmbake, work):
 def main():
     lmbake, work, check = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
-    ok = {"furnace": furnace, "furnace_auto": furnace_auto, "identity": identity, "determinism": determinism, "unbiased": unbiased}[check](lmbake, work)
+    ok = {"furnace": furnace, "furnace_auto": furnace_auto, "materials": materials, "identity": identity,
+          "determinism": determinism, "unbiased": unbiased}[check](lmbake, work)
     sys.exit(0 if ok else 1)
 
 

@@ -12,6 +12,7 @@ import math
 import os
 import struct
 import sys
+import zlib
 
 
 def base_doc(positions, indices, normals=None):
@@ -53,6 +54,14 @@ def base_doc(positions, indices, normals=None):
 
 
 QUAD = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]
+
+
+def grey_png(value=128):
+    """A 1 x 1 8-bit grey PNG."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 1, 1, 8, 0, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(bytes([0, value]))) + chunk(b"IEND", b""))
 QUAD_IDX = [0, 2, 1, 0, 3, 2]
 
 
@@ -110,6 +119,40 @@ def cases():
 
     # not JSON at all
     yield "not-json", "{ this is not json"
+
+    # required extensions (README "What load accepts"): ones that change only what a diffuse
+    # bake ignores load with a warning naming them; geometry compression stays an error
+    d = copy.deepcopy(ok)
+    d["materials"] = [{"name": "Velvet", "pbrMetallicRoughness": {"metallicFactor": 0},
+                       "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [1, 0.3, 0.1]},
+                                      "KHR_materials_clearcoat": {"clearcoatFactor": 1}}}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "KHR_materials_clearcoat"]
+    yield "required-sheen", d
+    d = copy.deepcopy(d)
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "EXT_meshopt_compression"]
+    yield "required-sheen-meshopt", d
+
+    # KHR_texture_basisu required: the base colour texture has only a KTX2 image (error), or
+    # also a PNG fallback `source` (loads with a warning). The KTX2 bytes are never decoded.
+    d = copy.deepcopy(ok)
+    blob = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
+    ktx = b"\xabKTX 20\xbb\r\n\x1a\n" + b"\0" * 8
+    d["bufferViews"].append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(ktx)})
+    blob += ktx
+    d["buffers"][0] = {"byteLength": len(blob),
+                       "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}
+    d["images"] = [{"bufferView": len(d["bufferViews"]) - 1, "mimeType": "image/ktx2"}]
+    d["textures"] = [{"extensions": {"KHR_texture_basisu": {"source": 0}}}]
+    d["materials"] = [{"name": "Wood", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_texture_basisu"]
+    yield "required-basisu-no-fallback", d
+    d = copy.deepcopy(d)
+    png = grey_png()
+    d["images"].append({"uri": "data:image/png;base64," + base64.b64encode(png).decode(), "mimeType": "image/png"})
+    d["textures"][0]["source"] = 1
+    yield "required-basisu-fallback", d
 
 
 def main():

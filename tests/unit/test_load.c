@@ -1,15 +1,18 @@
 /*
  * Load-stage tests on real glTF files (assets/scenes, from ../shared/assets with their
  * licenses): node transforms, mirrored instances, sparse accessors, strip/fan winding,
- * GPU instancing, lights and emissive strength, lightmap selection by glob and extras.
+ * GPU instancing, lights and emissive strength, lightmap selection by glob and extras,
+ * KHR_texture_transform and metalness textures on a real Blender export.
  * usage: test_load SCENES_DIR
  */
 #include "check.h"
 
 #include <lmbake/lmbake.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 static const char *scenes;
 
@@ -230,6 +233,46 @@ static void test_selection(void)
     lmb_scene_free(s);
 }
 
+static const lmb_material *material_named(const lmb_scene *s, const char *name)
+{
+    for (uint32_t i = 0; i < s->material_count; i++)
+        if (!strcmp(s->materials[i].name, name))
+            return &s->materials[i];
+    fprintf(stderr, "no material '%s'\n", name);
+    check_failed_count++;
+    return NULL;
+}
+
+/* bevy's MixedLightingExample (a Blender export): the wood's base colour and metallicRoughness
+ * textures carry KHR_texture_transform (offset, rotation 5 degrees, scale 3): the slot's UV map
+ * is T x R x S; metallicFactor is the default 1 with the metalness texture beside it. */
+static void test_texture_transform(void)
+{
+    lmb_scene *s = load("mixed-lighting-bevy/MixedLightingExample.gltf", NULL);
+    if (!s)
+        return;
+    const lmb_material *wood = material_named(s, "wood Brown"), *fabric = material_named(s, "fabric Mystere Mango Velvet");
+    if (wood && fabric) {
+        const double r = 0.0872664675116539, ox = -0.8635583765172254, oy = 1.125025697811076;
+        const double want[6] = {3 * cos(r), 3 * sin(r), ox, -3 * sin(r), 3 * cos(r), oy};
+        CHECK_INT(wood->base_color_texture.texture, 9);
+        CHECK_INT(wood->base_color_texture.texcoord, 0);
+        CHECK_INT(wood->metallic_texture.texture, 8);
+        CHECK_NEAR(wood->metallic, 1.0, 0);
+        CHECK_INT(wood->spec_gloss, 0);
+        for (int k = 0; k < 6; k++) {
+            CHECK_NEAR(wood->base_color_texture.uv[k], want[k], 1e-12);
+            CHECK_NEAR(wood->metallic_texture.uv[k], want[k], 1e-12);
+        }
+        const double identity[6] = {1, 0, 0, 0, 1, 0};
+        CHECK_INT(fabric->base_color_texture.texture, 1);
+        for (int k = 0; k < 6; k++)
+            CHECK_NEAR(fabric->base_color_texture.uv[k], identity[k], 0);
+        CHECK_INT(fabric->metallic_texture.texture, -1);
+    }
+    lmb_scene_free(s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -247,5 +290,6 @@ int main(int argc, char **argv)
     test_lights();
     test_emissive_strength();
     test_selection();
+    test_texture_transform();
     return check_failures();
 }

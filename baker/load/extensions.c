@@ -1,0 +1,54 @@
+/*
+ * The extension table. The rule: lmbake bakes diffuse irradiance, so an extension that only
+ * changes specular reflection, layers on top of the base (sheen, clear coat), refraction,
+ * animation or metadata changes nothing the bake reads, and a file requiring it is baked with
+ * a warning naming the file and the extension. One that changes geometry (Draco, meshopt),
+ * the diffuse colour in a way lmbake does not model (KHR_materials_diffuse_transmission) or the
+ * light (EXT_lights_image_based) is not listed: requiring it is an error.
+ * Choices worth knowing:
+ *   - KHR_materials_unlit: an unlit surface shows its base colour whatever the light, so it
+ *     reflects none in the bake (albedo 0: no invented bounce off a backdrop or sky dome); it
+ *     still blocks light and still emits its emissiveFactor, if any.
+ *   - KHR_materials_transmission / volume: baked as opaque (they block light and reflect their
+ *     diffuse colour); light through glass is not baked.
+ *   - KHR_materials_variants: the primitive's default material is baked.
+ */
+#include "extensions.h"
+
+#include <string.h>
+
+static const lmb_extension_info table[] = {
+    {"KHR_lights_punctual", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_materials_emissive_strength", LMB_EXT_SUPPORTED, NULL},
+    {"EXT_mesh_gpu_instancing", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_mesh_quantization", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_texture_transform", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_materials_pbrSpecularGlossiness", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_materials_sheen", LMB_EXT_IGNORED, "the sheen layer is not baked; the base colour is the albedo"},
+    {"KHR_materials_clearcoat", LMB_EXT_IGNORED, "the clear coat is not baked; the base colour is the albedo"},
+    {"KHR_materials_specular", LMB_EXT_IGNORED, "it changes specular reflection only, which a diffuse bake ignores"},
+    {"KHR_materials_ior", LMB_EXT_IGNORED, "it changes specular reflection only, which a diffuse bake ignores"},
+    {"KHR_materials_iridescence", LMB_EXT_IGNORED, "it changes specular reflection only, which a diffuse bake ignores"},
+    {"KHR_materials_anisotropy", LMB_EXT_IGNORED, "it changes specular reflection only, which a diffuse bake ignores"},
+    {"KHR_materials_dispersion", LMB_EXT_IGNORED, "it changes refraction only, which a diffuse bake ignores"},
+    {"KHR_materials_transmission", LMB_EXT_IGNORED,
+     "transmissive surfaces are baked as opaque (they block light and reflect their base colour)"},
+    {"KHR_materials_volume", LMB_EXT_IGNORED, "volumes are baked as opaque surfaces"},
+    {"KHR_materials_variants", LMB_EXT_IGNORED, "each primitive is baked with its default material, not the variants"},
+    {"KHR_materials_unlit", LMB_EXT_IGNORED,
+     "unlit materials reflect no light in the bake (their colour does not depend on light) but still block it"},
+    {"KHR_animation_pointer", LMB_EXT_IGNORED, "animations are not baked; the static values are"},
+    {"KHR_xmp_json_ld", LMB_EXT_IGNORED, "metadata only"},
+    {"KHR_texture_basisu", LMB_EXT_IMAGE, "KTX2 images are not decoded; textures use their fallback image"},
+    {"EXT_texture_webp", LMB_EXT_IMAGE, "textures use their fallback (PNG or JPEG) image"},
+    {"EXT_texture_avif", LMB_EXT_IMAGE, "textures use their fallback (PNG or JPEG) image"},
+    {"MSFT_texture_dds", LMB_EXT_IMAGE, "textures use their fallback (PNG or JPEG) image"},
+};
+
+const lmb_extension_info *lmb_extension_find(const char *name)
+{
+    for (size_t i = 0; i < sizeof table / sizeof *table; i++)
+        if (!strcmp(table[i].name, name))
+            return &table[i];
+    return NULL;
+}
