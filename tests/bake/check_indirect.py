@@ -114,6 +114,7 @@ def furnace_auto(lmbake, work):
         if bounces == "auto" and not (log and "geometric tail" in log[0]):
             print("  FAIL: the log does not say what the passes added and the tail")
             ok = False
+    return ok
 def materials(lmbake, work):
     sys.path.insert(0, os.path.join(ROOT, "tools"))
     from make_scenes import FURNACE_MATERIALS
