@@ -162,6 +162,79 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
     return st;
 }
 
+/* Progress of one band's direct light, reported as a share of the whole atlas's rows. */
+typedef struct band_progress {
+    lmb_progress_fn fn;
+    void *user;
+    uint64_t row0, rows, height;
+} band_progress;
+
+static void band_progress_update(void *user, const char *stage, uint64_t done, uint64_t total)
+{
+    const band_progress *b = user;
+    uint64_t scale = 1024;
+    b->fn(b->user, stage, b->row0 * scale + (total ? done * b->rows * scale / total : 0), b->height * scale);
+}
+
+/*
+ * Gather points and direct light of atlas a, band of rows by band (memory, issue 10): a
+ * band's sub-sampled points (samples.texel per texel, 56 bytes each) live only while its
+ * direct light is computed; the atlas keeps one point per texel, where indirect light is
+ * gathered, and its direct light. Results are the same as one pass over the atlas: random
+ * streams are keyed by (atlas, texel), not by band.
+ */
+static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direct, const lmb_cache *cache, uint32_t a,
+                                  atlas_work *w, lmb_progress_fn progress, void *user, uint64_t *rays, lmb_error *err)
+{
+    uint32_t width = cache->layout->width[a], height = cache->layout->height[a];
+    uint32_t rows = width ? (65536 + width - 1) / width : height; /* ~64k texels per band */
+    lmb_status st = LMB_OK;
+    size_t cap = 0;
+    for (uint32_t y0 = 0; y0 < height && st == LMB_OK; y0 += rows) {
+        uint32_t y1 = y0 + rows < height ? y0 + rows : height;
+        lmb_texels band;
+        st = lmb_texels_build_rows(cache->scene, cache->layout, a, cfg->texel_samples, y0, y1, &band, err);
+        float *e = st == LMB_OK ? calloc(3 * (size_t)band.count + 1, sizeof *e) : NULL;
+        if (st == LMB_OK && !e)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+        band_progress bp = {progress, user, y0, y1 - y0, height};
+        lmb_direct_job job = {direct, a, progress ? band_progress_update : NULL, &bp};
+        if (st == LMB_OK)
+            st = lmb_direct_compute(&job, &band, e, rays, err);
+        if (st == LMB_OK && w->t.count + (size_t)band.count > cap) {
+            cap = (w->t.count + (size_t)band.count) * 3 / 2;
+            float *d = realloc(w->direct, (3 * cap + 1) * sizeof *d);
+            if (!d)
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+            else
+                w->direct = d;
+        }
+        if (st == LMB_OK) {
+            memcpy(w->direct + 3 * (size_t)w->t.count, e, 3 * (size_t)band.count * sizeof *e);
+            st = lmb_texels_append(&w->t, &band, err);
+        }
+        free(e);
+        lmb_texels_free(&band);
+    }
+    if (st == LMB_OK && !w->t.texel) { /* an atlas without texels: empty arrays, not NULL */
+        lmb_texels empty;
+        memset(&empty, 0, sizeof empty);
+        empty.width = width;
+        empty.height = height;
+        empty.samples = 1;
+        st = lmb_texels_append(&w->t, &empty, err);
+    }
+    if (st == LMB_OK) {
+        lmb_texels_trim(&w->t);
+        float *d = realloc(w->direct, (3 * (size_t)w->t.count + 1) * sizeof *d);
+        if (d)
+            w->direct = d;
+        else if (!w->direct)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+    }
+    return st;
+}
+
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
                              lmb_progress_fn progress, void *user, lmb_bake_stats *stats, lmb_error *err)
 {
@@ -173,17 +246,14 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     uint64_t total = 0;
     /* gather points and direct light, atlas by atlas */
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        st = lmb_texels_build(cache->scene, cache->layout, a, cfg->texel_samples, &w[a].t, err);
+        st = direct_by_bands(cfg, direct, cache, a, &w[a], progress, user, &stats->rays, err);
         if (st != LMB_OK)
             break;
-        w[a].direct = calloc(3 * (size_t)w[a].t.count + 1, sizeof *w[a].direct);
         w[a].result = calloc(3 * (size_t)w[a].t.count + 1, sizeof *w[a].result);
-        if (!w[a].direct || !w[a].result) {
+        if (!w[a].result) {
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
             break;
         }
-        lmb_direct_job job = {direct, a, progress, user};
-        st = lmb_direct_compute(&job, &w[a].t, w[a].direct, &stats->rays, err);
         for (uint32_t i = 0; i < w[a].t.count; i++) {
             stats->texels++;
             stats->valid_texels += w[a].t.valid[i];

@@ -2,7 +2,9 @@
 """Generates level-sized test scenes for the unwrap/pack benchmark and the real-level tests
 (issue 10), as binary glTF (.glb). Deterministic: the same arguments give the same bytes.
 
-usage: make_levels.py OUTDIR [single|instances|furnace|all] ...
+usage: make_levels.py OUTDIR [single|instances|furnace|all|single:ROOMS|instances:COUNT] ...
+  (single:ROOMS: ROOMS x ROOMS rooms, level-single-ROOMS.glb; instances:COUNT: COUNT props,
+   level-instances-COUNT.glb; the benchmark's size series)
 
   level-single.glb     one mesh, ~60k triangles, 10 x 10 rooms of 24 units (240 units
                        across): tiled floors, walls with door gaps, pillars, stairs, rows of
@@ -209,26 +211,26 @@ def sun_rotation():
             w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2, w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2]
 
 
-def level_single(path):
+def level_single(path, rooms=10):
     rng = np.random.default_rng(1)
     m = Mesh()
-    for i in range(10):
-        for j in range(10):
+    for i in range(rooms):
+        for j in range(rooms):
             room(m, i * 24.0, j * 24.0, rng)
     g = Glb()
     mat = g.material("Concrete", 0.6)
     g.node({"name": "Level", "mesh": g.mesh("Level", m, mat)})
     lights = [{"type": "directional", "intensity": 3.0, "name": "Sun"}]
     places = [(0, {"name": "Sun", "rotation": sun_rotation()})]
-    for j in range(10):
+    for j in range(rooms):
         lights.append({"type": "point", "intensity": 500.0, "name": "Lamp %d" % j})
-        places.append((len(lights) - 1, {"name": "Lamp %d" % j, "translation": [120.0, 3.5, j * 24.0 + 12.0]}))
+        places.append((len(lights) - 1, {"name": "Lamp %d" % j, "translation": [rooms * 12.0, 3.5, j * 24.0 + 12.0]}))
     g.lights(lights, places)
     g.write(path)
     return m.triangles()
 
 
-def level_instances(path):
+def level_instances(path, count=2000):
     rng = np.random.default_rng(2)
     g = Glb()
     mat = g.material("Stone", 0.5)
@@ -257,7 +259,7 @@ def level_instances(path):
     total = ground.triangles()
     # weights so that 2,000 instances hold about 1M triangles
     order = rng.integers(0, 40, 2000)
-    for n in range(2000):
+    for n in range(count):
         k = int(order[n])
         i, j = divmod(n, 45)
         ang = rng.uniform(0, 2 * math.pi)
@@ -293,6 +295,12 @@ def main():
     for key, (name, fn) in jobs.items():
         if "all" in which or key in which:
             n = fn(os.path.join(out, name))
+            print("%s: %d triangles" % (os.path.join(out, name), n))
+    for w in which:
+        if ":" in w:
+            key, size = w.split(":")
+            name = "level-%s-%s.glb" % (key, size)
+            n = jobs[key][1](os.path.join(out, name), int(size))
             print("%s: %d triangles" % (os.path.join(out, name), n))
 
 

@@ -26,6 +26,67 @@ void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2])
     out[1] = ((k / sx) + 0.5) / sy;
 }
 
+static void copy_band(lmb_texels *dst, const lmb_texels *band);
+
+lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err)
+{
+    uint32_t n = dst->count + band->count;
+    if (n <= dst->capacity && dst->texel) {
+        copy_band(dst, band);
+        return LMB_OK;
+    }
+    size_t cap = (size_t)dst->capacity * 3 / 2 > n ? (size_t)dst->capacity * 3 / 2 : n; /* geometric growth */
+    cap = cap > UINT32_MAX ? UINT32_MAX : cap;
+    n = (uint32_t)cap;
+    uint32_t *texel = realloc(dst->texel, ((size_t)n + 1) * sizeof *texel);
+    if (texel) dst->texel = texel;
+    uint8_t *points_in = realloc(dst->points_in, (size_t)n + 1);
+    if (points_in) dst->points_in = points_in;
+    float *size = realloc(dst->texel_size, ((size_t)n + 1) * sizeof *size);
+    if (size) dst->texel_size = size;
+    lmb_gather_point *points = realloc(dst->points, ((size_t)n + 1) * sizeof *points);
+    if (points) dst->points = points;
+    uint8_t *valid = realloc(dst->valid, (size_t)n + 1);
+    if (valid) dst->valid = valid;
+    uint8_t *gather_at = realloc(dst->gather_at, (size_t)n + 1);
+    if (gather_at) dst->gather_at = gather_at;
+    if (!texel || !points_in || !size || !points || !valid || !gather_at)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", n);
+    dst->capacity = n;
+    copy_band(dst, band);
+    return LMB_OK;
+}
+
+void lmb_texels_trim(lmb_texels *t)
+{
+    size_t n = (size_t)t->count + 1;
+    void *p;
+    if ((p = realloc(t->texel, n * sizeof *t->texel))) t->texel = p;
+    if ((p = realloc(t->points_in, n))) t->points_in = p;
+    if ((p = realloc(t->texel_size, n * sizeof *t->texel_size))) t->texel_size = p;
+    if ((p = realloc(t->points, n * sizeof *t->points))) t->points = p;
+    if ((p = realloc(t->valid, n))) t->valid = p;
+    if ((p = realloc(t->gather_at, n))) t->gather_at = p;
+    t->capacity = t->count;
+}
+
+static void copy_band(lmb_texels *dst, const lmb_texels *band)
+{
+    for (uint32_t i = 0; i < band->count; i++) {
+        uint32_t j = dst->count + i;
+        dst->texel[j] = band->texel[i];
+        dst->points_in[j] = 1;
+        dst->texel_size[j] = band->texel_size[i];
+        dst->points[j] = band->points[(size_t)i * band->samples + band->gather_at[i]];
+        dst->valid[j] = band->valid[i];
+        dst->gather_at[j] = 0;
+    }
+    dst->width = band->width;
+    dst->height = band->height;
+    dst->samples = 1;
+    dst->count += band->count;
+}
+
 void lmb_texels_free(lmb_texels *t)
 {
     free(t->texel);
@@ -75,9 +136,11 @@ static double closest_on_triangle(const double *uv, const double p[2], double *b
     return bestd;
 }
 
-static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, uint32_t samples, best *b)
+/* Sub-samples of rows [y0, y1) only: b holds (y1 - y0) rows. */
+static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, uint32_t samples, uint32_t y0_band,
+                      uint32_t y1_band, best *b)
 {
-    uint32_t w = l->width[atlas], h = l->height[atlas];
+    uint32_t w = l->width[atlas];
     for (uint32_t i = 0; i < l->instance_count; i++) {
         const lmb_layout_instance *li = &l->instances[i];
         if (!li->lightmapped || li->atlas != atlas)
@@ -92,9 +155,9 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
             long x0 = (long)floor(lo[0]) - 1, x1 = (long)floor(hi[0]) + 1, y0 = (long)floor(lo[1]) - 1,
                  y1 = (long)floor(hi[1]) + 1;
             x0 = x0 < 0 ? 0 : x0;
-            y0 = y0 < 0 ? 0 : y0;
+            y0 = y0 < (long)y0_band ? (long)y0_band : y0;
             x1 = x1 >= (long)w ? (long)w - 1 : x1;
-            y1 = y1 >= (long)h ? (long)h - 1 : y1;
+            y1 = y1 >= (long)y1_band ? (long)y1_band - 1 : y1;
             for (long y = y0; y <= y1; y++)
                 for (long x = x0; x <= x1; x++)
                     for (uint32_t k = 0; k < samples; k++) {
@@ -103,7 +166,7 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
                         sp[0] += (double)x;
                         sp[1] += (double)y;
                         double d = closest_on_triangle(uv, sp, &b1, &b2);
-                        best *bb = &b[((size_t)y * w + (size_t)x) * samples + k];
+                        best *bb = &b[((size_t)(y - (long)y0_band) * w + (size_t)x) * samples + k];
                         if (d <= 1.0 && d < bb->dist) {
                             bb->dist = (float)d;
                             bb->b1 = (float)b1;
@@ -188,17 +251,23 @@ static void make_point(const lmb_scene *s, const lmb_layout *l, const best *b, l
 lmb_status lmb_texels_build(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t samples, lmb_texels *out,
                             lmb_error *err)
 {
+    return lmb_texels_build_rows(s, l, atlas, samples, 0, l->height[atlas], out, err);
+}
+
+lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t samples,
+                                 uint32_t y0, uint32_t y1, lmb_texels *out, lmb_error *err)
+{
     memset(out, 0, sizeof *out);
-    uint32_t w = l->width[atlas], h = l->height[atlas];
+    uint32_t w = l->width[atlas], h = y1 - y0;
     size_t n = (size_t)w * h * samples;
     best *b = malloc((n + 1) * sizeof *b);
     if (!b)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for a %ux%u atlas", w, h);
     for (size_t i = 0; i < n; i++)
         b[i].dist = FLT_MAX;
-    rasterize(l, s, atlas, samples, b);
+    rasterize(l, s, atlas, samples, y0, y1, b);
     out->width = w;
-    out->height = h;
+    out->height = l->height[atlas];
     out->samples = samples;
     for (size_t t = 0; t < (size_t)w * h; t++)
         for (uint32_t k = 0; k < samples; k++)
@@ -227,7 +296,7 @@ lmb_status lmb_texels_build(const lmb_scene *s, const lmb_layout *l, uint32_t at
         }
         if (!m)
             continue;
-        out->texel[c] = (uint32_t)t;
+        out->texel[c] = (uint32_t)(t + (size_t)y0 * w);
         out->points_in[c] = (uint8_t)m;
         out->texel_size[c] = (float)(1.0 / l->instances[out->points[(size_t)c * samples].instance].texel_density);
         out->valid[c] = 1;

@@ -24,6 +24,7 @@ typedef struct lmb_gather_point {
 typedef struct lmb_texels {
     uint32_t width, height, samples;
     uint32_t count;            /* texels that hold at least one point */
+    uint32_t capacity;         /* allocated entries (lmb_texels_append grows them) */
     uint32_t *texel;           /* per listed texel: y * width + x */
     uint8_t *points_in;        /* per listed texel: points (1..samples) */
     float *texel_size;         /* per listed texel: world units per texel */
@@ -36,6 +37,19 @@ typedef struct lmb_texels {
 /* Gather points for atlas `atlas` of layout l. `samples` per texel, 1..256. */
 lmb_status lmb_texels_build(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, uint32_t samples,
                             lmb_texels *out, lmb_error *err);
+
+/* The same for atlas rows [y0, y1) only (texel indices stay y * width + x of the atlas):
+ * the lights stage builds an atlas band by band so that sub-sampled points for the whole
+ * atlas never exist at once. */
+lmb_status lmb_texels_build_rows(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, uint32_t samples,
+                                 uint32_t y0, uint32_t y1, lmb_texels *out, lmb_error *err);
+
+/* Appends band's texels to dst keeping one point each, the one indirect light is gathered
+ * at (band->gather_at, set by the lights stage): dst then has samples = 1. */
+lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err);
+
+/* Gives back what appending reserved beyond count. */
+void lmb_texels_trim(lmb_texels *t);
 
 void lmb_texels_free(lmb_texels *t);
 
