@@ -91,7 +91,7 @@ void lmb_config_default(lmb_config *cfg)
     memset(cfg, 0, sizeof *cfg); /* also the padding bytes, so configs compare with memcmp */
     cfg->texel_density = 0;      /* auto */
     cfg->atlas_texels = 0;       /* auto: lmb_config_atlas_texels */
-    cfg->max_atlas_size = 1024;
+    cfg->max_atlas_size = 4096;  /* atlases are cropped to what they hold; texels follow atlas.texels */
     cfg->padding = 2;
     cfg->keep_uv1 = 0;
     cfg->texel_samples = 4;
@@ -116,10 +116,10 @@ void lmb_config_default(lmb_config *cfg)
 
 uint64_t lmb_config_atlas_texels(const lmb_config *cfg)
 {
-    /* 0.6: the share of a max_size atlas the packer fills with chart texels on real levels
-     * (README "Texel density": Cornell 0.9, many small props 0.5-0.7 with padding 2) */
-    return cfg->atlas_texels ? cfg->atlas_texels
-                             : (uint64_t)(0.6 * (double)cfg->max_atlas_size * (double)cfg->max_atlas_size);
+    /* one 1024^2 atlas (or one max_size atlas if smaller) at 0.6, the share of an atlas the
+     * packer fills with chart texels on real levels (README "Texel density") */
+    double side = cfg->max_atlas_size < 1024 ? cfg->max_atlas_size : 1024;
+    return cfg->atlas_texels ? cfg->atlas_texels : (uint64_t)(0.6 * side * side);
 }
 
 /* ---- density overrides: a list of mappings walked with their own schema ---- */

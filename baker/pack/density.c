@@ -115,12 +115,13 @@ static double override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i
 static lmb_status explicit_too_high(const lmb_scene *s, const lmb_config *cfg, uint32_t i, double d, double fit,
                                     int from_override, lmb_error *err)
 {
+    double would = 0.97 * fit;
     return lmb_error_set(err, LMB_ERR_INPUT,
                          "instance '%s' (mesh '%s') does not fit in one %ux%u atlas at %s %g texels per unit: at most "
-                         "about %.3g fits (or use texel_density: auto, or raise atlas.max_size)",
+                         "about %.*f fits (or use texel_density: auto, or raise atlas.max_size)",
                          s->instances[i].name, s->meshes[s->instances[i].mesh].name, cfg->max_atlas_size,
                          cfg->max_atlas_size, from_override ? "its density_overrides entry's" : "texel_density", d,
-                         0.97 * fit);
+                         would >= 100 ? 0 : would >= 1 ? 2 : 4, would);
 }
 
 lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,

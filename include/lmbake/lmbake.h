@@ -235,8 +235,8 @@ typedef struct lmb_config {
 /* Fills cfg with the documented defaults (README: "Bake config"). */
 void lmb_config_default(lmb_config *cfg);
 
-/* The auto density's texel budget: cfg->atlas_texels, or when 0 the texels of one
- * max_size atlas at the coverage the packer typically reaches on real levels. */
+/* The auto density's texel budget: cfg->atlas_texels, or when 0 the texels of one 1024^2
+ * atlas (max_size^2 if smaller) at the coverage the packer typically reaches on real levels. */
 uint64_t lmb_config_atlas_texels(const lmb_config *cfg);
 
 /* Reads a YAML bake config over the defaults already in cfg. Unknown keys, wrong

@@ -35,7 +35,7 @@ static void test_defaults(void)
     CHECK(c.atlas_texels == 0);        /* auto: 0.6 x max_size^2 */
     CHECK(lmb_config_atlas_texels(&c) == 629145);
     CHECK_INT(c.density_override_count, 0);
-    CHECK_INT(c.max_atlas_size, 1024);
+    CHECK_INT(c.max_atlas_size, 4096);
     CHECK_INT(c.padding, 2);
     CHECK_INT(c.keep_uv1, 0);
     CHECK_INT(c.texel_samples, 4);
@@ -126,7 +126,7 @@ static void test_partial_and_edges(void)
     lmb_error err;
     CHECK_INT(parse("atlas:\n  padding: 0\n", &c, &err), LMB_OK);
     CHECK_INT(c.padding, 0);
-    CHECK_INT(c.max_atlas_size, 1024);
+    CHECK_INT(c.max_atlas_size, 4096);
     CHECK(c.bounces == LMB_AUTO);
 
     /* auto and explicit values of the keys that take both */
@@ -142,7 +142,9 @@ static void test_partial_and_edges(void)
     CHECK_INT(c.bounces_max, 8);
     CHECK_NEAR(c.bounces_tail, 0.05, 0);
     CHECK_INT(parse("atlas: {max_size: 2048}\n", &c, &err), LMB_OK);
-    CHECK(lmb_config_atlas_texels(&c) == (uint64_t)(0.6 * 2048 * 2048));
+    CHECK(lmb_config_atlas_texels(&c) == 629145);
+    CHECK_INT(parse("atlas: {max_size: 512}\n", &c, &err), LMB_OK);
+    CHECK(lmb_config_atlas_texels(&c) == (uint64_t)(0.6 * 512 * 512));
     expect_error("texel_density: 'auto'\n", "level.yaml:1: ",
                  "key 'texel_density': expected auto or a number > 0 and <= 100000, got 'auto'");
     expect_error("bounces: Auto\n", "level.yaml:1: ", "key 'bounces': expected auto or an integer in 0..64, got 'Auto'");
