@@ -10,6 +10,6 @@ mkdir -p "$out/scenes"
 /usr/bin/python3 tools/make_scenes.py "$out/scenes" >/dev/null
 echo "demo: baking the Cornell box with a point light (generated: $out/scenes/cornell-point.gltf)"
 build/lmbake bake "$out/scenes/cornell-point.gltf" -c assets/demo-point-config.yaml -o "$out/cornell-point"
-echo "demo: baking bevy's Cornell box (assets/scenes/cornell-box-bevy/CornellBox.glb)"
-build/lmbake bake assets/scenes/cornell-box-bevy/CornellBox.glb -c assets/demo-config.yaml -o "$out/cornell-box-bevy"
+echo "demo: baking bevy's Cornell box (assets/scenes/cornell-box-bevy/CornellBox.glb, millimetres) with no config: the defaults"
+build/lmbake bake assets/scenes/cornell-box-bevy/CornellBox.glb -o "$out/cornell-box-bevy"
 echo "demo: output in $out/cornell-point and $out/cornell-box-bevy (.gltf + lightmap .exr/.hdr/.png)"
