@@ -412,11 +412,12 @@ int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, 
 
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp)
 {
-    const lmb_gather_point *g = &t->points[(size_t)i * t->samples + k];
+    lmb_gather_point g;
+    lmb_texels_point(t, i, k, &g);
     for (int r = 0; r < 3; r++) {
-        sp->p[r] = g->p[r];
-        sp->n[r] = g->n[r];
-        sp->ng[r] = g->ng[r];
+        sp->p[r] = g.p[r];
+        sp->n[r] = g.n[r];
+        sp->ng[r] = g.ng[r];
     }
     sp->eps = d->rt->eps + 1e-4 * t->texel_size[i];
 }

@@ -44,13 +44,13 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
     if (points_in) dst->points_in = points_in;
     float *size = realloc(dst->texel_size, ((size_t)n + 1) * sizeof *size);
     if (size) dst->texel_size = size;
-    lmb_gather_point *points = realloc(dst->points, ((size_t)n + 1) * sizeof *points);
-    if (points) dst->points = points;
+    lmb_point_ref *refs = realloc(dst->refs, ((size_t)n + 1) * sizeof *refs);
+    if (refs) dst->refs = refs;
     uint8_t *valid = realloc(dst->valid, (size_t)n + 1);
     if (valid) dst->valid = valid;
     uint8_t *gather_at = realloc(dst->gather_at, (size_t)n + 1);
     if (gather_at) dst->gather_at = gather_at;
-    if (!texel || !points_in || !size || !points || !valid || !gather_at)
+    if (!texel || !points_in || !size || !refs || !valid || !gather_at)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", n);
     dst->capacity = n;
     copy_band(dst, band);
@@ -64,7 +64,7 @@ void lmb_texels_trim(lmb_texels *t)
     if ((p = realloc(t->texel, n * sizeof *t->texel))) t->texel = p;
     if ((p = realloc(t->points_in, n))) t->points_in = p;
     if ((p = realloc(t->texel_size, n * sizeof *t->texel_size))) t->texel_size = p;
-    if ((p = realloc(t->points, n * sizeof *t->points))) t->points = p;
+    if ((p = realloc(t->refs, n * sizeof *t->refs))) t->refs = p;
     if ((p = realloc(t->valid, n))) t->valid = p;
     if ((p = realloc(t->gather_at, n))) t->gather_at = p;
     t->capacity = t->count;
@@ -77,13 +77,15 @@ static void copy_band(lmb_texels *dst, const lmb_texels *band)
         dst->texel[j] = band->texel[i];
         dst->points_in[j] = 1;
         dst->texel_size[j] = band->texel_size[i];
-        dst->points[j] = band->points[(size_t)i * band->samples + band->gather_at[i]];
+        dst->refs[j] = band->refs[(size_t)i * band->samples + band->gather_at[i]];
         dst->valid[j] = band->valid[i];
         dst->gather_at[j] = 0;
     }
     dst->width = band->width;
     dst->height = band->height;
     dst->samples = 1;
+    dst->scene = band->scene ? band->scene : dst->scene;
+    dst->layout = band->layout ? band->layout : dst->layout;
     dst->count += band->count;
 }
 
@@ -93,6 +95,7 @@ void lmb_texels_free(lmb_texels *t)
     free(t->points_in);
     free(t->texel_size);
     free(t->points);
+    free(t->refs);
     free(t->valid);
     free(t->gather_at);
     memset(t, 0, sizeof *t);
@@ -216,7 +219,7 @@ static void pull_inside(const double q[9], double texel_size, double p[3])
         p[r] += c[r] / d * step;
 }
 
-static void make_point(const lmb_scene *s, const lmb_layout *l, const best *b, lmb_gather_point *out)
+static void make_point(const lmb_scene *s, const lmb_layout *l, const lmb_point_ref *b, lmb_gather_point *out)
 {
     const lmb_instance *in = &s->instances[b->instance];
     const lmb_mesh_soup *soup = &l->meshes[in->mesh].soup;
@@ -246,6 +249,15 @@ static void make_point(const lmb_scene *s, const lmb_layout *l, const best *b, l
         memcpy(out->n, out->ng, sizeof out->n);
     out->instance = b->instance;
     out->triangle = b->triangle;
+}
+
+void lmb_texels_point(const lmb_texels *t, uint32_t i, uint32_t k, lmb_gather_point *out)
+{
+    size_t at = (size_t)i * t->samples + k;
+    if (t->points)
+        *out = t->points[at];
+    else
+        make_point(t->scene, t->layout, &t->refs[at], out);
 }
 
 lmb_status lmb_texels_build(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t samples, lmb_texels *out,
@@ -279,9 +291,13 @@ lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32
     out->points_in = calloc((size_t)out->count + 1, 1);
     out->texel_size = malloc(((size_t)out->count + 1) * sizeof *out->texel_size);
     out->points = calloc((size_t)out->count * samples + 1, sizeof *out->points);
+    out->refs = calloc((size_t)out->count * samples + 1, sizeof *out->refs);
+    out->scene = s;
+    out->layout = l;
     out->valid = malloc((size_t)out->count + 1);
     out->gather_at = calloc((size_t)out->count + 1, 1);
-    if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->valid || !out->gather_at) {
+    if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->refs || !out->valid ||
+        !out->gather_at) {
         free(b);
         lmb_texels_free(out);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", out->count);
@@ -291,8 +307,14 @@ lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32
         uint32_t m = 0;
         for (uint32_t k = 0; k < samples; k++) {
             const best *bb = &b[t * samples + k];
-            if (bb->dist < FLT_MAX)
-                make_point(s, l, bb, &out->points[(size_t)c * samples + m++]);
+            if (bb->dist < FLT_MAX) {
+                lmb_point_ref *r = &out->refs[(size_t)c * samples + m];
+                r->instance = bb->instance;
+                r->triangle = bb->triangle;
+                r->b1 = bb->b1;
+                r->b2 = bb->b2;
+                make_point(s, l, r, &out->points[(size_t)c * samples + m++]);
+            }
         }
         if (!m)
             continue;

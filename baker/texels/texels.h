@@ -21,6 +21,12 @@ typedef struct lmb_gather_point {
     uint32_t instance, triangle; /* triangle: index into the instance's mesh soup */
 } lmb_gather_point;
 
+/* A gather point by where it lies: 16 bytes instead of 56; lmb_texels_point expands it. */
+typedef struct lmb_point_ref {
+    uint32_t instance, triangle;
+    float b1, b2; /* barycentrics of corners 1 and 2 */
+} lmb_point_ref;
+
 typedef struct lmb_texels {
     uint32_t width, height, samples;
     uint32_t count;            /* texels that hold at least one point */
@@ -28,7 +34,11 @@ typedef struct lmb_texels {
     uint32_t *texel;           /* per listed texel: y * width + x */
     uint8_t *points_in;        /* per listed texel: points (1..samples) */
     float *texel_size;         /* per listed texel: world units per texel */
-    lmb_gather_point *points;  /* count * samples; the first points_in[i] of each are set */
+    lmb_gather_point *points;  /* count * samples; the first points_in[i] of each are set; NULL
+                                  after lmb_texels_append (points are expanded from refs) */
+    lmb_point_ref *refs;       /* count * samples, beside points: where each point lies */
+    const lmb_scene *scene;    /* what refs refer to */
+    const lmb_layout *layout;
     uint8_t *valid;            /* per listed texel: 1, or 0 when inside geometry (set by the lights stage) */
     uint8_t *gather_at;        /* per listed texel: its first point outside geometry, where indirect
                                   light is gathered (set by the lights stage) */
@@ -45,13 +55,18 @@ lmb_status lmb_texels_build_rows(const lmb_scene *scene, const lmb_layout *l, ui
                                  uint32_t y0, uint32_t y1, lmb_texels *out, lmb_error *err);
 
 /* Appends band's texels to dst keeping one point each, the one indirect light is gathered
- * at (band->gather_at, set by the lights stage): dst then has samples = 1. */
+ * at (band->gather_at, set by the lights stage), as a 16-byte reference: dst then has
+ * samples = 1 and no expanded points (memory: about 60 bytes per texel in all). */
 lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err);
 
 /* Gives back what appending reserved beyond count. */
 void lmb_texels_trim(lmb_texels *t);
 
 void lmb_texels_free(lmb_texels *t);
+
+/* Point k of listed texel i, stored or expanded from its reference (the same doubles either
+ * way: both come from one function). */
+void lmb_texels_point(const lmb_texels *t, uint32_t i, uint32_t k, lmb_gather_point *out);
 
 /* Sub-sample k of `samples` inside a texel, in [0,1)^2: stratum centres of a sx x sy grid. */
 void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2]);
