@@ -277,6 +277,9 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     double tl = lmb_seconds();
+    if (st == LMB_OK && !lmb_direct_any_light(direct))
+        lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material): the lightmaps "
+                 "are black", s->path);
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, err);
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)

@@ -166,14 +166,14 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
 typedef struct band_progress {
     lmb_progress_fn fn;
     void *user;
-    uint64_t row0, rows, height;
+    uint64_t row0, rows, height, width;
 } band_progress;
 
+/* In atlas texels: the band's rows before it, plus its share of its own rows. */
 static void band_progress_update(void *user, const char *stage, uint64_t done, uint64_t total)
 {
     const band_progress *b = user;
-    uint64_t scale = 1024;
-    b->fn(b->user, stage, b->row0 * scale + (total ? done * b->rows * scale / total : 0), b->height * scale);
+    b->fn(b->user, stage, b->row0 * b->width + (total ? done * b->rows * b->width / total : 0), b->height * b->width);
 }
 
 /*
@@ -197,7 +197,7 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
         float *e = st == LMB_OK ? calloc(3 * (size_t)band.count + 1, sizeof *e) : NULL;
         if (st == LMB_OK && !e)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-        band_progress bp = {progress, user, y0, y1 - y0, height};
+        band_progress bp = {progress, user, y0, y1 - y0, height, width};
         lmb_direct_job job = {direct, a, progress ? band_progress_update : NULL, &bp};
         if (st == LMB_OK)
             st = lmb_direct_compute(&job, &band, e, rays, err);
@@ -272,12 +272,16 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.progress = progress;
     job.progress_user = user;
     job.progress_total = total;
+    /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
+    int dark = !lmb_direct_any_light(direct);
+    stats->no_light = dark;
     /* bounce passes: classic gathering with few rays, a fixed number or until converged */
     uint32_t passes = 0;
-    if (st == LMB_OK && !cfg->reference && cfg->bounces == LMB_AUTO)
+    if (st == LMB_OK && !dark && !cfg->reference && cfg->bounces == LMB_AUTO)
         st = auto_bounces(cfg, &job, w, cache, stats, &passes, err);
     char stage[64];
-    for (uint32_t b = 1; cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK; b++) {
+    for (uint32_t b = 1; !dark && cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK;
+         b++) {
         lmb_gather_stats gs = {0, 0, 0};
         lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0, 0};
         job.estimator = e;
@@ -287,7 +291,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         st = gather_pass(&job, w, cache, stats, &gs, err);
         passes = b;
     }
-    uint32_t bounces = cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
+    uint32_t bounces = dark ? 0 : cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
     stats->bounces = bounces;
     /* the final gather, or the reference */
     if (bounces > 0 && st == LMB_OK) {

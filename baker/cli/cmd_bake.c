@@ -101,7 +101,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
  * ratio 0.79, estimated tail 9.8% of the total added" */
 static void print_bounces(const lmb_config *cfg, const lmb_bake_stats *bs)
 {
-    if (cfg->bounces != LMB_AUTO || cfg->reference)
+    if (cfg->bounces != LMB_AUTO || cfg->reference || bs->no_light)
         return;
     uint32_t passes = bs->bounces ? bs->bounces - 1 : 0;
     printf("bounces: auto, %u pass(es) + final gather", passes);

@@ -191,6 +191,11 @@ struct lmb_direct {
     uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
 };
 
+int lmb_direct_any_light(const lmb_direct *d)
+{
+    return (d->scene->light_count > 0 && d->cfg->light_intensity_scale > 0) || lmb_emitters_count(d->emitters) > 0;
+}
+
 typedef struct point_ctx {
     const lmb_direct *d;
     double o[3];    /* offset origin */

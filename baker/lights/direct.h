@@ -31,6 +31,10 @@ lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, cons
                              const lmb_emitters *emitters, lmb_direct **out, lmb_error *err);
 void lmb_direct_free(lmb_direct *d);
 
+/* 0 when nothing in the scene emits light (no punctual light that the config keeps, no
+ * emissive triangle): every lightmap is exactly 0 and no gather needs to run. */
+int lmb_direct_any_light(const lmb_direct *d);
+
 /* A point on a surface: position, shading and geometric normals (unit, front side) and the
  * offset along ng that rays start from (so they do not hit the surface itself). */
 typedef struct lmb_shading_point {

@@ -300,6 +300,7 @@ typedef struct lmb_bake_stats {
     double bounce_ratio;    /* bounces: auto: the last ratio of what two passes added */
     double tail_share;      /* bounces: auto: the estimated tail's share of the total */
     int tail_added;         /* bounces: auto: the geometric tail was added to the cache */
+    int no_light;           /* nothing in the scene emits: the lightmaps are 0, no gather ran */
     double texel_density;   /* the scene's density (auto: what the budget gave) */
     int density_auto;       /* texel_density: auto */
     uint32_t density_capped; /* auto: instances lowered to fit one atlas */
