@@ -30,6 +30,11 @@ static const char help[] =
     "  -q, --quiet         no progress or warnings\n"
     "  -h, --help          this help\n"
     "\n"
+    "With no config: texel_density auto (the lightmapped surface gets atlas.texels = 629,145\n"
+    "texels, whatever the level's units; the density chosen is printed) and bounces auto\n"
+    "(bounce passes until the light converges, then its geometric tail; the log says what each\n"
+    "pass added). Set either to a number in the config to fix it.\n"
+    "\n"
     "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
 
 typedef struct bake_args {
