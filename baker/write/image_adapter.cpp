@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -34,8 +35,19 @@ lmb_status write_image(const char *path, uint32_t w, uint32_t h, uint32_t ch, OI
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: no image writer for this extension: %s", path,
                              OIIO::geterror().c_str());
     OIIO::TypeDesc stored = type;
-    if (ends_with(target, ".exr"))
+    if (ends_with(target, ".exr")) {
+        /* half float holds up to 65504: sunlight (up to ~120,000 lux) would turn to Inf, so an
+         * atlas with a larger value is stored in 32-bit float */
         stored = OIIO::TypeDesc::HALF;
+        if (type == OIIO::TypeDesc::FLOAT) {
+            const float *f = static_cast<const float *>(pixels);
+            for (size_t i = 0; i < (size_t)w * h * ch; i++)
+                if (!(std::fabs(f[i]) <= 65504.0f)) {
+                    stored = OIIO::TypeDesc::FLOAT;
+                    break;
+                }
+        }
+    }
     OIIO::ImageSpec spec((int)w, (int)h, (int)ch, stored);
     if (ends_with(target, ".exr"))
         spec.attribute("compression", "zip");

@@ -17,7 +17,8 @@ extern "C" {
 lmb_status lmb_image_write_u8(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                               const uint8_t *pixels, lmb_error *err);
 
-/* Float pixels; .exr is written as half float with zip compression. */
+/* Float pixels; .exr is written as half float with zip compression, or as 32-bit float when
+ * a value is beyond half's range (65504: bright sunlight in lux). */
 lmb_status lmb_image_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                                const float *pixels, lmb_error *err);
 
