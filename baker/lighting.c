@@ -76,7 +76,8 @@ static double luminance(const double c[3])
  * computes form a geometric tail: after pass b the final gather adds bounce b + 1 and the
  * rest is D_b (r^2 + r^3 + ...). Passes go on until the tail the cache is missing,
  * T = D_b r / (1 - r), is below bounces_auto.tail of the total, with two ratios in a row
- * agreeing (the tail is an extrapolation: it needs a settled ratio), or bounces_auto.max.
+ * agreeing (the tail is an extrapolation: it needs a settled ratio), or a pass adds under 0.1%
+ * of the light (the passes' noise level), or bounces_auto.max.
  * Then the tail is added to the cache texel by texel, T_x = (E_b - E_{b-1})_x r / (1 - r),
  * so the final gather reads converged light and adds what the passes left out: a closed
  * room of albedo rho gets pi Le / (1 - rho), not the series cut after b + 1 terms.
@@ -125,8 +126,10 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
             tail[c] = added[c] * ratio[c] / (1 - ratio[c]);
         double tail_share = total + luminance(tail) > 0 ? luminance(tail) / (total + luminance(tail)) : 0;
         int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
-        int negligible = luminance(added) <= 1e-6 * total; /* nothing bounces: no tail to speak of */
-        converged = negligible || (settled && tail_share < cfg->bounces_tail);
+        /* a pass that adds under 0.1% of the light is at the passes' noise level: stop there */
+        int small = luminance(added) <= 1e-3 * total;
+        converged = small || (settled && tail_share < cfg->bounces_tail);
+        stats->bounce_stop = small ? LMB_BOUNCES_SMALL_PASS : converged ? LMB_BOUNCES_TAIL : LMB_BOUNCES_MAX;
         stats->tail_share = b >= 2 ? tail_share : 0;
         stats->bounce_ratio = b >= 2 ? r : 0;
         prev_ratio = b >= 2 ? r : -1;
@@ -136,7 +139,7 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
             before[c] = after[c];
         }
         if (converged || b == max_passes) {
-            if (negligible || b < 2) {
+            if (!(luminance(added) > 0) || b < 2) { /* nothing left to extrapolate */
                 stats->tail_share = 0;
                 break;
             }

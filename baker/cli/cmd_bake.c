@@ -115,11 +115,15 @@ static void print_bounces(const lmb_config *cfg, const lmb_bake_stats *bs)
         for (uint32_t b = 1; b <= passes && b < LMB_MAX_REPORTED_BOUNCES; b++)
             printf(" %.3g%%", 100.0 * bs->bounce_energy[b] / bs->bounce_energy[0]);
     }
+    if (bs->bounce_stop == LMB_BOUNCES_SMALL_PASS)
+        printf("; stopped: the last pass added under 0.1%% of the light");
+    else if (bs->bounce_stop == LMB_BOUNCES_MAX)
+        printf("; stopped at bounces_auto.max %u", cfg->bounces_max);
+    else if (bs->bounce_stop == LMB_BOUNCES_TAIL)
+        printf("; the bounce ratio settled");
     if (bs->tail_added)
         printf("; bounce ratio %.3f, geometric tail of %.2f%% of the total added", bs->bounce_ratio,
                100.0 * bs->tail_share);
-    else if (passes + 1 >= cfg->bounces_max)
-        printf("; stopped at bounces_auto.max %u", cfg->bounces_max);
     printf("\n");
 }
 

@@ -285,6 +285,9 @@ void lmb_scene_stats_compute(const lmb_scene *scene, lmb_scene_stats *out);
 
 #define LMB_MAX_REPORTED_BOUNCES 65
 
+/* Why bounces: auto stopped. */
+enum { LMB_BOUNCES_TAIL = 1, LMB_BOUNCES_SMALL_PASS = 2, LMB_BOUNCES_MAX = 3 };
+
 typedef struct lmb_bake_stats {
     uint32_t atlases;
     uint64_t texels;        /* texels holding gather points */
@@ -300,6 +303,7 @@ typedef struct lmb_bake_stats {
     double bounce_ratio;    /* bounces: auto: the last ratio of what two passes added */
     double tail_share;      /* bounces: auto: the estimated tail's share of the total */
     int tail_added;         /* bounces: auto: the geometric tail was added to the cache */
+    int bounce_stop;        /* bounces: auto: LMB_BOUNCES_* (0: no pass ran) */
     int no_light;           /* nothing in the scene emits: the lightmaps are 0, no gather ran */
     double texel_density;   /* the scene's density (auto: what the budget gave) */
     int density_auto;       /* texel_density: auto */
