@@ -14,7 +14,6 @@ typedef struct atlas_work {
     lmb_texels t;
     float *direct;   /* 3 per listed texel */
     float *result;   /* 3 per listed texel: the pass being computed */
-    float *prev;     /* 3 per listed texel: the pass before (bounces: auto) */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -23,14 +22,23 @@ static void work_free(atlas_work *w, uint32_t n)
         lmb_texels_free(&w[a].t);
         free(w[a].direct);
         free(w[a].result);
-        free(w[a].prev);
     }
     free(w);
 }
 
-/* One gather pass over every atlas: result = direct + gather(cache), then the cache := result. */
+/* The cache := every atlas's result (dilated). */
+static lmb_status store_pass(atlas_work *w, lmb_cache *cache, lmb_error *err)
+{
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
+        st = lmb_cache_store(cache, a, &w[a].t, w[a].result, err);
+    return st;
+}
+
+/* One gather pass over every atlas: result = direct + gather(cache), then (store) the cache :=
+ * result; without store the cache keeps the previous pass (bounces: auto reads it). */
 static lmb_status gather_pass(lmb_gather_job *job, atlas_work *w, lmb_cache *cache, lmb_bake_stats *stats,
-                              lmb_gather_stats *gs, lmb_error *err)
+                              lmb_gather_stats *gs, int store, lmb_error *err)
 {
     lmb_status st = LMB_OK;
     job->progress_done = 0;
@@ -40,13 +48,13 @@ static lmb_status gather_pass(lmb_gather_job *job, atlas_work *w, lmb_cache *cac
             w[a].result[k] += w[a].direct[k];
         job->progress_done += w[a].t.count;
     }
-    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
-        st = lmb_cache_store(cache, a, &w[a].t, w[a].result, err);
+    if (st == LMB_OK && store)
+        st = store_pass(w, cache, err);
     stats->rays += gs->rays;
     return st;
 }
 
-/* Mean of each channel over the valid texels of every atlas (field: direct, result or prev). */
+/* Mean of each channel over the valid texels of every atlas (field: direct or result). */
 static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3])
 {
     double sum[3] = {0, 0, 0};
@@ -91,13 +99,6 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
     uint32_t n = cache->atlas_count, max_passes = cfg->bounces_max - 1;
     double before[3], after[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
     lmb_status st = LMB_OK;
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        w[a].prev = malloc((3 * (size_t)w[a].t.count + 1) * sizeof *w[a].prev);
-        if (!w[a].prev)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
-        else
-            memcpy(w[a].prev, w[a].direct, 3 * (size_t)w[a].t.count * sizeof *w[a].prev);
-    }
     mean_rgb(w, n, offsetof(atlas_work, direct), before);
     stats->bounce_energy[0] = luminance(before);
     char stage[64];
@@ -110,7 +111,7 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
         job->pass = b;
         snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
         job->stage = stage;
-        st = gather_pass(job, w, cache, stats, &gs, err);
+        st = gather_pass(job, w, cache, stats, &gs, 0, err); /* the cache still holds pass b - 1 */
         if (st != LMB_OK)
             break;
         mean_rgb(w, n, offsetof(atlas_work, result), after);
@@ -138,28 +139,27 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
             last[c] = added[c];
             before[c] = after[c];
         }
-        if (converged || b == max_passes) {
-            if (!(luminance(added) > 0) || b < 2) { /* nothing left to extrapolate */
-                stats->tail_share = 0;
-                break;
-            }
-            /* the geometric tail, texel by texel, into the cache the final gather reads */
-            for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-                for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
-                    double f = ratio[k % 3] / (1 - ratio[k % 3]);
-                    double v = w[a].result[k] + (w[a].result[k] - w[a].prev[k]) * f;
-                    w[a].result[k] = (float)(v > 0 ? v : 0);
-                }
-                st = lmb_cache_store(cache, a, &w[a].t, w[a].result, err);
+        int last_pass = converged || b == max_passes;
+        if (last_pass && luminance(added) > 0 && b >= 2) {
+            /* the geometric tail, texel by texel, from E_b - E_{b-1} (E_{b-1} is what the cache
+             * holds at valid texels; invalid ones are stored as 0 whatever they hold) */
+            for (uint32_t a = 0; a < n; a++) {
+                const float *prev = cache->irradiance[a];
+                for (uint32_t i = 0; i < w[a].t.count; i++)
+                    for (int c = 0; c < 3; c++) {
+                        size_t k = 3 * (size_t)i + (size_t)c;
+                        double f = ratio[c] / (1 - ratio[c]);
+                        double v = w[a].result[k] + (w[a].result[k] - prev[3 * (size_t)w[a].t.texel[i] + c]) * f;
+                        w[a].result[k] = (float)(v > 0 ? v : 0);
+                    }
             }
             stats->tail_added = 1;
+        } else if (last_pass) {
+            stats->tail_share = 0; /* nothing left to extrapolate */
+        }
+        st = store_pass(w, cache, err);
+        if (last_pass)
             break;
-        }
-        for (uint32_t a = 0; a < n; a++) {
-            float *t = w[a].prev;
-            w[a].prev = w[a].result;
-            w[a].result = t;
-        }
     }
     *passes = done;
     return st;
@@ -205,7 +205,7 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
         if (st == LMB_OK)
             st = lmb_direct_compute(&job, &band, e, rays, err);
         if (st == LMB_OK && w->t.count + (size_t)band.count > cap) {
-            cap = (w->t.count + (size_t)band.count) * 3 / 2;
+            cap = w->t.count + (size_t)band.count; /* exact: see lmb_texels_append */
             float *d = realloc(w->direct, (3 * cap + 1) * sizeof *d);
             if (!d)
                 st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
@@ -291,7 +291,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         job.pass = b;
         snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
         job.stage = stage;
-        st = gather_pass(&job, w, cache, stats, &gs, err);
+        st = gather_pass(&job, w, cache, stats, &gs, 1, err);
         passes = b;
     }
     uint32_t bounces = dark ? 0 : cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
@@ -307,7 +307,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         job.depth = bounces;
         job.stage = cfg->reference ? "reference" : "final gather";
         double t0 = lmb_seconds();
-        st = gather_pass(&job, w, cache, stats, &gs, err);
+        st = gather_pass(&job, w, cache, stats, &gs, 1, err);
         stats->gather_seconds = lmb_seconds() - t0;
         stats->gather_rays = gs.rays;
         stats->amis_adapted = gs.adapted;

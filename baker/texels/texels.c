@@ -35,9 +35,8 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
         copy_band(dst, band);
         return LMB_OK;
     }
-    size_t cap = (size_t)dst->capacity * 3 / 2 > n ? (size_t)dst->capacity * 3 / 2 : n; /* geometric growth */
-    cap = cap > UINT32_MAX ? UINT32_MAX : cap;
-    n = (uint32_t)cap;
+    /* exact growth: large blocks are mmap'd and realloc moves them with mremap, not a copy,
+     * and no slack is left behind (memory per texel, README "Memory") */
     uint32_t *texel = realloc(dst->texel, ((size_t)n + 1) * sizeof *texel);
     if (texel) dst->texel = texel;
     uint8_t *points_in = realloc(dst->points_in, (size_t)n + 1);
