@@ -54,6 +54,13 @@ static lmb_status gather_pass(lmb_gather_job *job, atlas_work *w, lmb_cache *cac
     return st;
 }
 
+/* Rays per texel of bounce pass b: higher orders carry less light and reach the texel through
+ * more gathers (their noise averages out), so they may use fewer (samples.bounce_high). */
+static uint32_t pass_rays(const lmb_config *cfg, uint32_t b)
+{
+    return b >= 3 && cfg->bounce_rays_high ? cfg->bounce_rays_high : cfg->bounce_rays;
+}
+
 /* Mean of each channel over the valid texels of every atlas (field: direct or result). */
 static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3])
 {
@@ -106,7 +113,7 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
     uint32_t done = 0;
     for (uint32_t b = 1; b <= max_passes && !converged && st == LMB_OK; b++) {
         lmb_gather_stats gs = {0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0, 0};
+        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0};
         job->estimator = e;
         job->pass = b;
         snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
@@ -286,7 +293,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     for (uint32_t b = 1; !dark && cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK;
          b++) {
         lmb_gather_stats gs = {0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, cfg->bounce_rays, 1, 0, 0};
+        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0};
         job.estimator = e;
         job.pass = b;
         snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);

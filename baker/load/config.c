@@ -60,6 +60,7 @@ static const key_spec config_keys[] = {
     U32("samples.direct", OFF(direct_samples), 1, 65536),
     U32("samples.gather", OFF(gather_rays), 1, 1048576),
     U32("samples.bounce", OFF(bounce_rays), 1, 1048576),
+    U32("samples.bounce_high", OFF(bounce_rays_high), 0, 1048576),
     U32("samples.amis_iterations", OFF(amis_iterations), 1, 64),
     U32_AUTO("bounces", OFF(bounces), 0, 64),
     U32("bounces_auto.max", OFF(bounces_max), 1, 64),

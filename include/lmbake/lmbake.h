@@ -210,6 +210,7 @@ typedef struct lmb_config {
     uint32_t direct_samples;       /* shadow rays per area-light evaluation */
     uint32_t gather_rays;          /* final gather rays per texel (reference: paths per texel) */
     uint32_t bounce_rays;          /* rays per texel of each bounce pass before the final gather */
+    uint32_t bounce_rays_high;     /* rays per texel of bounce passes 3 and later; 0 = bounce_rays */
     uint32_t amis_iterations;
     uint32_t bounces;              /* indirect bounces, or LMB_AUTO: bounce passes until the tail is small, tail added */
     uint32_t bounces_max;          /* auto: at most this many bounces */
