@@ -99,6 +99,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->direct_samples = 16;
     cfg->gather_rays = 256;
     cfg->bounce_rays = 64;
+    cfg->bounce_rays_high = 16; /* README "Defaults for real levels": no measurable loss, 15% faster */
     cfg->amis_iterations = 4;
     cfg->bounces = LMB_AUTO;
     cfg->bounces_max = 32;

@@ -165,6 +165,7 @@ static void test_partial_and_edges(void)
 
     CHECK_INT(c.amis_weights, LMB_AMIS_UNBIASED);
     CHECK_INT(c.bounce_rays, 64);
+    CHECK_INT(c.bounce_rays_high, 16);
     CHECK_INT(parse("gather: {amis_weights: balance}\nsamples: {bounce: 7}\noutput: {formats: [exr, mask]}\n", &c, &err),
               LMB_OK);
     CHECK_INT(c.amis_weights, LMB_AMIS_BALANCE);
