@@ -1,7 +1,7 @@
 /*
  * The bake pipeline driver: layout (unwrap + pack) -> ray-tracing scene, textures, lights ->
  * lighting (lighting.h: texels, direct light, bounce passes, final gather, dilation) ->
- * images; then the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written into a staging folder inside outdir and moved into
+ * images (write/atlas_images.h); then the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written into a staging folder inside outdir and moved into
  * place only when everything succeeded, so a failed bake leaves nothing behind; outdir may
  * not be the input's own folder (the input and its .bin files are never written over).
  */
@@ -16,82 +16,13 @@
 #include "post/dilate.h"
 #include "texels/texels.h"
 #include "write/gltf_write.h"
-#include "write/image_adapter.h"
+#include "write/atlas_images.h"
 #include "write/output_dir.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Tonemapped 8-bit preview of irradiance: exposure maps the 95th percentile of the valid
- * texels' luminance to 0.8 before Reinhard x/(1+x) and the sRGB curve. For a quick look
- * only; the EXR is the lightmap. */
-static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t h, uint8_t *out)
-{
-    size_t n = (size_t)w * h, m = 0;
-    float *lum = malloc((n + 1) * sizeof *lum);
-    double scale = 1.0;
-    if (lum) {
-        for (size_t i = 0; i < n; i++)
-            if (valid[i] == LMB_TEXEL_VALID)
-                lum[m++] = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
-        if (m) {
-            /* 95th percentile by partial selection would be faster; a sort is fine at atlas sizes */
-            for (size_t gap = m / 2; gap > 0; gap /= 2)
-                for (size_t i = gap; i < m; i++)
-                    for (size_t j = i; j >= gap && lum[j - gap] > lum[j]; j -= gap) {
-                        float t = lum[j];
-                        lum[j] = lum[j - gap];
-                        lum[j - gap] = t;
-                    }
-            double p95 = lum[(size_t)(0.95 * (double)(m - 1))];
-            scale = p95 > 0 ? 0.8 / p95 : 1.0;
-        }
-        free(lum);
-    }
-    for (size_t i = 0; i < 3 * n; i++) {
-        double x = rgb[i] * scale, y = x / (1.0 + x);
-        y = y <= 0.0031308 ? 12.92 * y : 1.055 * pow(y, 1 / 2.4) - 0.055;
-        out[i] = (uint8_t)(y <= 0 ? 0 : y >= 1 ? 255 : lround(y * 255.0));
-    }
-}
-
-static lmb_status write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
-                                     const float *rgb, const uint8_t *valid, uint32_t w, uint32_t h, lmb_error *err)
-{
-    char path[8600];
-    lmb_status st = LMB_OK;
-    if (cfg->output_formats & LMB_OUTPUT_EXR) {
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u.exr", dir, stem, a);
-        st = lmb_image_write_f32(path, w, h, 3, rgb, err);
-    }
-    /* the glTF references the .hdr and .png: write them whatever the formats say */
-    if (st == LMB_OK) {
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
-        st = lmb_image_write_f32(path, w, h, 3, rgb, err);
-    }
-    if (st == LMB_OK) {
-        uint8_t *png = malloc((size_t)w * h * 3 + 1);
-        if (!png)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "png: out of memory");
-        tonemap(rgb, valid, w, h, png);
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u.png", dir, stem, a);
-        st = lmb_image_write_u8(path, w, h, 3, png, err);
-        free(png);
-    }
-    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_MASK)) {
-        uint8_t *mask = malloc((size_t)w * h + 1);
-        if (!mask)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "mask: out of memory");
-        for (size_t i = 0; i < (size_t)w * h; i++)
-            mask[i] = valid[i] == LMB_TEXEL_VALID ? 255 : valid[i] == LMB_TEXEL_INSIDE ? 128 : 0;
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u-mask.png", dir, stem, a);
-        st = lmb_image_write_u8(path, w, h, 1, mask, err);
-        free(mask);
-    }
-    return st;
-}
 
 /* New vertices of one glTF primitive: one per (original vertex, chart). */
 static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, uint32_t i, lmb_gltf_prim_out **out,
@@ -283,8 +214,8 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, err);
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
-        st = write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
-                                l.height[a], err);
+        st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
+                                    l.height[a], err);
     stats->light_seconds = lmb_seconds() - tl;
     stats->atlases = l.atlas_count;
     stats->texel_density = l.density.scene_density;

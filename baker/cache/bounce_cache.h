@@ -19,7 +19,7 @@
 
 #include <lmbake/lmbake.h>
 
-#include "lights/rt_scene.h"
+#include "raytrace/rt_scene.h"
 #include "load/textures.h"
 #include "pack/layout.h"
 #include "texels/texels.h"

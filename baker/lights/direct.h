@@ -9,7 +9,7 @@
 #ifndef LMBAKE_DIRECT_H
 #define LMBAKE_DIRECT_H
 
-#include "rt_scene.h"
+#include "raytrace/rt_scene.h"
 #include "load/textures.h"
 #include "texels/texels.h"
 #include "util/rng.h"

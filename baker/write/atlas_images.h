@@ -1,0 +1,17 @@
+/*
+ * Writing one atlas's lightmap: <stem>-lightmap-N.exr (linear irradiance, half float or 32-bit
+ * when beyond half's range), .hdr (the glTF references it), .png (tonemapped preview: the
+ * 95th percentile of valid texels' luminance at 0.8, Reinhard, sRGB) and, with output.formats
+ * mask, -mask.png (255 valid, 128 inside geometry, 0 padding).
+ */
+#ifndef LMBAKE_ATLAS_IMAGES_H
+#define LMBAKE_ATLAS_IMAGES_H
+
+#include <lmbake/lmbake.h>
+
+/* rgb: 3 floats per atlas texel; valid: LMB_TEXEL_* per texel. Files go into dir. */
+lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
+                                  const float *rgb, const uint8_t *valid, uint32_t width, uint32_t height,
+                                  lmb_error *err);
+
+#endif
