@@ -42,4 +42,28 @@ static inline int lmb_mask_bit(const lmb_mask *m, uint32_t x, uint32_t y)
     return (int)(m->bits[(size_t)y * m->words + x / 64] >> (x % 64) & 1);
 }
 
+/* One atlas's occupancy for placement (atlas_space.c): bit rows of recorded footprints and,
+ * per row, what the search skips by. */
+typedef struct lmb_atlas {
+    uint32_t size, words, width; /* width: the part in use for placement */
+    uint64_t *rows;
+    uint32_t *free_from; /* per row: every column before it is occupied */
+    uint32_t *max_run;   /* per row: the longest free run inside width */
+    uint32_t used_w, used_h;
+    uint32_t open_row;   /* rows below it are full up to `width` */
+    uint64_t free_area;  /* texels not recorded by any footprint */
+    uint32_t generation; /* bumped when occupancy shrinks or the width grows: older hints are void */
+} lmb_atlas;
+
+int lmb_atlas_open(lmb_atlas *a, uint32_t size, uint32_t width);
+void lmb_atlas_free(lmb_atlas *a);
+/* Placement width := size (rows are re-measured; hints of this atlas become void). */
+void lmb_atlas_widen(lmb_atlas *a);
+/* Bottom-left first fit of m inside a->width, starting at (from_y, from_x) (no earlier
+ * position fits: an identical mask's earlier first fit); 1 with (*ox, *oy). */
+int lmb_atlas_find(lmb_atlas *a, const lmb_mask *m, uint32_t from_y, uint32_t from_x, uint32_t *ox, uint32_t *oy);
+/* Records footprint m at (x, y) (area: its set texels), or clears it exactly. */
+void lmb_atlas_occupy(lmb_atlas *a, const lmb_mask *m, uint32_t x, uint32_t y, uint64_t area);
+void lmb_atlas_vacate(lmb_atlas *a, const lmb_mask *m, uint32_t x, uint32_t y, uint64_t area);
+
 #endif
