@@ -9,13 +9,6 @@
 
 #define FIT_AREA_SHARE 0.8
 
-static double area3(const double *q)
-{
-    double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
-    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
-    return 0.5 * sqrt(x * x + y * y + z * z);
-}
-
 double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t i)
 {
     const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
@@ -23,7 +16,7 @@ double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t
     for (uint32_t f = 0; f < c->triangle_count; f++)
         if (c->chart_of[f] != UINT32_MAX) {
             lmb_layout_world_triangle(s, l, i, f, q);
-            a += area3(q);
+            a += lmb_triangle_area(q);
         }
     return a;
 }
@@ -42,7 +35,7 @@ static int chart_boxes(const lmb_scene *s, const lmb_layout *l, uint32_t i, doub
             const double *u = c->uv + 6 * f;
             memcpy(uv + 6 * t, u, 6 * sizeof(double));
             lmb_layout_world_triangle(s, l, i, f, q);
-            aw += area3(q);
+            aw += lmb_triangle_area(q);
             auv += 0.5 * fabs((u[2] - u[0]) * (u[5] - u[1]) - (u[4] - u[0]) * (u[3] - u[1]));
         }
         lmb_pack_chart pc = {len, uv, 0};

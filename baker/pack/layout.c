@@ -50,6 +50,13 @@ static lmb_status build_soup(const lmb_scene *s, uint32_t mesh, lmb_mesh_soup *s
     return LMB_OK;
 }
 
+double lmb_triangle_area(const double q[9])
+{
+    double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
+    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
+    return 0.5 * sqrt(x * x + y * y + z * z);
+}
+
 void lmb_layout_world_triangle(const lmb_scene *s, const lmb_layout *l, uint32_t i, uint32_t f, double out[9])
 {
     const lmb_instance *in = &s->instances[i];
@@ -59,13 +66,6 @@ void lmb_layout_world_triangle(const lmb_scene *s, const lmb_layout *l, uint32_t
         double q[3] = {p[0], p[1], p[2]};
         lmb_mat4_point(in->world, q, out + 3 * k);
     }
-}
-
-static double area3(const double *q)
-{
-    double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
-    double x = e1[1] * e2[2] - e1[2] * e2[1], y = e1[2] * e2[0] - e1[0] * e2[2], z = e1[0] * e2[1] - e1[1] * e2[0];
-    return 0.5 * sqrt(x * x + y * y + z * z);
 }
 
 /* Scales instance i's charts into uv1 (texel units, chart-local) and returns its texel area. */
@@ -81,7 +81,7 @@ static double scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
             uint32_t f = c->order[j];
             const double *u = c->uv + 6 * f;
             lmb_layout_world_triangle(s, l, i, f, q);
-            aw += area3(q);
+            aw += lmb_triangle_area(q);
             auv += 0.5 * fabs((u[2] - u[0]) * (u[5] - u[1]) - (u[4] - u[0]) * (u[3] - u[1]));
         }
         double sc = auv > 0 ? li->texel_density * sqrt(aw / auv) : 0;
@@ -268,7 +268,7 @@ static lmb_status own_atlas(const lmb_scene *s, const lmb_config *cfg, lmb_layou
     for (uint32_t f = 0; f < c->triangle_count; f++)
         if (c->chart_of[f] != UINT32_MAX) {
             lmb_layout_world_triangle(s, l, i, f, q);
-            world += area3(q);
+            world += lmb_triangle_area(q);
         }
     uint32_t size = lmb_uv1_atlas_size(world, c, li->texel_density, cfg->max_atlas_size);
     uint32_t *w = realloc(l->width, (l->atlas_count + 1) * sizeof *w);

@@ -64,6 +64,9 @@ lmb_status lmb_layout_build(const lmb_scene *scene, const lmb_config *cfg, lmb_p
 
 void lmb_layout_free(lmb_layout *l);
 
+/* Area of a triangle given as 9 doubles (three corners). */
+double lmb_triangle_area(const double q[9]);
+
 /* World-space corners of instance i's mesh triangle f (9 doubles). */
 void lmb_layout_world_triangle(const lmb_scene *scene, const lmb_layout *l, uint32_t instance, uint32_t f,
                                double out[9]);
