@@ -199,7 +199,6 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
     uint32_t width = cache->layout->width[a], height = cache->layout->height[a];
     uint32_t rows = width ? (65536 + width - 1) / width : height; /* ~64k texels per band */
     lmb_status st = LMB_OK;
-    size_t cap = 0;
     for (uint32_t y0 = 0; y0 < height && st == LMB_OK; y0 += rows) {
         uint32_t y1 = y0 + rows < height ? y0 + rows : height;
         lmb_texels band;
@@ -211,9 +210,8 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
         lmb_direct_job job = {direct, a, progress ? band_progress_update : NULL, &bp};
         if (st == LMB_OK)
             st = lmb_direct_compute(&job, &band, e, rays, err);
-        if (st == LMB_OK && w->t.count + (size_t)band.count > cap) {
-            cap = w->t.count + (size_t)band.count; /* exact: see lmb_texels_append */
-            float *d = realloc(w->direct, (3 * cap + 1) * sizeof *d);
+        if (st == LMB_OK) { /* exact growth, as lmb_texels_append */
+            float *d = realloc(w->direct, (3 * (w->t.count + (size_t)band.count) + 1) * sizeof *d);
             if (!d)
                 st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
             else
@@ -233,14 +231,6 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
         empty.height = height;
         empty.samples = 1;
         st = lmb_texels_append(&w->t, &empty, err);
-    }
-    if (st == LMB_OK) {
-        lmb_texels_trim(&w->t);
-        float *d = realloc(w->direct, (3 * (size_t)w->t.count + 1) * sizeof *d);
-        if (d)
-            w->direct = d;
-        else if (!w->direct)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
     }
     return st;
 }

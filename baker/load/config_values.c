@@ -181,34 +181,33 @@ static lmb_status or_auto_error(parse_ctx *c, const key_spec *k, const yaml_node
     return lmb_cfg_bad_value(c, k, n, what);
 }
 
-lmb_status lmb_cfg_set_float_or_auto(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+/* "auto" stores auto_value (size bytes); anything else goes through set. */
+static lmb_status set_or_auto(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base, setter_fn set,
+                              const void *auto_value, size_t size)
 {
     if (is_auto(n)) {
-        double zero = 0;
-        memcpy(base + k->offset, &zero, sizeof zero);
+        memcpy(base + k->offset, auto_value, size);
         return LMB_OK;
     }
-    return or_auto_error(c, k, n, lmb_cfg_set_float(c, k, n, base));
+    return or_auto_error(c, k, n, set(c, k, n, base));
+}
+
+lmb_status lmb_cfg_set_float_or_auto(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    const double zero = 0;
+    return set_or_auto(c, k, n, base, lmb_cfg_set_float, &zero, sizeof zero);
 }
 
 lmb_status lmb_cfg_set_u32_or_auto(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    if (is_auto(n)) {
-        uint32_t a = LMB_AUTO;
-        memcpy(base + k->offset, &a, sizeof a);
-        return LMB_OK;
-    }
-    return or_auto_error(c, k, n, lmb_cfg_set_u32(c, k, n, base));
+    const uint32_t a = LMB_AUTO;
+    return set_or_auto(c, k, n, base, lmb_cfg_set_u32, &a, sizeof a);
 }
 
 lmb_status lmb_cfg_set_u64_or_auto(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    if (is_auto(n)) {
-        uint64_t zero = 0;
-        memcpy(base + k->offset, &zero, sizeof zero);
-        return LMB_OK;
-    }
-    return or_auto_error(c, k, n, lmb_cfg_set_u64(c, k, n, base));
+    const uint64_t zero = 0;
+    return set_or_auto(c, k, n, base, lmb_cfg_set_u64, &zero, sizeof zero);
 }
 
 static int ieq(const char *a, const char *b)

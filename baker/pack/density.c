@@ -93,8 +93,7 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
     return result;
 }
 
-/* The first density_overrides entry matching the instance's node or mesh name, or 0. */
-static double override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i)
+double lmb_density_override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i)
 {
     const lmb_instance *in = &s->instances[i];
     for (uint32_t k = 0; k < cfg->density_override_count; k++)
@@ -129,7 +128,7 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
     double fixed_texels = 0, free_area = 0;
     for (uint32_t k = 0; st == LMB_OK && k < n; k++) {
         uint32_t i = list[k];
-        double o = override_for(s, cfg, i), d = o > 0 ? o : cfg->texel_density;
+        double o = lmb_density_override_for(s, cfg, i), d = o > 0 ? o : cfg->texel_density;
         fit[k] = lmb_density_fit(s, l, cfg, i);
         area[k] = lmb_instance_world_area(s, l, i);
         if (!(fit[k] > 0)) {

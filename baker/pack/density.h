@@ -26,6 +26,9 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
 lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
                               uint32_t n, const lmb_log *log, lmb_density_report *report, lmb_error *err);
 
+/* The first density_overrides entry matching instance i's node or mesh name, or 0. */
+double lmb_density_override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t instance);
+
 /* World area of instance i's lightmapped triangles. */
 double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t instance);
 

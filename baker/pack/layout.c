@@ -203,26 +203,15 @@ static lmb_status pack_level(const lmb_scene *s, const lmb_config *cfg, lmb_layo
         uint32_t failed;
         lmb_status st = pack_instances(s, cfg, l, list, n, &failed, err);
         if (st != LMB_ERR_INPUT || !l->density.automatic || failed == UINT32_MAX || attempt >= 24 ||
-            l->meshes[s->instances[failed].mesh].kept_uv1)
-            return st;
-        int overridden = 0;
-        for (uint32_t k = 0; k < cfg->density_override_count; k++)
-            overridden |= lmb_glob_match(cfg->density_overrides[k].pattern, s->instances[failed].name) ||
-                          lmb_glob_match(cfg->density_overrides[k].pattern, s->meshes[s->instances[failed].mesh].name);
-        if (overridden)
+            l->meshes[s->instances[failed].mesh].kept_uv1 || lmb_density_override_for(s, cfg, failed) > 0)
             return st;
         lmb_layout_instance *li = &l->instances[failed];
         li->texel_density *= 0.85;
         lmb_warn(log, "instance '%s' (mesh '%s') lowered to %.4g texels per unit to fit one %ux%u atlas",
                  s->instances[failed].name, s->meshes[s->instances[failed].mesh].name, li->texel_density,
                  cfg->max_atlas_size, cfg->max_atlas_size);
-        /* start again from chart-local UVs */
-        for (uint32_t a = 0; a < l->atlas_count; a++)
-            l->width[a] = l->height[a] = 0;
-        l->atlas_count = l->kept_atlases;
-        l->chart_total = l->kept_atlases;
-        for (uint32_t j = 0; j < n; j++)
-            scale_instance(s, l, list[j]);
+        /* a failed packing wrote nothing back: only this instance's charts change scale */
+        scale_instance(s, l, failed);
     }
 }
 
@@ -338,7 +327,6 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             list[packed++] = list[j];
     }
     n = packed;
-    l->kept_atlases = l->atlas_count;
     double t0 = lmb_seconds();
     if (st == LMB_OK && n)
         st = pack_level(s, cfg, l, list, n, log, err);

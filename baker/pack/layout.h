@@ -51,7 +51,6 @@ typedef struct lmb_layout {
     lmb_layout_instance *instances;
     uint32_t atlas_count;
     uint32_t *width, *height;
-    uint32_t kept_atlases; /* the first atlases: one per kept-TEXCOORD_1 instance */
     uint32_t chart_total;  /* charts placed, over all instances */
     lmb_density_report density;    /* how densities were chosen */
     double pack_seconds;

@@ -31,10 +31,6 @@ static void copy_band(lmb_texels *dst, const lmb_texels *band);
 lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err)
 {
     uint32_t n = dst->count + band->count;
-    if (n <= dst->capacity && dst->texel) {
-        copy_band(dst, band);
-        return LMB_OK;
-    }
     /* exact growth: large blocks are mmap'd and realloc moves them with mremap, not a copy,
      * and no slack is left behind (memory per texel, README "Memory") */
     uint32_t *texel = realloc(dst->texel, ((size_t)n + 1) * sizeof *texel);
@@ -51,22 +47,8 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
     if (gather_at) dst->gather_at = gather_at;
     if (!texel || !points_in || !size || !refs || !valid || !gather_at)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", n);
-    dst->capacity = n;
     copy_band(dst, band);
     return LMB_OK;
-}
-
-void lmb_texels_trim(lmb_texels *t)
-{
-    size_t n = (size_t)t->count + 1;
-    void *p;
-    if ((p = realloc(t->texel, n * sizeof *t->texel))) t->texel = p;
-    if ((p = realloc(t->points_in, n))) t->points_in = p;
-    if ((p = realloc(t->texel_size, n * sizeof *t->texel_size))) t->texel_size = p;
-    if ((p = realloc(t->refs, n * sizeof *t->refs))) t->refs = p;
-    if ((p = realloc(t->valid, n))) t->valid = p;
-    if ((p = realloc(t->gather_at, n))) t->gather_at = p;
-    t->capacity = t->count;
 }
 
 static void copy_band(lmb_texels *dst, const lmb_texels *band)

@@ -30,7 +30,6 @@ typedef struct lmb_point_ref {
 typedef struct lmb_texels {
     uint32_t width, height, samples;
     uint32_t count;            /* texels that hold at least one point */
-    uint32_t capacity;         /* allocated entries (lmb_texels_append grows them) */
     uint32_t *texel;           /* per listed texel: y * width + x */
     uint8_t *points_in;        /* per listed texel: points (1..samples) */
     float *texel_size;         /* per listed texel: world units per texel */
@@ -58,9 +57,6 @@ lmb_status lmb_texels_build_rows(const lmb_scene *scene, const lmb_layout *l, ui
  * at (band->gather_at, set by the lights stage), as a 16-byte reference: dst then has
  * samples = 1 and no expanded points (memory: about 60 bytes per texel in all). */
 lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err);
-
-/* Gives back what appending reserved beyond count. */
-void lmb_texels_trim(lmb_texels *t);
 
 void lmb_texels_free(lmb_texels *t);
 
