@@ -212,7 +212,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
         lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material): the lightmaps "
                  "are black", s->path);
     if (st == LMB_OK)
-        st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, err);
+        st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, log, err);
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
                                     l.height[a], err);

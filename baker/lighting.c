@@ -2,6 +2,7 @@
 #include "lighting.h"
 
 #include "gather/gather.h"
+#include "irradiance_cache/ic_pass.h"
 #include "util/clock.h"
 
 #include <math.h>
@@ -35,15 +36,67 @@ static lmb_status store_pass(atlas_work *w, lmb_cache *cache, lmb_error *err)
     return st;
 }
 
-/* One gather pass over every atlas: result = direct + gather(cache), then (store) the cache :=
- * result; without store the cache keeps the previous pass (bounces: auto reads it). */
-static lmb_status gather_pass(lmb_gather_job *job, atlas_work *w, lmb_cache *cache, lmb_bake_stats *stats,
-                              lmb_gather_stats *gs, int store, lmb_error *err)
+/* What the passes share. */
+typedef struct pass_env {
+    const lmb_config *cfg;
+    const lmb_log *log;
+    lmb_gather_job *job;
+    atlas_work *w;
+    lmb_cache *cache;
+    lmb_bake_stats *stats;
+} pass_env;
+
+/* The pass's gather through the irradiance cache, every atlas at once (records are shared
+ * across atlases), with one report line per atlas. */
+static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_error *err)
 {
+    uint32_t n = env->cache->atlas_count;
+    const lmb_texels **t = calloc((size_t)n + 1, sizeof *t);
+    float **out = calloc((size_t)n + 1, sizeof *out);
+    uint64_t *records = calloc((size_t)n + 1, sizeof *records), *valid = calloc((size_t)n + 1, sizeof *valid);
+    lmb_status st = LMB_OK;
+    if (!t || !out || !records || !valid)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
+    for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
+        t[a] = &env->w[a].t;
+        out[a] = env->w[a].result;
+    }
+    lmb_ic_options opt = {env->cfg->ic_error, env->cfg->ic_min_spacing, env->cfg->ic_max_spacing,
+                          env->cfg->ic_ray_scale};
+    lmb_ic_pass_stats ps = {records, valid};
+    if (st == LMB_OK)
+        st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, gs, err);
+    uint64_t all = 0;
+    for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
+        all += records[a];
+        lmb_info(env->log, "%s, atlas %u: %llu records, %.1f%% of %llu valid texels interpolated", env->job->stage, a,
+                 (unsigned long long)records[a], valid[a] ? 100.0 * (double)(valid[a] - records[a]) / (double)valid[a] : 0.0,
+                 (unsigned long long)valid[a]);
+    }
+    gs->records = all;
+    free(t);
+    free(out);
+    free(records);
+    free(valid);
+    return st;
+}
+
+/* One gather pass over every atlas: result = direct + gather(cache), then (store) the cache :=
+ * result; without store the cache keeps the previous pass (bounces: auto reads it). The
+ * gather runs at every texel, or at irradiance-cache records (irradiance_cache.error > 0). */
+static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int store, lmb_error *err)
+{
+    lmb_gather_job *job = env->job;
+    atlas_work *w = env->w;
+    lmb_cache *cache = env->cache;
+    lmb_bake_stats *stats = env->stats;
     lmb_status st = LMB_OK;
     job->progress_done = 0;
+    if (env->cfg->ic_error > 0 && !job->reference)
+        st = cached_gather(env, gs, err);
     for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
-        st = lmb_gather_atlas(job, a, &w[a].t, w[a].result, gs, err);
+        if (!(env->cfg->ic_error > 0) || job->reference)
+            st = lmb_gather_atlas(job, a, &w[a].t, w[a].result, gs, err);
         for (size_t k = 0; st == LMB_OK && k < 3 * (size_t)w[a].t.count; k++)
             w[a].result[k] += w[a].direct[k];
         job->progress_done += w[a].t.count;
@@ -100,9 +153,13 @@ static double luminance(const double c[3])
  * ~20 passes; the ratio settles after 3-4, and the extrapolation is exact for a furnace and
  * within the ratio's error times the tail elsewhere.
  */
-static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas_work *w, lmb_cache *cache,
-                               lmb_bake_stats *stats, uint32_t *passes, lmb_error *err)
+static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error *err)
 {
+    const lmb_config *cfg = env->cfg;
+    lmb_gather_job *job = env->job;
+    atlas_work *w = env->w;
+    lmb_cache *cache = env->cache;
+    lmb_bake_stats *stats = env->stats;
     uint32_t n = cache->atlas_count, max_passes = cfg->bounces_max - 1;
     double before[3], after[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
     lmb_status st = LMB_OK;
@@ -112,13 +169,13 @@ static lmb_status auto_bounces(const lmb_config *cfg, lmb_gather_job *job, atlas
     int converged = 0;
     uint32_t done = 0;
     for (uint32_t b = 1; b <= max_passes && !converged && st == LMB_OK; b++) {
-        lmb_gather_stats gs = {0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0};
+        lmb_gather_stats gs = {0, 0, 0, 0};
+        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0, 0};
         job->estimator = e;
         job->pass = b;
         snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
         job->stage = stage;
-        st = gather_pass(job, w, cache, stats, &gs, 0, err); /* the cache still holds pass b - 1 */
+        st = gather_pass(env, &gs, 0, err); /* the cache still holds pass b - 1 */
         if (st != LMB_OK)
             break;
         mean_rgb(w, n, offsetof(atlas_work, result), after);
@@ -236,7 +293,8 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
 }
 
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
-                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, lmb_error *err)
+                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
+                             lmb_error *err)
 {
     uint32_t n = cache->atlas_count;
     atlas_work *w = calloc((size_t)n + 1, sizeof *w);
@@ -272,39 +330,41 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.progress = progress;
     job.progress_user = user;
     job.progress_total = total;
+    pass_env env = {cfg, log, &job, w, cache, stats};
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);
     stats->no_light = dark;
     /* bounce passes: classic gathering with few rays, a fixed number or until converged */
     uint32_t passes = 0;
     if (st == LMB_OK && !dark && !cfg->reference && cfg->bounces == LMB_AUTO)
-        st = auto_bounces(cfg, &job, w, cache, stats, &passes, err);
+        st = auto_bounces(&env, &passes, err);
     char stage[64];
     for (uint32_t b = 1; !dark && cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK;
          b++) {
-        lmb_gather_stats gs = {0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0};
+        lmb_gather_stats gs = {0, 0, 0, 0};
+        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0, 0};
         job.estimator = e;
         job.pass = b;
         snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
         job.stage = stage;
-        st = gather_pass(&job, w, cache, stats, &gs, 1, err);
+        st = gather_pass(&env, &gs, 1, err);
         passes = b;
     }
     uint32_t bounces = dark ? 0 : cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
     stats->bounces = bounces;
     /* the final gather, or the reference */
     if (bounces > 0 && st == LMB_OK) {
-        lmb_gather_stats gs = {0, 0, 0};
+        lmb_gather_stats gs = {0, 0, 0, 0};
         lmb_estimator_options e = {cfg->gather_method, cfg->gather_rays, cfg->amis_iterations, cfg->defensive_fraction,
-                                   cfg->amis_weights == LMB_AMIS_UNBIASED};
+                                   cfg->amis_weights == LMB_AMIS_UNBIASED, 0};
         job.estimator = e;
         job.pass = 1000;
         job.reference = cfg->reference;
         job.depth = bounces;
         job.stage = cfg->reference ? "reference" : "final gather";
         double t0 = lmb_seconds();
-        st = gather_pass(&job, w, cache, stats, &gs, 1, err);
+        st = gather_pass(&env, &gs, 1, err);
+        stats->gather_records = gs.records;
         stats->gather_seconds = lmb_seconds() - t0;
         stats->gather_rays = gs.rays;
         stats->amis_adapted = gs.adapted;

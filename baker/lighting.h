@@ -8,6 +8,8 @@
  *                samples.bounce rays) each set the cache to E_direct + gather(previous cache);
  *                the final gather (gather.method, samples.gather rays) gives
  *                E = E_direct + gather(cache): k bounces of indirect light in all.
+ *   irradiance_cache.error > 0: every pass gathers at records only and interpolates the
+ *                rest (irradiance_cache/ic_pass.h), each pass with its own records.
  *   --reference: E = E_direct + path-traced indirect light of depth k, no cache.
  * The result is left in the cache (its images, dilated), which the writer saves.
  */
@@ -20,6 +22,7 @@
 #include "lights/direct.h"
 
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
-                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats, lmb_error *err);
+                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats, const lmb_log *log,
+                             lmb_error *err);
 
 #endif

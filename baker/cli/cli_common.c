@@ -14,9 +14,19 @@ static void print_warning(void *user, const char *message)
         fprintf(stderr, "lmbake: warning: %s\n", message);
 }
 
+/* Report lines go to stdout with the summary (progress is on stderr). */
+static void print_info(void *user, const char *message)
+{
+    cli_warnings *w = user;
+    if (!w->quiet) {
+        printf("%s\n", message);
+        fflush(stdout);
+    }
+}
+
 lmb_log cli_log(cli_warnings *w)
 {
-    lmb_log log = {print_warning, w};
+    lmb_log log = {print_warning, w, print_info};
     return log;
 }
 

@@ -192,9 +192,16 @@ int cmd_bake(int argc, char **argv)
         print_bounces(&cfg, &bs);
     }
     if (!a.quiet && bs.bounces > 0)
-        printf("%s: %.3f s, %llu rays, %.4g rays/s, %u rays per texel, %u bounce(s)\n",
-               cfg.reference ? "reference" : "final gather", bs.gather_seconds, (unsigned long long)bs.gather_rays,
-               bs.gather_seconds > 0 ? (double)bs.gather_rays / bs.gather_seconds : 0.0, cfg.gather_rays, bs.bounces);
+    {
+        printf("%s: %.3f s, %llu rays, %.4g rays/s, ", cfg.reference ? "reference" : "final gather", bs.gather_seconds,
+               (unsigned long long)bs.gather_rays, bs.gather_seconds > 0 ? (double)bs.gather_rays / bs.gather_seconds : 0.0);
+        if (bs.gather_records)
+            printf("%llu records of %u rays (irradiance_cache.error %g)", (unsigned long long)bs.gather_records,
+                   cfg.gather_rays * cfg.ic_ray_scale, cfg.ic_error);
+        else
+            printf("%u rays per texel", cfg.gather_rays);
+        printf(", %u bounce(s)\n", bs.bounces);
+    }
     if (!a.quiet)
         printf("bake: %.2f s (lighting %.2f s), %u atlas(es), %llu texels (%llu valid), %llu rays, %.3g rays/s\n"
                "output: %s (lightmaps beside it)\n",

@@ -74,6 +74,15 @@ static int draw_and_trace(const lmb_lobe *lobe, const lmb_lobe *cosine, const do
     return 1;
 }
 
+/* The rotation gradient's term of a sample of weight x = f / (N q) per channel (estimator.h). */
+static void add_rotation(lmb_estimate *out, const double n[3], const double w[3], double c, const double x[3])
+{
+    double nxw[3] = {n[1] * w[2] - n[2] * w[1], n[2] * w[0] - n[0] * w[2], n[0] * w[1] - n[1] * w[0]};
+    for (int ch = 0; ch < 3; ch++)
+        for (int k = 0; k < 3; k++)
+            out->rot[ch][k] += x[ch] / c * nxw[k];
+}
+
 /* Classic final gathering: E = 1/N sum f(w_j) / p_cos(w_j). */
 static void classic(const lmb_estimator_options *opt, const lmb_lobe *cosine, const double ng[3], lmb_rng rng,
                     lmb_radiance_fn radiance, void *user, lmb_estimate *out)
@@ -83,9 +92,11 @@ static void classic(const lmb_estimator_options *opt, const lmb_lobe *cosine, co
         sample_uniforms(rng, j, u);
         if (!draw_and_trace(cosine, cosine, ng, u, j, radiance, user, w, l, &c, out))
             continue;
-        double denom = (double)opt->rays * lmb_lobe_pdf(cosine, w);
+        double denom = (double)opt->rays * lmb_lobe_pdf(cosine, w), x[3];
         for (int k = 0; k < 3; k++)
-            out->e[k] += l[k] * c / denom;
+            out->e[k] += x[k] = l[k] * c / denom;
+        if (opt->gradient)
+            add_rotation(out, cosine->axis, w, c, x);
     }
 }
 
@@ -188,9 +199,13 @@ static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine,
                 out->adapted++;
         }
     }
-    for (uint32_t q = 0; q < s->count; q++)
+    for (uint32_t q = 0; q < s->count; q++) {
+        double x[3];
         for (int k = 0; k < 3; k++)
-            out->e[k] += s->f[3 * q + k] / (opt->unbiased ? s->own[q] : s->denom[q]);
+            out->e[k] += x[k] = s->f[3 * q + k] / (opt->unbiased ? s->own[q] : s->denom[q]);
+        if (opt->gradient)
+            add_rotation(out, cosine->axis, s->w + 3 * q, lmb_dot3(s->w + 3 * q, cosine->axis), x);
+    }
     out->last = lobes[T - 1];
     return LMB_OK;
 }

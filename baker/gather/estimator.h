@@ -22,6 +22,10 @@
  * the later, adapted iterations (Owen, "Monte Carlo theory", ch. 10.5: fixed-weight combination
  * of adaptive importance sampling stages).
  * A sample whose direction lies below the geometric normal has f = 0 and traces no ray.
+ * Rotation gradient (options.gradient): turning the normal by the small rotation vector v
+ * changes w.n by v.(n x w), so dE/dv = integral of L(w) (n x w) dw (Ward and Heckbert 1992's
+ * rotation gradient, written for any pdf): every sample adds its weight f/q times
+ * (n x w) / (w.n), with the same weights as E, so it is unbiased whenever E is.
  * Random numbers: sample j of the point uses counter 4j.. of the caller's stream, so the
  * same stream gives the same directions to every method (AMIS with T = 1 is classic
  * gathering, bit for bit).
@@ -46,6 +50,7 @@ typedef struct lmb_estimator_options {
     uint32_t iterations; /* T, AMIS only; 1..LMB_AMIS_MAX_ITERATIONS */
     double defensive;    /* d, AMIS defensive only, in [0, 1) */
     int unbiased;        /* AMIS: weight each iteration's samples by its own pdf (see above) */
+    int gradient;        /* also estimate the rotation gradient (irradiance cache records) */
 } lmb_estimator_options;
 
 /* Per-thread memory for the AMIS samples (grows as needed; free with lmb_estimator_scratch_free). */
@@ -62,6 +67,7 @@ typedef struct lmb_estimate {
     uint32_t traced;   /* rays traced (samples above the surface) */
     lmb_lobe last;     /* the last lobe used (AMIS), or the cosine lobe */
     uint32_t adapted;  /* iterations that changed the lobe */
+    double rot[3][3];  /* with options.gradient: per channel, dE/d(rotation vector of the normal) */
 } lmb_estimate;
 
 void lmb_estimator_scratch_free(lmb_estimator_scratch *s);

@@ -3,6 +3,7 @@
 
 #include <omp.h>
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -13,6 +14,9 @@ typedef struct point_rays {
     double o[3];
     uint64_t key;
     uint64_t rays;
+    uint32_t cosine_samples;   /* samples below this index are cosine-distributed */
+    uint32_t distances;        /* of those, how many were traced */
+    double inverse_distances;  /* and the sum of 1 / hit distance (0 for a miss) */
 } point_rays;
 
 /* A hit as a shading point (its geometric normal, front side) for direct light there. */
@@ -33,7 +37,12 @@ static void cached_radiance(void *user, const double w[3], uint32_t sample, doub
     lmb_rt_hit h;
     out[0] = out[1] = out[2] = 0;
     pr->rays++;
-    if (!lmb_rt_intersect(job->rt, pr->o, w, pr->sp.eps, 1e300, &h))
+    int hit = lmb_rt_intersect(job->rt, pr->o, w, pr->sp.eps, 1e300, &h);
+    if (sample < pr->cosine_samples) {
+        pr->distances++;
+        pr->inverse_distances += hit && h.t > 0 ? 1.0 / h.t : 0.0;
+    }
+    if (!hit)
         return;
     double albedo[3], e[3];
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
@@ -92,6 +101,26 @@ static void reference(point_rays *pr, double out[3])
         out[k] = sum[k] / paths;
 }
 
+/* The texel's gather point, the origin of its rays and its random-stream key. */
+static void point_setup(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i, point_rays *pr)
+{
+    memset(pr, 0, sizeof *pr);
+    pr->job = job;
+    pr->key = ((uint64_t)atlas << 32) | t->texel[i];
+    lmb_texel_shading_point(job->direct, t, i, t->gather_at[i], &pr->sp);
+    for (int k = 0; k < 3; k++)
+        pr->o[k] = pr->sp.p[k] + pr->sp.ng[k] * pr->sp.eps;
+}
+
+/* The estimator at the point (the same stream whether a texel or a record asks). */
+static lmb_status estimate_at(const lmb_gather_job *job, point_rays *pr, lmb_estimator_scratch *scratch,
+                              const lmb_estimator_options *opt, lmb_estimate *est)
+{
+    /* stream b = pass << 32 | 0xFFFFFFFF: apart from the per-sample streams of hits */
+    lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | 0xFFFFFFFFu);
+    return lmb_estimate_irradiance(opt, pr->sp.n, pr->sp.ng, rng, cached_radiance, pr, scratch, est);
+}
+
 static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
                                lmb_estimator_scratch *scratch, float *out, lmb_gather_stats *st)
 {
@@ -99,20 +128,13 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
     if (!t->valid[i])
         return LMB_OK;
     point_rays pr;
-    memset(&pr, 0, sizeof pr);
-    pr.job = job;
-    pr.key = ((uint64_t)atlas << 32) | t->texel[i];
-    lmb_texel_shading_point(job->direct, t, i, t->gather_at[i], &pr.sp);
-    for (int k = 0; k < 3; k++)
-        pr.o[k] = pr.sp.p[k] + pr.sp.ng[k] * pr.sp.eps;
+    point_setup(job, atlas, t, i, &pr);
     double e[3];
     if (job->reference) {
         reference(&pr, e);
     } else {
         lmb_estimate est;
-        /* stream b = pass << 32 | 0xFFFFFFFF: apart from the per-sample streams of hits */
-        lmb_rng rng = lmb_rng_make(job->seed, pr.key, ((uint64_t)job->pass << 32) | 0xFFFFFFFFu);
-        if (lmb_estimate_irradiance(&job->estimator, pr.sp.n, pr.sp.ng, rng, cached_radiance, &pr, scratch, &est) != LMB_OK)
+        if (estimate_at(job, &pr, scratch, &job->estimator, &est) != LMB_OK)
             return LMB_ERR_INTERNAL;
         memcpy(e, est.e, sizeof e);
         st->adapted += est.adapted;
@@ -121,6 +143,29 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
         out[3 * (size_t)i + k] = (float)e[k];
     st->rays += pr.rays;
     st->texels++;
+    return LMB_OK;
+}
+
+lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
+                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st)
+{
+    point_rays pr;
+    point_setup(job, atlas, t, i, &pr);
+    lmb_estimator_options opt = job->estimator;
+    opt.gradient = 1;
+    uint32_t iterations = opt.method == LMB_GATHER_COSINE || opt.iterations < 1 ? 1 : opt.iterations;
+    pr.cosine_samples = opt.rays / iterations + (opt.rays % iterations != 0); /* iteration 0 (estimator.c) */
+    lmb_estimate est;
+    if (estimate_at(job, &pr, scratch, &opt, &est) != LMB_OK)
+        return LMB_ERR_INTERNAL;
+    memcpy(out->p, pr.sp.p, sizeof out->p);
+    memcpy(out->n, pr.sp.n, sizeof out->n);
+    memcpy(out->e, est.e, sizeof out->e);
+    memcpy(out->rot, est.rot, sizeof out->rot);
+    out->harmonic = pr.inverse_distances > 0 ? pr.distances / pr.inverse_distances : HUGE_VAL;
+    st->rays += pr.rays;
+    st->texels++;
+    st->adapted += est.adapted;
     return LMB_OK;
 }
 
@@ -136,7 +181,7 @@ lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb
         {
             lmb_rt_thread_init();
             lmb_estimator_scratch scratch = {0};
-            lmb_gather_stats st = {0, 0, 0};
+            lmb_gather_stats st = {0, 0, 0, 0};
 #pragma omp for schedule(dynamic, 4)
             for (uint32_t i = start; i < end; i++)
                 if (gather_texel(job, atlas, t, i, &scratch, out, &st) != LMB_OK)

@@ -41,7 +41,19 @@ typedef struct lmb_gather_stats {
     uint64_t rays;      /* rays traced (gather rays, and shadow rays at hits) */
     uint64_t texels;    /* texels gathered */
     uint64_t adapted;   /* AMIS: lobe updates that changed the lobe */
+    uint64_t records;   /* irradiance cache: records placed (texels counts their gathers too) */
 } lmb_gather_stats;
+
+/* One gather at listed texel i's gather point, as an irradiance-cache record needs it. */
+typedef struct lmb_gather_point_result {
+    double p[3], n[3];  /* the gather point and its shading normal */
+    double e[3];        /* irradiance (the same value lmb_gather_atlas gives the texel) */
+    double rot[3][3];   /* rotation gradient per channel (estimator.h) */
+    double harmonic;    /* harmonic mean hit distance of its cosine-distributed rays (HUGE_VAL: none hit) */
+} lmb_gather_point_result;
+
+lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
+                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st);
 
 /* Indirect irradiance of every listed texel of t (atlas `atlas`) into out (3 floats per texel;
  * 0 for invalid texels). */

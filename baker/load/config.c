@@ -68,6 +68,10 @@ static const key_spec config_keys[] = {
     ENUM("gather.method", OFF(gather_method), gather_methods),
     ENUM("gather.amis_weights", OFF(amis_weights), amis_weights),
     FLOAT("gather.defensive", OFF(defensive_fraction), 0, 1, OPEN_HI),
+    FLOAT("irradiance_cache.error", OFF(ic_error), 0, 10, 0),
+    FLOAT("irradiance_cache.min_spacing", OFF(ic_min_spacing), 0.5, 4096, 0),
+    FLOAT("irradiance_cache.max_spacing", OFF(ic_max_spacing), 1, 4096, 0),
+    U32("irradiance_cache.ray_scale", OFF(ic_ray_scale), 1, 1024),
     U64("seed", OFF(seed), 0, 9223372036854775807LL),
     U32("threads", OFF(threads), 0, 1024),
     FLAGS("output.formats", OFF(output_formats), output_formats),
@@ -106,6 +110,10 @@ void lmb_config_default(lmb_config *cfg)
     cfg->bounces_tail = 0.2;
     cfg->gather_method = LMB_GATHER_AMIS_DEFENSIVE;
     cfg->defensive_fraction = 0.1;
+    cfg->ic_error = 0.3;
+    cfg->ic_min_spacing = 4;
+    cfg->ic_max_spacing = 32;
+    cfg->ic_ray_scale = 4;
     cfg->seed = 1;
     cfg->threads = 0;
     cfg->output_formats = LMB_OUTPUT_EXR | LMB_OUTPUT_HDR | LMB_OUTPUT_PNG;
@@ -358,6 +366,10 @@ lmb_status lmb_config_parse(const char *name, const char *text, size_t length, l
         st = apply_root(&c, yaml_document_get_root_node(&doc), cfg);
         yaml_document_delete(&doc);
     }
+    if (st == LMB_OK && cfg->ic_min_spacing > cfg->ic_max_spacing)
+        st = lmb_error_set(err, LMB_ERR_INPUT,
+                           "%s: irradiance_cache.min_spacing (%g) is larger than irradiance_cache.max_spacing (%g)",
+                           name, cfg->ic_min_spacing, cfg->ic_max_spacing);
     yaml_parser_delete(&parser);
     return st;
 }

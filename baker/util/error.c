@@ -20,6 +20,18 @@ lmb_status lmb_error_set(lmb_error *err, lmb_status status, const char *fmt, ...
     return status;
 }
 
+void lmb_info(const lmb_log *log, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    if (!log || !log->info)
+        return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    log->info(log->user, buf);
+}
+
 void lmb_warn(const lmb_log *log, const char *fmt, ...)
 {
     char buf[1024];

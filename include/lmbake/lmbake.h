@@ -50,9 +50,17 @@ typedef void (*lmb_warn_fn)(void *user, const char *message);
 typedef struct lmb_log {
     lmb_warn_fn warn; /* NULL: warnings are dropped */
     void *user;
+    lmb_warn_fn info; /* plain report lines (what a stage did); NULL: dropped. Same user. */
 } lmb_log;
 
 void lmb_warn(const lmb_log *log, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* A report line (lmb_log.info). */
+void lmb_info(const lmb_log *log, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
@@ -219,6 +227,11 @@ typedef struct lmb_config {
     double defensive_fraction;     /* share of cosine samples, AMIS defensive */
     lmb_amis_weights amis_weights; /* how AMIS weights its samples in the estimate */
     int reference;                 /* path-trace indirect light with no cache (ground truth) */
+    /* irradiance cache (Ward): gathers at records, interpolation elsewhere */
+    double ic_error;               /* Ward's a; 0 = a gather at every texel */
+    double ic_min_spacing;         /* texels: the smallest record reach */
+    double ic_max_spacing;         /* texels: the largest record reach */
+    uint32_t ic_ray_scale;         /* a record gathers with this many times the per-texel rays */
     uint64_t seed;
     uint32_t threads;              /* 0: all cores */
     unsigned output_formats;       /* LMB_OUTPUT_* bits */
@@ -299,6 +312,7 @@ typedef struct lmb_bake_stats {
     double gather_seconds;  /* wall time of the final gather (or the reference) */
     uint64_t gather_rays;   /* rays of the final gather (or the reference) */
     uint64_t amis_adapted;  /* AMIS lobe updates that changed a lobe */
+    uint64_t gather_records; /* irradiance cache: records of the final gather (0: a gather per texel) */
     uint32_t bounces;       /* bounces of indirect light computed (passes + the final gather) */
     double bounce_energy[LMB_MAX_REPORTED_BOUNCES]; /* mean luminance: [0] direct, [b] what pass b added */
     double bounce_ratio;    /* bounces: auto: the last ratio of what two passes added */

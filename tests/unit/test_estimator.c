@@ -64,7 +64,7 @@ typedef struct moments {
 static moments run(env *e, lmb_gather_method m, uint32_t rays, uint32_t iters, double def, int seeds,
                    lmb_estimator_scratch *s, lmb_estimate *last)
 {
-    lmb_estimator_options o = {m, rays, iters, def, unbiased_weights};
+    lmb_estimator_options o = {m, rays, iters, def, unbiased_weights, 0};
     double sum = 0, sum2 = 0;
     for (int k = 0; k < seeds; k++) {
         lmb_estimate est;
@@ -110,8 +110,8 @@ int main(void)
     /* 1. AMIS with one iteration = classic, bit for bit, and the same rays */
     env spot = {1.0, {make_cap(40, 30, 6, 400.0)}, 1, 0};
     for (uint64_t seed = 0; seed < 50; seed++) {
-        lmb_estimator_options oc = {LMB_GATHER_COSINE, 333, 1, 0, 0}, oa = {LMB_GATHER_AMIS, 333, 1, 0, 0},
-                              ou = {LMB_GATHER_AMIS, 333, 1, 0, 1};
+        lmb_estimator_options oc = {LMB_GATHER_COSINE, 333, 1, 0, 0, 0}, oa = {LMB_GATHER_AMIS, 333, 1, 0, 0, 0},
+                              ou = {LMB_GATHER_AMIS, 333, 1, 0, 1, 0};
         lmb_estimate c, a, u;
         lmb_estimate_irradiance(&oc, N, N, lmb_rng_make(seed, 1, 2), env_radiance, &spot, &s, &c);
         lmb_estimate_irradiance(&oa, N, N, lmb_rng_make(seed, 1, 2), env_radiance, &spot, &s, &a);
@@ -177,7 +177,7 @@ int main(void)
 
     /* 5. nothing seen: E = 0, no adaptation, the cosine lobe stays */
     env dark = {0.0, {{{0, 0, 1}, 2.0, 0}}, 0, 0};
-    lmb_estimator_options o = {LMB_GATHER_AMIS, 256, 4, 0, 0};
+    lmb_estimator_options o = {LMB_GATHER_AMIS, 256, 4, 0, 0, 0};
     lmb_estimate z;
     lmb_estimate_irradiance(&o, N, N, lmb_rng_make(1, 2, 3), env_radiance, &dark, &s, &z);
     CHECK(z.e[0] == 0 && z.e[1] == 0 && z.e[2] == 0);

@@ -1,0 +1,270 @@
+/* A gather pass through the irradiance cache: placement, gradients, interpolation (ic_pass.h). */
+#include "ic_pass.h"
+
+#include "irradiance_cache/records.h"
+#include "util/frame.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Rounds of the last level (spacing 1) at most; see lmb_ic_gather_pass. */
+#define LMB_IC_FINAL_ROUNDS 4
+
+/* A listed texel of some atlas. */
+typedef struct texel_at {
+    uint32_t atlas, index;
+} texel_at;
+
+typedef struct pass_ctx {
+    const lmb_gather_job *job;    /* with the record's rays */
+    const lmb_ic_options *opt;
+    uint32_t atlas_count;
+    const lmb_texels *const *t;
+    uint8_t **is_record;          /* per atlas, per listed texel */
+    lmb_ic_records records;
+    int threads;
+    uint64_t valid_total, levels, level;
+    char stage[96];
+} pass_ctx;
+
+static void texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
+{
+    lmb_shading_point sp;
+    const lmb_texels *t = c->t[x.atlas];
+    lmb_texel_shading_point(c->job->direct, t, x.index, t->gather_at[x.index], &sp);
+    memcpy(p, sp.p, 3 * sizeof *p);
+    memcpy(n, sp.n, 3 * sizeof *n);
+}
+
+static void report(const pass_ctx *c, uint64_t done_in_level, uint64_t level_total)
+{
+    const lmb_gather_job *job = c->job;
+    if (!job->progress)
+        return;
+    uint64_t total = c->valid_total * (c->levels + 1);
+    uint64_t done = c->valid_total * c->level + (level_total ? done_in_level * c->valid_total / level_total : 0);
+    job->progress(job->progress_user, c->stage, done < total ? done : total - (total > 0), total);
+}
+
+/* Valid texels on this level's grid that are not records yet, in (atlas, texel) order. */
+static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, texel_at **out, uint64_t *count, lmb_error *err)
+{
+    uint64_t n = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        n = 0;
+        for (uint32_t a = 0; a < c->atlas_count; a++) {
+            const lmb_texels *t = c->t[a];
+            for (uint32_t i = 0; i < t->count; i++) {
+                uint32_t x = t->texel[i] % t->width, y = t->texel[i] / t->width;
+                if (!t->valid[i] || c->is_record[a][i] || x % spacing || y % spacing)
+                    continue;
+                if (pass)
+                    (*out)[n] = (texel_at){a, i};
+                n++;
+            }
+        }
+        if (!pass) {
+            *out = malloc((size_t)(n + 1) * sizeof **out);
+            if (!*out)
+                return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu candidates",
+                                     (unsigned long long)n);
+        }
+    }
+    *count = n;
+    return LMB_OK;
+}
+
+/* Record from a gather at texel x: reach clamps from the texel's size, the rotation gradient
+ * bounded like the translation one (at most E over the largest normal difference served). */
+static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_result *g, lmb_ic_record *r)
+{
+    memset(r, 0, sizeof *r);
+    memcpy(r->p, g->p, sizeof r->p);
+    memcpy(r->n, g->n, sizeof r->n);
+    memcpy(r->e, g->e, sizeof r->e);
+    double size = c->t[x.atlas]->texel_size[x.index];
+    r->r_min = c->opt->min_spacing * size;
+    r->r_max = c->opt->max_spacing * size;
+    r->harmonic = g->harmonic;
+    double reach = c->opt->error * g->harmonic;
+    r->r = reach < r->r_min ? r->r_min : reach > r->r_max ? r->r_max : reach;
+    double turn = sqrt(2.0) * c->records.normal_limit; /* |n_i x n| at the largest difference */
+    for (int ch = 0; ch < 3; ch++) {
+        double mag = sqrt(lmb_dot3(g->rot[ch], g->rot[ch])) * turn;
+        double scale = mag > r->e[ch] ? r->e[ch] / mag : 1;
+        for (int k = 0; k < 3; k++)
+            r->grad_r[ch][k] = scale * g->rot[ch][k];
+    }
+    r->atlas = x.atlas;
+    r->texel = x.index;
+}
+
+/* Gathers at the uncovered candidates of one level and appends them as records. */
+static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t *placed, lmb_gather_stats *stats,
+                              lmb_error *err)
+{
+    texel_at *cand;
+    uint64_t n;
+    lmb_status st = level_candidates(c, spacing, &cand, &n, err);
+    if (st != LMB_OK)
+        return st;
+    uint8_t *uncovered = calloc((size_t)n + 1, 1);
+    if (!uncovered) {
+        free(cand);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    }
+#pragma omp parallel for num_threads(c->threads) schedule(dynamic, 256)
+    for (uint64_t k = 0; k < n; k++) {
+        double p[3], nn[3];
+        texel_point(c, cand[k], p, nn);
+        uncovered[k] = lmb_ic_interpolate(&c->records, p, nn, NULL) < LMB_IC_COVERED;
+    }
+    uint64_t m = 0;
+    for (uint64_t k = 0; k < n; k++)
+        if (uncovered[k])
+            cand[m++] = cand[k];
+    free(uncovered);
+    lmb_ic_record *fresh = malloc((size_t)(m + 1) * sizeof *fresh);
+    if (!fresh) {
+        free(cand);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu records",
+                             (unsigned long long)m);
+    }
+    const uint64_t block = 64;
+    int failed = 0;
+    for (uint64_t start = 0; start < m && !failed; start += block) {
+        uint64_t end = start + block < m ? start + block : m, rays = 0, texels = 0, adapted = 0;
+#pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
+        {
+            lmb_rt_thread_init();
+            lmb_estimator_scratch scratch = {0};
+            lmb_gather_stats gs = {0, 0, 0, 0};
+#pragma omp for schedule(dynamic, 1)
+            for (uint64_t k = start; k < end; k++) {
+                lmb_gather_point_result g;
+                if (lmb_gather_record(c->job, cand[k].atlas, c->t[cand[k].atlas], cand[k].index, &scratch, &g, &gs) !=
+                    LMB_OK) {
+                    failed = 1;
+                    continue;
+                }
+                make_record(c, cand[k], &g, &fresh[k]);
+            }
+            lmb_estimator_scratch_free(&scratch);
+            rays += gs.rays;
+            texels += gs.texels;
+            adapted += gs.adapted;
+        }
+        stats->rays += rays;
+        stats->texels += texels;
+        stats->adapted += adapted;
+        report(c, end, m);
+    }
+    if (failed)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", c->job->stage,
+                           c->job->estimator.rays);
+    for (uint64_t k = 0; st == LMB_OK && k < m; k++)
+        c->is_record[cand[k].atlas][cand[k].index] = 1;
+    if (st == LMB_OK)
+        st = lmb_ic_records_append(&c->records, fresh, (uint32_t)m, err);
+    free(fresh);
+    free(cand);
+    if (st == LMB_OK)
+        st = lmb_ic_records_index(&c->records, err);
+    *placed = m;
+    if (st == LMB_OK && m && clamp)
+        st = lmb_ic_records_clamp(&c->records, (uint32_t)c->threads, err);
+    return st;
+}
+
+/* Every valid texel := the interpolation at its gather point (invalid: 0). */
+static void interpolate_all(const pass_ctx *c, float *const *out)
+{
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        const lmb_texels *t = c->t[a];
+        float *o = out[a];
+#pragma omp parallel for num_threads(c->threads) schedule(dynamic, 1024)
+        for (uint32_t i = 0; i < t->count; i++) {
+            double e[3] = {0, 0, 0}, p[3], n[3];
+            if (t->valid[i]) {
+                texel_point(c, (texel_at){a, i}, p, n);
+                lmb_ic_interpolate(&c->records, p, n, e);
+            }
+            for (int k = 0; k < 3; k++)
+                o[3 * (size_t)i + k] = (float)e[k];
+        }
+    }
+}
+
+lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
+                              const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
+                              lmb_gather_stats *stats, lmb_error *err)
+{
+    lmb_gather_job record_job = *job;
+    uint64_t rays = (uint64_t)job->estimator.rays * opt->ray_scale;
+    record_job.estimator.rays = rays > 1048576 * 64 ? 1048576 * 64 : (uint32_t)rays;
+    pass_ctx c;
+    memset(&c, 0, sizeof c);
+    c.job = &record_job;
+    c.opt = opt;
+    c.atlas_count = atlas_count;
+    c.t = t;
+    c.threads = job->threads ? (int)job->threads : omp_get_max_threads();
+    snprintf(c.stage, sizeof c.stage, "%s (cache)", job->stage);
+    lmb_ic_records_init(&c.records, opt->error);
+    lmb_status st = LMB_OK;
+    c.is_record = calloc((size_t)atlas_count + 1, sizeof *c.is_record);
+    if (!c.is_record)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    for (uint32_t a = 0; a < atlas_count && st == LMB_OK; a++) {
+        c.is_record[a] = calloc((size_t)t[a]->count + 1, 1);
+        if (!c.is_record[a])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
+        for (uint32_t i = 0; i < t[a]->count; i++)
+            c.valid_total += t[a]->valid[i];
+    }
+    uint32_t top = 1;
+    while ((double)top * 2 <= opt->max_spacing)
+        top *= 2;
+    for (uint32_t s = top; s >= 1; s /= 2)
+        c.levels++;
+    if (st == LMB_OK)
+        st = lmb_ic_records_index(&c.records, err);
+    /* The last level runs until it places nothing: clamping after a level can shrink reaches
+     * and uncover texels it had found covered. Its last allowed round does not clamp, so no
+     * valid texel is left uncovered. */
+    for (uint32_t s = top, round = 0; s >= 1 && st == LMB_OK; c.level += s > 1) {
+        uint64_t placed = 0;
+        int last_round = s == 1 && round + 1 == LMB_IC_FINAL_ROUNDS;
+        st = place_level(&c, s, !last_round, &placed, stats, err);
+        if (s > 1)
+            s /= 2;
+        else if (!placed || last_round)
+            break;
+        else
+            round++;
+    }
+    if (st == LMB_OK)
+        st = lmb_ic_records_fit_gradients(&c.records, (uint32_t)c.threads, err);
+    if (st == LMB_OK) {
+        interpolate_all(&c, out);
+        report(&c, 1, 1);
+        c.level = c.levels + 1;
+        if (job->progress)
+            job->progress(job->progress_user, c.stage, c.valid_total * (c.levels + 1), c.valid_total * (c.levels + 1));
+    }
+    for (uint32_t a = 0; st == LMB_OK && pass && a < atlas_count; a++) {
+        pass->records[a] = pass->valid[a] = 0;
+        for (uint32_t i = 0; i < t[a]->count; i++) {
+            pass->records[a] += c.is_record[a][i];
+            pass->valid[a] += t[a]->valid[i];
+        }
+    }
+    for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
+        free(c.is_record[a]);
+    free(c.is_record);
+    lmb_ic_records_free(&c.records);
+    return st;
+}

@@ -1,0 +1,48 @@
+/*
+ * One gather pass through the irradiance cache (DESIGN.md section 7): the gather runs only at
+ * records, placed where the light changes, and every other texel interpolates them.
+ *
+ * Placement, coarse to fine in lightmap space, over all atlases at once: level k looks at the
+ * valid texels on a grid of spacing s_k = max_spacing / 2^k texels (s = max_spacing, ..., 2, 1)
+ * and turns into a record every one that the records of the levels before do not cover
+ * (sum of weights below LMB_IC_COVERED). A level's candidates are decided from the earlier
+ * levels only, and its records are gathered in parallel and appended in texel order, so the
+ * record set does not depend on the thread count or on any split of the work. The last level
+ * (spacing 1) leaves no valid texel uncovered: each is at worst its own record.
+ * A record's reach is r = clamp(error x R, min_spacing, max_spacing texels), R the harmonic
+ * mean distance of its gather rays (Ward 1988), neighbour-clamped after every level.
+ * Then translation gradients are fitted from neighbouring records (records.h), and every
+ * valid texel, records included, takes the interpolation at its gather point. Texels inside
+ * geometry place no records and receive nothing (0).
+ */
+#ifndef LMBAKE_IC_PASS_H
+#define LMBAKE_IC_PASS_H
+
+#include "gather/gather.h"
+#include "texels/texels.h"
+
+/* A texel is covered when the weights of the records that reach it sum to at least this
+ * (one record at a third of its reach, or two at two thirds). */
+#define LMB_IC_COVERED 0.6
+
+typedef struct lmb_ic_options {
+    double error;          /* Ward's a (> 0) */
+    double min_spacing;    /* texels: the smallest reach */
+    double max_spacing;    /* texels: the largest reach, and the first level's grid */
+    uint32_t ray_scale;    /* a record gathers with ray_scale x the pass's rays per texel */
+} lmb_ic_options;
+
+/* What one pass did, per atlas (arrays of atlas_count, owned by the caller). */
+typedef struct lmb_ic_pass_stats {
+    uint64_t *records;     /* records placed in the atlas */
+    uint64_t *valid;       /* valid texels of the atlas */
+} lmb_ic_pass_stats;
+
+/* Indirect irradiance of every listed texel of every atlas (t[a], out[a]: 3 floats per listed
+ * texel) through a cache built for this pass. job->estimator gives the method and the rays
+ * per texel; stats add up the gathers' rays. */
+lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
+                              const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
+                              lmb_gather_stats *stats, lmb_error *err);
+
+#endif

@@ -1,0 +1,81 @@
+/*
+ * Irradiance-cache records (DESIGN.md section 7) and the queries on them: which records may
+ * be used at a point, the interpolated irradiance there, and the clamps and gradients that
+ * make interpolation safe.
+ *
+ * A record holds a gather's result at one texel's gather point: position, normal, RGB
+ * irradiance E, its translation and rotation gradients and its radius of influence r. Records
+ * are found by world position and normal only, whatever chart, atlas or instance they came
+ * from (light does not stop at a UV seam). The weight of record i at (p, n) is Tabellion and
+ * Lamorlette's (2004, eq. 2), 1 - max(eps_p, eps_n), with
+ *     eps_p = sqrt(|p - p_i|^2 + 3 ((p - p_i).n_i)^2) / r_i     (an offset off the record's
+ *              plane counts double: a shelf's records do not serve the floor under it)
+ *     eps_n = sqrt(1 - n.n_i) / normal_limit
+ * so weights fall smoothly to 0 at the edge of a record's reach (no blotch outlines, which
+ * Ward's 1 / eps weight with a cut-off leaves). A record whose normal faces away (n.n_i <= 0,
+ * the other wall of a corner) or that lies in front of p (Ward 1988: (p - p_i).(n + n_i)/2 <
+ * 0, the record sees what p does not) is never used.
+ * The interpolated value is sum_i w_i (E_i + g_t,i . (p - p_i) + g_r,i . (n_i x n)) / sum_i w_i
+ * (Ward and Heckbert 1992, first-order gradients), each term kept >= 0.
+ *
+ * Records live in a k-d tree over their positions whose nodes also keep the largest radius
+ * below them, so "records whose reach covers p" and "records within d of p" are the same
+ * pruned walk. The walk visits records in an order fixed by the record set alone: results do
+ * not depend on thread counts or on when records were inserted.
+ */
+#ifndef LMBAKE_IC_RECORDS_H
+#define LMBAKE_IC_RECORDS_H
+
+#include <lmbake/lmbake.h>
+
+typedef struct lmb_ic_record {
+    double p[3], n[3];     /* gather point and shading normal (unit) */
+    double e[3];           /* irradiance, RGB */
+    double grad_t[3][3];   /* per channel: dE/dp, world, in the record's tangent plane */
+    double grad_r[3][3];   /* per channel: dE/d(rotation vector) of the normal */
+    double harmonic;       /* harmonic mean distance of its gather rays (neighbour-clamped) */
+    double r_min, r_max;   /* the reach's clamps in world units (spacing x the texel's size) */
+    double r;              /* reach: clamp(error x harmonic, r_min, r_max) */
+    uint32_t atlas, texel; /* where it was gathered: atlas and listed-texel index */
+} lmb_ic_record;
+
+typedef struct lmb_ic_records {
+    lmb_ic_record *rec;
+    uint32_t count, cap;
+    double error;          /* Ward's a: reach = a x harmonic mean distance */
+    double normal_limit;   /* eps_n's scale, sqrt(1 - cos(largest normal difference)) */
+    /* k-d tree (lmb_ic_records_index): node k covers order[lo, hi), children 2k and 2k + 1 */
+    uint32_t *order;
+    uint32_t nodes;
+    float (*box)[6];       /* per node: min xyz, max xyz of its records' positions */
+    float *reach;          /* per node: the largest r below it */
+} lmb_ic_records;
+
+/* An empty set for error setting a (> 0). Free with lmb_ic_records_free. */
+void lmb_ic_records_init(lmb_ic_records *s, double error);
+void lmb_ic_records_free(lmb_ic_records *s);
+
+/* Appends records (copied). LMB_ERR_INTERNAL when out of memory. */
+lmb_status lmb_ic_records_append(lmb_ic_records *s, const lmb_ic_record *r, uint32_t n, lmb_error *err);
+
+/* Rebuilds the k-d tree after records were added or their reach changed. */
+lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err);
+
+/* Weight of record r at (p, n) (see above): in (0, 1], or 0 when it may not be used. */
+double lmb_ic_weight(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3]);
+
+/* Sum of the weights at (p, n); with e != NULL also the interpolated irradiance (0 when the
+ * sum is 0). Reads the index: call lmb_ic_records_index first. */
+double lmb_ic_interpolate(const lmb_ic_records *s, const double p[3], const double n[3], double e[3]);
+
+/* Neighbour clamping (Krivanek et al. 2006): no record's harmonic distance exceeds a
+ * neighbour's plus the distance between them, R_i <= R_j + |p_i - p_j| over the records
+ * within its reach; then every reach is recomputed. One Jacobi sweep (each record reads the
+ * others' values from before the sweep), so the result does not depend on the order. */
+lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *err);
+
+/* Translation gradients by a weighted least-squares fit over each record's neighbours (see
+ * README "Irradiance cache": why not Ward and Heckbert's stratified formula). Reads the index. */
+lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb_error *err);
+
+#endif
