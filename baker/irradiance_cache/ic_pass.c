@@ -27,6 +27,7 @@ typedef struct pass_ctx {
     lmb_ic_records records;
     int threads;
     uint64_t valid_total, levels, level;
+    uint64_t reported;            /* progress never goes back (the last level may run several rounds) */
     char stage[96];
 } pass_ctx;
 
@@ -39,14 +40,18 @@ static void texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
     memcpy(n, sp.n, 3 * sizeof *n);
 }
 
-static void report(const pass_ctx *c, uint64_t done_in_level, uint64_t level_total)
+static void report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total)
 {
     const lmb_gather_job *job = c->job;
     if (!job->progress)
         return;
     uint64_t total = c->valid_total * (c->levels + 1);
     uint64_t done = c->valid_total * c->level + (level_total ? done_in_level * c->valid_total / level_total : 0);
-    job->progress(job->progress_user, c->stage, done < total ? done : total - (total > 0), total);
+    done = done < total ? done : total - (total > 0);
+    if (done < c->reported)
+        done = c->reported;
+    c->reported = done;
+    job->progress(job->progress_user, c->stage, done, total);
 }
 
 /* Valid texels on this level's grid that are not records yet, in (atlas, texel) order. */

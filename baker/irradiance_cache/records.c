@@ -348,7 +348,7 @@ lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb
         lmb_frame(r->n, c.t, c.b);
         walk(s, r->p, 2 * r->r, fit_visit, &c);
         memset(g[i], 0, sizeof g[i]);
-        double ridge = 1e-2 * (c.a[0] + c.a[2]) + 1e-30;
+        double ridge = 1e-3 * (c.a[0] + c.a[2]) + 1e-30;
         double a0 = c.a[0] + ridge, a1 = c.a[1], a2 = c.a[2] + ridge, det = a0 * a2 - a1 * a1;
         if (c.used < 2 || !(det > 0))
             continue;

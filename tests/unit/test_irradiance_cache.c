@@ -1,0 +1,152 @@
+/*
+ * Irradiance-cache records (baker/irradiance_cache/records.h) on hand-made record sets:
+ *   - a constant field on a plane interpolates to that constant everywhere (to 1e-12);
+ *   - at a corner, points on the floor never use the wall's records (normals 90 degrees
+ *     apart) although they lie within the wall records' reach, and the other side of a thin
+ *     wall (normal facing away) is never used either;
+ *   - a record above a point, on a parallel shelf, is not used for the floor under it;
+ *   - gradients fitted from neighbours recover a linear field's slope (within 1%), and the
+ *     interpolation then reproduces the field between records (within 1%);
+ *   - neighbour clamping: a record's harmonic distance ends at most a neighbour's plus the
+ *     distance between them.
+ */
+#include "check.h"
+
+#include "irradiance_cache/records.h"
+
+#include <stdlib.h>
+
+static lmb_ic_record rec(double x, double y, double z, double nx, double ny, double nz, double e, double reach)
+{
+    lmb_ic_record r;
+    memset(&r, 0, sizeof r);
+    r.p[0] = x;
+    r.p[1] = y;
+    r.p[2] = z;
+    r.n[0] = nx;
+    r.n[1] = ny;
+    r.n[2] = nz;
+    r.e[0] = r.e[1] = r.e[2] = e;
+    r.r = r.r_min = r.r_max = reach;
+    r.harmonic = reach / 0.3;
+    return r;
+}
+
+/* Floor z = 0 (normal +z) on a grid of spacing h, value f(x, y). */
+static void floor_grid(lmb_ic_records *s, double h, int n, double (*f)(double, double))
+{
+    lmb_error err;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            lmb_ic_record r = rec(i * h, j * h, 0, 0, 0, 1, f(i * h, j * h), 1.5 * h);
+            CHECK(lmb_ic_records_append(s, &r, 1, &err) == LMB_OK);
+        }
+}
+
+static double constant(double x, double y)
+{
+    (void)x;
+    (void)y;
+    return 3.5;
+}
+
+static double linear(double x, double y)
+{
+    return 2.0 + 0.5 * x - 0.25 * y;
+}
+
+static void test_constant_plane(void)
+{
+    lmb_ic_records s;
+    lmb_error err;
+    lmb_ic_records_init(&s, 0.3);
+    floor_grid(&s, 0.1, 20, constant);
+    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_fit_gradients(&s, 1, &err) == LMB_OK);
+    double n[3] = {0, 0, 1}, worst = 0;
+    for (int k = 0; k < 400; k++) {
+        double p[3] = {0.0123 + 0.0047 * k, 0.05 + 0.0041 * k, 0}, e[3];
+        double sum = lmb_ic_interpolate(&s, p, n, e);
+        CHECK(sum > 0);
+        worst = fmax(worst, fabs(e[0] - 3.5));
+    }
+    CHECK(worst < 1e-12);
+    lmb_ic_records_free(&s);
+}
+
+static void test_corner_and_facing_away(void)
+{
+    lmb_ic_records s;
+    lmb_error err;
+    lmb_ic_records_init(&s, 0.3);
+    lmb_ic_record r[] = {
+        rec(0.5, 0.5, 0, 0, 0, 1, 1.0, 0.3),      /* floor */
+        rec(0.5, 0.0, 0.05, 0, 1, 0, 100.0, 0.3), /* the wall at y = 0, facing +y, close to the floor */
+        rec(0.5, 0.5, -0.01, 0, 0, -1, 50.0, 0.3), /* under a thin floor, facing down */
+        rec(0.5, 0.5, 0.1, 0, 0, 1, 7.0, 0.3),    /* a shelf 10 cm above, facing up */
+    };
+    CHECK(lmb_ic_records_append(&s, r, 4, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    double up[3] = {0, 0, 1};
+    /* floor points near the corner: within the wall record's reach, never its value */
+    for (int k = 0; k < 10; k++) {
+        double p[3] = {0.45 + 0.01 * k, 0.3 + 0.01 * k, 0}, e[3];
+        CHECK(lmb_ic_weight(&s, &s.rec[1], p, up) == 0);
+        CHECK(lmb_ic_weight(&s, &s.rec[2], p, up) == 0);
+        CHECK(lmb_ic_weight(&s, &s.rec[3], p, up) == 0); /* the shelf: p lies behind its plane */
+        CHECK(lmb_ic_interpolate(&s, p, up, e) > 0);
+        CHECK_NEAR(e[0], 1.0, 1e-12);
+    }
+    lmb_ic_records_free(&s);
+}
+
+static void test_gradients(void)
+{
+    lmb_ic_records s;
+    lmb_error err;
+    lmb_ic_records_init(&s, 0.3);
+    floor_grid(&s, 0.1, 20, linear);
+    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_fit_gradients(&s, 2, &err) == LMB_OK);
+    const lmb_ic_record *mid = &s.rec[10 * 20 + 10];
+    CHECK_NEAR(mid->grad_t[0][0], 0.5, 0.005);
+    CHECK_NEAR(mid->grad_t[0][1], -0.25, 0.0025);
+    CHECK_NEAR(mid->grad_t[0][2], 0.0, 1e-9);
+    double n[3] = {0, 0, 1}, worst = 0;
+    for (int k = 0; k < 200; k++) { /* inside the grid, off the records */
+        double x = 0.3 + 0.0061 * k, y = 0.35 + 0.0057 * k, p[3] = {x, y, 0}, e[3];
+        lmb_ic_interpolate(&s, p, n, e);
+        worst = fmax(worst, fabs(e[0] / linear(x, y) - 1));
+    }
+    CHECK(worst < 0.01);
+    lmb_ic_records_free(&s);
+}
+
+static void test_neighbour_clamp(void)
+{
+    lmb_ic_records s;
+    lmb_error err;
+    lmb_ic_records_init(&s, 0.5);
+    lmb_ic_record a = rec(0, 0, 0, 0, 0, 1, 1, 1.0), b = rec(0.2, 0, 0, 0, 0, 1, 1, 1.0);
+    a.harmonic = 2.0;  /* reach 1.0 at error 0.5 */
+    b.harmonic = 0.05; /* saw a nearby occluder that a's rays missed */
+    a.r_min = b.r_min = 0.01;
+    a.r_max = b.r_max = 10;
+    CHECK(lmb_ic_records_append(&s, &a, 1, &err) == LMB_OK);
+    CHECK(lmb_ic_records_append(&s, &b, 1, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_clamp(&s, 1, &err) == LMB_OK);
+    CHECK_NEAR(s.rec[0].harmonic, 0.25, 1e-12);
+    CHECK_NEAR(s.rec[0].r, 0.125, 1e-12);
+    CHECK_NEAR(s.rec[1].harmonic, 0.05, 1e-12);
+    lmb_ic_records_free(&s);
+}
+
+int main(void)
+{
+    test_constant_plane();
+    test_corner_and_facing_away();
+    test_gradients();
+    test_neighbour_clamp();
+    return check_failed_count != 0;
+}
