@@ -23,6 +23,8 @@ usage: make_scenes.py OUTDIR
                       each states the albedo rho it must bounce with
   two-spots.gltf      the Cornell room without blocks, two point lights 3 cm from the left and
                       right walls: two bright spots in opposite directions (benchmark)
+  contact.gltf        a 2 m room with two blocks and a thin-legged chair on its floor, a point light
+                      near the ceiling (contact shadows for the irradiance cache's benchmark)
   grazing.gltf        a 4 m x 1 m x 0.6 m corridor, a point light 3 cm above the floor near one
                       end: the floor sees its spot at grazing angles (benchmark)
 
@@ -350,6 +352,20 @@ def indirect(out):
     s.mesh("corridor", box(0, 0, 0, 4, 0.6, 1, inward=True), white)
     s.light("floor_spot", "point", 5.0, translation=(0.5, 0.03, 0.5))
     s.write(os.path.join(out, "grazing.gltf"))
+
+    s = Scene()
+    white = s.material("white", (0.73, 0.73, 0.73))
+    wood = s.material("wood", (0.45, 0.3, 0.2))
+    s.mesh("room", box(0, 0, 0, 2, 1.5, 2, inward=True), white)
+    s.mesh("block_a", box(0.2, 0, 1.2, 0.6, 0.4, 1.6, bottom=False), white)
+    s.mesh("block_b", box(0.75, 0, 1.3, 0.95, 0.2, 1.5, bottom=False), white)
+    chair = box(1.0, 0.42, 0.5, 1.45, 0.47, 0.95)  # seat
+    for x, z in ((1.0, 0.5), (1.42, 0.5), (1.0, 0.92), (1.42, 0.92)):  # 3 cm legs
+        chair += box(x, 0, z, x + 0.03, 0.42, z + 0.03, bottom=False)
+    chair += box(1.0, 0.47, 0.91, 1.45, 0.95, 0.95)  # back
+    s.mesh("chair", chair, wood)
+    s.light("lamp", "point", 8.0, translation=(1.6, 1.4, 1.6))
+    s.write(os.path.join(out, "contact.gltf"))
 
 
 if __name__ == "__main__":
