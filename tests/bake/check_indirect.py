@@ -37,28 +37,15 @@ import sys
 import numpy as np
 import OpenImageIO as oiio
 
+import bake_cli
+from bake_cli import scenes
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 
 
-def scenes(work):
-    d = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), d], check=True,
-                   stdout=subprocess.DEVNULL)
-    return d
-
-
 def bake(lmbake, work, scene, name, config, *args):
-    cfg = os.path.join(work, name + ".yaml")
-    with open(cfg, "w") as f:
-        f.write(config)
-    out = os.path.join(work, name)
-    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "-q"] + list(args), capture_output=True, text=True)
-    if p.returncode != 0:
-        sys.exit("bake %s failed (%d): %s" % (name, p.returncode, p.stderr))
-    exr = glob.glob(os.path.join(out, "*-lightmap-0.exr"))
-    assert len(exr) == 1, exr
-    return exr[0]
+    return bake_cli.bake(lmbake, work, scene, name, config, "-q", *args)[0]
 
 
 def read(path):

@@ -18,44 +18,22 @@ usage: check_irradiance_cache.py LMBAKE WORKDIR CHECK
                commit without the cache) for the same scene, config and seed.
   determinism  the cache on, AMIS: byte-identical EXR at --threads 1 and 2.
 """
-import glob
 import hashlib
 import math
 import os
-import subprocess
 import sys
 
 import numpy as np
 import OpenImageIO as oiio
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
+from bake_cli import bake, scenes
+
 
 # tools/make_scenes.py cornell-point.gltf, config PER_TEXEL_CONFIG, seed 1: the EXR's half pixels
 # (44 x 80 x 3) hashed; baked by commit 821943f (before the irradiance cache).
 PER_TEXEL_SHA256 = "339c688b1298fb9382a7d95cd20d307ce2d5a24cfc5a1b4b82ce0782412a402b"
 PER_TEXEL_CONFIG = ("texel_density: 16\nbounces: 2\nsamples: {texel: 2, direct: 4, gather: 64, bounce: 16}\n"
                     "output: {formats: [exr]}\n")
-
-
-def scenes(work):
-    d = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), d], check=True,
-                   stdout=subprocess.DEVNULL)
-    return d
-
-
-def bake(lmbake, work, scene, name, config, *args):
-    cfg = os.path.join(work, name + ".yaml")
-    with open(cfg, "w") as f:
-        f.write(config)
-    out = os.path.join(work, name)
-    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out] + list(args), capture_output=True, text=True)
-    if p.returncode != 0:
-        sys.exit("bake %s failed (%d): %s" % (name, p.returncode, p.stderr))
-    exr = glob.glob(os.path.join(out, "*-lightmap-0.exr"))
-    assert len(exr) == 1, exr
-    return exr[0], p.stdout
 
 
 def read(exr, with_mask=True):
