@@ -92,10 +92,11 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int sto
     lmb_bake_stats *stats = env->stats;
     lmb_status st = LMB_OK;
     job->progress_done = 0;
-    if (env->cfg->ic_error > 0 && !job->reference)
+    int through_cache = env->cfg->ic_error > 0 && !job->reference;
+    if (through_cache)
         st = cached_gather(env, gs, err);
     for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
-        if (!(env->cfg->ic_error > 0) || job->reference)
+        if (!through_cache)
             st = lmb_gather_atlas(job, a, &w[a].t, w[a].result, gs, err);
         for (size_t k = 0; st == LMB_OK && k < 3 * (size_t)w[a].t.count; k++)
             w[a].result[k] += w[a].direct[k];

@@ -77,7 +77,8 @@ static int draw_and_trace(const lmb_lobe *lobe, const lmb_lobe *cosine, const do
 /* The rotation gradient's term of a sample of weight x = f / (N q) per channel (estimator.h). */
 static void add_rotation(lmb_estimate *out, const double n[3], const double w[3], double c, const double x[3])
 {
-    double nxw[3] = {n[1] * w[2] - n[2] * w[1], n[2] * w[0] - n[0] * w[2], n[0] * w[1] - n[1] * w[0]};
+    double nxw[3];
+    lmb_cross3(n, w, nxw);
     for (int ch = 0; ch < 3; ch++)
         for (int k = 0; k < 3; k++)
             out->rot[ch][k] += x[ch] / c * nxw[k];
@@ -136,10 +137,22 @@ static int next_lobe(const lmb_estimator_scratch *s, lmb_lobe *next)
     return 1;
 }
 
+/* T as the options give it, within 1..LMB_AMIS_MAX_ITERATIONS. */
+static uint32_t iteration_count(const lmb_estimator_options *opt)
+{
+    return opt->iterations < 1 ? 1 : opt->iterations > LMB_AMIS_MAX_ITERATIONS ? LMB_AMIS_MAX_ITERATIONS : opt->iterations;
+}
+
+uint32_t lmb_estimator_cosine_samples(const lmb_estimator_options *opt)
+{
+    uint32_t T = opt->method == LMB_GATHER_COSINE ? 1 : iteration_count(opt);
+    return opt->rays / T + (opt->rays % T != 0); /* N_0, as amis() splits the rays */
+}
+
 static lmb_status amis(const lmb_estimator_options *opt, const lmb_lobe *cosine, const double ng[3], lmb_rng rng,
                        lmb_radiance_fn radiance, void *user, lmb_estimator_scratch *s, lmb_estimate *out)
 {
-    uint32_t T = opt->iterations < 1 ? 1 : opt->iterations > LMB_AMIS_MAX_ITERATIONS ? LMB_AMIS_MAX_ITERATIONS : opt->iterations;
+    uint32_t T = iteration_count(opt);
     double d = opt->method == LMB_GATHER_AMIS_DEFENSIVE ? opt->defensive : 0.0;
     lmb_lobe lobes[LMB_AMIS_MAX_ITERATIONS];
     double nk[LMB_AMIS_MAX_ITERATIONS];

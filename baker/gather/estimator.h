@@ -72,6 +72,10 @@ typedef struct lmb_estimate {
 
 void lmb_estimator_scratch_free(lmb_estimator_scratch *s);
 
+/* How many leading samples (indices 0..) are drawn from the cosine lobe: all of classic's,
+ * AMIS's first iteration. */
+uint32_t lmb_estimator_cosine_samples(const lmb_estimator_options *opt);
+
 /* Estimates E at a point with shading normal n and geometric normal ng (both unit). Returns
  * LMB_ERR_INTERNAL only when the scratch cannot grow (out of memory). */
 lmb_status lmb_estimate_irradiance(const lmb_estimator_options *opt, const double n[3], const double ng[3],

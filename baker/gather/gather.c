@@ -153,8 +153,7 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     point_setup(job, atlas, t, i, &pr);
     lmb_estimator_options opt = job->estimator;
     opt.gradient = 1;
-    uint32_t iterations = opt.method == LMB_GATHER_COSINE || opt.iterations < 1 ? 1 : opt.iterations;
-    pr.cosine_samples = opt.rays / iterations + (opt.rays % iterations != 0); /* iteration 0 (estimator.c) */
+    pr.cosine_samples = lmb_estimator_cosine_samples(&opt);
     lmb_estimate est;
     if (estimate_at(job, &pr, scratch, &opt, &est) != LMB_OK)
         return LMB_ERR_INTERNAL;

@@ -94,8 +94,7 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     r->r_min = c->opt->min_spacing * size;
     r->r_max = c->opt->max_spacing * size;
     r->harmonic = g->harmonic;
-    double reach = c->opt->error * g->harmonic;
-    r->r = reach < r->r_min ? r->r_min : reach > r->r_max ? r->r_max : reach;
+    r->r = lmb_ic_reach(&c->records, r);
     double turn = sqrt(2.0) * c->records.normal_limit; /* |n_i x n| at the largest difference */
     for (int ch = 0; ch < 3; ch++) {
         double mag = sqrt(lmb_dot3(g->rot[ch], g->rot[ch])) * turn;
@@ -255,9 +254,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
         st = lmb_ic_records_fit_gradients(&c.records, (uint32_t)c.threads, err);
     if (st == LMB_OK) {
         interpolate_all(&c, out);
-        report(&c, 1, 1);
-        c.level = c.levels + 1;
-        if (job->progress)
+        if (job->progress) /* done (report() stops short of the total until here) */
             job->progress(job->progress_user, c.stage, c.valid_total * (c.levels + 1), c.valid_total * (c.levels + 1));
     }
     for (uint32_t a = 0; st == LMB_OK && pass && a < atlas_count; a++) {

@@ -95,7 +95,6 @@ static void build(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32_t hi)
     float *b = s->box[node];
     b[0] = b[1] = b[2] = FLT_MAX;
     b[3] = b[4] = b[5] = -FLT_MAX;
-    float reach = 0;
     for (uint32_t k = lo; k < hi; k++) {
         const lmb_ic_record *r = &s->rec[s->order[k]];
         for (int a = 0; a < 3; a++) {
@@ -104,10 +103,7 @@ static void build(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32_t hi)
             b[a] = lo_f < b[a] ? lo_f : b[a];
             b[3 + a] = hi_f > b[3 + a] ? hi_f : b[3 + a];
         }
-        float rr = nextafterf((float)r->r, FLT_MAX);
-        reach = rr > reach ? rr : reach;
     }
-    s->reach[node] = reach;
     if (hi - lo <= LEAF)
         return;
     int axis = 0;
@@ -118,6 +114,24 @@ static void build(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32_t hi)
     select_kth(s, axis, s->order, lo, hi, mid);
     build(s, 2 * node, lo, mid);
     build(s, 2 * node + 1, mid, hi);
+}
+
+/* Every node's largest reach below it (positions, hence the tree, unchanged). */
+static float refresh_reach(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32_t hi)
+{
+    float reach = 0;
+    if (hi - lo <= LEAF) {
+        for (uint32_t k = lo; k < hi; k++) {
+            float rr = nextafterf((float)s->rec[s->order[k]].r, FLT_MAX); /* rounded up */
+            reach = rr > reach ? rr : reach;
+        }
+    } else {
+        uint32_t mid = lo + (hi - lo) / 2;
+        float left = refresh_reach(s, 2 * node, lo, mid), right = refresh_reach(s, 2 * node + 1, mid, hi);
+        reach = left > right ? left : right;
+    }
+    s->reach[node] = reach;
+    return reach;
 }
 
 lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err)
@@ -137,8 +151,10 @@ lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory indexing %u records", s->count);
     for (uint32_t k = 0; k < s->count; k++)
         s->order[k] = k;
-    if (s->count)
+    if (s->count) {
         build(s, 1, 0, s->count);
+        refresh_reach(s, 1, 0, s->count);
+    }
     return LMB_OK;
 }
 
@@ -211,13 +227,6 @@ typedef struct interp_ctx {
     int want_e;
 } interp_ctx;
 
-static void cross3(const double a[3], const double b[3], double out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static void interp_visit(void *user, uint32_t k)
 {
     interp_ctx *c = user;
@@ -229,7 +238,7 @@ static void interp_visit(void *user, uint32_t k)
     if (!c->want_e)
         return;
     double d[3] = {c->p[0] - r->p[0], c->p[1] - r->p[1], c->p[2] - r->p[2]}, rot[3];
-    cross3(r->n, c->n, rot); /* the rotation taking n_i to n, for small angles */
+    lmb_cross3(r->n, c->n, rot); /* the rotation taking n_i to n, for small angles */
     for (int ch = 0; ch < 3; ch++) {
         double v = r->e[ch] + lmb_dot3(r->grad_t[ch], d) + lmb_dot3(r->grad_r[ch], rot);
         c->e[ch] += w * (v > 0 ? v : 0);
@@ -264,7 +273,7 @@ static void clamp_visit(void *user, uint32_t k)
         c->harmonic = bound;
 }
 
-static double reach_of(const lmb_ic_records *s, const lmb_ic_record *r)
+double lmb_ic_reach(const lmb_ic_records *s, const lmb_ic_record *r)
 {
     double reach = s->error * r->harmonic;
     return reach < r->r_min ? r->r_min : reach > r->r_max ? r->r_max : reach;
@@ -284,10 +293,12 @@ lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *
     }
     for (uint32_t i = 0; i < s->count; i++) {
         s->rec[i].harmonic = h[i];
-        s->rec[i].r = reach_of(s, &s->rec[i]);
+        s->rec[i].r = lmb_ic_reach(s, &s->rec[i]);
     }
     free(h);
-    return lmb_ic_records_index(s, err);
+    if (s->count)
+        refresh_reach(s, 1, 0, s->count);
+    return LMB_OK;
 }
 
 /* ---- gradients ----------------------------------------------------------------------------- */

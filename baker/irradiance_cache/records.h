@@ -61,6 +61,9 @@ lmb_status lmb_ic_records_append(lmb_ic_records *s, const lmb_ic_record *r, uint
 /* Rebuilds the k-d tree after records were added or their reach changed. */
 lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err);
 
+/* The reach of r from its harmonic distance and clamps: clamp(error x harmonic, r_min, r_max). */
+double lmb_ic_reach(const lmb_ic_records *s, const lmb_ic_record *r);
+
 /* Weight of record r at (p, n) (see above): in (0, 1], or 0 when it may not be used. */
 double lmb_ic_weight(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3]);
 
@@ -70,7 +73,7 @@ double lmb_ic_interpolate(const lmb_ic_records *s, const double p[3], const doub
 
 /* Neighbour clamping (Krivanek et al. 2006): no record's harmonic distance exceeds a
  * neighbour's plus the distance between them, R_i <= R_j + |p_i - p_j| over the records
- * within its reach; then every reach is recomputed. One Jacobi sweep (each record reads the
+ * within its reach; then every reach is recomputed (the index follows). One Jacobi sweep (each record reads the
  * others' values from before the sweep), so the result does not depend on the order. */
 lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *err);
 

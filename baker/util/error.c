@@ -20,26 +20,30 @@ lmb_status lmb_error_set(lmb_error *err, lmb_status status, const char *fmt, ...
     return status;
 }
 
-void lmb_info(const lmb_log *log, const char *fmt, ...)
+/* Formats a message into the sink (NULL: dropped). */
+static void send(lmb_warn_fn sink, void *user, const char *fmt, va_list ap)
 {
     char buf[1024];
-    va_list ap;
-    if (!log || !log->info)
+    if (!sink)
         return;
-    va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
+    sink(user, buf);
+}
+
+void lmb_info(const lmb_log *log, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    if (log)
+        send(log->info, log->user, fmt, ap);
     va_end(ap);
-    log->info(log->user, buf);
 }
 
 void lmb_warn(const lmb_log *log, const char *fmt, ...)
 {
-    char buf[1024];
     va_list ap;
-    if (!log || !log->warn)
-        return;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    if (log)
+        send(log->warn, log->user, fmt, ap);
     va_end(ap);
-    log->warn(log->user, buf);
 }

@@ -1,5 +1,5 @@
 /*
- * Vector helpers shared by the samplers: the dot product and an orthonormal tangent frame
+ * Vector helpers shared by the samplers: dot and cross products and an orthonormal tangent frame
  * around a unit normal (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 2017:
  * branch-free, continuous except at n.z = -1).
  */
@@ -9,6 +9,13 @@
 static inline double lmb_dot3(const double *a, const double *b)
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void lmb_cross3(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 /* Two unit tangents t, b with (t, b, n) right-handed and orthonormal. */
