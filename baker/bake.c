@@ -1,7 +1,9 @@
 /*
  * The bake pipeline driver: layout (unwrap + pack) -> ray-tracing scene, textures, lights ->
  * lighting (lighting.h: texels, direct light, bounce passes, final gather, dilation) ->
- * images (write/atlas_images.h); then the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written into a staging folder inside outdir and moved into
+ * images (write/atlas_images.h); then the final gather's irradiance-cache records
+ * (write/records_file.h) and the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written
+ * into a staging folder inside outdir and moved into
  * place only when everything succeeded, so a failed bake leaves nothing behind; outdir may
  * not be the input's own folder (the input and its .bin files are never written over).
  */
@@ -18,6 +20,7 @@
 #include "write/gltf_write.h"
 #include "write/atlas_images.h"
 #include "write/output_dir.h"
+#include "write/records_file.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -41,8 +44,8 @@ static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
     }
 }
 
-static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir, const char *stem, lmb_bake_stats *stats,
-                             lmb_error *err)
+static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir, const char *stem,
+                             const lmb_ic_points *records, lmb_error *err)
 {
     int32_t *tex = malloc(((size_t)l->atlas_count + 1) * sizeof *tex);
     if (!tex)
@@ -70,13 +73,17 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir,
         free(owned);
         free(prims);
     }
-    char path[8600], bin[512];
+    char path[8600], bin[512], rec[512];
+    lmb_records_file_name(stem, rec, sizeof rec);
+    if (st == LMB_OK && records->count) /* the file itself, before the glTF that names it */
+        st = lmb_write_records(dir, rec, records, err);
+    if (st == LMB_OK && records->count)
+        st = lmb_gltf_set_records(s->doc, rec, records->count, err);
     snprintf(path, sizeof path, "%s/%s.gltf", dir, stem);
     snprintf(bin, sizeof bin, "%s-lightmap.bin", stem);
     if (st == LMB_OK)
         st = lmb_gltf_save(s->doc, path, bin, err);
     free(tex);
-    (void)stats;
     return st;
 }
 
@@ -193,6 +200,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     lmb_direct *direct = NULL;
     lmb_textures tx;
     lmb_cache cache;
+    lmb_ic_points records = {NULL, 0};
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
@@ -212,7 +220,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
         lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material): the lightmaps "
                  "are black", s->path);
     if (st == LMB_OK)
-        st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, log, err);
+        st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, &records, log, err);
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
                                     l.height[a], err);
@@ -223,7 +231,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     stats->density_capped = l.density.capped;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
-        st = write_gltf(s, &l, od.staging, od.stem, stats, err);
+        st = write_gltf(s, &l, od.staging, od.stem, &records, err);
     }
     if (st == LMB_OK)
         st = lmb_output_dir_commit(&od, err);
@@ -232,6 +240,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
     lmb_cache_free(&cache);
+    free(records.xyzr);
     lmb_direct_free(direct);
     lmb_emitters_free(em);
     lmb_textures_free(&tx);

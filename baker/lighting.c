@@ -44,6 +44,7 @@ typedef struct pass_env {
     atlas_work *w;
     lmb_cache *cache;
     lmb_bake_stats *stats;
+    lmb_ic_points *points; /* set during the final gather only: where its records go */
 } pass_env;
 
 /* The pass's gather through the irradiance cache, every atlas at once (records are shared
@@ -63,7 +64,7 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     }
     lmb_ic_options opt = {env->cfg->ic_error, env->cfg->ic_min_spacing, env->cfg->ic_max_spacing,
                           env->cfg->ic_ray_scale};
-    lmb_ic_pass_stats ps = {records, valid};
+    lmb_ic_pass_stats ps = {records, valid, env->points};
     if (st == LMB_OK)
         st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, gs, err);
     uint64_t all = 0;
@@ -294,8 +295,8 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
 }
 
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
-                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
-                             lmb_error *err)
+                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, lmb_ic_points *records,
+                             const lmb_log *log, lmb_error *err)
 {
     uint32_t n = cache->atlas_count;
     atlas_work *w = calloc((size_t)n + 1, sizeof *w);
@@ -331,7 +332,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.progress = progress;
     job.progress_user = user;
     job.progress_total = total;
-    pass_env env = {cfg, log, &job, w, cache, stats};
+    pass_env env = {cfg, log, &job, w, cache, stats, NULL};
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);
     stats->no_light = dark;
@@ -364,7 +365,9 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         job.depth = bounces;
         job.stage = cfg->reference ? "reference" : "final gather";
         double t0 = lmb_seconds();
+        env.points = records;
         st = gather_pass(&env, &gs, 1, err);
+        env.points = NULL;
         stats->gather_records = gs.records;
         stats->gather_seconds = lmb_seconds() - t0;
         stats->gather_rays = gs.rays;

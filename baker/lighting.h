@@ -11,7 +11,8 @@
  *   irradiance_cache.error > 0: every pass gathers at records only and interpolates the
  *                rest (irradiance_cache/ic_pass.h), each pass with its own records.
  *   --reference: E = E_direct + path-traced indirect light of depth k, no cache.
- * The result is left in the cache (its images, dilated), which the writer saves.
+ * The result is left in the cache (its images, dilated), which the writer saves; `records`
+ * (may be NULL) receives the final gather's irradiance-cache records (none without the cache).
  */
 #ifndef LMBAKE_LIGHTING_H
 #define LMBAKE_LIGHTING_H
@@ -19,10 +20,11 @@
 #include <lmbake/lmbake.h>
 
 #include "cache/bounce_cache.h"
+#include "irradiance_cache/ic_pass.h"
 #include "lights/direct.h"
 
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
-                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats, const lmb_log *log,
-                             lmb_error *err);
+                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats,
+                             lmb_ic_points *records, const lmb_log *log, lmb_error *err);
 
 #endif

@@ -202,6 +202,22 @@ static void interpolate_all(const pass_ctx *c, float *const *out)
     }
 }
 
+static lmb_status export_points(const lmb_ic_records *s, lmb_ic_points *out, lmb_error *err)
+{
+    float *p = malloc(4 * ((size_t)s->count + 1) * sizeof *p);
+    if (!p)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u record points", s->count);
+    for (uint32_t i = 0; i < s->count; i++) {
+        for (int k = 0; k < 3; k++)
+            p[4 * (size_t)i + k] = (float)s->rec[i].p[k];
+        p[4 * (size_t)i + 3] = (float)s->rec[i].r;
+    }
+    free(out->xyzr);
+    out->xyzr = p;
+    out->count = s->count;
+    return LMB_OK;
+}
+
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
                               lmb_gather_stats *stats, lmb_error *err)
@@ -264,6 +280,8 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
             pass->valid[a] += t[a]->valid[i];
         }
     }
+    if (st == LMB_OK && pass && pass->points)
+        st = export_points(&c.records, pass->points, err);
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);

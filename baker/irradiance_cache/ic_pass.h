@@ -32,10 +32,17 @@ typedef struct lmb_ic_options {
     uint32_t ray_scale;    /* a record gathers with ray_scale x the pass's rays per texel */
 } lmb_ic_options;
 
+/* A pass's records as the preview draws them: x, y, z (world) and reach per record. */
+typedef struct lmb_ic_points {
+    float *xyzr;           /* 4 per record; owned (free()) */
+    uint32_t count;
+} lmb_ic_points;
+
 /* What one pass did, per atlas (arrays of atlas_count, owned by the caller). */
 typedef struct lmb_ic_pass_stats {
     uint64_t *records;     /* records placed in the atlas */
     uint64_t *valid;       /* valid texels of the atlas */
+    lmb_ic_points *points; /* when not NULL: receives the records (previous contents freed) */
 } lmb_ic_pass_stats;
 
 /* Indirect irradiance of every listed texel of every atlas (t[a], out[a]: 3 floats per listed

@@ -244,7 +244,27 @@ extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, c
     }
 }
 
-extern "C" lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err)
+extern "C" lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, uint32_t count, lmb_error *err)
+{
+    try {
+        tinygltf::Asset &asset = doc->model.asset;
+        Value::Object extras = asset.extras.IsObject() ? asset.extras.Get<Value::Object>() : Value::Object();
+        Value::Object lmbake = extras.count("lmbake") && extras["lmbake"].IsObject()
+                                   ? extras["lmbake"].Get<Value::Object>() : Value::Object();
+        Value::Object records;
+        records["uri"] = Value(std::string(uri));
+        records["count"] = Value((int)count);
+        records["layout"] = Value(std::string("float32le x y z reach"));
+        lmbake["irradianceCacheRecords"] = Value(records);
+        extras["lmbake"] = Value(lmbake);
+        asset.extras = Value(extras);
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: cannot name the records file: %s", e.what());
+    }
+}
+
+lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err)
 {
     try {
         tinygltf::Model &m = doc->model;

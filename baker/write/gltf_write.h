@@ -36,6 +36,11 @@ int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *png_uri, co
 lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count,
                                   int32_t texture, lmb_error *err);
 
+/* Names the irradiance cache's records file in asset.extras.lmbake.irradianceCacheRecords:
+ * {"uri": uri, "count": count, "layout": "float32le x y z reach"} (write/records_file.h);
+ * the asset's other extras are kept. */
+lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, uint32_t count, lmb_error *err);
+
 /* Writes the document as path (.gltf) with its new data in `bin_name` beside it. Buffers of
  * the input are written beside it too; images keep their URIs (the caller copies files). */
 lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err);

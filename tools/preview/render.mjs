@@ -8,7 +8,7 @@ import path from 'node:path';
 import { startServer, InputError } from './server.mjs';
 import { launchBrowser, openPreview } from './browser.mjs';
 
-const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas'];
+const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
 const usage = 'usage: node tools/preview/render.mjs OUT.gltf OUTDIR [--ev N|auto] [--tonemap none|agx|aces|neutral] [--modes m1,m2,...]';
 const args = process.argv.slice(2), pos = [];
 const opt = { ev: 'auto', tonemap: 'agx', modes: MODES };

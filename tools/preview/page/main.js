@@ -1,5 +1,5 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
-// the view modes (lit, lightmap, checker, invalid, atlas). The URL query drives everything
+// the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
 // (mode, ev, tonemap, view|cam, atlas, layer, zoom, at, ui) and the page exposes hooks for
 // tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen.
 import * as THREE from 'three';
@@ -9,8 +9,9 @@ import { lightmapPlugin } from './lightmap-plugin.js';
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
+import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
 
-const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas'];
+const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
 // "none" is three's LinearToneMapping: clamp(colour x 2^EV) (three applies no exposure at all
 // with NoToneMapping). Default: AgX, which keeps a bright hotspot from clipping.
 const TONEMAPS = { none: THREE.LinearToneMapping, agx: THREE.AgXToneMapping, aces: THREE.ACESFilmicToneMapping, neutral: THREE.NeutralToneMapping };
@@ -60,6 +61,9 @@ for (const l of lights) l.removeFromParent(); // lit = lightmap only, no other l
 const scene = new THREE.Scene();
 scene.add(root);
 root.updateMatrixWorld(true);
+// The irradiance cache's records (null: the bake has none)
+const records = await loadRecords(gltf.parser.json, sceneInfo.gltf);
+if (records) scene.add(records.points);
 
 // ev=auto (the default): the median E/pi of the non-zero texels maps to 0.18 (middle grey),
 // rounded to half an EV. Measured on every 7th texel of every atlas.
@@ -134,10 +138,13 @@ function apply() {
   for (const e of entries) {
     let mat = e.lit, geom = e.geometry;
     if (m === 'lightmap') mat = e.lightmap || GREY;
+    else if (m === 'records') mat = e.lightmap ? (e.recordsBase ||= recordsBaseMaterial(e.lightmap)) : GREY;
     else if (m === 'invalid') mat = e.invalid || GREY;
     else if (m === 'checker') { mat = e.checker || GREY; geom = e.checkerGeometry || e.geometry; }
     e.mesh.material = mat; e.mesh.geometry = geom;
   }
+  if (records) records.points.visible = m === 'records';
+  $('noRecords').classList.toggle('hidden', m !== 'records' || !!records);
   renderer.toneMapping = TONEMAPS[state.tonemap];
   renderer.toneMappingExposure = Math.pow(2, state.ev);
   atlasView.atlas = state.atlas; atlasView.layer = state.layer;
@@ -156,6 +163,7 @@ function updateInfo() {
     atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
     meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
     charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),
+    records: records ? { count: records.count, reachMin: records.reachMin, reachMax: records.reachMax, uri: records.uri } : { count: 0 },
     atlasView: { atlas: atlasView.atlas, layer: atlasView.layer, zoom: atlasView.zoom, originX: atlasView.originX, originY: atlasView.originY },
   });
 }
@@ -168,7 +176,7 @@ function render() {
 // UI
 $('panel').classList.toggle('hidden', !state.ui);
 $('hover').classList.toggle('hidden', !state.ui);
-$('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-5: views';
+$('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-6: views';
 $('atlas').innerHTML = atlases.filter(Boolean).map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
 const sync = () => {
   $('mode').value = state.mode; $('ev').value = state.ev; $('evText').textContent = state.ev.toFixed(1);
@@ -198,7 +206,7 @@ addEventListener('keydown', (e) => {
   if (['INPUT', 'SELECT'].includes(e.target.tagName)) return;
   if (e.code === 'KeyF') setFly(!fly.enabled);
   else if (e.code === 'KeyR') $('reset').click();
-  else if (/^Digit[1-5]$/.test(e.code)) { state.mode = MODES[Number(e.code[5]) - 1]; sync(); apply(); }
+  else if (/^Digit[1-6]$/.test(e.code)) { state.mode = MODES[Number(e.code[5]) - 1]; sync(); apply(); }
 });
 addEventListener('resize', () => {
   renderer.setSize(innerWidth, innerHeight);
@@ -248,6 +256,10 @@ addEventListener('pointermove', (e) => {
 });
 
 // Hooks for tests (pixel coordinates: CSS pixels from the canvas's top-left)
+// Record i: its world position, reach and the ramp colour (sRGB 8-bit) it is drawn in.
+window.lmbRecord = (i) => records && i < records.count ? {
+  point: Array.from(records.records.subarray(4 * i, 4 * i + 3)), reach: records.records[4 * i + 3], colour: RECORD_RAMP[records.rampIndex(i)],
+} : null;
 window.lmbProject = (x, y, z) => {
   const v = new THREE.Vector3(x, y, z).project(camera);
   return { x: (v.x + 1) / 2 * innerWidth, y: (1 - v.y) / 2 * innerHeight, inFront: v.z < 1 };
