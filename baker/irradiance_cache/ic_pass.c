@@ -10,8 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Rounds of the last level (spacing 1) at most; see lmb_ic_gather_pass. */
-#define LMB_IC_FINAL_ROUNDS 4
+/* Rounds of placement at most; see lmb_ic_gather_pass. */
+#define LMB_IC_ROUNDS 4
 
 /* A listed texel of some atlas. */
 typedef struct texel_at {
@@ -252,19 +252,20 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
         c.levels++;
     if (st == LMB_OK)
         st = lmb_ic_records_index(&c.records, err);
-    /* The last level runs until it places nothing: clamping after a level can shrink reaches
-     * and uncover texels it had found covered. Its last allowed round does not clamp, so no
-     * valid texel is left uncovered. */
-    for (uint32_t s = top, round = 0; s >= 1 && st == LMB_OK; c.level += s > 1) {
-        uint64_t placed = 0;
-        int last_round = s == 1 && round + 1 == LMB_IC_FINAL_ROUNDS;
-        st = place_level(&c, s, !last_round, &placed, stats, err);
-        if (s > 1)
-            s /= 2;
-        else if (!placed || last_round)
+    /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a
+     * level can shrink reaches and uncover texels found covered before, and such a patch is
+     * refilled coarse to fine too (a round of spacing 1 alone would fill it texel by texel).
+     * The last allowed round does not clamp, so no valid texel is left uncovered. */
+    for (uint32_t round = 0; round < LMB_IC_ROUNDS && st == LMB_OK; round++) {
+        int last_round = round + 1 == LMB_IC_ROUNDS;
+        uint64_t placed_in_round = 0;
+        for (uint32_t s = top; s >= 1 && st == LMB_OK; s /= 2, c.level += round == 0) {
+            uint64_t placed = 0;
+            st = place_level(&c, s, !last_round, &placed, stats, err);
+            placed_in_round += placed;
+        }
+        if (!placed_in_round)
             break;
-        else
-            round++;
     }
     if (st == LMB_OK)
         st = lmb_ic_records_fit_gradients(&c.records, (uint32_t)c.threads, err);

@@ -7,8 +7,10 @@
  * and turns into a record every one that the records of the levels before do not cover
  * (sum of weights below LMB_IC_COVERED). A level's candidates are decided from the earlier
  * levels only, and its records are gathered in parallel and appended in texel order, so the
- * record set does not depend on the thread count or on any split of the work. The last level
- * (spacing 1) leaves no valid texel uncovered: each is at worst its own record.
+ * record set does not depend on the thread count or on any split of the work. The level
+ * sequence repeats (at most 4 rounds) while neighbour clamping uncovers texels; the last
+ * round does not clamp, and its spacing-1 level leaves no valid texel uncovered (each is at
+ * worst its own record).
  * A record's reach is r = clamp(error x R, min_spacing, max_spacing texels), R the harmonic
  * mean distance of its gather rays (Ward 1988), neighbour-clamped after every level.
  * Then translation gradients are fitted from neighbouring records (records.h), and every
