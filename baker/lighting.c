@@ -45,6 +45,7 @@ typedef struct pass_env {
     lmb_cache *cache;
     lmb_bake_stats *stats;
     lmb_ic_points *points; /* set during the final gather only: where its records go */
+    lmb_ic_records *shared; /* irradiance_cache.records: shared: the records passed on; else NULL */
 } pass_env;
 
 /* The pass's gather through the irradiance cache, every atlas at once (records are shared
@@ -66,7 +67,7 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
                           env->cfg->ic_ray_scale};
     lmb_ic_pass_stats ps = {records, valid, env->points};
     if (st == LMB_OK)
-        st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, gs, err);
+        st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, env->shared, gs, err);
     uint64_t all = 0;
     for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
         all += records[a];
@@ -332,7 +333,9 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.progress = progress;
     job.progress_user = user;
     job.progress_total = total;
-    pass_env env = {cfg, log, &job, w, cache, stats, NULL};
+    lmb_ic_records shared;
+    lmb_ic_records_init(&shared, cfg->ic_error > 0 ? cfg->ic_error : 1);
+    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL};
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);
     stats->no_light = dark;
@@ -373,6 +376,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         stats->gather_rays = gs.rays;
         stats->amis_adapted = gs.adapted;
     }
+    lmb_ic_records_free(&shared);
     work_free(w, n);
     return st;
 }

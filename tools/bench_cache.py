@@ -12,6 +12,8 @@ Speed-up at equal RMSE: per-texel gathering's time at the cache's RMSE (log-log 
 over its three ray counts) over the cache's time. At equal time: per-texel's RMSE at the
 cache's time over the cache's RMSE.
 
+At the defaults it also bakes with irradiance_cache.records: per_pass (every pass places its
+own records) beside the default shared (one record set refined pass by pass).
 Then the path tracer: the Cornell box with all bounces (bounces: auto against a 32-bounce
 reference of BENCH_PT_REF paths): the RMSE and time of `--reference` with 1024 paths per texel,
 and of lmbake's default bake (the cache on).
@@ -96,7 +98,7 @@ def main():
           "lighting wall time (direct + bounce pass + final gather), %s threads, fastest of %d runs. Two bounces, "
           "defensive AMIS. `records` = final gather records." % (REF_PATHS, THREADS, REPEAT), ""]
     fig, axes = plt.subplots(1, len(SCENES), figsize=(5 * len(SCENES), 4.5))
-    summary = []
+    summary, modes = [], []
     for col, (name, density) in enumerate(SCENES):
         scene = os.path.join(work, "scenes", name + ".gltf")
         print("bench: %s: reference (%d paths)" % (name, REF_PATHS), flush=True)
@@ -138,6 +140,17 @@ def main():
                   flush=True)
             if (err, rays) == (0.3, 256):
                 summary.append((name, speedup, at_time, e, secs))
+                # the other record mode at the defaults: every pass places its own records
+                img2, _, secs2, rec2 = bake(lmbake, os.path.join(work, "%s-ic-per-pass" % name), scene,
+                                            base_cfg(density) + "irradiance_cache: {error: 0.3, records: per_pass}\n",
+                                            ["--rays", str(rays)], REPEAT)
+                e2 = rel_rmse(img2, ref, lit)
+                modes.append((name, secs2, e2, rec2, secs, e, records))
+                rows.append({"scene": name, "method": "cache per_pass", "error": err, "rays": rays, "records": rec2,
+                             "lighting_s": "%.3f" % secs2, "rmse": "%.5f" % e2, "speedup_equal_rmse": "",
+                             "rmse_ratio_equal_time": ""})
+                print("bench: %-14s cache per_pass: %.3f s, RMSE %.4f (shared: %.3f s, RMSE %.4f)"
+                      % (name, secs2, e2, secs, e), flush=True)
         md.append("")
         ax = axes[col]
         ax.plot(ts, es, "o-", label="per-texel (64/256/1024 rays)")
@@ -157,6 +170,10 @@ def main():
            "| scene | speed-up at equal RMSE | per-texel RMSE / cache RMSE at equal time |", "|---|---|---|"]
     md += ["| %s | %.1fx | %.2f |" % (n, s, a) for n, s, a, _, _ in summary]
     md.append("")
+    md += ["## irradiance_cache.records: per_pass vs shared (the default), error 0.3, 256 rays", "",
+           "| scene | per_pass s | per_pass RMSE | shared s | shared RMSE | time per_pass / shared |", "|---|---|---|---|---|---|"]
+    md += ["| %s | %.3f | %.4f | %.3f | %.4f | %.2f |" % (n, t2, e2, t1, e1, t2 / t1) for n, t2, e2, _, t1, e1, _ in modes]
+    md.append("")
 
     # against the path tracer, all bounces
     name, density = "cornell-point", 32
@@ -167,13 +184,17 @@ def main():
     lit = mask & (truth.mean(axis=2) > 0)
     pt, _, pt_s, _ = bake(lmbake, os.path.join(work, "pt-1024"), scene, cfg, ["--reference", "--rays", "1024"])
     lm, _, lm_s, records = bake(lmbake, os.path.join(work, "pt-lmbake"), scene, cfg, [], REPEAT)
+    lmp, _, lmp_s, _ = bake(lmbake, os.path.join(work, "pt-lmbake-per-pass"), scene,
+                            cfg + "irradiance_cache: {records: per_pass}\n", [], REPEAT)
     lm0, _, lm0_s, _ = bake(lmbake, os.path.join(work, "pt-lmbake-per-texel"), scene,
                             cfg + "irradiance_cache: {error: 0}\n", [], REPEAT)
     e_pt, e_lm, e_lm0 = rel_rmse(pt, truth, lit), rel_rmse(lm, truth, lit), rel_rmse(lm0, truth, lit)
+    e_lmp = rel_rmse(lmp, truth, lit)
     md += ["## Against the path tracer (cornell-point, density %d, all bounces)" % density, "",
            "| bake | lighting s | RMSE vs %d-path reference | time vs path tracer |" % PT_REF, "|---|---|---|---|",
            "| `--reference --rays 1024` | %.2f | %.4f | 1 |" % (pt_s, e_pt),
            "| lmbake defaults (cache) | %.2f | %.4f | 1/%.1f |" % (lm_s, e_lm, pt_s / lm_s),
+           "| lmbake defaults, `irradiance_cache.records: per_pass` | %.2f | %.4f | 1/%.1f |" % (lmp_s, e_lmp, pt_s / lmp_s),
            "| lmbake defaults, `irradiance_cache.error: 0` | %.2f | %.4f | 1/%.1f |" % (lm0_s, e_lm0, pt_s / lm0_s), ""]
     for label, secs, e in (("reference-1024", pt_s, e_pt), ("defaults-cache", lm_s, e_lm), ("defaults-per-texel", lm0_s, e_lm0)):
         rows.append({"scene": "cornell-point all bounces", "method": label, "error": "", "rays": "", "records": "",

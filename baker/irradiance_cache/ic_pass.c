@@ -106,6 +106,71 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     r->texel = x.index;
 }
 
+/*
+ * Gathers at the m texels at[], in parallel blocks: keep = 0 makes records of them in rec[];
+ * keep = 1 updates rec[] (records placed by an earlier pass, `irradiance_cache.records:
+ * shared`) with this pass's irradiance and rotation gradient, keeping position and reach.
+ */
+static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, lmb_ic_record *rec, int keep,
+                                 lmb_gather_stats *stats, lmb_error *err)
+{
+    const uint64_t block = 64;
+    int failed = 0;
+    for (uint64_t start = 0; start < m && !failed; start += block) {
+        uint64_t end = start + block < m ? start + block : m, rays = 0, texels = 0, adapted = 0;
+#pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
+        {
+            lmb_rt_thread_init();
+            lmb_estimator_scratch scratch = {0};
+            lmb_gather_stats gs = {0, 0, 0, 0};
+#pragma omp for schedule(dynamic, 1)
+            for (uint64_t k = start; k < end; k++) {
+                lmb_gather_point_result g;
+                lmb_ic_record fresh;
+                if (lmb_gather_record(c->job, at[k].atlas, c->t[at[k].atlas], at[k].index, &scratch, &g, &gs) !=
+                    LMB_OK) {
+                    failed = 1;
+                    continue;
+                }
+                make_record(c, at[k], &g, keep ? &fresh : &rec[k]);
+                if (keep) {
+                    memcpy(rec[k].e, fresh.e, sizeof fresh.e);
+                    memcpy(rec[k].grad_r, fresh.grad_r, sizeof fresh.grad_r);
+                }
+            }
+            lmb_estimator_scratch_free(&scratch);
+            rays += gs.rays;
+            texels += gs.texels;
+            adapted += gs.adapted;
+        }
+        stats->rays += rays;
+        stats->texels += texels;
+        stats->adapted += adapted;
+        report(c, end, m);
+    }
+    if (failed)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", c->job->stage,
+                             c->job->estimator.rays);
+    return LMB_OK;
+}
+
+/* The records of an earlier pass, gathered again with this pass's light. */
+static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
+{
+    uint32_t m = c->records.count;
+    texel_at *at = malloc(((size_t)m + 1) * sizeof *at);
+    if (!at)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", m);
+    for (uint32_t k = 0; k < m; k++) {
+        at[k] = (texel_at){c->records.rec[k].atlas, c->records.rec[k].texel};
+        c->is_record[at[k].atlas][at[k].index] = 1;
+    }
+    c->level = c->levels - 1;
+    lmb_status st = gather_records(c, at, m, c->records.rec, 1, stats, err);
+    free(at);
+    return st;
+}
+
 /* Gathers at the uncovered candidates of one level and appends them as records. */
 static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t *placed, lmb_gather_stats *stats,
                               lmb_error *err)
@@ -137,38 +202,7 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu records",
                              (unsigned long long)m);
     }
-    const uint64_t block = 64;
-    int failed = 0;
-    for (uint64_t start = 0; start < m && !failed; start += block) {
-        uint64_t end = start + block < m ? start + block : m, rays = 0, texels = 0, adapted = 0;
-#pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
-        {
-            lmb_rt_thread_init();
-            lmb_estimator_scratch scratch = {0};
-            lmb_gather_stats gs = {0, 0, 0, 0};
-#pragma omp for schedule(dynamic, 1)
-            for (uint64_t k = start; k < end; k++) {
-                lmb_gather_point_result g;
-                if (lmb_gather_record(c->job, cand[k].atlas, c->t[cand[k].atlas], cand[k].index, &scratch, &g, &gs) !=
-                    LMB_OK) {
-                    failed = 1;
-                    continue;
-                }
-                make_record(c, cand[k], &g, &fresh[k]);
-            }
-            lmb_estimator_scratch_free(&scratch);
-            rays += gs.rays;
-            texels += gs.texels;
-            adapted += gs.adapted;
-        }
-        stats->rays += rays;
-        stats->texels += texels;
-        stats->adapted += adapted;
-        report(c, end, m);
-    }
-    if (failed)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", c->job->stage,
-                           c->job->estimator.rays);
+    st = gather_records(c, cand, m, fresh, 0, stats, err);
     for (uint64_t k = 0; st == LMB_OK && k < m; k++)
         c->is_record[cand[k].atlas][cand[k].index] = 1;
     if (st == LMB_OK)
@@ -220,7 +254,7 @@ static lmb_status export_points(const lmb_ic_records *s, lmb_ic_points *out, lmb
 
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
-                              lmb_gather_stats *stats, lmb_error *err)
+                              lmb_ic_records *shared, lmb_gather_stats *stats, lmb_error *err)
 {
     lmb_gather_job record_job = *job;
     uint64_t rays = (uint64_t)job->estimator.rays * opt->ray_scale;
@@ -234,6 +268,11 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     c.threads = job->threads ? (int)job->threads : omp_get_max_threads();
     snprintf(c.stage, sizeof c.stage, "%s (cache)", job->stage);
     lmb_ic_records_init(&c.records, opt->error);
+    int reuse = shared && shared->count;
+    if (reuse) { /* take the earlier pass's records */
+        c.records = *shared;
+        lmb_ic_records_init(shared, opt->error);
+    }
     lmb_status st = LMB_OK;
     c.is_record = calloc((size_t)atlas_count + 1, sizeof *c.is_record);
     if (!c.is_record)
@@ -252,11 +291,13 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
         c.levels++;
     if (st == LMB_OK)
         st = lmb_ic_records_index(&c.records, err);
+    if (st == LMB_OK && reuse)
+        st = regather(&c, stats, err);
     /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a
      * level can shrink reaches and uncover texels found covered before, and such a patch is
      * refilled coarse to fine too (a round of spacing 1 alone would fill it texel by texel).
      * The last allowed round does not clamp, so no valid texel is left uncovered. */
-    for (uint32_t round = 0; round < LMB_IC_ROUNDS && st == LMB_OK; round++) {
+    for (uint32_t round = 0; round < LMB_IC_ROUNDS && st == LMB_OK && !reuse; round++) {
         int last_round = round + 1 == LMB_IC_ROUNDS;
         uint64_t placed_in_round = 0;
         for (uint32_t s = top; s >= 1 && st == LMB_OK; s /= 2, c.level += round == 0) {
@@ -286,6 +327,11 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);
-    lmb_ic_records_free(&c.records);
+    if (shared && st == LMB_OK) { /* handed to the next pass */
+        lmb_ic_records_free(shared);
+        *shared = c.records;
+    } else {
+        lmb_ic_records_free(&c.records);
+    }
     return st;
 }

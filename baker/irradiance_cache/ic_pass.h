@@ -21,6 +21,7 @@
 #define LMBAKE_IC_PASS_H
 
 #include "gather/gather.h"
+#include "irradiance_cache/records.h"
 #include "texels/texels.h"
 
 /* A texel is covered when the weights of the records that reach it sum to at least this
@@ -49,9 +50,13 @@ typedef struct lmb_ic_pass_stats {
 
 /* Indirect irradiance of every listed texel of every atlas (t[a], out[a]: 3 floats per listed
  * texel) through a cache built for this pass. job->estimator gives the method and the rays
- * per texel; stats add up the gathers' rays. */
+ * per texel; stats add up the gathers' rays.
+ * shared: NULL, each pass places its own records (irradiance_cache.records: per_pass); else
+ * the records of one pass refined by the next (shared): empty, this pass places records and
+ * leaves them there; holding records, this pass gathers again at them (same positions and
+ * reaches, this pass's light) and leaves them updated. The caller frees it. */
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
-                              lmb_gather_stats *stats, lmb_error *err);
+                              lmb_ic_records *shared, lmb_gather_stats *stats, lmb_error *err);
 
 #endif

@@ -190,6 +190,11 @@ typedef enum lmb_amis_weights {
     LMB_AMIS_BALANCE = 1   /* the paper: every sample by the balance heuristic over all lobes (biased, consistent) */
 } lmb_amis_weights;
 
+typedef enum lmb_ic_records_mode {
+    LMB_IC_RECORDS_PER_PASS = 0, /* every pass places its own records */
+    LMB_IC_RECORDS_SHARED = 1    /* the first pass places them, later passes gather again at them */
+} lmb_ic_records_mode;
+
 /* MASK: <stem>-lightmap-N-mask.png, per texel 255 = lit (valid), 128 = inside geometry, 0 = padding */
 enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8 };
 
@@ -232,6 +237,7 @@ typedef struct lmb_config {
     double ic_min_spacing;         /* texels: the smallest record reach */
     double ic_max_spacing;         /* texels: the largest record reach */
     uint32_t ic_ray_scale;         /* a record gathers with this many times the per-texel rays */
+    lmb_ic_records_mode ic_records; /* records per pass, or one set refined pass by pass */
     uint64_t seed;
     uint32_t threads;              /* 0: all cores */
     unsigned output_formats;       /* LMB_OUTPUT_* bits */
