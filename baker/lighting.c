@@ -173,7 +173,7 @@ static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error 
     uint32_t done = 0;
     for (uint32_t b = 1; b <= max_passes && !converged && st == LMB_OK; b++) {
         lmb_gather_stats gs = {0, 0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0, 0};
+        lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
         job->estimator = e;
         job->pass = b;
         snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
@@ -347,7 +347,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     for (uint32_t b = 1; !dark && cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK;
          b++) {
         lmb_gather_stats gs = {0, 0, 0, 0};
-        lmb_estimator_options e = {LMB_GATHER_COSINE, pass_rays(cfg, b), 1, 0, 0, 0};
+        lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
         job.estimator = e;
         job.pass = b;
         snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
@@ -360,9 +360,14 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     /* the final gather, or the reference */
     if (bounces > 0 && st == LMB_OK) {
         lmb_gather_stats gs = {0, 0, 0, 0};
-        lmb_estimator_options e = {cfg->gather_method, cfg->gather_rays, cfg->amis_iterations, cfg->defensive_fraction,
-                                   cfg->amis_weights == LMB_AMIS_UNBIASED, 0};
+        lmb_estimator_options e = {.method = cfg->gather_method,
+                                   .rays = cfg->gather_rays,
+                                   .iterations = cfg->amis_iterations,
+                                   .defensive = cfg->defensive_fraction,
+                                   .unbiased = cfg->amis_weights == LMB_AMIS_UNBIASED};
         job.estimator = e;
+        job.guide_stride = cfg->guide_stride;
+        job.guide_lobes = cfg->guide_lobes;
         job.pass = 1000;
         job.reference = cfg->reference;
         job.depth = bounces;

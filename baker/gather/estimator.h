@@ -36,13 +36,16 @@
 #include <lmbake/lmbake.h>
 
 #include "gather/lobe.h"
+#include "gather/mixture.h"
 #include "util/rng.h"
 
 #define LMB_AMIS_MAX_ITERATIONS 64
 #define LMB_AMIS_MAX_EXPONENT 1000.0 /* a lobe narrower than ~4 degrees (half width) is not learned */
 
-/* Radiance (RGB) arriving from unit direction w; `sample` is the sample's index at the point. */
-typedef void (*lmb_radiance_fn)(void *user, const double w[3], uint32_t sample, double out[3]);
+/* Radiance (RGB) arriving from unit direction w; `sample` is the sample's index at the point.
+ * Returns the distance to what it came from (INFINITY: the ray escaped), which lets a learned
+ * mixture aim its lobes at the same places from a neighbouring point (mixture.h). */
+typedef double (*lmb_radiance_fn)(void *user, const double w[3], uint32_t sample, double out[3]);
 
 typedef struct lmb_estimator_options {
     lmb_gather_method method;
@@ -51,6 +54,10 @@ typedef struct lmb_estimator_options {
     double defensive;    /* d, AMIS defensive only, in [0, 1) */
     int unbiased;        /* AMIS: weight each iteration's samples by its own pdf (see above) */
     int gradient;        /* also estimate the rotation gradient (irradiance cache records) */
+    /* guided gathering (unbiased AMIS with a defensive share, T >= 2): a mixture learned at a
+     * neighbouring point before this point's samples (spatial reuse); NULL or empty: none */
+    const lmb_mixture *guide;
+    uint32_t learn_lobes; /* > 0: fit a mixture of up to this many lobes to all samples (out->learned) */
 } lmb_estimator_options;
 
 /* Per-thread memory for the AMIS samples (grows as needed; free with lmb_estimator_scratch_free). */
@@ -58,8 +65,11 @@ typedef struct lmb_estimator_scratch {
     uint32_t cap, count;
     double *w, *f;        /* 3 each per kept sample: direction, integrand f (RGB) */
     double *lum, *denom;  /* luminance of f; sum over lobes so far of N_k q_k(w) */
-    double *own;          /* N_t q_t(w) / a_t: the unbiased estimate's denominator */
+    double *own;          /* unbiased AMIS: q_t(w), the pdf the sample was drawn from */
+    uint32_t *iteration;  /* unbiased AMIS: the sample's iteration t */
+    double *dist;         /* unbiased AMIS: the sample's hit distance */
     double *si;           /* eq. 3's s_i of the current lobe update */
+    lmb_mixture_scratch fit;
 } lmb_estimator_scratch;
 
 typedef struct lmb_estimate {
@@ -68,9 +78,14 @@ typedef struct lmb_estimate {
     lmb_lobe last;     /* the last lobe used (AMIS), or the cosine lobe */
     uint32_t adapted;  /* iterations that changed the lobe */
     double rot[3][3];  /* with options.gradient: per channel, dE/d(rotation vector of the normal) */
+    lmb_mixture learned; /* with options.learn_lobes: the mixture fitted to all samples (count 0: none) */
+    double share[LMB_AMIS_MAX_ITERATIONS]; /* unbiased AMIS: the weight a_t given to iteration t */
 } lmb_estimate;
 
 void lmb_estimator_scratch_free(lmb_estimator_scratch *s);
+
+/* Whether these options gather guided (a learned guide given to unbiased defensive AMIS, T >= 2). */
+int lmb_estimator_guided(const lmb_estimator_options *opt);
 
 /* How many leading samples (indices 0..) are drawn from the cosine lobe: all of classic's,
  * AMIS's first iteration. */

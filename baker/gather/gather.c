@@ -1,6 +1,8 @@
 /* The gather stage (see gather.h): cache passes, the path-traced reference, threads. */
 #include "gather.h"
 
+#include "gather/guide.h"
+
 #include <omp.h>
 
 #include <math.h>
@@ -30,7 +32,7 @@ static void hit_point(const lmb_rt *rt, const double o[3], const double w[3], co
 }
 
 /* Radiance arriving from w: B at the first hit, from the cache or (no lightmap) direct light. */
-static void cached_radiance(void *user, const double w[3], uint32_t sample, double out[3])
+static double cached_radiance(void *user, const double w[3], uint32_t sample, double out[3])
 {
     point_rays *pr = user;
     const lmb_gather_job *job = pr->job;
@@ -43,11 +45,11 @@ static void cached_radiance(void *user, const double w[3], uint32_t sample, doub
         pr->inverse_distances += hit && h.t > 0 ? 1.0 / h.t : 0.0;
     }
     if (!hit)
-        return;
+        return INFINITY;
     double albedo[3], e[3];
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
     if (kind == LMB_HIT_DARK)
-        return;
+        return h.t;
     if (kind == LMB_HIT_UNMAPPED) {
         lmb_shading_point y;
         hit_point(job->rt, pr->o, w, &h, &y);
@@ -56,6 +58,7 @@ static void cached_radiance(void *user, const double w[3], uint32_t sample, doub
     }
     for (int k = 0; k < 3; k++)
         out[k] = albedo[k] * e[k];
+    return h.t;
 }
 
 /* Path-traced indirect irradiance at sp: paths x depth cosine bounces, direct light at each hit. */
@@ -121,9 +124,20 @@ static lmb_status estimate_at(const lmb_gather_job *job, point_rays *pr, lmb_est
     return lmb_estimate_irradiance(opt, pr->sp.n, pr->sp.ng, rng, cached_radiance, pr, scratch, est);
 }
 
+/* Guided gathering's part in a per-texel pass: pilots first, then the texels they guide. */
+typedef struct guide_phase {
+    lmb_guide *guide; /* NULL: every texel gathers alone */
+    int pilots;       /* 1: this sweep gathers the pilots; 0: the other texels */
+    uint32_t lobes;   /* lobes a pilot learns */
+} guide_phase;
+
 static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
-                               lmb_estimator_scratch *scratch, float *out, lmb_gather_stats *st)
+                               const guide_phase *gp, lmb_estimator_scratch *scratch, float *out,
+                               lmb_gather_stats *st)
 {
+    uint32_t pilot = gp->guide ? gp->guide->pilot_of[i] : UINT32_MAX;
+    if (gp->guide && gp->pilots != (pilot != UINT32_MAX))
+        return LMB_OK; /* the other sweep's texel */
     out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0;
     if (!t->valid[i])
         return LMB_OK;
@@ -133,11 +147,24 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
     if (job->reference) {
         reference(&pr, e);
     } else {
+        lmb_estimator_options opt = job->estimator;
+        lmb_mixture guide;
+        if (pilot != UINT32_MAX)
+            opt.learn_lobes = gp->lobes;
+        else if (gp->guide && lmb_guide_find(gp->guide, t, i, pr.sp.p, pr.sp.n, &guide))
+            opt.guide = &guide;
         lmb_estimate est;
-        if (estimate_at(job, &pr, scratch, &job->estimator, &est) != LMB_OK)
+        if (estimate_at(job, &pr, scratch, &opt, &est) != LMB_OK)
             return LMB_ERR_INTERNAL;
         memcpy(e, est.e, sizeof e);
         st->adapted += est.adapted;
+        if (pilot != UINT32_MAX) {
+            lmb_guide_pilot *pl = &gp->guide->pilots[pilot];
+            memcpy(pl->p, pr.sp.p, sizeof pl->p);
+            memcpy(pl->n, pr.sp.n, sizeof pl->n);
+            pl->reach = 2.0f * (float)gp->guide->stride * t->texel_size[i];
+            pl->mixture = est.learned;
+        }
     }
     for (int k = 0; k < 3; k++)
         out[3 * (size_t)i + k] = (float)e[k];
@@ -168,8 +195,14 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     return LMB_OK;
 }
 
-lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,
-                            lmb_gather_stats *stats, lmb_error *err)
+int lmb_gather_guided(const lmb_estimator_options *opt)
+{
+    return opt->method == LMB_GATHER_AMIS_DEFENSIVE && opt->unbiased && opt->defensive > 0 && opt->iterations >= 2;
+}
+
+/* One sweep over the atlas's texels in blocks (progress after each block when `report`). */
+static int sweep(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, const guide_phase *gp, int report,
+                 float *out, lmb_gather_stats *stats)
 {
     const uint32_t block = 256;
     int threads = job->threads ? (int)job->threads : omp_get_max_threads(), failed = 0;
@@ -183,7 +216,7 @@ lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb
             lmb_gather_stats st = {0, 0, 0, 0};
 #pragma omp for schedule(dynamic, 4)
             for (uint32_t i = start; i < end; i++)
-                if (gather_texel(job, atlas, t, i, &scratch, out, &st) != LMB_OK)
+                if (gather_texel(job, atlas, t, i, gp, &scratch, out, &st) != LMB_OK)
                     failed = 1;
             lmb_estimator_scratch_free(&scratch);
             rays += st.rays;
@@ -193,10 +226,33 @@ lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb
         stats->rays += rays;
         stats->texels += texels;
         stats->adapted += adapted;
-        if (job->progress)
+        if (report && job->progress)
             job->progress(job->progress_user, job->stage, job->progress_done + end, job->progress_total);
     }
-    if (failed)
+    return !failed;
+}
+
+lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,
+                            lmb_gather_stats *stats, lmb_error *err)
+{
+    lmb_guide guide;
+    guide_phase gp = {NULL, 0, job->guide_lobes};
+    if (!job->reference && job->guide_stride > 0 && lmb_gather_guided(&job->estimator)) {
+        if (!lmb_guide_init(&guide, t, job->guide_stride))
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for the guide of atlas %u", job->stage,
+                                 atlas);
+        gp.guide = &guide;
+        gp.pilots = 1;
+    }
+    int ok = 1;
+    if (gp.guide) { /* the pilots first: every guided texel reads a finished mixture */
+        ok = sweep(job, atlas, t, &gp, 0, out, stats);
+        gp.pilots = 0;
+    }
+    ok = ok && sweep(job, atlas, t, &gp, 1, out, stats);
+    if (gp.guide)
+        lmb_guide_free(&guide);
+    if (!ok)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", job->stage,
                              job->estimator.rays);
     return LMB_OK;

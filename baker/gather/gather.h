@@ -31,6 +31,8 @@ typedef struct lmb_gather_job {
     int reference;              /* path tracing, estimator.rays paths per texel */
     uint32_t depth;             /* reference: bounces */
     uint32_t pass;              /* keys the random streams */
+    uint32_t guide_stride;      /* guided gathering: pilot texels every this many texels (0: off; guide.h) */
+    uint32_t guide_lobes;       /* lobes a pilot learns (gather.lobes) */
     const char *stage;          /* progress stage name */
     lmb_progress_fn progress;
     void *progress_user;

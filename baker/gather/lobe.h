@@ -29,11 +29,11 @@ static inline double lmb_lobe_pdf(const lmb_lobe *l, const double w[3])
     return (l->a + 1.0) * (0.5 * LMB_INV_PI) * (l->a == 1.0 ? c : (double)expf((float)l->a * logf((float)c)));
 }
 
-/* Direction drawn from the lobe with uniforms u1, u2 in [0, 1). */
-static inline void lmb_lobe_sample(const lmb_lobe *l, double u1, double u2, double w[3])
+/* Direction drawn from the lobe with uniforms u1, u2 in [0, 1), in the lobe's frame (t, b, axis)
+ * from lmb_frame (a mixture computes its lobes' frames once). */
+static inline void lmb_lobe_sample_in_frame(const lmb_lobe *l, const double t[3], const double b[3], double u1,
+                                            double u2, double w[3])
 {
-    double t[3], b[3];
-    lmb_frame(l->axis, t, b);
     /* 1 - u1 is in (0, 1]: cos(theta) > 0, so the pdf of the sample is never 0 */
     double ct = l->a == 1.0 ? sqrt(1.0 - u1) : (double)expf(logf((float)(1.0 - u1)) / (float)(l->a + 1.0));
     double st = sqrt(fmax(0.0, 1.0 - ct * ct));
@@ -41,6 +41,14 @@ static inline void lmb_lobe_sample(const lmb_lobe *l, double u1, double u2, doub
     double x = st * (double)cosf(phi), y = st * (double)sinf(phi);
     for (int k = 0; k < 3; k++)
         w[k] = x * t[k] + y * b[k] + ct * l->axis[k];
+}
+
+/* Direction drawn from the lobe with uniforms u1, u2 in [0, 1). */
+static inline void lmb_lobe_sample(const lmb_lobe *l, double u1, double u2, double w[3])
+{
+    double t[3], b[3];
+    lmb_frame(l->axis, t, b);
+    lmb_lobe_sample_in_frame(l, t, b, u1, u2, w);
 }
 
 #endif

@@ -69,6 +69,8 @@ static const key_spec config_keys[] = {
     ENUM("gather.method", OFF(gather_method), gather_methods),
     ENUM("gather.amis_weights", OFF(amis_weights), amis_weights),
     FLOAT("gather.defensive", OFF(defensive_fraction), 0, 1, OPEN_HI),
+    U32("gather.guide_stride", OFF(guide_stride), 0, 64),
+    U32("gather.lobes", OFF(guide_lobes), 1, 3),
     FLOAT("irradiance_cache.error", OFF(ic_error), 0, 10, 0),
     FLOAT("irradiance_cache.min_spacing", OFF(ic_min_spacing), 0.5, 4096, 0),
     FLOAT("irradiance_cache.max_spacing", OFF(ic_max_spacing), 1, 4096, 0),
@@ -112,6 +114,8 @@ void lmb_config_default(lmb_config *cfg)
     cfg->bounces_tail = 0.2;
     cfg->gather_method = LMB_GATHER_AMIS_DEFENSIVE;
     cfg->defensive_fraction = 0.1;
+    cfg->guide_stride = 8;
+    cfg->guide_lobes = 2;
     cfg->ic_error = 0.3;
     cfg->ic_min_spacing = 4;
     cfg->ic_max_spacing = 32;
