@@ -449,9 +449,12 @@ static void guided(const lmb_estimator_options *opt, const lmb_lobe *cosine, con
         double c = lmb_dot3(w, cosine->axis);
         if (c <= 0 || lmb_dot3(w, ng) <= 0)
             continue;
-        radiance(user, w, j, l);
+        double dist = radiance(user, w, j, l);
         out->traced++;
-        double denom = (double)opt->rays * proposal_pdf(&prop, cosine, w), x[3];
+        double q = proposal_pdf(&prop, cosine, w), denom = (double)opt->rays * q, x[3];
+        double wc = c * LMB_INV_PI / q; /* p_cos / q */
+        out->cos_weight += wc;
+        out->cos_inverse_distance += dist > 0 && isfinite(dist) ? wc / dist : 0;
         for (int k = 0; k < 3; k++)
             out->e[k] += x[k] = l[k] * c / denom;
         if (opt->gradient)

@@ -174,12 +174,16 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
 }
 
 lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
-                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st)
+                            const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
+                            lmb_gather_point_result *out, lmb_gather_stats *st)
 {
     point_rays pr;
     point_setup(job, atlas, t, i, &pr);
     lmb_estimator_options opt = job->estimator;
     opt.gradient = 1;
+    opt.guide = guide;
+    int guided = lmb_estimator_guided(&opt);
+    opt.learn_lobes = guided ? 0 : learn_lobes;
     pr.cosine_samples = lmb_estimator_cosine_samples(&opt);
     lmb_estimate est;
     if (estimate_at(job, &pr, scratch, &opt, &est) != LMB_OK)
@@ -188,7 +192,11 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     memcpy(out->n, pr.sp.n, sizeof out->n);
     memcpy(out->e, est.e, sizeof out->e);
     memcpy(out->rot, est.rot, sizeof out->rot);
-    out->harmonic = pr.inverse_distances > 0 ? pr.distances / pr.inverse_distances : HUGE_VAL;
+    if (guided)
+        out->harmonic = est.cos_inverse_distance > 0 ? est.cos_weight / est.cos_inverse_distance : HUGE_VAL;
+    else
+        out->harmonic = pr.inverse_distances > 0 ? pr.distances / pr.inverse_distances : HUGE_VAL;
+    out->learned = est.learned;
     st->rays += pr.rays;
     st->texels++;
     st->adapted += est.adapted;

@@ -51,11 +51,20 @@ typedef struct lmb_gather_point_result {
     double p[3], n[3];  /* the gather point and its shading normal */
     double e[3];        /* irradiance (the same value lmb_gather_atlas gives the texel) */
     double rot[3][3];   /* rotation gradient per channel (estimator.h) */
-    double harmonic;    /* harmonic mean hit distance of its cosine-distributed rays (HUGE_VAL: none hit) */
+    double harmonic;    /* harmonic mean hit distance of its cosine-distributed rays (HUGE_VAL: none hit;
+                           guided: of all its rays, weighted p_cos / q) */
+    lmb_mixture learned; /* with learn_lobes: what it learned for its neighbours (guide.h) */
 } lmb_gather_point_result;
 
+/* guide: a mixture to gather by (lmb_estimator_guided; NULL: none); learn_lobes > 0: fit one
+ * (out->learned) when not guided. */
 lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
-                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st);
+                            const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
+                            lmb_gather_point_result *out, lmb_gather_stats *st);
+
+/* Whether the estimator options can gather guided (unbiased defensive AMIS, T >= 2): a pass
+ * with them gathers pilots first and guides the rest (gather/guide.h). */
+int lmb_gather_guided(const lmb_estimator_options *opt);
 
 /* Indirect irradiance of every listed texel of t (atlas `atlas`) into out (3 floats per texel;
  * 0 for invalid texels). */

@@ -29,7 +29,40 @@ typedef struct pass_ctx {
     uint64_t valid_total, levels, level;
     uint64_t reported;            /* progress never goes back (the last level may run several rounds) */
     char stage[96];
+    uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
+    /* guided gathering (gather/guide.h): per record, the mixture it gathered by or learned in
+     * this pass; has_mix[k] is set once record k's whole group is gathered, so a record is
+     * guided only by records of earlier groups (deterministic at any thread count) */
+    int guided;
+    uint32_t lobes;
+    lmb_mixture *mix;
+    uint8_t *has_mix;
+    uint32_t mix_cap;
 } pass_ctx;
+
+#define SAME_SURFACE_COS 0.9 /* a record guides another whose normal is within ~25 degrees */
+
+/* Room for the mixtures of n records (new ones not yet had). */
+static int reserve_mix(pass_ctx *c, uint32_t n)
+{
+    if (!c->guided || n <= c->mix_cap)
+        return 1;
+    uint32_t cap = c->mix_cap ? c->mix_cap : 1024;
+    while (cap < n)
+        cap = cap > UINT32_MAX / 2 ? n : cap * 2;
+    lmb_mixture *m = realloc(c->mix, (size_t)cap * sizeof *m);
+    if (m)
+        c->mix = m;
+    uint8_t *h = realloc(c->has_mix, cap);
+    if (h) {
+        memset(h + c->mix_cap, 0, cap - c->mix_cap);
+        c->has_mix = h;
+    }
+    if (!m || !h)
+        return 0;
+    c->mix_cap = cap;
+    return 1;
+}
 
 static void texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
 {
@@ -107,15 +140,19 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
 }
 
 /*
- * Gathers at the m texels at[], in parallel blocks: keep = 0 makes records of them in rec[];
- * keep = 1 updates rec[] (records placed by an earlier pass, `irradiance_cache.records:
- * shared`) with this pass's irradiance and rotation gradient, keeping position and reach.
+ * Gathers at the m texels at[], in parallel blocks. slots == NULL: new records, made in rec[k],
+ * record index records.count + k. slots != NULL: records placed by an earlier pass
+ * (`irradiance_cache.records: shared`), record slots[k], updated with this pass's irradiance
+ * and rotation gradient, keeping position and reach. Guided: each gathers by the nearest
+ * record of an earlier group on the same surface (its mixture re-aimed), or learns one.
  */
-static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, lmb_ic_record *rec, int keep,
-                                 lmb_gather_stats *stats, lmb_error *err)
+static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, lmb_ic_record *rec,
+                                 uint64_t done_before, uint64_t total, lmb_gather_stats *stats, lmb_error *err)
 {
     const uint64_t block = 64;
     int failed = 0;
+    if (!reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for guides");
     for (uint64_t start = 0; start < m && !failed; start += block) {
         uint64_t end = start + block < m ? start + block : m, rays = 0, texels = 0, adapted = 0;
 #pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
@@ -125,17 +162,31 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, lm
             lmb_gather_stats gs = {0, 0, 0, 0};
 #pragma omp for schedule(dynamic, 1)
             for (uint64_t k = start; k < end; k++) {
+                uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)k;
+                lmb_mixture guide;
+                const lmb_mixture *by = NULL;
+                if (c->guided) {
+                    double p[3], n[3];
+                    texel_point(c, at[k], p, n);
+                    int64_t j = lmb_ic_records_nearest(&c->records, p, n, SAME_SURFACE_COS, c->has_mix);
+                    if (j >= 0) {
+                        lmb_mixture_reaim(&c->mix[j], c->records.rec[j].p, p, &guide);
+                        by = &guide;
+                    }
+                }
                 lmb_gather_point_result g;
                 lmb_ic_record fresh;
-                if (lmb_gather_record(c->job, at[k].atlas, c->t[at[k].atlas], at[k].index, &scratch, &g, &gs) !=
-                    LMB_OK) {
+                if (lmb_gather_record(c->job, at[k].atlas, c->t[at[k].atlas], at[k].index, by, c->lobes, &scratch,
+                                      &g, &gs) != LMB_OK) {
                     failed = 1;
                     continue;
                 }
-                make_record(c, at[k], &g, keep ? &fresh : &rec[k]);
-                if (keep) {
-                    memcpy(rec[k].e, fresh.e, sizeof fresh.e);
-                    memcpy(rec[k].grad_r, fresh.grad_r, sizeof fresh.grad_r);
+                if (c->guided)
+                    c->mix[slot] = by ? guide : g.learned;
+                make_record(c, at[k], &g, slots ? &fresh : &rec[k]);
+                if (slots) {
+                    memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
+                    memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
                 }
             }
             lmb_estimator_scratch_free(&scratch);
@@ -146,28 +197,48 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, lm
         stats->rays += rays;
         stats->texels += texels;
         stats->adapted += adapted;
-        report(c, end, m);
+        report(c, done_before + end, total);
     }
     if (failed)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", c->job->stage,
                              c->job->estimator.rays);
+    for (uint64_t k = 0; c->guided && k < m; k++)
+        c->has_mix[slots ? slots[k] : c->records.count + (uint32_t)k] = 1;
     return LMB_OK;
 }
 
-/* The records of an earlier pass, gathered again with this pass's light. */
+/* The records of an earlier pass, gathered again with this pass's light, group by group in
+ * placement order (guided gathering reads earlier groups' mixtures). */
 static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
 {
-    uint32_t m = c->records.count;
+    uint32_t m = c->records.count, groups = 0;
     texel_at *at = malloc(((size_t)m + 1) * sizeof *at);
-    if (!at)
+    uint32_t *slots = malloc(((size_t)m + 1) * sizeof *slots);
+    if (!at || !slots) {
+        free(at);
+        free(slots);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", m);
+    }
     for (uint32_t k = 0; k < m; k++) {
-        at[k] = (texel_at){c->records.rec[k].atlas, c->records.rec[k].texel};
-        c->is_record[at[k].atlas][at[k].index] = 1;
+        c->is_record[c->records.rec[k].atlas][c->records.rec[k].texel] = 1;
+        groups = c->records.rec[k].group + 1 > groups ? c->records.rec[k].group + 1 : groups;
     }
     c->level = c->levels - 1;
-    lmb_status st = gather_records(c, at, m, c->records.rec, 1, stats, err);
+    lmb_status st = LMB_OK;
+    uint64_t done = 0;
+    for (uint32_t g = 0; g < groups && st == LMB_OK; g++) {
+        uint32_t n = 0;
+        for (uint32_t k = 0; k < m; k++)
+            if (c->records.rec[k].group == g) {
+                slots[n] = k;
+                at[n++] = (texel_at){c->records.rec[k].atlas, c->records.rec[k].texel};
+            }
+        if (n)
+            st = gather_records(c, at, n, slots, NULL, done, m, stats, err);
+        done += n;
+    }
     free(at);
+    free(slots);
     return st;
 }
 
@@ -202,9 +273,12 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu records",
                              (unsigned long long)m);
     }
-    st = gather_records(c, cand, m, fresh, 0, stats, err);
-    for (uint64_t k = 0; st == LMB_OK && k < m; k++)
+    st = gather_records(c, cand, m, NULL, fresh, 0, m, stats, err);
+    for (uint64_t k = 0; st == LMB_OK && k < m; k++) {
         c->is_record[cand[k].atlas][cand[k].index] = 1;
+        fresh[k].group = c->group;
+    }
+    c->group++;
     if (st == LMB_OK)
         st = lmb_ic_records_append(&c->records, fresh, (uint32_t)m, err);
     free(fresh);
@@ -267,6 +341,8 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     c.t = t;
     c.threads = job->threads ? (int)job->threads : omp_get_max_threads();
     snprintf(c.stage, sizeof c.stage, "%s (cache)", job->stage);
+    c.guided = job->guide_stride > 0 && lmb_gather_guided(&job->estimator);
+    c.lobes = job->guide_lobes;
     lmb_ic_records_init(&c.records, opt->error);
     int reuse = shared && shared->count;
     if (reuse) { /* take the earlier pass's records */
@@ -327,6 +403,8 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);
+    free(c.mix);
+    free(c.has_mix);
     if (shared && st == LMB_OK) { /* handed to the next pass */
         lmb_ic_records_free(shared);
         *shared = c.records;

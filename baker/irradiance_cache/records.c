@@ -172,7 +172,7 @@ static double box_distance2(const float *b, const double p[3])
 typedef void (*visit_fn)(void *user, uint32_t record);
 
 /* Visits, in tree order, every record that may lie within `radius` of p (radius < 0: within
- * the record's own reach). */
+ * -radius times the record's own reach). */
 static void walk(const lmb_ic_records *s, const double p[3], double radius, visit_fn visit, void *user)
 {
     if (!s->count)
@@ -183,7 +183,7 @@ static void walk(const lmb_ic_records *s, const double p[3], double radius, visi
     stack[top++] = s->count;
     while (top) {
         uint32_t hi = stack[--top], lo = stack[--top], node = stack[--top];
-        double r = radius < 0 ? s->reach[node] : radius;
+        double r = radius < 0 ? -radius * s->reach[node] : radius;
         if (box_distance2(s->box[node], p) >= r * r)
             continue;
         if (hi - lo <= LEAF) {
@@ -200,6 +200,37 @@ static void walk(const lmb_ic_records *s, const double p[3], double radius, visi
         stack[top++] = lo;
         stack[top++] = mid;
     }
+}
+
+typedef struct nearest_ctx {
+    const lmb_ic_records *s;
+    const double *p, *n;
+    double min_cos, best_d2;
+    const uint8_t *eligible;
+    int64_t best;
+} nearest_ctx;
+
+static void nearest_visit(void *user, uint32_t k)
+{
+    nearest_ctx *c = user;
+    const lmb_ic_record *r = &c->s->rec[k];
+    if (!c->eligible[k] || lmb_dot3(r->n, c->n) < c->min_cos)
+        return;
+    double d[3] = {r->p[0] - c->p[0], r->p[1] - c->p[1], r->p[2] - c->p[2]}, d2 = lmb_dot3(d, d);
+    if (d2 >= 4 * r->r * r->r)
+        return;
+    if (c->best < 0 || d2 < c->best_d2 || (d2 == c->best_d2 && k < c->best)) {
+        c->best = k;
+        c->best_d2 = d2;
+    }
+}
+
+int64_t lmb_ic_records_nearest(const lmb_ic_records *s, const double p[3], const double n[3], double min_cos,
+                               const uint8_t *eligible)
+{
+    nearest_ctx c = {s, p, n, min_cos, 0, eligible, -1};
+    walk(s, p, -2, nearest_visit, &c);
+    return c.best;
 }
 
 /* ---- weights and interpolation -------------------------------------------------------- */

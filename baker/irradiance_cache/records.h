@@ -37,6 +37,7 @@ typedef struct lmb_ic_record {
     double r_min, r_max;   /* the reach's clamps in world units (spacing x the texel's size) */
     double r;              /* reach: clamp(error x harmonic, r_min, r_max) */
     uint32_t atlas, texel; /* where it was gathered: atlas and listed-texel index */
+    uint32_t group;        /* placement order: the level (of all rounds) that placed it */
 } lmb_ic_record;
 
 typedef struct lmb_ic_records {
@@ -70,6 +71,11 @@ double lmb_ic_weight(const lmb_ic_records *s, const lmb_ic_record *r, const doub
 /* Sum of the weights at (p, n); with e != NULL also the interpolated irradiance (0 when the
  * sum is 0). Reads the index: call lmb_ic_records_index first. */
 double lmb_ic_interpolate(const lmb_ic_records *s, const double p[3], const double n[3], double e[3]);
+
+/* The nearest record k with eligible[k] set whose shading normal is within acos(min_cos) of n
+ * and that lies within twice its reach of p; -1 when there is none. Reads the index. */
+int64_t lmb_ic_records_nearest(const lmb_ic_records *s, const double p[3], const double n[3], double min_cos,
+                               const uint8_t *eligible);
 
 /* Neighbour clamping (Krivanek et al. 2006): no record's harmonic distance exceeds a
  * neighbour's plus the distance between them, R_i <= R_j + |p_i - p_j| over the records
