@@ -36,6 +36,24 @@ static lmb_status store_pass(atlas_work *w, lmb_cache *cache, lmb_error *err)
     return st;
 }
 
+/* The cache := indirect light only, the last pass stored (result; with no bounce pass before
+ * the final gather, direct light alone) minus direct light, for gather.direct_at_hits. */
+static lmb_status store_indirect(atlas_work *w, lmb_cache *cache, int passes_ran, lmb_error *err)
+{
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
+        size_t n = 3 * (size_t)w[a].t.count;
+        float *ind = calloc(n + 1, sizeof *ind);
+        if (!ind)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+        for (size_t k = 0; passes_ran && k < n; k++)
+            ind[k] = w[a].result[k] > w[a].direct[k] ? w[a].result[k] - w[a].direct[k] : 0.0f;
+        st = lmb_cache_store(cache, a, &w[a].t, ind, err);
+        free(ind);
+    }
+    return st;
+}
+
 /* What the passes share. */
 typedef struct pass_env {
     const lmb_config *cfg;
@@ -366,6 +384,9 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
                                    .defensive = cfg->defensive_fraction,
                                    .unbiased = cfg->amis_weights == LMB_AMIS_UNBIASED};
         job.estimator = e;
+        job.direct_at_hits = cfg->direct_at_hits && !cfg->reference;
+        if (job.direct_at_hits) /* the cache := the last pass minus direct light */
+            st = store_indirect(w, cache, bounces > 1, err);
         job.guide_stride = cfg->guide_stride;
         job.guide_lobes = cfg->guide_lobes;
         job.pass = 1000;
@@ -374,7 +395,8 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         job.stage = cfg->reference ? "reference" : "final gather";
         double t0 = lmb_seconds();
         env.points = records;
-        st = gather_pass(&env, &gs, 1, err);
+        if (st == LMB_OK)
+            st = gather_pass(&env, &gs, 1, err);
         env.points = NULL;
         stats->gather_records = gs.records;
         stats->gather_seconds = lmb_seconds() - t0;

@@ -50,11 +50,14 @@ static double cached_radiance(void *user, const double w[3], uint32_t sample, do
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
     if (kind == LMB_HIT_DARK)
         return h.t;
-    if (kind == LMB_HIT_UNMAPPED) {
+    if (kind == LMB_HIT_UNMAPPED || job->direct_at_hits) {
         lmb_shading_point y;
+        double d[3];
         hit_point(job->rt, pr->o, w, &h, &y);
         lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
-        pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e);
+        pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, d);
+        for (int k = 0; k < 3; k++) /* unmapped: direct light only (one bounce) */
+            e[k] = kind == LMB_HIT_UNMAPPED ? d[k] : e[k] + d[k];
     }
     for (int k = 0; k < 3; k++)
         out[k] = albedo[k] * e[k];

@@ -33,6 +33,8 @@ typedef struct lmb_gather_job {
     uint32_t pass;              /* keys the random streams */
     uint32_t guide_stride;      /* guided gathering: pilot texels every this many texels (0: off; guide.h) */
     uint32_t guide_lobes;       /* lobes a pilot learns (gather.lobes) */
+    int direct_at_hits;         /* the cache holds indirect light only; direct light is computed
+                                   at each hit with shadow rays (gather.direct_at_hits) */
     const char *stage;          /* progress stage name */
     lmb_progress_fn progress;
     void *progress_user;

@@ -71,6 +71,7 @@ static const key_spec config_keys[] = {
     FLOAT("gather.defensive", OFF(defensive_fraction), 0, 1, OPEN_HI),
     U32("gather.guide_stride", OFF(guide_stride), 0, 64),
     U32("gather.lobes", OFF(guide_lobes), 1, 3),
+    BOOL("gather.direct_at_hits", OFF(direct_at_hits)),
     FLOAT("irradiance_cache.error", OFF(ic_error), 0, 10, 0),
     FLOAT("irradiance_cache.min_spacing", OFF(ic_min_spacing), 0.5, 4096, 0),
     FLOAT("irradiance_cache.max_spacing", OFF(ic_max_spacing), 1, 4096, 0),

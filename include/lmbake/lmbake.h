@@ -233,6 +233,7 @@ typedef struct lmb_config {
     lmb_amis_weights amis_weights; /* how AMIS weights its samples in the estimate */
     uint32_t guide_stride;         /* guided gathering: pilot texels every N texels (0: off) */
     uint32_t guide_lobes;          /* lobes a pilot learns (1..3) */
+    int direct_at_hits;            /* final gather: direct light at each hit by shadow rays, the cache only for indirect */
     int reference;                 /* path-trace indirect light with no cache (ground truth) */
     /* irradiance cache (Ward): gathers at records, interpolation elsewhere */
     double ic_error;               /* Ward's a; 0 = a gather at every texel */
