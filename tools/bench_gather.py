@@ -1,16 +1,23 @@
 #!/usr/bin/env python3
-"""Final-gather benchmark (issue 5): error against time for classic gathering, AMIS and
-defensive AMIS (both with lmbake's unbiased estimate) and the paper's AMIS (balance weights),
-at 64, 256 and 1024 rays per texel, on four generated scenes (tools/make_scenes.py):
+"""Final-gather benchmark (issues 5 and 12): error against time for classic gathering, the
+default gather (guided AMIS: defensive AMIS whose texels start from a mixture learned at pilot
+texels), unguided defensive AMIS (every texel adapts alone) and the paper's AMIS (balance
+weights, biased), at 64, 256 and 1024 rays per texel, a gather at every texel
+(irradiance_cache.error 0: the estimators alone), on five generated scenes (tools/make_scenes.py):
   cornell-point  the paper's Figure 1: Cornell box, point light 3 cm under the ceiling
   two-spots      two bright spots on opposite walls (one lobe cannot fit both)
   furnace        light from everywhere alike (nothing to adapt to)
   grazing        a spot on a corridor floor, seen at grazing angles from the floor
+  gap            a room lit through a 4 cm slit only (the failure case: pilots rarely see it)
 Errors: relative RMSE over valid texels (the mask output) against
-  - the reference: `lmbake bake --reference` (path tracing, no cache, BENCH_REF_PATHS paths);
+  - the reference: `lmbake bake --reference` (path tracing, no cache, BENCH_REF_PATHS paths),
+    whose own noise is reported too (a second reference with another seed);
   - the converged gather: classic gathering with BENCH_CONVERGED_RAYS rays through the same
-    cache, so the difference is the estimator's noise alone (the cache's own resolution error
-    is the gap between the two references, also reported).
+    cache, so the difference is the estimator's noise alone.
+gather.direct_at_hits: the converged gather with direct light computed at every hit differs
+from the converged gather through the cache by the cache's resolution error for direct light;
+reported at the benchmark's density and at 8 texels/m, with the time it costs the default
+gather at 1024 rays.
 Time: the final gather's wall time as lmbake prints it (2 threads), the fastest of BENCH_REPEAT
 (3) runs: the machine is shared and single runs move by tens of percent.
 usage: bench_gather.py LMBAKE OUTDIR   (writes gather.csv, gather.md, gather.png, gather-<scene>.png)
@@ -30,11 +37,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCENES = [("cornell-point", 32), ("two-spots", 32), ("furnace", 16), ("grazing", 24)]
+SCENES = [("cornell-point", 32, ""), ("two-spots", 32, ""), ("furnace", 16, ""), ("grazing", 24, ""),
+          ("gap", 32, "lightmap: {exclude: [lit_room]}\n")]
+DEFAULT = "default (guided)"
 METHODS = [("classic", ["--method", "cosine"], ""),
-           ("AMIS", ["--method", "amis"], ""),
-           ("AMIS defensive", ["--method", "amis_defensive"], ""),
+           (DEFAULT, ["--method", "amis_defensive"], ""),
+           ("unguided defensive", ["--method", "amis_defensive"], "  guide_stride: 0\n"),
            ("AMIS paper", ["--method", "amis"], "  amis_weights: balance\n")]
+PER_TEXEL = "irradiance_cache: {error: 0}\n"
+DIRECT_AT_HITS = "  direct_at_hits: true\n"
 RAYS = [64, 256, 1024]
 REF_PATHS = int(os.environ.get("BENCH_REF_PATHS", "8192"))
 CONVERGED = int(os.environ.get("BENCH_CONVERGED_RAYS", "16384"))
@@ -42,11 +53,14 @@ THREADS = os.environ.get("BENCH_THREADS", "2")
 REPEAT = int(os.environ.get("BENCH_REPEAT", "3"))  # timed runs per setting; the fastest counts
 
 
-def bake(lmbake, out, scene, density, extra_cfg, args, repeat=1):
+def bake(lmbake, out, scene, density, extra_cfg, args, repeat=1, scene_cfg=""):
+    """extra_cfg: lines under gather:; scene_cfg: top-level lines (a gather at every texel unless it
+    sets irradiance_cache)."""
     cfg = out + ".yaml"
     with open(cfg, "w") as f:
         f.write("texel_density: %d\nbounces: 1\nsamples: {texel: 4, direct: 16, amis_iterations: 4}\n"
-                "output: {formats: [exr, mask]}\ngather:\n  defensive: 0.1\n%s" % (density, extra_cfg))
+                "output: {formats: [exr, mask]}\ngather:\n  defensive: 0.1\n%s%s%s"
+                % (density, extra_cfg, "" if "irradiance_cache" in scene_cfg else PER_TEXEL, scene_cfg))
     secs = []
     for _ in range(repeat):  # same seed, same files: only the time differs (this machine is shared)
         p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "--threads", THREADS] + args,
@@ -88,24 +102,31 @@ def main():
     os.makedirs(work, exist_ok=True)
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
                    check=True, stdout=subprocess.DEVNULL)
-    rows, md = [], ["# Final gather benchmark", "",
-                    "Relative RMSE over valid texels; `vs ref` against the path-traced reference (%d paths), "
-                    "`noise` against the converged gather (classic, %d rays, same cache). One bounce, 4 AMIS "
-                    "iterations, defensive share 0.1, %s threads, fastest of %d timed runs." % (REF_PATHS, CONVERGED, THREADS, REPEAT), ""]
-    fig, axes = plt.subplots(2, 4, figsize=(18, 8))
-    for col, (name, density) in enumerate(SCENES):
+    rows, hits_rows, summary = [], [], []
+    md = ["# Final gather benchmark", "",
+          "Relative RMSE over valid texels, a gather at every texel; `vs ref` against the path-traced reference "
+          "(%d paths), `noise` against the converged gather (classic, %d rays, same cache). One bounce, 4 AMIS "
+          "iterations, defensive share 0.1, %s threads, fastest of %d timed runs. \"noise at classic's time\": "
+          "log-log interpolation of the method's noise to classic's time at the same rays."
+          % (REF_PATHS, CONVERGED, THREADS, REPEAT), ""]
+    fig, axes = plt.subplots(2, len(SCENES), figsize=(4.5 * len(SCENES), 8))
+    for col, (name, density, scene_cfg) in enumerate(SCENES):
         scene = os.path.join(work, "scenes", name + ".gltf")
-        print("bench: %s: reference (%d paths)" % (name, REF_PATHS), flush=True)
-        ref, mask, ref_s, ref_rays = bake(lmbake, os.path.join(work, name + "-ref"), scene, density, "",
-                                          ["--reference", "--rays", str(REF_PATHS)])
-        conv, _, _, _ = bake(lmbake, os.path.join(work, name + "-conv"), scene, density, "",
-                             ["--method", "cosine", "--rays", str(CONVERGED)])
+        path = lambda tag: os.path.join(work, "%s-%s" % (name, tag))  # noqa: E731
+        print("bench: %s: references (%d paths, two seeds)" % (name, REF_PATHS), flush=True)
+        ref, mask, _, _ = bake(lmbake, path("ref"), scene, density, "", ["--reference", "--rays", str(REF_PATHS)],
+                               scene_cfg=scene_cfg)
+        ref2, _, _, _ = bake(lmbake, path("ref2"), scene, density, "", ["--reference", "--rays", str(REF_PATHS)],
+                             scene_cfg=scene_cfg + "seed: 2\n")
+        ref_noise = rel_rmse(ref, ref2, mask) / math.sqrt(2)
+        conv, _, _, _ = bake(lmbake, path("conv"), scene, density, "", ["--method", "cosine", "--rays", str(CONVERGED)],
+                             scene_cfg=scene_cfg)
         cache_err = rel_rmse(conv, ref, mask)
         results, images = {}, {}
         for label, args, extra in METHODS:
             for rays in RAYS:
-                img, _, secs, nrays = bake(lmbake, os.path.join(work, "%s-%s-%d" % (name, label.replace(" ", "_"), rays)),
-                                           scene, density, extra, args + ["--rays", str(rays)], REPEAT)
+                img, _, secs, nrays = bake(lmbake, path("%s-%d" % (label.replace(" ", "_").replace("(", "").replace(")", ""), rays)),
+                                           scene, density, extra, args + ["--rays", str(rays)], REPEAT, scene_cfg)
                 e_ref, e_noise = rel_rmse(img, ref, mask), rel_rmse(img, conv, mask)
                 results[(label, rays)] = (secs, e_ref, e_noise, nrays)
                 if rays == 1024:
@@ -113,11 +134,29 @@ def main():
                 rows.append({"scene": name, "method": label, "rays_per_texel": rays, "gather_s": "%.4f" % secs,
                              "rays": nrays, "rays_per_s": "%.4g" % (nrays / secs if secs > 0 else 0),
                              "rmse_vs_reference": "%.5f" % e_ref, "rmse_noise": "%.5f" % e_noise,
-                             "cache_error": "%.5f" % cache_err, "valid_texels": int(mask.sum())})
-                print("bench: %-14s %-15s %5d rays: %.3f s, %.3g rays/s, RMSE vs ref %.4f, noise %.4f"
+                             "reference_noise": "%.5f" % ref_noise, "converged_vs_reference": "%.5f" % cache_err,
+                             "valid_texels": int(mask.sum())})
+                print("bench: %-14s %-20s %5d rays: %.3f s, %.3g rays/s, RMSE vs ref %.4f, noise %.4f"
                       % (name, label, rays, secs, nrays / max(secs, 1e-9), e_ref, e_noise), flush=True)
+        # direct light at gather hits: the cache's resolution error and what computing it costs
+        for dens in (density, 8):
+            c0 = conv if dens == density else bake(lmbake, path("conv-d8"), scene, dens, "",
+                                                   ["--method", "cosine", "--rays", str(CONVERGED)],
+                                                   scene_cfg=scene_cfg)[0]
+            c1, m1, _, _ = bake(lmbake, path("conv-hits-d%d" % dens), scene, dens, DIRECT_AT_HITS,
+                                ["--method", "cosine", "--rays", str(CONVERGED)], scene_cfg=scene_cfg)
+            off = bake(lmbake, path("default-d%d" % dens), scene, dens, "", ["--method", "amis_defensive", "--rays", "1024"],
+                       REPEAT, scene_cfg)
+            on = bake(lmbake, path("default-hits-d%d" % dens), scene, dens, DIRECT_AT_HITS,
+                      ["--method", "amis_defensive", "--rays", "1024"], REPEAT, scene_cfg)
+            hits_rows.append({"scene": name, "texel_density": dens, "cache_resolution_error": "%.5f" % rel_rmse(c0, c1, m1),
+                              "default_1024_s": "%.4f" % off[2], "default_1024_direct_at_hits_s": "%.4f" % on[2],
+                              "noise_off": "%.5f" % rel_rmse(off[0], c0, m1), "noise_on": "%.5f" % rel_rmse(on[0], c1, m1)})
+            print("bench: %-14s direct at hits, %d texels/m: cache resolution error %.4f, default 1024 rays %.3f s -> %.3f s"
+                  % (name, dens, rel_rmse(c0, c1, m1), off[2], on[2]), flush=True)
         # tables
-        md += ["## %s (%d valid texels; cache error vs reference %.4f)" % (name, int(mask.sum()), cache_err), "",
+        md += ["## %s (%d valid texels; reference noise %.4f, converged gather vs reference %.4f)"
+               % (name, int(mask.sum()), ref_noise, cache_err), "",
                "| method | rays | gather s | rays/s | time vs classic | RMSE vs ref | noise RMSE | noise at classic's time |",
                "|---|---|---|---|---|---|---|---|"]
         for label, _, _ in METHODS:
@@ -130,6 +169,16 @@ def main():
                           % (label, r, secs, nrays / max(secs, 1e-9), 100 * (secs / tc - 1), e_ref, e_noise,
                              loglog_at(ts, ns, tc)))
         md.append("")
+        # the summary at 1024 rays: equal-time noise over classic's, efficiency, overhead
+        tc, _, nc, _ = results[("classic", 1024)]
+        line = {"scene": name}
+        for label, _, _ in METHODS[1:]:
+            ts = np.array([results[(label, r)][0] for r in RAYS])
+            ns = np.array([results[(label, r)][2] for r in RAYS])
+            t, _, n, _ = results[(label, 1024)]
+            line[label] = (loglog_at(ts, ns, tc) / nc, (nc * nc * tc) / (n * n * t) if n > 0 else float("inf"))
+        line["overheads"] = [results[(DEFAULT, r)][0] / results[("classic", r)][0] - 1 for r in RAYS]
+        summary.append(line)
         for row, key, title in ((0, 2, "noise RMSE (vs converged gather)"), (1, 1, "RMSE vs path-traced reference")):
             ax = axes[row][col]
             for label, _, _ in METHODS:
@@ -138,7 +187,7 @@ def main():
                 for r in RAYS:
                     ax.annotate(str(r), (results[(label, r)][0], results[(label, r)][key]), fontsize=6)
             if row == 1:
-                ax.axhline(cache_err, color="grey", ls="--", lw=0.8, label="cache error")
+                ax.axhline(ref_noise, color="grey", ls="--", lw=0.8, label="reference's own noise")
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_title("%s: %s" % (name, title), fontsize=9)
@@ -162,13 +211,38 @@ def main():
         plt.close(f2)
     fig.tight_layout()
     fig.savefig(os.path.join(outdir, "gather.png"), dpi=100)
+    overheads = sorted(o for line in summary for o in line["overheads"])
+    head = ["## Summary at 1024 rays", "",
+            "Noise at classic's time over classic's noise (below 1: better at equal time) and efficiency "
+            "(classic noise^2 x time over the method's). Median time the default adds over classic at equal rays, "
+            "over the %d settings (5 scenes x %s rays): %+.0f%% (range %+.0f%% to %+.0f%%)."
+            % (len(overheads), "/".join(str(r) for r in RAYS), 100 * float(np.median(overheads)),
+               100 * overheads[0], 100 * overheads[-1]), "",
+            "| scene | " + " | ".join("%s: equal-time ratio / efficiency" % l for l, _, _ in METHODS[1:]) + " |",
+            "|---|" + "---|" * (len(METHODS) - 1)]
+    for line in summary:
+        head.append("| %s | " % line["scene"] + " | ".join("%.2f / %.2f" % line[l] for l, _, _ in METHODS[1:]) + " |")
+    head += ["", "## gather.direct_at_hits", "",
+             "Cache resolution error: the converged gather with direct light computed at every hit against the "
+             "converged gather through the cache. Time and noise: the default gather at 1024 rays without and with it.",
+             "", "| scene | texels/m | cache resolution error | default 1024 s: off / on | noise off / on |",
+             "|---|---|---|---|---|"]
+    for h in hits_rows:
+        head.append("| %s | %d | %s | %s / %s | %s / %s |" % (h["scene"], h["texel_density"], h["cache_resolution_error"],
+                                                           h["default_1024_s"], h["default_1024_direct_at_hits_s"],
+                                                           h["noise_off"], h["noise_on"]))
+    md = md[:3] + head + [""] + md[3:]
     with open(os.path.join(outdir, "gather.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
+    with open(os.path.join(outdir, "gather-direct-at-hits.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(hits_rows[0].keys()))
+        w.writeheader()
+        w.writerows(hits_rows)
     with open(os.path.join(outdir, "gather.md"), "w") as f:
         f.write("\n".join(md) + "\n")
-    print("bench: wrote %s/gather.csv, gather.md, gather.png and gather-<scene>.png" % outdir)
+    print("bench: wrote %s/gather.csv, gather-direct-at-hits.csv, gather.md, gather.png and gather-<scene>.png" % outdir)
 
 
 if __name__ == "__main__":

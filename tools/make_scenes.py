@@ -27,6 +27,10 @@ usage: make_scenes.py OUTDIR
                       near the ceiling (contact shadows for the irradiance cache's benchmark)
   grazing.gltf        a 4 m x 1 m x 0.6 m corridor, a point light 3 cm above the floor near one
                       end: the floor sees its spot at grazing angles (benchmark)
+  gap.gltf            two 1 m rooms side by side, a wall between them with a 4 cm slit from floor
+                      to ceiling, a point light in the left room: the right room is lit through the
+                      slit only (guided gathering's failure case in the benchmark, which lightmaps
+                      the dark room alone: lightmap.exclude lit_room)
 
 The analytic values the tests compare with are in tests/bake/check_analytic.py.
 """
@@ -366,6 +370,19 @@ def indirect(out):
     s.mesh("chair", chair, wood)
     s.light("lamp", "point", 8.0, translation=(1.6, 1.4, 1.6))
     s.write(os.path.join(out, "contact.gltf"))
+
+    s = Scene()
+    white = s.material("white", (0.73, 0.73, 0.73))
+    lit = [t for k, t in enumerate(box(0, 0, 0, 1, 1, 1, inward=True)) if k // 2 != 2]  # no face at x = 1
+    dark = [t for k, t in enumerate(box(1, 0, 0, 2, 1, 1, inward=True)) if k // 2 != 4]  # no face at x = 1
+    for z0, z1 in ((0, 0.48), (0.52, 1)):  # the divider at x = 1, a 4 cm slit from floor to ceiling
+        q = [(1, 0, z0), (1, 0, z1), (1, 1, z1), (1, 1, z0)]  # faces -x (the lit room)
+        lit += quad(*q)
+        dark += quad(*q[::-1])
+    s.mesh("lit_room", lit, white)
+    s.mesh("dark_room", dark, white)
+    s.light("lamp", "point", 5.0, translation=(0.5, 0.9, 0.5))
+    s.write(os.path.join(out, "gap.gltf"))
 
 
 if __name__ == "__main__":

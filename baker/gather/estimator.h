@@ -79,7 +79,7 @@ typedef struct lmb_estimate {
     uint32_t adapted;  /* iterations that changed the lobe */
     double rot[3][3];  /* with options.gradient: per channel, dE/d(rotation vector of the normal) */
     lmb_mixture learned; /* with options.learn_lobes: the mixture fitted to all samples (count 0: none) */
-    /* guided gathering: the cosine-weighted harmonic mean hit distance, as importance weights
+    /* classic and guided gathering with options.gradient: the cosine-weighted harmonic mean hit distance, as importance weights
      * p_cos / q over its traced samples: sum of p_cos/q and of p_cos/q / t (t = inf adds 0) */
     double cos_weight, cos_inverse_distance;
     double share[LMB_AMIS_MAX_ITERATIONS]; /* unbiased AMIS: the weight a_t given to iteration t */

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define EM_STEPS 12     /* a mixture learned for the neighbours */
+#define EM_STEPS 8      /* a mixture learned for the neighbours */
 #define EM_STEPS_COLD 6 /* a point's own first adaptation (lmb_mixture_update) */
 #define EM_STEPS_WARM 2 /* its later ones, from the previous */
 #define MIN_COS 1e-4f
@@ -16,6 +16,7 @@ void lmb_mixture_scratch_free(lmb_mixture_scratch *s)
     free(s->w);
     free(s->s);
     free(s->r);
+    free(s->r2);
     free(s->d);
     memset(s, 0, sizeof *s);
 }
@@ -33,10 +34,13 @@ static int reserve(lmb_mixture_scratch *s, uint32_t n)
     float *r = realloc(s->r, (LMB_MIXTURE_MAX_LOBES + 1) * (size_t)n * sizeof *r);
     if (r)
         s->r = r;
+    float *r2 = realloc(s->r2, (LMB_MIXTURE_MAX_LOBES + 1) * (size_t)n * sizeof *r2);
+    if (r2)
+        s->r2 = r2;
     float *d = realloc(s->d, (size_t)n * sizeof *d);
     if (d)
         s->d = d;
-    if (!w || !x || !r || !d)
+    if (!w || !x || !r || !r2 || !d)
         return 0;
     s->cap = n;
     return 1;
@@ -275,24 +279,25 @@ int lmb_mixture_fit(const double *w, const double *s, const double *dist, uint32
     model best = {0}, cand;
     best.lobe[0] = (lmb_lobe){{normal[0], normal[1], normal[2]}, 1.0};
     best.share[0] = 1;
-    double best_score = n_eff * responsibilities(&best, scratch->w, scratch->s, m, scratch->r);
+    float *r_best = scratch->r, *r_cand = scratch->r2; /* the responsibilities of each model */
+    double best_score = n_eff * responsibilities(&best, scratch->w, scratch->s, m, r_best);
     for (uint32_t K = 1; K <= max_lobes && m >= 8 * K; K++) {
-        double ll = fit_k(scratch->w, scratch->s, scratch->r, m, K, normal, EM_STEPS, &cand);
+        double ll = fit_k(scratch->w, scratch->s, r_cand, m, K, normal, EM_STEPS, &cand);
         /* BIC: n_eff x mean log-likelihood - (parameters / 2) ln n_eff, 4 K parameters */
         double score = n_eff * ll - 2.0 * K * log(n_eff);
         if (!(score > best_score))
             break;
         best = cand;
         best_score = score;
+        float *swap = r_best;
+        r_best = r_cand;
+        r_cand = swap;
     }
     uint32_t index[LMB_MIXTURE_MAX_LOBES];
     to_mixture(&best, out, index);
     if (best.K == 0 || out->count == 0)
         return 1;
-    /* r must be the chosen model's for the targets: refit when a larger K was tried and lost */
-    if (best.K < max_lobes && m >= 8 * (best.K + 1))
-        fit_k(scratch->w, scratch->s, scratch->r, m, best.K, normal, EM_STEPS, &best);
-    set_targets(out, index, scratch->w, scratch->s, scratch->d, scratch->r, m, best.K + 1);
+    set_targets(out, index, scratch->w, scratch->s, scratch->d, r_best, m, best.K + 1);
     return 1;
 }
 

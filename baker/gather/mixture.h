@@ -49,7 +49,7 @@ void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double 
 /* Per-thread memory of the fit. */
 typedef struct lmb_mixture_scratch {
     uint32_t cap;
-    float *w, *s, *r; /* directions (3 per sample), weights, responsibilities (K + 1 per sample) */
+    float *w, *s, *r, *r2; /* directions (3 per sample), weights, responsibilities (K + 1 per sample, two models) */
     float *d;         /* hit distances */
 } lmb_mixture_scratch;
 

@@ -20,10 +20,11 @@ usage: check_indirect.py LMBAKE WORKDIR CHECK
                MIRRORED_REPEAT (sRGB 188 = 0.5029). k = 2: the mean over texels is within 1% of
                pi Le (1 + rho + rho^2), 98% of texels within 6%.
   identity     AMIS with one iteration and classic gathering: byte-identical EXR for the same seed.
-  determinism  AMIS bake at --threads 1 and --threads 2: byte-identical EXR.
+  determinism  AMIS and guided defensive AMIS bakes at --threads 1 and --threads 2: byte-identical EXR.
   unbiased     bright-spot Cornell box (point light 3 cm under the ceiling), one bounce, 1024 rays:
                at 8 texels spread over the atlas (each 2 texels from any chart border), the mean of
-               AMIS over 32 seeds and of defensive AMIS over 32 seeds lie within 3 standard errors
+               AMIS, of defensive AMIS guided (the default: texels sampling from a pilot's mixture)
+               and of defensive AMIS unguided, each over 32 seeds, lie within 3 standard errors
                of the reference for the cached integrand: classic gathering over 32 seeds (classic
                is unbiased for it, and AMIS with T = 1 is classic). The path-traced --reference
                also differs by the cache's own resolution error, which the benchmark charts.
@@ -141,11 +142,14 @@ def identity(lmbake, work):
 
 def determinism(lmbake, work):
     s = os.path.join(scenes(work), "cornell-point.gltf")
-    a = bake(lmbake, work, s, "t1", CORNELL % (16, 4), "--method", "amis", "--rays", "512", "--threads", "1")
-    b = bake(lmbake, work, s, "t2", CORNELL % (16, 4), "--method", "amis", "--rays", "512", "--threads", "2")
-    same = open(a, "rb").read() == open(b, "rb").read()
-    print("AMIS, 1 and 2 threads: EXR byte-identical: %s" % same)
-    return same
+    ok = True
+    for method in ("amis", "amis_defensive"):  # amis_defensive: guided, pilots first (issue 12)
+        a = bake(lmbake, work, s, method + "-t1", CORNELL % (16, 4), "--method", method, "--rays", "512", "--threads", "1")
+        b = bake(lmbake, work, s, method + "-t2", CORNELL % (16, 4), "--method", method, "--rays", "512", "--threads", "2")
+        same = open(a, "rb").read() == open(b, "rb").read()
+        print("%s, 1 and 2 threads: EXR byte-identical: %s" % (method, same))
+        ok &= same
+    return ok
 
 
 def pick_texels(valid, count, ring):
@@ -164,14 +168,18 @@ def pick_texels(valid, count, ring):
 def unbiased(lmbake, work):
     s = os.path.join(scenes(work), "cornell-point.gltf")
     runs = {}
-    for method in ("cosine", "amis", "amis_defensive"):
-        runs[method] = np.array([read(bake(lmbake, work, s, "%s-%d" % (method, seed), PER_TEXEL % (16, 4), "--method",
-                                           method, "--rays", "1024", "--seed", str(seed))).mean(axis=2)
-                                 for seed in range(1, 33)])
+    # amis_defensive is guided (pilot texels every 8th texel learn mixtures, the rest sample from
+    # them); "unguided" is the same estimator with gather.guide_stride 0
+    variants = {"cosine": ("cosine", ""), "amis": ("amis", ""), "amis_defensive": ("amis_defensive", ""),
+                "unguided": ("amis_defensive", "gather: {guide_stride: 0}\n")}
+    for name, (method, extra) in variants.items():
+        runs[name] = np.array([read(bake(lmbake, work, s, "%s-%d" % (name, seed), PER_TEXEL % (16, 4) + extra,
+                                         "--method", method, "--rays", "1024", "--seed", str(seed))).mean(axis=2)
+                               for seed in range(1, 33)])
     ref = runs["cosine"]
     ys, xs = pick_texels(ref.min(axis=0) > 0, 8, 2)
     ok = True
-    for method in ("amis", "amis_defensive"):
+    for method in ("amis", "amis_defensive", "unguided"):
         r = runs[method]
         for y, x in zip(ys, xs):
             a, c = r[:, y, x], ref[:, y, x]
