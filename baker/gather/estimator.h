@@ -10,17 +10,21 @@
  *   AMIS defensive: every iteration samples the mixture q_t = d p_cos + (1 - d) p_t, so every
  *                   weight is bounded by f / (d N p_cos): at most 1/d times classic's variance
  *                   (Hesterberg's defensive importance sampling); d = 0 is the paper exactly.
+ *                   The default, guided below.
  * AMIS as the paper gives it is consistent, not unbiased: a sample is re-weighted by lobes that
  * were fitted to it, which lowers the weight of exactly the samples that found a bright spot
  * (measured: -10% at 1024 rays on some Cornell box texels, -15% for two caps in
- * tests/unit/test_estimator.c). With `unbiased` the lobes adapt the same way (eqs. 2-4), but
- * the estimate is E = sum_t a_t (1/N_t) sum_i f / q_t: each iteration's samples weighted by
- * the pdf they were drawn from, which depends only on earlier iterations, so each term is
- * unbiased. That pdf must cover every direction f > 0: with a defensive share it does
- * (q_t >= d p_cos); without one, iteration t samples the mixture of lobes 0..t
- * (sum_k N_k p_k / S_t, the cosine lobe included) instead of lobe t alone. The shares a_t = N_t (t + 1) / sum_k N_k (k + 1) are fixed in advance and favour
- * the later, adapted iterations (Owen, "Monte Carlo theory", ch. 10.5: fixed-weight combination
- * of adaptive importance sampling stages).
+ * tests/unit/test_estimator.c). With `unbiased` (amis.c) iteration t samples a pdf q_t fixed
+ * before its samples: the cosine lobe at t = 0, then d p_cos + (1 - d) F_t, F_t the cosine
+ * share and lobe fitted by a few EM steps (mixture.h: eqs. 2 and 4 per lobe) to the earlier
+ * samples weighted lum(f)/q; without a defensive share, the mixture of p_cos and F_1..F_t by
+ * their sample counts. E = sum_t a_t (1/N_t) sum_i f / q_t: each term is unbiased, and the
+ * shares a_t depend on earlier iterations only (their measured variances; Owen, "Monte Carlo
+ * theory", ch. 10.5) and sum to 1, so E is unbiased.
+ *   Guided (options.guide, unbiased defensive AMIS with T >= 2): a mixture G learned at a
+ * neighbouring point before this point's samples (spatial reuse, guide.h); every sample is
+ * drawn from d p_cos + (1 - d) G and E = 1/N sum f / q: one importance-sampling estimate with
+ * a fixed pdf, unbiased. options.learn_lobes fits the mixture a point passes on (out->learned).
  * A sample whose direction lies below the geometric normal has f = 0 and traces no ray.
  * Rotation gradient (options.gradient): turning the normal by the small rotation vector v
  * changes w.n by v.(n x w), so dE/dv = integral of L(w) (n x w) dw (Ward and Heckbert 1992's

@@ -19,7 +19,8 @@ usage: check_indirect.py LMBAKE WORKDIR CHECK
                (no bounce: E = pi Le), and a base colour texture read through a transform and
                MIRRORED_REPEAT (sRGB 188 = 0.5029). k = 2: the mean over texels is within 1% of
                pi Le (1 + rho + rho^2), 98% of texels within 6%.
-  identity     AMIS with one iteration and classic gathering: byte-identical EXR for the same seed.
+  identity     AMIS and defensive AMIS (the default, guided) with one iteration and classic
+               gathering: byte-identical EXR for the same seed.
   determinism  AMIS and guided defensive AMIS bakes at --threads 1 and --threads 2: byte-identical EXR.
   unbiased     bright-spot Cornell box (point light 3 cm under the ceiling), one bounce, 1024 rays:
                at 8 texels spread over the atlas (each 2 texels from any chart border), the mean of
@@ -133,11 +134,14 @@ def identity(lmbake, work):
     s = os.path.join(scenes(work), "cornell-point.gltf")
     a = bake(lmbake, work, s, "cosine", CORNELL % (16, 1), "--method", "cosine", "--rays", "300")
     b = bake(lmbake, work, s, "amis-t1", CORNELL % (16, 1), "--method", "amis", "--rays", "300")
+    d = bake(lmbake, work, s, "defensive-t1", CORNELL % (16, 1), "--method", "amis_defensive", "--rays", "300")
     c = bake(lmbake, work, s, "amis-t4", CORNELL % (16, 4), "--method", "amis", "--rays", "300")
     same = open(a, "rb").read() == open(b, "rb").read()
+    same_d = open(a, "rb").read() == open(d, "rb").read()
     differs = open(a, "rb").read() != open(c, "rb").read()
-    print("classic vs AMIS with 1 iteration: EXR byte-identical: %s; with 4 iterations it differs: %s" % (same, differs))
-    return same and differs
+    print("classic vs AMIS with 1 iteration: EXR byte-identical: %s; vs defensive (guided) AMIS with 1 iteration: %s; "
+          "AMIS with 4 iterations differs: %s" % (same, same_d, differs))
+    return same and same_d and differs
 
 
 def determinism(lmbake, work):

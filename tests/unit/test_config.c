@@ -173,6 +173,16 @@ static void test_partial_and_edges(void)
     CHECK_INT(c.output_formats, LMB_OUTPUT_EXR | LMB_OUTPUT_MASK);
     expect_error("gather:\n  amis_weights: paper\n", "level.yaml:2: ",
                  "key 'gather.amis_weights': expected one of unbiased, balance, got 'paper'");
+    /* guided gathering (issue 12) */
+    CHECK_INT(c.guide_stride, 8);
+    CHECK_INT(c.guide_lobes, 2);
+    CHECK_INT(c.direct_at_hits, 0);
+    CHECK_INT(parse("gather: {guide_stride: 0, lobes: 3, direct_at_hits: true}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.guide_stride, 0);
+    CHECK_INT(c.guide_lobes, 3);
+    CHECK_INT(c.direct_at_hits, 1);
+    expect_error("gather:\n  lobes: 4\n", "level.yaml:2: ", "key 'gather.lobes'");
+    expect_error("gather: {guide_stride: 65}\n", "level.yaml:1: ", "key 'gather.guide_stride'");
 
     CHECK_INT(parse("atlas: {keep_uv1: On}\noutput: {formats: hdr}\nlightmap: {include: []}\n", &c, &err), LMB_OK);
     CHECK_INT(c.keep_uv1, 1);

@@ -113,13 +113,17 @@ int main(void)
     for (uint64_t seed = 0; seed < 50; seed++) {
         lmb_estimator_options oc = {.method = LMB_GATHER_COSINE, .rays = 333, .iterations = 1},
                               oa = {.method = LMB_GATHER_AMIS, .rays = 333, .iterations = 1},
-                              ou = {.method = LMB_GATHER_AMIS, .rays = 333, .iterations = 1, .unbiased = 1};
+                              ou = {.method = LMB_GATHER_AMIS, .rays = 333, .iterations = 1, .unbiased = 1},
+                              od = {.method = LMB_GATHER_AMIS_DEFENSIVE, .rays = 333, .iterations = 1, .defensive = 0.1,
+                                    .unbiased = 1};
         lmb_estimate c, a, u;
         lmb_estimate_irradiance(&oc, N, N, lmb_rng_make(seed, 1, 2), env_radiance, &spot, &s, &c);
         lmb_estimate_irradiance(&oa, N, N, lmb_rng_make(seed, 1, 2), env_radiance, &spot, &s, &a);
         lmb_estimate_irradiance(&ou, N, N, lmb_rng_make(seed, 1, 2), env_radiance, &spot, &s, &u);
         CHECK(memcmp(c.e, a.e, sizeof c.e) == 0);
         CHECK(memcmp(c.e, u.e, sizeof c.e) == 0);
+        lmb_estimate_irradiance(&od, N, N, lmb_rng_make(seed, 1, 2), env_radiance, &spot, &s, &u);
+        CHECK(memcmp(c.e, u.e, sizeof c.e) == 0); /* the default method with T = 1, too */
         CHECK_INT(c.traced, a.traced);
         CHECK_INT(a.traced, 333);
     }
