@@ -24,6 +24,9 @@ typedef struct proposal {
     double share[PROPOSAL_MAX_LOBES];
     lmb_lobe lobe[PROPOSAL_MAX_LOBES];
     double t[PROPOSAL_MAX_LOBES][3], b[PROPOSAL_MAX_LOBES][3];
+    /* per lobe for draw_four, in single precision: the axis, a, 1 / (a + 1) and
+     * share (a + 1) / (2 pi) (its pdf's factor) */
+    float axis_f[PROPOSAL_MAX_LOBES][3], a_f[PROPOSAL_MAX_LOBES], inv_a1[PROPOSAL_MAX_LOBES], scale[PROPOSAL_MAX_LOBES];
 } proposal;
 
 static void proposal_init(proposal *p, const lmb_lobe *cosine, double share)
@@ -41,6 +44,11 @@ static void proposal_add(proposal *p, const lmb_mixture *m, double share)
         p->lobe[p->count] = m->lobe[k];
         memcpy(p->t[p->count], m->tangent[k], sizeof p->t[0]);
         memcpy(p->b[p->count], m->bitangent[k], sizeof p->b[0]);
+        for (int c = 0; c < 3; c++)
+            p->axis_f[p->count][c] = (float)m->lobe[k].axis[c];
+        p->a_f[p->count] = (float)m->lobe[k].a;
+        p->inv_a1[p->count] = (float)(1.0 / (m->lobe[k].a + 1.0));
+        p->scale[p->count] = (float)(p->share[p->count] * (m->lobe[k].a + 1.0) * (0.5 * LMB_INV_PI));
     }
 }
 
@@ -112,7 +120,7 @@ static void draw_four(const proposal *p, const lmb_lobe *cosine, lmb_rng rng, ui
                 k++;
             lobe[b] = k;
             base[b] = (float)(1.0 - u[b][0]);
-            expo[b] = (float)(1.0 / (p->lobe[k].a + 1.0));
+            expo[b] = p->inv_a1[k];
         }
     }
     lmb_f4 ct = lmb_pow_f4(base, expo), wx, wy, wz; /* cos(theta) = (1 - u1)^(1 / (a + 1)), lobe.h */
@@ -120,7 +128,7 @@ static void draw_four(const proposal *p, const lmb_lobe *cosine, lmb_rng rng, ui
         const double *axis = lobe[b] < 0 ? cosine->axis : p->lobe[lobe[b]].axis;
         const double *t = lobe[b] < 0 ? p->cos_t : p->t[lobe[b]], *bt = lobe[b] < 0 ? p->cos_b : p->b[lobe[b]];
         double c = lobe[b] < 0 ? sqrt(1.0 - u[b][0]) : (double)ct[b];
-        double st = sqrt(fmax(0.0, 1.0 - c * c));
+        double s2 = 1.0 - c * c, st = sqrt(s2 > 0 ? s2 : 0.0);
         float phi = (float)(2.0 * LMB_PI * u[b][1]);
         double x = st * (double)cosf(phi), y = st * (double)sinf(phi);
         for (int k = 0; k < 3; k++)
@@ -132,10 +140,10 @@ static void draw_four(const proposal *p, const lmb_lobe *cosine, lmb_rng rng, ui
     }
     lmb_f4 sum = {0, 0, 0, 0};
     for (uint32_t k = 0; k < p->count; k++) {
-        const double *a = p->lobe[k].axis;
-        lmb_f4 c = wx * (float)a[0] + wy * (float)a[1] + wz * (float)a[2];
-        lmb_f4 e = {(float)p->lobe[k].a, (float)p->lobe[k].a, (float)p->lobe[k].a, (float)p->lobe[k].a};
-        sum += lmb_pow_f4(c, e) * (float)(p->share[k] * (p->lobe[k].a + 1.0) * (0.5 * LMB_INV_PI));
+        const float *a = p->axis_f[k];
+        lmb_f4 c = wx * a[0] + wy * a[1] + wz * a[2], e = {0, 0, 0, 0};
+        e += p->a_f[k];
+        sum += lmb_pow_f4(c, e) * p->scale[k];
     }
     for (int b = 0; b < 4; b++)
         q[b] += (double)sum[b];
