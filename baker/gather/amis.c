@@ -192,17 +192,13 @@ lmb_status lmb_amis_unbiased(const lmb_estimator_options *opt, const lmb_lobe *c
                 continue;
             double dist = radiance(user, w, j, l);
             out->traced++;
-            double f[3] = {l[0] * c, l[1] * c, l[2] * c}, lum = luminance(f);
-            if (!(lum > 0))
+            int64_t q = keep_sample(s, w, l, c);
+            if (q < 0)
                 continue;
-            uint32_t q = s->count++;
-            memcpy(s->w + 3 * q, w, sizeof w);
-            memcpy(s->f + 3 * q, f, sizeof f);
-            s->lum[q] = lum;
             s->own[q] = q4[i % 4];
             s->iteration[q] = t;
             s->dist[q] = dist;
-            double y = lum / s->own[q];
+            double y = s->lum[q] / s->own[q];
             sum += y;
             sum2 += y * y;
         }

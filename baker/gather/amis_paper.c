@@ -74,13 +74,10 @@ lmb_status lmb_amis_balance(const lmb_estimator_options *opt, const lmb_lobe *co
             double c, dist;
             if (!draw_and_trace(lobe, NULL, cosine, ng, u, j, radiance, user, w, l, &c, &dist, out))
                 continue;
-            double f[3] = {l[0] * c, l[1] * c, l[2] * c}, lum = luminance(f);
-            if (!(lum > 0))
+            int64_t q = keep_sample(s, w, l, c);
+            if (q < 0)
                 continue;
-            uint32_t q = s->count++;
-            memcpy(s->w + 3 * q, w, sizeof w);
-            memcpy(s->f + 3 * q, f, sizeof f);
-            s->lum[q] = lum;
+            (void)dist;
             s->denom[q] = 0;
             for (uint32_t k = 0; k < t; k++) /* a new sample sees every earlier lobe once */
                 s->denom[q] += nk[k] * mixture_pdf(cosine, &lobes[k], d, w);

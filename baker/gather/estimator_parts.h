@@ -47,6 +47,20 @@ static inline int draw_and_trace(const lmb_lobe *lobe, double frame[2][3], const
     return 1;
 }
 
+/* Keeps a traced sample for re-weighting and fitting: direction w, integrand f = l c and its
+ * luminance. Returns its index, or -1 when f is 0 (it adds nothing to any estimate or fit). */
+static inline int64_t keep_sample(lmb_estimator_scratch *s, const double w[3], const double l[3], double c)
+{
+    double f[3] = {l[0] * c, l[1] * c, l[2] * c}, lum = luminance(f);
+    if (!(lum > 0))
+        return -1;
+    uint32_t q = s->count++;
+    memcpy(s->w + 3 * q, w, 3 * sizeof *w);
+    memcpy(s->f + 3 * q, f, sizeof f);
+    s->lum[q] = lum;
+    return q;
+}
+
 /* The rotation gradient's term of a sample of weight x = f / (N q) per channel (estimator.h). */
 static inline void add_rotation(lmb_estimate *out, const double n[3], const double w[3], double c, const double x[3])
 {
