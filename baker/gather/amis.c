@@ -107,21 +107,23 @@ static double iteration_share(uint32_t t, uint32_t T, const double *nk, const do
 static void draw_four(const proposal *p, const lmb_lobe *cosine, lmb_rng rng, uint32_t j0, double w[4][3],
                       double q[4])
 {
-    double u[4][3];
+    double u[4][3], cum[PROPOSAL_MAX_LOBES]; /* cosine + share_0 + ... + share_j: where lobe j's picks end */
     int lobe[4];
     lmb_f4 base = {1, 1, 1, 1}, expo = {0, 0, 0, 0};
+    double acc = p->cosine;
+    for (uint32_t i = 0; i < p->count; i++)
+        cum[i] = acc += p->share[i];
     for (int b = 0; b < 4; b++) {
         sample_uniforms(rng, j0 + (uint32_t)b, u[b]);
-        lobe[b] = -1; /* the cosine lobe */
-        if (u[b][2] >= p->cosine && p->count) {
-            double acc = p->cosine;
-            int k = 0;
-            while (k + 1 < (int)p->count && u[b][2] >= (acc += p->share[k]))
-                k++;
-            lobe[b] = k;
-            base[b] = (float)(1.0 - u[b][0]);
-            expo[b] = p->inv_a1[k];
-        }
+        /* the component: -1 (the cosine lobe) or the lobe whose interval of [0, 1) holds u2,
+         * counted without branches (the picks are random: a branch would mispredict) */
+        int k = 0;
+        for (uint32_t i = 0; i + 1 < p->count; i++)
+            k += u[b][2] >= cum[i];
+        int cosine_pick = u[b][2] < p->cosine || p->count == 0;
+        lobe[b] = cosine_pick ? -1 : k;
+        base[b] = cosine_pick ? 1.0f : (float)(1.0 - u[b][0]);
+        expo[b] = cosine_pick ? 0.0f : p->inv_a1[k];
     }
     lmb_f4 ct = lmb_pow_f4(base, expo), wx, wy, wz; /* cos(theta) = (1 - u1)^(1 / (a + 1)), lobe.h */
     for (int b = 0; b < 4; b++) {
