@@ -324,18 +324,27 @@ int lmb_mixture_update(const double *w, const double *s, uint32_t n, const doubl
     uint32_t m = select_samples(w, s, NULL, n, scratch, &n_eff);
     if (!m)
         return 0;
-    model md;
+    model md, diffuse = {0};
+    diffuse.lobe[0] = (lmb_lobe){{normal[0], normal[1], normal[2]}, 1.0};
+    diffuse.share[0] = 1;
+    double ll;
     if (start && start->count == 1) {
         md.K = 1;
-        md.lobe[0] = (lmb_lobe){{normal[0], normal[1], normal[2]}, 1.0};
+        md.lobe[0] = diffuse.lobe[0];
         md.share[0] = start->diffuse;
         md.lobe[1] = start->lobe[0];
         md.share[1] = 1.0 - start->diffuse;
-        if (!(em(scratch->w, scratch->s, scratch->r, m, EM_STEPS_WARM, &md) > -HUGE_VAL))
-            return 0;
-    } else if (!(fit_k(scratch->w, scratch->s, scratch->r, m, 1, normal, EM_STEPS_COLD, &md) > -HUGE_VAL)) {
-        return 0;
+        ll = em(scratch->w, scratch->s, scratch->r, m, EM_STEPS_WARM, &md);
+    } else {
+        ll = fit_k(scratch->w, scratch->s, scratch->r, m, 1, normal, EM_STEPS_COLD, &md);
     }
+    if (!(ll > -HUGE_VAL))
+        return 0;
+    /* the cosine lobe alone unless the lobe pays for its 4 parameters (BIC, as lmb_mixture_fit):
+     * where light comes from everywhere alike the next iteration samples as classic gathering */
+    double ll0 = responsibilities(&diffuse, scratch->w, scratch->s, m, scratch->r2);
+    if (n_eff * ll0 >= n_eff * ll - 2.0 * log(n_eff))
+        md = diffuse;
     uint32_t index[1];
     to_mixture(&md, out, index);
     return 1;
