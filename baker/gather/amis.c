@@ -151,13 +151,12 @@ static void draw_four(const proposal *p, const lmb_lobe *cosine, lmb_rng rng, ui
         q[b] += (double)sum[b];
 }
 
-/* Eqs. 2 and 4 (or the EM fit for several lobes) over the kept samples, weighted by
- * s_i = lum(f_i) / q_{t_i}(w_i): each sample over the pdf it was drawn from. */
-static int fit_samples(lmb_estimator_scratch *s, const double normal[3], uint32_t lobes, lmb_mixture *out)
+/* The weights every fit of the kept samples uses (mixture.h): s_i = lum(f_i) / q_{t_i}(w_i),
+ * each sample over the pdf it was drawn from. */
+static void set_fit_weights(lmb_estimator_scratch *s)
 {
     for (uint32_t q = 0; q < s->count; q++)
         s->si[q] = s->lum[q] / s->own[q];
-    return lmb_mixture_fit(s->w, s->si, s->dist, s->count, normal, lobes, &s->fit, out);
 }
 
 lmb_status lmb_amis_unbiased(const lmb_estimator_options *opt, const lmb_lobe *cosine, const double ng[3],
@@ -208,8 +207,7 @@ lmb_status lmb_amis_unbiased(const lmb_estimator_options *opt, const lmb_lobe *c
         if (t + 1 < T) {
             fits[t + 1] = fits[t];
             lmb_mixture next;
-            for (uint32_t q = 0; q < s->count; q++)
-                s->si[q] = s->lum[q] / s->own[q];
+            set_fit_weights(s);
             if (lmb_mixture_update(s->w, s->si, s->count, cosine->axis, t > 0 ? &fits[t] : NULL, &s->fit, &next)) {
                 fits[t + 1] = next;
                 out->adapted++;
@@ -226,8 +224,10 @@ lmb_status lmb_amis_unbiased(const lmb_estimator_options *opt, const lmb_lobe *c
     }
     if (fits[T - 1].count)
         out->last = fits[T - 1].lobe[0];
-    if (opt->learn_lobes && s->count)
-        fit_samples(s, cosine->axis, opt->learn_lobes, &out->learned);
+    if (opt->learn_lobes && s->count) {
+        set_fit_weights(s);
+        lmb_mixture_fit(s->w, s->si, s->dist, s->count, cosine->axis, opt->learn_lobes, &s->fit, &out->learned);
+    }
     return LMB_OK;
 }
 

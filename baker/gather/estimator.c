@@ -69,10 +69,14 @@ void lmb_estimate_classic(const lmb_estimator_options *opt, const lmb_lobe *cosi
     }
 }
 
+int lmb_estimator_can_guide(const lmb_estimator_options *opt)
+{
+    return opt->method == LMB_GATHER_AMIS_DEFENSIVE && opt->unbiased && opt->defensive > 0 && opt->iterations >= 2;
+}
+
 int lmb_estimator_guided(const lmb_estimator_options *opt)
 {
-    return opt->method == LMB_GATHER_AMIS_DEFENSIVE && opt->unbiased && opt->defensive > 0 && opt->iterations >= 2 &&
-           opt->guide && lmb_mixture_learned(opt->guide);
+    return lmb_estimator_can_guide(opt) && opt->guide && lmb_mixture_learned(opt->guide);
 }
 
 uint32_t lmb_estimator_cosine_samples(const lmb_estimator_options *opt)

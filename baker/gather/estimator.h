@@ -91,6 +91,10 @@ typedef struct lmb_estimate {
 
 void lmb_estimator_scratch_free(lmb_estimator_scratch *s);
 
+/* Whether these options can gather guided (unbiased defensive AMIS, T >= 2): a pass with them
+ * gathers pilots first and guides the rest (gather/guide.h, the irradiance cache's records). */
+int lmb_estimator_can_guide(const lmb_estimator_options *opt);
+
 /* Whether these options gather guided (a learned guide given to unbiased defensive AMIS, T >= 2). */
 int lmb_estimator_guided(const lmb_estimator_options *opt);
 

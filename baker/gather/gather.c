@@ -206,11 +206,6 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     return LMB_OK;
 }
 
-int lmb_gather_guided(const lmb_estimator_options *opt)
-{
-    return opt->method == LMB_GATHER_AMIS_DEFENSIVE && opt->unbiased && opt->defensive > 0 && opt->iterations >= 2;
-}
-
 /* One sweep over the atlas's texels in blocks (progress after each block when `report`). */
 static int sweep(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, const guide_phase *gp, int report,
                  float *out, lmb_gather_stats *stats)
@@ -248,7 +243,7 @@ lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb
 {
     lmb_guide guide;
     guide_phase gp = {NULL, 0, job->guide_lobes};
-    if (!job->reference && job->guide_stride > 0 && lmb_gather_guided(&job->estimator)) {
+    if (!job->reference && job->guide_stride > 0 && lmb_estimator_can_guide(&job->estimator)) {
         if (!lmb_guide_init(&guide, t, job->guide_stride))
             return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for the guide of atlas %u", job->stage,
                                  atlas);

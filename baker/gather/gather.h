@@ -64,10 +64,6 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
                             const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
                             lmb_gather_point_result *out, lmb_gather_stats *st);
 
-/* Whether the estimator options can gather guided (unbiased defensive AMIS, T >= 2): a pass
- * with them gathers pilots first and guides the rest (gather/guide.h). */
-int lmb_gather_guided(const lmb_estimator_options *opt);
-
 /* Indirect irradiance of every listed texel of t (atlas `atlas`) into out (3 floats per texel;
  * 0 for invalid texels). */
 lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,

@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SAME_SURFACE_COS 0.9 /* shading normals within ~25 degrees */
 
 void lmb_guide_free(lmb_guide *g)
 {
@@ -59,7 +58,7 @@ int lmb_guide_find(const lmb_guide *g, const lmb_texels *t, uint32_t i, const do
         if (c < 0)
             continue;
         const lmb_guide_pilot *pl = &g->pilots[g->pilot_of[c]];
-        if (!lmb_mixture_learned(&pl->mixture) || lmb_dot3(pl->n, n) < SAME_SURFACE_COS)
+        if (!lmb_mixture_learned(&pl->mixture) || lmb_dot3(pl->n, n) < LMB_GUIDE_SAME_SURFACE_COS)
             continue;
         double d[3] = {pl->p[0] - p[0], pl->p[1] - p[1], pl->p[2] - p[2]}, d2 = lmb_dot3(d, d);
         if (d2 > (double)pl->reach * pl->reach || (best && d2 >= best_d2))

@@ -19,6 +19,10 @@
 #include "gather/mixture.h"
 #include "texels/texels.h"
 
+/* A point guides another only on the same surface: shading normals within ~25 degrees (pilot
+ * texels here, records in the irradiance cache). */
+#define LMB_GUIDE_SAME_SURFACE_COS 0.9
+
 typedef struct lmb_guide_pilot {
     double p[3], n[3];  /* the pilot's gather point and shading normal */
     float reach;        /* world distance within which it guides (2 x stride texels) */

@@ -1,6 +1,7 @@
 /* A gather pass through the irradiance cache: placement, gradients, interpolation (ic_pass.h). */
 #include "ic_pass.h"
 
+#include "gather/guide.h"
 #include "irradiance_cache/records.h"
 #include "util/frame.h"
 
@@ -40,7 +41,6 @@ typedef struct pass_ctx {
     uint32_t mix_cap;
 } pass_ctx;
 
-#define SAME_SURFACE_COS 0.9 /* a record guides another whose normal is within ~25 degrees */
 
 /* Room for the mixtures of n records (new ones not yet had). */
 static int reserve_mix(pass_ctx *c, uint32_t n)
@@ -168,7 +168,7 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
                 if (c->guided) {
                     double p[3], n[3];
                     texel_point(c, at[k], p, n);
-                    int64_t j = lmb_ic_records_nearest(&c->records, p, n, SAME_SURFACE_COS, c->has_mix);
+                    int64_t j = lmb_ic_records_nearest(&c->records, p, n, LMB_GUIDE_SAME_SURFACE_COS, c->has_mix);
                     if (j >= 0) {
                         lmb_mixture_reaim(&c->mix[j], c->records.rec[j].p, p, &guide);
                         by = &guide;
@@ -341,7 +341,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     c.t = t;
     c.threads = job->threads ? (int)job->threads : omp_get_max_threads();
     snprintf(c.stage, sizeof c.stage, "%s (cache)", job->stage);
-    c.guided = job->guide_stride > 0 && lmb_gather_guided(&job->estimator);
+    c.guided = job->guide_stride > 0 && lmb_estimator_can_guide(&job->estimator);
     c.lobes = job->guide_lobes;
     lmb_ic_records_init(&c.records, opt->error);
     int reuse = shared && shared->count;
