@@ -16,6 +16,7 @@
 #include "load/textures.h"
 #include "pack/layout.h"
 #include "post/dilate.h"
+#include "seams/seams.h"
 #include "texels/texels.h"
 #include "write/gltf_write.h"
 #include "write/atlas_images.h"
@@ -45,18 +46,20 @@ static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
 }
 
 static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir, const char *stem,
-                             const lmb_ic_points *records, lmb_error *err)
+                             const lmb_ic_points *records, int directional, lmb_error *err)
 {
-    int32_t *tex = malloc(((size_t)l->atlas_count + 1) * sizeof *tex);
+    int32_t *tex = malloc(((size_t)l->atlas_count + 1) * 2 * sizeof *tex), *dir_tex = tex + l->atlas_count + 1;
     if (!tex)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
     lmb_status st = LMB_OK;
     for (uint32_t a = 0; a < l->atlas_count && st == LMB_OK; a++) {
-        char png[512], hdr[512];
+        char png[512], hdr[512], dpng[512];
         snprintf(png, sizeof png, "%s-lightmap-%u.png", stem, a);
         snprintf(hdr, sizeof hdr, "%s-lightmap-%u.hdr", stem, a);
+        snprintf(dpng, sizeof dpng, "%s-lightmap-%u-dir.png", stem, a);
         tex[a] = lmb_gltf_add_lightmap_texture(s->doc, png, hdr, err);
-        if (tex[a] < 0)
+        dir_tex[a] = directional && tex[a] >= 0 ? lmb_gltf_add_direction_texture(s->doc, dpng, err) : -1;
+        if (tex[a] < 0 || (directional && dir_tex[a] < 0))
             st = LMB_ERR_INTERNAL;
     }
     for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
@@ -67,7 +70,8 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir,
         void **owned = NULL;
         st = instance_primitives(s, l, i, &prims, &n, &owned, &owned_n, err);
         if (st == LMB_OK)
-            st = lmb_gltf_lightmap_node(s->doc, s->instances[i].node, prims, n, tex[l->instances[i].atlas], err);
+            st = lmb_gltf_lightmap_node(s->doc, s->instances[i].node, prims, n, tex[l->instances[i].atlas],
+                                        dir_tex[l->instances[i].atlas], err);
         for (uint32_t k = 0; k < owned_n; k++)
             free(owned[k]);
         free(owned);
@@ -221,9 +225,22 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
                  "are black", s->path);
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, &records, log, err);
+    if (st == LMB_OK && cfg->seam_stitch) {
+        lmb_seam_report sr;
+        st = lmb_seams_stitch(s, &l, cache.irradiance, (const uint8_t *const *)cache.state, &sr, err);
+        stats->seam_edges = sr.edges;
+        stats->seam_jump_before = sr.jump_before;
+        stats->seam_jump_after = sr.jump_after;
+        if (st == LMB_OK && sr.edges)
+            lmb_info(log, "seams: %llu edges stitched (%llu points, %llu texels) in %.2fs; largest jump %.2f%% -> %.2f%%",
+                     (unsigned long long)sr.edges, (unsigned long long)sr.samples, (unsigned long long)sr.texels,
+                     sr.seconds, 100 * sr.jump_before, 100 * sr.jump_after);
+    }
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
                                     l.height[a], err);
+    for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)
+        st = lmb_write_direction_images(od.staging, od.stem, a, cache.direction[a], l.width[a], l.height[a], err);
     stats->light_seconds = lmb_seconds() - tl;
     stats->atlases = l.atlas_count;
     stats->texel_density = l.density.scene_density;
@@ -231,7 +248,7 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     stats->density_capped = l.density.capped;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
-        st = write_gltf(s, &l, od.staging, od.stem, &records, err);
+        st = write_gltf(s, &l, od.staging, od.stem, &records, cache.direction != NULL, err);
     }
     if (st == LMB_OK)
         st = lmb_output_dir_commit(&od, err);

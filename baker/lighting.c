@@ -3,6 +3,7 @@
 
 #include "gather/gather.h"
 #include "irradiance_cache/ic_pass.h"
+#include "post/rim.h"
 #include "util/clock.h"
 
 #include <math.h>
@@ -15,6 +16,7 @@ typedef struct atlas_work {
     lmb_texels t;
     float *direct;   /* 3 per listed texel */
     float *result;   /* 3 per listed texel: the pass being computed */
+    float *direct_dir; /* output.directional: 3 per listed texel, direct light's direction sum */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -23,6 +25,7 @@ static void work_free(atlas_work *w, uint32_t n)
         lmb_texels_free(&w[a].t);
         free(w[a].direct);
         free(w[a].result);
+        free(w[a].direct_dir);
     }
     free(w);
 }
@@ -250,6 +253,49 @@ static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error 
     return st;
 }
 
+/*
+ * Directional lightmaps (output.directional; README "Directional lightmaps"): per texel the
+ * mean direction the light arrives from, weighted by irradiance,
+ *   D = (v_direct + v_indirect) / lum(E),   v = integral lum(L(w)) w cos dw,
+ * v_direct from the lights stage (exact per light), v_indirect from samples.directional cosine
+ * rays reading the finished cache (lmb_gather_directions). |D| <= 1: 1 when all light comes
+ * from one direction, 2/3 under a uniform sky. Noise can push |D| past 1: it is clamped.
+ */
+static lmb_status light_directions(const lmb_config *cfg, lmb_gather_job *job, atlas_work *w, lmb_cache *cache,
+                                   lmb_bake_stats *stats, lmb_error *err)
+{
+    lmb_status st = LMB_OK;
+    job->pass = 2000;
+    job->direct_at_hits = 0; /* the cache holds all the light now */
+    job->stage = "directions";
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
+        const lmb_texels *t = &w[a].t;
+        float *d = calloc(3 * (size_t)t->count + 1, sizeof *d);
+        if (!d)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u's directions", a);
+        lmb_gather_stats gs = {0, 0, 0, 0};
+        if (!stats->no_light)
+            st = lmb_gather_directions(job, a, t, cfg->directional_rays, d, &gs);
+        stats->rays += gs.rays;
+        for (uint32_t i = 0; st == LMB_OK && i < t->count; i++) {
+            const float *e = (stats->bounces ? w[a].result : w[a].direct) + 3 * (size_t)i;
+            double lum = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2], v[3], len = 0;
+            for (int k = 0; k < 3; k++) {
+                v[k] = (double)d[3 * (size_t)i + k] + (double)w[a].direct_dir[3 * (size_t)i + k];
+                v[k] = lum > 0 ? v[k] / lum : 0;
+                len += v[k] * v[k];
+            }
+            len = sqrt(len);
+            for (int k = 0; k < 3; k++)
+                d[3 * (size_t)i + k] = (float)(len > 1 ? v[k] / len : v[k]);
+        }
+        if (st == LMB_OK)
+            st = lmb_cache_store_direction(cache, a, t, d, err);
+        free(d);
+    }
+    return st;
+}
+
 /* Progress of one band's direct light, reported as a share of the whole atlas's rows. */
 typedef struct band_progress {
     lmb_progress_fn fn;
@@ -282,10 +328,11 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
         lmb_texels band;
         st = lmb_texels_build_rows(cache->scene, cache->layout, a, cfg->texel_samples, y0, y1, &band, err);
         float *e = st == LMB_OK ? calloc(3 * (size_t)band.count + 1, sizeof *e) : NULL;
-        if (st == LMB_OK && !e)
+        float *dir = st == LMB_OK && cfg->directional ? calloc(3 * (size_t)band.count + 1, sizeof *dir) : NULL;
+        if (st == LMB_OK && (!e || (cfg->directional && !dir)))
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
         band_progress bp = {progress, user, y0, y1 - y0, height, width};
-        lmb_direct_job job = {direct, a, progress ? band_progress_update : NULL, &bp};
+        lmb_direct_job job = {direct, a, progress ? band_progress_update : NULL, &bp, dir};
         if (st == LMB_OK)
             st = lmb_direct_compute(&job, &band, e, rays, err);
         if (st == LMB_OK) { /* exact growth, as lmb_texels_append */
@@ -295,11 +342,21 @@ static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direc
             else
                 w->direct = d;
         }
+        if (st == LMB_OK && dir) {
+            float *d = realloc(w->direct_dir, (3 * (w->t.count + (size_t)band.count) + 1) * sizeof *d);
+            if (!d)
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+            else
+                w->direct_dir = d;
+        }
         if (st == LMB_OK) {
             memcpy(w->direct + 3 * (size_t)w->t.count, e, 3 * (size_t)band.count * sizeof *e);
+            if (dir)
+                memcpy(w->direct_dir + 3 * (size_t)w->t.count, dir, 3 * (size_t)band.count * sizeof *dir);
             st = lmb_texels_append(&w->t, &band, err);
         }
         free(e);
+        free(dir);
         lmb_texels_free(&band);
     }
     if (st == LMB_OK && !w->t.texel) { /* an atlas without texels: empty arrays, not NULL */
@@ -323,9 +380,12 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
     lmb_status st = LMB_OK;
     uint64_t total = 0;
+    lmb_rim_stats rim = {0, 0, 0};
     /* gather points and direct light, atlas by atlas */
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
         st = direct_by_bands(cfg, direct, cache, a, &w[a], progress, user, &stats->rays, err);
+        if (st == LMB_OK)
+            st = lmb_rim_limit(&w[a].t, w[a].direct, &rim, err);
         if (st != LMB_OK)
             break;
         w[a].result = calloc(3 * (size_t)w[a].t.count + 1, sizeof *w[a].result);
@@ -341,6 +401,11 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         if (st == LMB_OK)
             st = lmb_cache_store(cache, a, &w[a].t, w[a].direct, err);
     }
+    stats->rim_limited = rim.limited;
+    stats->rim_energy = rim.total > 0 ? rim.removed / rim.total : 0;
+    if (rim.limited)
+        lmb_info(log, "rims: %llu partly covered texels limited to their neighbours (%.3f%% of the direct light)",
+                 (unsigned long long)rim.limited, 100.0 * stats->rim_energy);
     lmb_gather_job job;
     memset(&job, 0, sizeof job);
     job.direct = direct;
@@ -403,6 +468,8 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         stats->gather_rays = gs.rays;
         stats->amis_adapted = gs.adapted;
     }
+    if (st == LMB_OK && cfg->directional)
+        st = light_directions(cfg, &job, w, cache, stats, err);
     lmb_ic_records_free(&shared);
     work_free(w, n);
     return st;

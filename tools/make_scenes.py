@@ -73,8 +73,10 @@ class Scene:
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
-    def material(self, name, color, emissive=None, strength=None):
+    def material(self, name, color, emissive=None, strength=None, double_sided=False):
         m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0}}
+        if double_sided:
+            m["doubleSided"] = True
         if emissive:
             m["emissiveFactor"] = list(emissive)
         if strength:
@@ -139,6 +141,14 @@ class Scene:
         self.doc["meshes"].append({"name": name, "primitives": [prim]})
         self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1,
                                   "translation": list(translation)})
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def smooth_mesh(self, name, positions, normals, indices, material, translation=(0, 0, 0)):
+        """An indexed mesh with the given vertex normals (shared vertices: smooth shading)."""
+        prim = {"attributes": {"POSITION": self._accessor(positions, 3), "NORMAL": self._accessor(normals, 3)},
+                "indices": self._accessor(indices, 1, True), "material": material}
+        self.doc["meshes"].append({"name": name, "primitives": [prim]})
+        self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1, "translation": list(translation)})
         self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
 
     def light(self, name, kind, intensity, color=(1, 1, 1), translation=(0, 0, 0), rotation=None, **spot):
@@ -385,9 +395,84 @@ def indirect(out):
     s.write(os.path.join(out, "gap.gltf"))
 
 
+def uv_sphere(r, rings=12, segments=24):
+    """Positions, normals, indices of a latitude-longitude sphere (counter-clockwise outside)."""
+    pos, nrm, idx = [], [], []
+    for i in range(rings + 1):
+        th = math.pi * i / rings
+        for j in range(segments + 1):  # a duplicated column at the date line, as UV spheres have
+            ph = 2 * math.pi * j / segments
+            n = (math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph))
+            pos.append(tuple(r * c for c in n))
+            nrm.append(n)
+    for i in range(rings):
+        for j in range(segments):
+            a, b = i * (segments + 1) + j, (i + 1) * (segments + 1) + j
+            if i > 0:
+                idx += [a, a + 1, b]
+            if i < rings - 1:
+                idx += [a + 1, b + 1, b]
+    return pos, nrm, idx
+
+
+def smooth_box(h, turn=0.0):
+    """A cube of half side h turned by `turn` radians about +y, 8 shared corners whose normals
+    point out along the diagonals."""
+    c, s = math.cos(turn), math.sin(turn)
+    pos = [(c * x + s * z, y, -s * x + c * z) for x in (-h, h) for y in (-h, h) for z in (-h, h)]
+    nrm = [tuple(v / (h * math.sqrt(3)) for v in p) for p in pos]
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    idx = []
+    for a, b, c, d in faces:
+        idx += [a, b, c, a, c, d]
+    return pos, nrm, idx
+
+
+RIM_GAP = 0.001  # the emitter quad hangs 1 mm under the ceiling (bevy's Cornell box: 0.9 mm)
+RIM_HALF = 0.3   # half its side
+RIM_TURN = math.radians(20)  # turned about the vertical: its outline crosses texels at every offset
+
+
+def rim_corner(sx, sz):
+    """A corner of the fixture quad (sx, sz = -1 or 1) in world x, z."""
+    c, s = math.cos(RIM_TURN), math.sin(RIM_TURN)
+    return (RIM_HALF * (c * sx - s * sz), RIM_HALF * (s * sx + c * sz))
+
+
+def artists(out):
+    """Scenes for what artists see: light fixtures flush under a ceiling, sealed double-sided rooms."""
+    for name, double in (("rim-front", False), ("rim-double", True)):
+        s = Scene()
+        s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), s.material("grey", (0.5, 0.5, 0.5), double_sided=double))
+        y = 2 - RIM_GAP
+        q = [rim_corner(sx, sz) for sx, sz in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+        s.mesh("fixture", quad(*[(x, y, z) for x, z in q]),  # faces -y
+               s.material("panel", (0.8, 0.8, 0.8), emissive=(1, 1, 1), strength=20.0, double_sided=double))
+        s.write(os.path.join(out, name + ".gltf"))
+
+    s = Scene()
+    s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), s.material("grey", (0.5, 0.5, 0.5), double_sided=True))
+    s.light("outside", "point", 1000.0, translation=(3, 1, 0))
+    s.light("sun", "directional", 1000.0, rotation=[-0.3826834, 0, 0, 0.9238795])  # 45 deg down
+    s.mesh("outside_panel", quad((3, 0.5, -0.5), (3, 0.5, 0.5), (3, 1.5, 0.5), (3, 1.5, -0.5)),  # faces -x, both sides
+           s.material("panel", (0.8, 0.8, 0.8), emissive=(1, 1, 1), strength=20.0, double_sided=True))
+    s.write(os.path.join(out, "sealed-room-double.gltf"))
+
+    # seams: a UV sphere and a smooth-normal cube (its faces are separate charts) in a dim
+    # emissive room, a lamp above and to the side: light that varies smoothly over both
+    s = Scene()
+    s.mesh("room", box(-3, -1, -3, 3, 5, 3, inward=True), s.material("sky", (0.5, 0.5, 0.5), emissive=(0.3, 0.3, 0.3)))
+    grey = s.material("grey", (0.7, 0.7, 0.7))
+    s.smooth_mesh("sphere", *uv_sphere(0.5), grey, translation=(-0.8, 1, 0))
+    s.smooth_mesh("cube", *smooth_box(0.4, math.radians(40)), grey, translation=(0.8, 1, 0))  # two faces to the camera
+    s.light("lamp", "point", 40.0, translation=(-1.5, 3.0, 2.0))
+    s.write(os.path.join(out, "seams.gltf"))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     cornell(out)
     analytic(out)
     indirect(out)
+    artists(out)

@@ -15,9 +15,12 @@ void lmb_cache_free(lmb_cache *c)
             free(c->irradiance[a]);
         if (c->state)
             free(c->state[a]);
+        if (c->direction)
+            free(c->direction[a]);
     }
     free(c->irradiance);
     free(c->state);
+    free(c->direction);
     memset(c, 0, sizeof *c);
 }
 
@@ -44,11 +47,10 @@ lmb_status lmb_cache_init(lmb_cache *c, const lmb_scene *scene, const lmb_layout
     return LMB_OK;
 }
 
-lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err)
+/* img := e at t's texels (0 at invalid ones), st := their states; then dilated. */
+static lmb_status scatter(float *img, uint8_t *st, uint32_t w, uint32_t h, const lmb_texels *t, const float *e,
+                          lmb_error *err)
 {
-    uint32_t w = c->layout->width[a], h = c->layout->height[a];
-    float *img = c->irradiance[a];
-    uint8_t *st = c->state[a];
     memset(img, 0, (size_t)w * h * 3 * sizeof *img);
     memset(st, LMB_TEXEL_EMPTY, (size_t)w * h);
     for (uint32_t i = 0; i < t->count; i++) {
@@ -57,6 +59,26 @@ lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const 
             img[3 * (size_t)t->texel[i] + k] = t->valid[i] ? e[3 * (size_t)i + k] : 0.0f;
     }
     return lmb_dilate(img, st, w, h, err);
+}
+
+lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err)
+{
+    return scatter(c->irradiance[a], c->state[a], c->layout->width[a], c->layout->height[a], t, e, err);
+}
+
+lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *d, lmb_error *err)
+{
+    size_t n = (size_t)c->layout->width[a] * c->layout->height[a];
+    if (!c->direction)
+        c->direction = calloc((size_t)c->atlas_count + 1, sizeof *c->direction);
+    if (c->direction && !c->direction[a])
+        c->direction[a] = malloc((3 * n + 1) * sizeof **c->direction);
+    uint8_t *st = malloc(n + 1);
+    lmb_status s = c->direction && c->direction[a] && st
+                       ? scatter(c->direction[a], st, c->layout->width[a], c->layout->height[a], t, d, err)
+                       : lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u's directions", a);
+    free(st);
+    return s;
 }
 
 /* Diffuse albedo / pi of primitive pr's material at barycentrics (b1, b2) of triangle f. */

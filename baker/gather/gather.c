@@ -55,7 +55,7 @@ static double cached_radiance(void *user, const double w[3], uint32_t sample, do
         double d[3];
         hit_point(job->rt, pr->o, w, &h, &y);
         lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
-        pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, d);
+        pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, d, NULL);
         for (int k = 0; k < 3; k++) /* unmapped: direct light only (one bounce) */
             e[k] = kind == LMB_HIT_UNMAPPED ? d[k] : e[k] + d[k];
     }
@@ -90,7 +90,7 @@ static void reference(point_rays *pr, double out[3])
             lmb_shading_point y;
             hit_point(job->rt, o, w, &h, &y);
             double e[3];
-            pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e);
+            pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);
             /* cosine sampling: f / p = pi B = pi albedo/pi E, so the path weight gains rho = pi albedo/pi */
             for (int k = 0; k < 3; k++) {
                 beta[k] *= LMB_PI * albedo[k];
@@ -203,6 +203,57 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     st->rays += pr.rays;
     st->texels++;
     st->adapted += est.adapted;
+    return LMB_OK;
+}
+
+/*
+ * The indirect part of a texel's light direction (directional lightmaps): `rays` stratified
+ * cosine-distributed rays read the finished cache; with p(w) = cos / pi,
+ *   v = integral L(w) w cos dw  ~  pi / N sum lum(L(w_i)) w_i,
+ * the irradiance-weighted direction sum in the units of lmb_direct_at's dir (lux).
+ */
+static void texel_direction(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i, uint32_t rays,
+                            float *out, uint64_t *traced)
+{
+    double v[3] = {0, 0, 0};
+    out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0;
+    if (!t->valid[i])
+        return;
+    point_rays pr;
+    point_setup(job, atlas, t, i, &pr);
+    uint32_t sx = (uint32_t)ceil(sqrt((double)rays)), sy = (rays + sx - 1) / sx;
+    lmb_lobe cosine = {{pr.sp.n[0], pr.sp.n[1], pr.sp.n[2]}, 1.0};
+    for (uint32_t s = 0; s < rays; s++) {
+        /* pass + 1: apart from the streams of light samples at unmapped hits (pass, s) */
+        lmb_rng rng = lmb_rng_make(job->seed, pr.key, ((uint64_t)(job->pass + 1) << 32) | s);
+        double u1 = ((s % sx) + lmb_rng_next(&rng)) / sx, u2 = (((s / sx) % sy) + lmb_rng_next(&rng)) / sy, w[3], l[3];
+        lmb_lobe_sample(&cosine, u1, u2, w);
+        if (lmb_dot3(w, pr.sp.ng) <= 0)
+            continue;
+        cached_radiance(&pr, w, s, l);
+        double lum = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+        for (int k = 0; k < 3; k++)
+            v[k] += lum * w[k];
+    }
+    for (int k = 0; k < 3; k++)
+        out[3 * (size_t)i + k] = (float)(LMB_PI * v[k] / rays);
+    *traced += pr.rays;
+}
+
+lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t rays,
+                                 float *out, lmb_gather_stats *stats)
+{
+    int threads = job->threads ? (int)job->threads : omp_get_max_threads();
+    uint64_t traced = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : traced)
+    {
+        lmb_rt_thread_init();
+#pragma omp for schedule(dynamic, 64)
+        for (uint32_t i = 0; i < t->count; i++)
+            texel_direction(job, atlas, t, i, rays, out, &traced);
+    }
+    stats->rays += traced;
+    stats->texels += t->count;
     return LMB_OK;
 }
 

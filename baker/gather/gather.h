@@ -64,6 +64,13 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
                             const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
                             lmb_gather_point_result *out, lmb_gather_stats *st);
 
+/* The indirect part of every listed texel's light direction (directional lightmaps): the
+ * irradiance-weighted sum of incoming directions, sum lum(L) w cos over the hemisphere (lux),
+ * from `rays` cosine rays that read the finished cache (job->direct_at_hits must be off: the
+ * cache then holds all the light). 3 floats per texel into out; 0 for invalid texels. */
+lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t rays,
+                                 float *out, lmb_gather_stats *stats);
+
 /* Indirect irradiance of every listed texel of t (atlas `atlas`) into out (3 floats per texel;
  * 0 for invalid texels). */
 lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,

@@ -8,7 +8,8 @@
  *   area:        E = sum over samples of L_e cos(theta_x) cos(theta_y) / d^2 / p_A(y) / N,
  *                triangles chosen in proportion to power (area x luminance), points uniform
  *                on the triangle: p_A(y) = P_tri / A_tri (area sampling; one-sided emitters
- *                unless the material is double-sided).
+ *                unless the material is double-sided and lights.emission_sides is
+ *                "material").
  * Every contribution needs an unoccluded shadow ray. A gather point whose hemisphere rays
  * (16, cosine-distributed) mostly hit back faces lies inside geometry and is not used;
  * a texel with no usable point is invalid and filled later by dilation.
@@ -135,7 +136,7 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const l
                 x.area = 0.5 * len;
                 for (int k = 0; k < 3; k++)
                     x.le[k] = (float)(mat->emissive[k] * cfg->emissive_scale);
-                x.two_sided = mat->double_sided;
+                x.two_sided = cfg->emission_sides == LMB_EMIT_MATERIAL && mat->double_sided;
                 x.tex = emitter_texture(tx, mat, pr, f, x.uv);
                 x.instance = i;
                 x.primitive = m->first_primitive + p;
@@ -203,7 +204,18 @@ typedef struct point_ctx {
     double eps;
     uint32_t samples; /* area-light and many-light samples */
     uint64_t rays;
+    double dir[3];    /* sum of each contribution's luminance times its direction (unit, toward the light) */
 } point_ctx;
+
+/* Adds one light's contribution rgb, arriving from unit direction d, to e (and to c->dir). */
+static void add_light(point_ctx *c, const double d[3], const double rgb[3], double e[3])
+{
+    double lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    for (int k = 0; k < 3; k++) {
+        e[k] += rgb[k];
+        c->dir[k] += lum * d[k];
+    }
+}
 
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
@@ -239,8 +251,10 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     c->rays++;
     if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
         return;
+    double rgb[3];
     for (int k = 0; k < 3; k++)
-        e[k] += weight * scale * l->intensity * l->color[k] * cosang * w;
+        rgb[k] = weight * scale * l->intensity * l->color[k] * cosang * w;
+    add_light(c, d, rgb, e);
 }
 
 /* Point and spot lights: all of them when few, else power-proportional samples. */
@@ -319,9 +333,10 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
                 c->rays++;
                 if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
                     double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
-                    double g = cx * pl / (pl * pl + pb * pb) / n; /* (cx / pl) x power weight */
+                    double g = cx * pl / (pl * pl + pb * pb) / n, rgb[3]; /* (cx / pl) x power weight */
                     for (int k = 0; k < 3; k++)
-                        e[k] += le[k] * g;
+                        rgb[k] = le[k] * g;
+                    add_light(c, d, rgb, e);
                 }
             }
         }
@@ -346,14 +361,15 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
             continue;
         double pt = (es->cdf[k1] - es->cdf[k1 - 1]) / total;
         double pl = pt / x->area * h.t * h.t / cy, pb = cz * LMB_INV_PI;
-        double g = cz * pb / (pl * pl + pb * pb) / n; /* (cz / pb) x power weight */
+        double g = cz * pb / (pl * pl + pb * pb) / n, rgb[3]; /* (cz / pb) x power weight */
         for (int k = 0; k < 3; k++)
-            e[k] += le[k] * g;
+            rgb[k] = le[k] * g;
+        add_light(c, w, rgb, e);
     }
 }
 
-/* Inside geometry: more than half of the hemisphere rays hit back faces. */
-static int inside_geometry(point_ctx *c, lmb_rng *rng)
+/* How many of VALIDITY_RAYS hemisphere rays hit back faces (inside geometry: more than half). */
+static int back_face_hits(point_ctx *c, lmb_rng *rng)
 {
     double t1[3], t2[3], a[3] = {fabs(c->ng[0]) < 0.9 ? 1 : 0, fabs(c->ng[0]) < 0.9 ? 0 : 1, 0};
     t1[0] = a[1] * c->ng[2] - a[2] * c->ng[1];
@@ -376,7 +392,7 @@ static int inside_geometry(point_ctx *c, lmb_rng *rng)
         if (lmb_rt_intersect(c->d->rt, c->o, d, c->eps, 1e300, &h) && h.backface)
             back++;
     }
-    return 2 * back > VALIDITY_RAYS;
+    return back;
 }
 
 static void point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp)
@@ -392,7 +408,8 @@ static void point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_poin
     c->eps = sp->eps;
 }
 
-uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3])
+uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3],
+                       double dir[3])
 {
     point_ctx c;
     point_init(&c, d, sp);
@@ -403,16 +420,20 @@ uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_
     local_lights(&c, rng, e);
     if (lmb_emitters_count(d->emitters))
         area_lights(&c, rng, e);
+    if (dir)
+        memcpy(dir, c.dir, sizeof c.dir);
     return (uint32_t)c.rays;
 }
 
-int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays)
+int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays,
+                              int *sees_back)
 {
     point_ctx c;
     point_init(&c, d, sp);
-    int inside = inside_geometry(&c, rng);
+    int back = back_face_hits(&c, rng);
     *rays += (uint32_t)c.rays;
-    return inside;
+    *sees_back = back > 0;
+    return 2 * back > VALIDITY_RAYS;
 }
 
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp)
@@ -429,27 +450,36 @@ void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t 
 
 static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, float *out, uint64_t *rays)
 {
-    double sum[3] = {0, 0, 0};
+    double sum[3] = {0, 0, 0}, dir_sum[3] = {0, 0, 0};
     uint32_t used = 0, r = 0;
+    int near_back = 0;
     uint64_t key = ((uint64_t)job->atlas << 32) | t->texel[i];
     t->gather_at[i] = 0;
     for (uint32_t k = 0; k < t->points_in[i]; k++) {
         lmb_shading_point sp;
         lmb_texel_shading_point(job->direct, t, i, k, &sp);
         lmb_rng rng = lmb_rng_make(job->direct->cfg->seed, key, k);
-        if (lmb_point_inside_geometry(job->direct, &sp, &rng, &r))
+        int sees_back;
+        if (lmb_point_inside_geometry(job->direct, &sp, &rng, &r, &sees_back))
             continue;
+        near_back |= sees_back;
         if (!used)
             t->gather_at[i] = (uint8_t)k;
-        double e[3];
-        r += lmb_direct_at(job->direct, &sp, 0, &rng, e);
-        for (int d = 0; d < 3; d++)
+        double e[3], dir[3];
+        r += lmb_direct_at(job->direct, &sp, 0, &rng, e, dir);
+        for (int d = 0; d < 3; d++) {
             sum[d] += e[d];
+            dir_sum[d] += dir[d];
+        }
         used++;
     }
     t->valid[i] = used > 0;
-    for (int d = 0; d < 3; d++)
+    t->partly_covered[i] = used > 0 && (used < t->points_in[i] || near_back);
+    for (int d = 0; d < 3; d++) {
         out[3 * i + d] = used ? (float)(sum[d] / used) : 0.0f;
+        if (job->direction)
+            job->direction[3 * (size_t)i + d] = used ? (float)(dir_sum[d] / used) : 0.0f;
+    }
     *rays += r;
 }
 

@@ -44,11 +44,16 @@ typedef struct lmb_shading_point {
 
 /* Direct irradiance at sp (lux, RGB) from every light with shadow rays; rng drives area-light
  * and many-light sampling, `samples` of each (0: samples.direct; a caller that averages many
- * evaluations, as gather rays and reference paths do, passes 1). Returns the rays traced. */
-uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3]);
+ * evaluations, as gather rays and reference paths do, passes 1). Returns the rays traced.
+ * dir (may be NULL): the sum over contributions of their luminance times their direction
+ * (unit, toward the light): the direct part of the texel's light direction (lmb_direction). */
+uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3],
+                       double dir[3]);
 
-/* 1 when sp lies inside geometry (most of its hemisphere rays hit back faces); adds to *rays. */
-int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays);
+/* 1 when sp lies inside geometry (most of its hemisphere rays hit back faces); adds to *rays;
+ * *sees_back: any of them hit a back face (sp is near geometry's inside: in a gap, at a contact). */
+int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays,
+                              int *sees_back);
 
 /* Gather point k of listed texel i of t as a shading point (offset scaled to the texel). */
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp);
@@ -58,6 +63,8 @@ typedef struct lmb_direct_job {
     uint32_t atlas;      /* keys the random streams */
     lmb_progress_fn progress;
     void *progress_user;
+    float *direction;    /* NULL, or 3 floats per listed texel: lmb_direct_at's dir, averaged over the
+                            texel's points as the irradiance is (directional lightmaps) */
 } lmb_direct_job;
 
 /* Fills irradiance (3 floats per listed texel of t), t->valid and t->gather_at. Counts rays. */

@@ -45,8 +45,10 @@ static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node
 static const char *const gather_methods[] = {"cosine", "amis", "amis_defensive", NULL};
 static const char *const amis_weights[] = {"unbiased", "balance", NULL};
 static const char *const ic_records_modes[] = {"per_pass", "shared", NULL};
+static const char *const emission_sides[] = {"front", "material", NULL};
 static const char *const output_formats[] = {"exr", "hdr", "png", "mask", NULL};
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
+_Static_assert(LMB_EMIT_FRONT == 0 && LMB_EMIT_MATERIAL == 1, "emission_sides");
 _Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4 && LMB_OUTPUT_MASK == 8,
                "output_formats");
 
@@ -63,6 +65,7 @@ static const key_spec config_keys[] = {
     U32("samples.bounce", OFF(bounce_rays), 1, 1048576),
     U32("samples.bounce_high", OFF(bounce_rays_high), 0, 1048576),
     U32("samples.amis_iterations", OFF(amis_iterations), 1, 64),
+    U32("samples.directional", OFF(directional_rays), 1, 65536),
     U32_AUTO("bounces", OFF(bounces), 0, 64),
     U32("bounces_auto.max", OFF(bounces_max), 1, 64),
     FLOAT("bounces_auto.tail", OFF(bounces_tail), 0, 1, OPEN_LO | OPEN_HI),
@@ -80,11 +83,14 @@ static const key_spec config_keys[] = {
     U64("seed", OFF(seed), 0, 9223372036854775807LL),
     U32("threads", OFF(threads), 0, 1024),
     FLAGS("output.formats", OFF(output_formats), output_formats),
+    BOOL("output.directional", OFF(directional)),
     LIST("lightmap.include", lmb_cfg_set_globs, OFF(include), OFF(include_count)),
     LIST("lightmap.exclude", lmb_cfg_set_globs, OFF(exclude), OFF(exclude_count)),
     STRING("lightmap.extras_key", OFF(extras_key)),
     FLOAT("lights.intensity_scale", OFF(light_intensity_scale), 0, 1e9, 0),
     FLOAT("lights.emissive_scale", OFF(emissive_scale), 0, 1e9, 0),
+    ENUM("lights.emission_sides", OFF(emission_sides), emission_sides),
+    BOOL("seams.stitch", OFF(seam_stitch)),
 };
 
 /* One density_overrides entry, filled into an lmb_density_override. */
@@ -130,6 +136,10 @@ void lmb_config_default(lmb_config *cfg)
     strcpy(cfg->extras_key, "lightmap");
     cfg->light_intensity_scale = 1.0;
     cfg->emissive_scale = 1.0;
+    cfg->emission_sides = LMB_EMIT_FRONT; /* README "Which side of a face counts" */
+    cfg->seam_stitch = 1;
+    cfg->directional = 0;
+    cfg->directional_rays = 32;
 }
 
 uint64_t lmb_config_atlas_texels(const lmb_config *cfg)

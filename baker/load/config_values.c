@@ -250,8 +250,9 @@ static lmb_status bad_name(parse_ctx *c, const key_spec *k, const yaml_node_t *n
     return lmb_cfg_bad_value(c, k, n, want);
 }
 
-/* Enum keys (gather.method, gather.amis_weights) are C enums of the same size. */
-_Static_assert(sizeof(lmb_gather_method) == sizeof(lmb_amis_weights) && sizeof(lmb_gather_method) == sizeof(lmb_ic_records_mode),
+/* Enum keys (gather.method, gather.amis_weights, ...) are C enums of the same size. */
+_Static_assert(sizeof(lmb_gather_method) == sizeof(lmb_amis_weights) && sizeof(lmb_gather_method) == sizeof(lmb_ic_records_mode) &&
+                   sizeof(lmb_gather_method) == sizeof(lmb_emission_sides),
                "enum keys share lmb_cfg_set_enum");
 lmb_status lmb_cfg_set_enum(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {

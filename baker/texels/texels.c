@@ -45,7 +45,9 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
     if (valid) dst->valid = valid;
     uint8_t *gather_at = realloc(dst->gather_at, (size_t)n + 1);
     if (gather_at) dst->gather_at = gather_at;
-    if (!texel || !points_in || !size || !refs || !valid || !gather_at)
+    uint8_t *partly = realloc(dst->partly_covered, (size_t)n + 1);
+    if (partly) dst->partly_covered = partly;
+    if (!texel || !points_in || !size || !refs || !valid || !gather_at || !partly)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", n);
     copy_band(dst, band);
     return LMB_OK;
@@ -61,6 +63,7 @@ static void copy_band(lmb_texels *dst, const lmb_texels *band)
         dst->refs[j] = band->refs[(size_t)i * band->samples + band->gather_at[i]];
         dst->valid[j] = band->valid[i];
         dst->gather_at[j] = 0;
+        dst->partly_covered[j] = band->partly_covered[i];
     }
     dst->width = band->width;
     dst->height = band->height;
@@ -79,6 +82,7 @@ void lmb_texels_free(lmb_texels *t)
     free(t->refs);
     free(t->valid);
     free(t->gather_at);
+    free(t->partly_covered);
     memset(t, 0, sizeof *t);
 }
 
@@ -200,21 +204,33 @@ static void pull_inside(const double q[9], double texel_size, double p[3])
         p[r] += c[r] / d * step;
 }
 
-static void make_point(const lmb_scene *s, const lmb_layout *l, const lmb_point_ref *b, lmb_gather_point *out)
+int lmb_triangle_corner_normals(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, double out[9])
 {
-    const lmb_instance *in = &s->instances[b->instance];
+    const lmb_instance *in = &s->instances[instance];
     const lmb_mesh_soup *soup = &l->meshes[in->mesh].soup;
-    const uint32_t *t = soup->indices + 3 * (size_t)b->triangle;
-    double w[3] = {1.0 - b->b1 - b->b2, b->b1, b->b2}, q[9], nm[9], n[3] = {0, 0, 0}, p[3] = {0, 0, 0};
-    lmb_layout_world_triangle(s, l, b->instance, b->triangle, q);
+    const uint32_t *t = soup->indices + 3 * (size_t)f;
+    double nm[9];
     normal_matrix(in->world, nm);
     for (int k = 0; k < 3; k++) {
         const float *vn = soup->normals + 3 * t[k];
+        for (int r = 0; r < 3; r++)
+            out[3 * k + r] = nm[3 * r] * vn[0] + nm[3 * r + 1] * vn[1] + nm[3 * r + 2] * vn[2];
+    }
+    return !soup->flat[f];
+}
+
+static void make_point(const lmb_scene *s, const lmb_layout *l, const lmb_point_ref *b, lmb_gather_point *out)
+{
+    const lmb_mesh_soup *soup = &l->meshes[s->instances[b->instance].mesh].soup;
+    const lmb_instance *in = &s->instances[b->instance];
+    double w[3] = {1.0 - b->b1 - b->b2, b->b1, b->b2}, q[9], cn[9], n[3] = {0, 0, 0}, p[3] = {0, 0, 0};
+    lmb_layout_world_triangle(s, l, b->instance, b->triangle, q);
+    lmb_triangle_corner_normals(s, l, b->instance, b->triangle, cn);
+    for (int k = 0; k < 3; k++)
         for (int r = 0; r < 3; r++) {
             p[r] += w[k] * q[3 * k + r];
-            n[r] += w[k] * (nm[3 * r] * vn[0] + nm[3 * r + 1] * vn[1] + nm[3 * r + 2] * vn[2]);
+            n[r] += w[k] * cn[3 * k + r];
         }
-    }
     double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
     double g[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
     if (in->flips_winding)
@@ -277,8 +293,9 @@ lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32
     out->layout = l;
     out->valid = malloc((size_t)out->count + 1);
     out->gather_at = calloc((size_t)out->count + 1, 1);
+    out->partly_covered = calloc((size_t)out->count + 1, 1);
     if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->refs || !out->valid ||
-        !out->gather_at) {
+        !out->gather_at || !out->partly_covered) {
         free(b);
         lmb_texels_free(out);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", out->count);

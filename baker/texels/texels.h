@@ -41,6 +41,9 @@ typedef struct lmb_texels {
     uint8_t *valid;            /* per listed texel: 1, or 0 when inside geometry (set by the lights stage) */
     uint8_t *gather_at;        /* per listed texel: its first point outside geometry, where indirect
                                   light is gathered (set by the lights stage) */
+    uint8_t *partly_covered;   /* per listed texel: 1 when valid but some of its points are inside
+                                  geometry or see a back face (set by the lights stage; post/rim.c
+                                  limits these) */
 } lmb_texels;
 
 /* Gather points for atlas `atlas` of layout l. `samples` per texel, 1..256. */
@@ -63,6 +66,11 @@ void lmb_texels_free(lmb_texels *t);
 /* Point k of listed texel i, stored or expanded from its reference (the same doubles either
  * way: both come from one function). */
 void lmb_texels_point(const lmb_texels *t, uint32_t i, uint32_t k, lmb_gather_point *out);
+
+/* The shading normals at the corners of triangle f of an instance, in world space, not
+ * normalised (the vertex normals through the inverse transpose of the instance matrix).
+ * Returns 0 when the triangle is shaded flat (no NORMAL: out is then meaningless). */
+int lmb_triangle_corner_normals(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, double out[9]);
 
 /* Sub-sample k of `samples` inside a texel, in [0,1)^2: stratum centres of a sx x sy grid. */
 void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2]);

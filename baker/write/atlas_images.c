@@ -80,3 +80,24 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
     return st;
 }
 
+
+lmb_status lmb_write_direction_images(const char *dir, const char *stem, uint32_t a, const float *d, uint32_t w,
+                                      uint32_t h, lmb_error *err)
+{
+    char path[8600];
+    snprintf(path, sizeof path, "%s/%s-lightmap-%u-dir.exr", dir, stem, a);
+    lmb_status st = lmb_image_write_f32(path, w, h, 3, d, err);
+    if (st != LMB_OK)
+        return st;
+    uint8_t *png = malloc((size_t)w * h * 3 + 1);
+    if (!png)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "png: out of memory");
+    for (size_t i = 0; i < (size_t)w * h * 3; i++) { /* (D + 1) / 2, linear: a data texture, not a colour */
+        double v = 0.5 * ((double)d[i] + 1.0);
+        png[i] = (uint8_t)(v <= 0 ? 0 : v >= 1 ? 255 : lround(v * 255.0));
+    }
+    snprintf(path, sizeof path, "%s/%s-lightmap-%u-dir.png", dir, stem, a);
+    st = lmb_image_write_u8(path, w, h, 3, png, err);
+    free(png);
+    return st;
+}

@@ -2,7 +2,8 @@
  * Writing one atlas's lightmap: <stem>-lightmap-N.exr (linear irradiance, half float or 32-bit
  * when beyond half's range), .hdr (the glTF references it), .png (tonemapped preview: the
  * 95th percentile of valid texels' luminance at 0.8, Reinhard, sRGB) and, with output.formats
- * mask, -mask.png (255 valid, 128 inside geometry, 0 padding).
+ * mask, -mask.png (255 valid, 128 inside geometry, 0 padding); with output.directional,
+ * -dir.exr and -dir.png.
  */
 #ifndef LMBAKE_ATLAS_IMAGES_H
 #define LMBAKE_ATLAS_IMAGES_H
@@ -13,5 +14,12 @@
 lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
                                   const float *rgb, const uint8_t *valid, uint32_t width, uint32_t height,
                                   lmb_error *err);
+
+/* The directional atlas (output.directional; README "Directional lightmaps"): d holds the
+ * light's mean direction D per texel (3 floats, world space, |D| <= 1).
+ * <stem>-lightmap-N-dir.exr holds D as floats, <stem>-lightmap-N-dir.png (the glTF references
+ * it) (D + 1) / 2 in 8 bits, linear. */
+lmb_status lmb_write_direction_images(const char *dir, const char *stem, uint32_t atlas, const float *d, uint32_t width,
+                                      uint32_t height, lmb_error *err);
 
 #endif

@@ -102,7 +102,8 @@ int gather_accessor(writer &w, int index, const uint32_t *source, uint32_t count
     return (int)w.m.accessors.size() - 1;
 }
 
-int lightmapped_material(tinygltf::Model &m, int material, int texture, std::map<std::pair<int, int>, int> &cache)
+int lightmapped_material(tinygltf::Model &m, int material, int texture, int direction_texture,
+                         std::map<std::pair<int, int>, int> &cache)
 {
     auto key = std::make_pair(material, texture);
     auto it = cache.find(key);
@@ -117,6 +118,16 @@ int lightmapped_material(tinygltf::Model &m, int material, int texture, std::map
     ext["texCoord"] = Value(1);
     ext["intensity"] = Value(1.0);
     mat.extensions["MOZ_lightmap"] = Value(ext);
+    if (direction_texture >= 0) {
+        Value::Object extras = mat.extras.IsObject() ? mat.extras.Get<Value::Object>() : Value::Object();
+        Value::Object dir;
+        dir["index"] = Value(direction_texture);
+        dir["texCoord"] = Value(1);
+        dir["encoding"] = Value(std::string("rgb = (D + 1) / 2, linear; D = the light's mean direction, world space, |D| <= 1"));
+        dir["decode"] = Value(std::string("E(n') = E * max(0, 1 + 1.5 dot(D, n')) / (1 + 1.5 dot(D, n)); E: MOZ_lightmap, n: the vertex normal"));
+        extras["lightmap_directional"] = Value(dir);
+        mat.extras = Value(extras);
+    }
     m.materials.push_back(mat);
     int index = (int)m.materials.size() - 1;
     cache[key] = index;
@@ -219,8 +230,26 @@ extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *
     }
 }
 
+extern "C" int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char *png_uri, lmb_error *err)
+{
+    try {
+        tinygltf::Model &m = doc->model;
+        tinygltf::Image png;
+        png.uri = png_uri;
+        png.mimeType = "image/png";
+        m.images.push_back(png);
+        tinygltf::Texture t;
+        t.source = (int)m.images.size() - 1;
+        m.textures.push_back(t);
+        return (int32_t)m.textures.size() - 1;
+    } catch (const std::exception &e) {
+        lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: %s", e.what());
+        return -1;
+    }
+}
+
 extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
-                                             uint32_t count, int32_t texture, lmb_error *err)
+                                             uint32_t count, int32_t texture, int32_t direction_texture, lmb_error *err)
 {
     try {
         tinygltf::Model &m = doc->model;
@@ -233,7 +262,7 @@ extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, c
         for (uint32_t k = 0; k < count; k++) {
             const lmb_gltf_prim_out &p = prims[k];
             tinygltf::Primitive q = rebuild(w, mesh.primitives[p.gltf_primitive], p);
-            q.material = lightmapped_material(m, q.material, texture, doc->lightmap_materials);
+            q.material = lightmapped_material(m, q.material, texture, direction_texture, doc->lightmap_materials);
             mesh.primitives[p.gltf_primitive] = q;
         }
         m.meshes.push_back(mesh);

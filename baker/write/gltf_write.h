@@ -31,10 +31,15 @@ typedef struct lmb_gltf_prim_out {
  * Returns its index, or -1 on failure. */
 int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *png_uri, const char *hdr_uri, lmb_error *err);
 
+/* Adds a texture for one atlas's directions (png_uri: the -dir.png). Returns its index, or -1. */
+int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char *png_uri, lmb_error *err);
+
 /* Gives node `node` a copy of its mesh with the primitives in prims replaced (others kept)
- * and lightmapped materials using `texture`. */
+ * and lightmapped materials using `texture`; with direction_texture >= 0 the materials name
+ * it in extras.lightmap_directional {index, texCoord: 1, encoding, decode} (README
+ * "Directional lightmaps"; the material's other extras are kept). */
 lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count,
-                                  int32_t texture, lmb_error *err);
+                                  int32_t texture, int32_t direction_texture, lmb_error *err);
 
 /* Names the irradiance cache's records file in asset.extras.lmbake.irradianceCacheRecords:
  * {"uri": uri, "count": count, "layout": "float32le x y z reach"} (write/records_file.h);

@@ -195,6 +195,12 @@ typedef enum lmb_ic_records_mode {
     LMB_IC_RECORDS_SHARED = 1    /* the first pass places them, later passes gather again at them */
 } lmb_ic_records_mode;
 
+/* Which sides of an emissive face emit (README "Which side of a face counts"). */
+typedef enum lmb_emission_sides {
+    LMB_EMIT_FRONT = 0,    /* the front only, whatever the material says (as Unity's default GI) */
+    LMB_EMIT_MATERIAL = 1  /* both sides where the material is doubleSided (as Cycles renders glTF) */
+} lmb_emission_sides;
+
 /* MASK: <stem>-lightmap-N-mask.png, per texel 255 = lit (valid), 128 = inside geometry, 0 = padding */
 enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8 };
 
@@ -253,6 +259,11 @@ typedef struct lmb_config {
     /* lights */
     double light_intensity_scale;  /* multiplies punctual lights */
     double emissive_scale;         /* multiplies emissive materials */
+    lmb_emission_sides emission_sides; /* front only, or as the material's doubleSided */
+    uint32_t directional_rays;     /* samples.directional: cosine rays per texel for the indirect light's direction */
+    int directional;               /* output.directional: directional lightmaps (lmb_direction.h) */
+    /* seams */
+    int seam_stitch;               /* least-squares seam stitching after the gather */
 } lmb_config;
 
 /* Fills cfg with the documented defaults (README: "Bake config"). */
@@ -332,6 +343,10 @@ typedef struct lmb_bake_stats {
     double texel_density;   /* the scene's density (auto: what the budget gave) */
     int density_auto;       /* texel_density: auto */
     uint32_t density_capped; /* auto: instances lowered to fit one atlas */
+    uint64_t rim_limited;   /* partly covered texels limited to their neighbours (post/rim.c) */
+    double rim_energy;      /* the direct light that removed, as a share of all direct light */
+    uint64_t seam_edges;    /* seam edges stitched */
+    double seam_jump_before, seam_jump_after; /* largest relative luminance jump across them */
     char gltf_path[8600];   /* the output glTF */
 } lmb_bake_stats;
 

@@ -106,8 +106,8 @@ export function readExr(file) {
 
 export function readImage(file) { return file.toLowerCase().endsWith('.exr') ? readExr(file) : readHdr(file); }
 
-// TEXCOORD_1 triangles ([u0,v0,u1,v1,u2,v2] per triangle, with world-free positions for the
-// chart-border weld) of every primitive whose material's MOZ_lightmap texture has the .hdr
+// TEXCOORD_1 triangles ([u0,v0,u1,v1,u2,v2] per triangle, with object-space positions for the
+// chart-border weld and the node's translation) of every primitive whose material's MOZ_lightmap texture has the .hdr
 // image `hdrName` (basename). Float or normalized unsigned accessors.
 export function lightmapTriangles(gltfFile, hdrName) {
   const g = JSON.parse(fs.readFileSync(gltfFile, 'utf8')), dir = path.dirname(gltfFile);
@@ -137,7 +137,7 @@ export function lightmapTriangles(gltfFile, hdrName) {
       const ind = prim.indices !== undefined ? read(prim.indices) : uv.map((_, i) => i).slice(0, uv.length / 2);
       for (let t = 0; t < ind.length; t += 3) {
         const v = [ind[t], ind[t + 1], ind[t + 2]];
-        tris.push({ node: node.name, uv: v.flatMap((i) => [uv[2 * i], uv[2 * i + 1]]), pos: v.flatMap((i) => [pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]]) });
+        tris.push({ node: node.name, translation: node.translation || [0, 0, 0], uv: v.flatMap((i) => [uv[2 * i], uv[2 * i + 1]]), pos: v.flatMap((i) => [pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]]) });
       }
     }
   }

@@ -56,6 +56,7 @@ static void test_defaults(void)
     CHECK(!strcmp(c.extras_key, "lightmap"));
     CHECK_NEAR(c.light_intensity_scale, 1.0, 0);
     CHECK_NEAR(c.emissive_scale, 1.0, 0);
+    CHECK(c.emission_sides == LMB_EMIT_FRONT);
 }
 
 /* Every key set away from its default, in block and flow style. */
@@ -84,7 +85,7 @@ static void test_full(void)
                        "  include: [\"Room*\", \"Prop?\"]\n"
                        "  exclude: Sky\n"
                        "  extras_key: bake\n"
-                       "lights: {intensity_scale: 0.5, emissive_scale: 2}\n";
+                       "lights: {intensity_scale: 0.5, emissive_scale: 2, emission_sides: material}\n";
     lmb_config c;
     lmb_error err;
     CHECK_INT(parse(text, &c, &err), LMB_OK);
@@ -115,6 +116,7 @@ static void test_full(void)
     CHECK(!strcmp(c.extras_key, "bake"));
     CHECK_NEAR(c.light_intensity_scale, 0.5, 0);
     CHECK_NEAR(c.emissive_scale, 2, 0);
+    CHECK(c.emission_sides == LMB_EMIT_MATERIAL);
 }
 
 /* Keys not named keep what cfg held; values at the edges of their ranges are accepted. */
@@ -228,6 +230,7 @@ static void test_value_errors(void)
     expect_error("gather:\n  defensive: 1\n", "level.yaml:2: ",
                  "key 'gather.defensive': expected a number >= 0 and < 1, got '1'");
     expect_error("lights:\n  emissive_scale: -0.5\n", "level.yaml:2: ", "key 'lights.emissive_scale'");
+    expect_error("lights:\n  emission_sides: both\n", "level.yaml:2: ", "one of front, material");
     expect_error("\n\ngather:\n  method: fancy\n", "level.yaml:4: ",
                  "key 'gather.method': expected one of cosine, amis, amis_defensive, got 'fancy'");
     expect_error("atlas:\n  keep_uv1: maybe\n", "level.yaml:2: ",

@@ -1,0 +1,425 @@
+/* Least-squares seam stitching (see seams.h). */
+#include "seams.h"
+
+#include "post/dilate.h"
+#include "texels/texels.h"
+#include "util/clock.h"
+
+#include <cholmod.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* One triangle edge, found by a hash of its endpoints (snapped to 1/1000 texel, in order). */
+typedef struct edge_ref {
+    uint64_t hash;
+    uint32_t instance, triangle;
+    uint8_t corner;  /* the edge runs from corner `corner` to corner + 1 (mod 3) */
+    uint8_t swapped; /* corner + 1 holds the smaller endpoint */
+} edge_ref;
+
+/* One side of a seam: where the edge lies in the atlas, from the smaller endpoint. */
+typedef struct seam_side {
+    uint32_t atlas;
+    double uv[4];
+} seam_side;
+
+typedef struct solve_ctx {
+    const lmb_layout *l;
+    float *const *rgb;
+    const uint8_t *const *state;
+    int32_t **unknown;   /* per atlas, per texel: its unknown index or -1 */
+    uint32_t *atlas_of;  /* per unknown */
+    uint32_t *texel_of;  /* per unknown */
+    uint32_t count, cap;
+} solve_ctx;
+
+static void snapped_endpoint(const double *p, double snap, int64_t out[3])
+{
+    for (int r = 0; r < 3; r++)
+        out[r] = (int64_t)llround(p[r] / snap);
+}
+
+static int endpoint_less(const int64_t a[3], const int64_t b[3])
+{
+    for (int r = 0; r < 3; r++)
+        if (a[r] != b[r])
+            return a[r] < b[r];
+    return 0;
+}
+
+static uint64_t hash_key(const int64_t k[6])
+{
+    uint64_t h = 1469598103934665603ull;
+    for (int i = 0; i < 6; i++) {
+        h ^= (uint64_t)k[i];
+        h *= 1099511628211ull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* The snapped endpoints of an edge, smaller first; *swapped as in edge_ref. */
+static void edge_key(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, int corner, double snap,
+                     int64_t key[6], int *swapped)
+{
+    double q[9];
+    lmb_layout_world_triangle(s, l, instance, f, q);
+    int64_t a[3], b[3];
+    snapped_endpoint(q + 3 * corner, snap, a);
+    snapped_endpoint(q + 3 * ((corner + 1) % 3), snap, b);
+    *swapped = endpoint_less(b, a);
+    memcpy(key, *swapped ? b : a, sizeof a);
+    memcpy(key + 3, *swapped ? a : b, sizeof a);
+}
+
+static int edge_ref_order(const void *pa, const void *pb)
+{
+    const edge_ref *a = pa, *b = pb;
+    if (a->hash != b->hash)
+        return a->hash < b->hash ? -1 : 1;
+    if (a->instance != b->instance)
+        return a->instance < b->instance ? -1 : 1;
+    if (a->triangle != b->triangle)
+        return a->triangle < b->triangle ? -1 : 1;
+    return (int)a->corner - (int)b->corner;
+}
+
+/* The snapping grid: 1/1000 of the finest texel of any lightmapped instance. */
+static double snap_size(const lmb_layout *l)
+{
+    double d = 0;
+    for (uint32_t i = 0; i < l->instance_count; i++)
+        if (l->instances[i].lightmapped && l->instances[i].texel_density > d)
+            d = l->instances[i].texel_density;
+    return d > 0 ? 1e-3 / d : 1e-6;
+}
+
+static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double snap, edge_ref **out, size_t *count,
+                                lmb_error *err)
+{
+    size_t n = 0;
+    for (uint32_t i = 0; i < l->instance_count; i++)
+        if (l->instances[i].lightmapped)
+            n += 3 * (size_t)l->meshes[s->instances[i].mesh].soup.triangle_count;
+    edge_ref *e = malloc((n + 1) * sizeof *e);
+    if (!e)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu edges", n);
+    size_t m = 0;
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        if (!l->instances[i].lightmapped)
+            continue;
+        const lmb_mesh_soup *soup = &l->meshes[s->instances[i].mesh].soup;
+        for (uint32_t f = 0; f < soup->triangle_count; f++) {
+            if (soup->skip[f])
+                continue;
+            for (int c = 0; c < 3; c++) {
+                int64_t key[6];
+                int swapped;
+                edge_key(s, l, i, f, c, snap, key, &swapped);
+                e[m++] = (edge_ref){hash_key(key), i, f, (uint8_t)c, (uint8_t)swapped};
+            }
+        }
+    }
+    qsort(e, m, sizeof *e, edge_ref_order);
+    *out = e;
+    *count = m;
+    return LMB_OK;
+}
+
+/* Unit shading normal at corner c of a triangle (the face normal when it is shaded flat). */
+static void corner_normal(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, int c, double n[3])
+{
+    double cn[9], q[9];
+    if (lmb_triangle_corner_normals(s, l, instance, f, cn)) {
+        memcpy(n, cn + 3 * c, 3 * sizeof *n);
+    } else {
+        lmb_layout_world_triangle(s, l, instance, f, q);
+        double e1[3] = {q[3] - q[0], q[4] - q[1], q[5] - q[2]}, e2[3] = {q[6] - q[0], q[7] - q[1], q[8] - q[2]};
+        double sg = s->instances[instance].flips_winding ? -1 : 1;
+        n[0] = sg * (e1[1] * e2[2] - e1[2] * e2[1]);
+        n[1] = sg * (e1[2] * e2[0] - e1[0] * e2[2]);
+        n[2] = sg * (e1[0] * e2[1] - e1[1] * e2[0]);
+    }
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int r = 0; r < 3; r++)
+        n[r] = len > 0 ? n[r] / len : 0;
+}
+
+/* The side of edge e in the atlas, endpoints in key order (smaller first). */
+static void side_of(const lmb_layout *l, const edge_ref *e, seam_side *side)
+{
+    const lmb_layout_instance *li = &l->instances[e->instance];
+    const double *uv = li->uv1 + 6 * (size_t)e->triangle;
+    int a = e->corner, b = (e->corner + 1) % 3;
+    if (e->swapped) {
+        int t = a;
+        a = b;
+        b = t;
+    }
+    side->atlas = li->atlas;
+    side->uv[0] = uv[2 * a];
+    side->uv[1] = uv[2 * a + 1];
+    side->uv[2] = uv[2 * b];
+    side->uv[3] = uv[2 * b + 1];
+}
+
+/* Is the pair (x, y) of equal snapped edges a seam? Smooth across (shading normals within
+ * about 8 degrees at both ends) and cut in the atlas. */
+static int is_seam(const lmb_scene *s, const lmb_layout *l, const edge_ref *x, const edge_ref *y, seam_side sides[2])
+{
+    side_of(l, x, &sides[0]);
+    side_of(l, y, &sides[1]);
+    if (sides[0].atlas == sides[1].atlas) {
+        double d = 0;
+        for (int k = 0; k < 4; k++)
+            d = fmax(d, fabs(sides[0].uv[k] - sides[1].uv[k]));
+        if (d < 1e-6)
+            return 0; /* one chart: the same texels on both sides */
+    }
+    for (int end = 0; end < 2; end++) {
+        int cx = (x->corner + ((end ^ x->swapped) ? 1 : 0)) % 3, cy = (y->corner + ((end ^ y->swapped) ? 1 : 0)) % 3;
+        double nx[3], ny[3];
+        corner_normal(s, l, x->instance, x->triangle, cx, nx);
+        corner_normal(s, l, y->instance, y->triangle, cy, ny);
+        if (nx[0] * ny[0] + nx[1] * ny[1] + nx[2] * ny[2] < 0.99)
+            return 0;
+    }
+    return 1;
+}
+
+/* The 4 bilinear taps at atlas texel coordinates (x, y), clamped as the cache's lookup. */
+static void bilinear_taps(double x, double y, uint32_t w, uint32_t h, uint32_t idx[4], double wt[4])
+{
+    x -= 0.5;
+    y -= 0.5;
+    double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
+    long x0 = (long)fx, y0 = (long)fy;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            long xx = x0 + i, yy = y0 + j;
+            xx = xx < 0 ? 0 : xx >= (long)w ? (long)w - 1 : xx;
+            yy = yy < 0 ? 0 : yy >= (long)h ? (long)h - 1 : yy;
+            idx[2 * j + i] = (uint32_t)((size_t)yy * w + (size_t)xx);
+            wt[2 * j + i] = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
+        }
+}
+
+/* Unknown index of a texel, made on first use. -1: out of memory. */
+static int64_t unknown_of(solve_ctx *c, uint32_t atlas, uint32_t texel)
+{
+    int32_t *u = &c->unknown[atlas][texel];
+    if (*u >= 0)
+        return *u;
+    if (c->count == c->cap) {
+        uint32_t cap = c->cap ? 2 * c->cap : 1024;
+        uint32_t *a = realloc(c->atlas_of, (size_t)cap * sizeof *a);
+        if (a)
+            c->atlas_of = a;
+        uint32_t *t = realloc(c->texel_of, (size_t)cap * sizeof *t);
+        if (t)
+            c->texel_of = t;
+        if (!a || !t)
+            return -1;
+        c->cap = cap;
+    }
+    c->atlas_of[c->count] = atlas;
+    c->texel_of[c->count] = texel;
+    *u = (int32_t)c->count;
+    return c->count++;
+}
+
+/* Points along a seam: four per texel of its longer side (two left the bilinear lookups
+ * between them up to 0.5% apart on a sphere), at least two. */
+static uint32_t seam_points(const seam_side sides[2])
+{
+    double len = 0;
+    for (int k = 0; k < 2; k++)
+        len = fmax(len, hypot(sides[k].uv[2] - sides[k].uv[0], sides[k].uv[3] - sides[k].uv[1]));
+    double n = ceil(4 * len);
+    return n < 2 ? 2 : n > 4096 ? 4096 : (uint32_t)n;
+}
+
+/* One seam point: 8 taps (4 per side; side B's weights negated), as unknowns. */
+typedef struct seam_row {
+    uint32_t atlas[8], texel[8];
+    double w[8];
+} seam_row;
+
+static void row_at(const lmb_layout *l, const seam_side sides[2], double t, seam_row *r)
+{
+    for (int k = 0; k < 2; k++) {
+        const seam_side *sd = &sides[k];
+        double x = sd->uv[0] + t * (sd->uv[2] - sd->uv[0]), y = sd->uv[1] + t * (sd->uv[3] - sd->uv[1]);
+        uint32_t idx[4];
+        double wt[4];
+        bilinear_taps(x, y, l->width[sd->atlas], l->height[sd->atlas], idx, wt);
+        for (int j = 0; j < 4; j++) {
+            r->atlas[4 * k + j] = sd->atlas;
+            r->texel[4 * k + j] = idx[j];
+            r->w[4 * k + j] = k ? -wt[j] : wt[j];
+        }
+    }
+}
+
+static double luminance(const double c[3])
+{
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
+
+/* |lum A - lum B| / their mean at a seam point, from the atlases as they are. */
+static double jump_at(float *const *rgb, const seam_row *r)
+{
+    double side[2][3] = {{0, 0, 0}, {0, 0, 0}};
+    for (int j = 0; j < 8; j++) {
+        const float *p = rgb[r->atlas[j]] + 3 * (size_t)r->texel[j];
+        for (int c = 0; c < 3; c++)
+            side[j / 4][c] += fabs(r->w[j]) * p[c];
+    }
+    double a = luminance(side[0]), b = luminance(side[1]), m = 0.5 * (a + b);
+    return m > 0 ? fabs(a - b) / m : 0;
+}
+
+/* Every seam point, in a deterministic order (the sorted edges). rows may be NULL to count. */
+static size_t seam_rows(const lmb_scene *s, const lmb_layout *l, double snap, const edge_ref *e, size_t ne,
+                        seam_row *rows, uint64_t *edges)
+{
+    size_t m = 0;
+    *edges = 0;
+    for (size_t i = 0; i < ne;) {
+        size_t j = i + 1;
+        while (j < ne && e[j].hash == e[i].hash)
+            j++;
+        if (j - i == 2) { /* two triangles share it: check it really is one edge (not a hash collision) */
+            int64_t ka[6], kb[6];
+            int sa, sb;
+            seam_side sides[2];
+            edge_key(s, l, e[i].instance, e[i].triangle, e[i].corner, snap, ka, &sa);
+            edge_key(s, l, e[i + 1].instance, e[i + 1].triangle, e[i + 1].corner, snap, kb, &sb);
+            if (!memcmp(ka, kb, sizeof ka) && is_seam(s, l, &e[i], &e[i + 1], sides)) {
+                uint32_t n = seam_points(sides);
+                for (uint32_t k = 0; k < n; k++, m++)
+                    if (rows)
+                        row_at(l, sides, (k + 0.5) / n, &rows[m]);
+                (*edges)++;
+            }
+        }
+        i = j;
+    }
+    return m;
+}
+
+/* The normal equations (upper triangle) and their solution, written back into the atlases. */
+static lmb_status solve(solve_ctx *c, const seam_row *rows, size_t nr, lmb_error *err)
+{
+    for (size_t r = 0; r < nr; r++)
+        for (int j = 0; j < 8; j++)
+            if (unknown_of(c, rows[r].atlas[j], rows[r].texel[j]) < 0)
+                return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for the unknowns");
+    size_t n = c->count;
+    cholmod_common cm;
+    cholmod_start(&cm);
+    cm.print = 0;
+    cm.supernodal = CHOLMOD_SIMPLICIAL; /* deterministic, no threaded BLAS */
+    cm.nmethods = 1;
+    cm.method[0].ordering = CHOLMOD_AMD;
+    /* at most 8 x 8 pairs per row (its taps may repeat a texel), and the diagonal */
+    cholmod_triplet *T = cholmod_allocate_triplet(n, n, nr * 64 + n, 1, CHOLMOD_REAL, &cm);
+    cholmod_dense *b = cholmod_zeros(n, 3, CHOLMOD_REAL, &cm);
+    cholmod_sparse *A = NULL;
+    cholmod_factor *L = NULL;
+    cholmod_dense *x = NULL;
+    lmb_status st = LMB_OK;
+    if (T && b) {
+        int *ti = T->i, *tj = T->j;
+        double *tx = T->x, *bx = b->x;
+        for (size_t u = 0; u < n; u++) {
+            uint32_t a = c->atlas_of[u], t = c->texel_of[u];
+            double d = c->state[a][t] == LMB_TEXEL_VALID ? 1.0 : LMB_SEAM_FREE;
+            ti[T->nnz] = tj[T->nnz] = (int)u;
+            tx[T->nnz++] = d;
+            for (int k = 0; k < 3; k++)
+                bx[u + k * n] = d * c->rgb[a][3 * (size_t)t + k];
+        }
+        for (size_t r = 0; r < nr; r++)
+            for (int p = 0; p < 8; p++)
+                for (int q = 0; q < 8; q++) {
+                    int up = c->unknown[rows[r].atlas[p]][rows[r].texel[p]];
+                    int uq = c->unknown[rows[r].atlas[q]][rows[r].texel[q]];
+                    if (up > uq)
+                        continue;
+                    ti[T->nnz] = up;
+                    tj[T->nnz] = uq;
+                    tx[T->nnz++] = LMB_SEAM_WEIGHT * rows[r].w[p] * rows[r].w[q];
+                }
+        A = cholmod_triplet_to_sparse(T, T->nnz, &cm);
+    }
+    if (A)
+        L = cholmod_analyze(A, &cm);
+    if (L && cholmod_factorize(A, L, &cm) && cm.status == CHOLMOD_OK)
+        x = cholmod_solve(CHOLMOD_A, L, b, &cm);
+    if (x) {
+        const double *xv = x->x;
+        for (size_t u = 0; u < n; u++)
+            for (int k = 0; k < 3; k++) {
+                double v = xv[u + k * n];
+                c->rgb[c->atlas_of[u]][3 * (size_t)c->texel_of[u] + k] = (float)(isfinite(v) && v > 0 ? v : 0);
+            }
+    } else {
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: the stitching solve failed (CHOLMOD status %d, %zu unknowns)",
+                           cm.status, n);
+    }
+    cholmod_free_dense(&x, &cm);
+    cholmod_free_factor(&L, &cm);
+    cholmod_free_sparse(&A, &cm);
+    cholmod_free_dense(&b, &cm);
+    cholmod_free_triplet(&T, &cm);
+    cholmod_finish(&cm);
+    return st;
+}
+
+lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, float *const *rgb, const uint8_t *const *state,
+                            lmb_seam_report *report, lmb_error *err)
+{
+    double t0 = lmb_seconds();
+    memset(report, 0, sizeof *report);
+    double snap = snap_size(l);
+    edge_ref *e = NULL;
+    size_t ne = 0;
+    lmb_status st = collect_edges(s, l, snap, &e, &ne, err);
+    if (st != LMB_OK)
+        return st;
+    size_t nr = seam_rows(s, l, snap, e, ne, NULL, &report->edges);
+    seam_row *rows = nr ? malloc(nr * sizeof *rows) : NULL;
+    solve_ctx c = {l, rgb, state, calloc((size_t)l->atlas_count + 1, sizeof *c.unknown), NULL, NULL, 0, 0};
+    if ((nr && !rows) || !c.unknown)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu seam points", nr);
+    for (uint32_t a = 0; st == LMB_OK && nr && a < l->atlas_count; a++) {
+        size_t texels = (size_t)l->width[a] * l->height[a];
+        c.unknown[a] = malloc((texels + 1) * sizeof *c.unknown[a]);
+        if (!c.unknown[a])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for atlas %u", a);
+        else
+            memset(c.unknown[a], 0xff, texels * sizeof *c.unknown[a]);
+    }
+    if (st == LMB_OK && nr) {
+        seam_rows(s, l, snap, e, ne, rows, &report->edges);
+        for (size_t r = 0; r < nr; r++)
+            report->jump_before = fmax(report->jump_before, jump_at(rgb, &rows[r]));
+        st = solve(&c, rows, nr, err);
+        for (size_t r = 0; st == LMB_OK && r < nr; r++)
+            report->jump_after = fmax(report->jump_after, jump_at(rgb, &rows[r]));
+        report->samples = nr;
+        report->texels = c.count;
+    }
+    for (uint32_t a = 0; c.unknown && a < l->atlas_count; a++)
+        free(c.unknown[a]);
+    free(c.unknown);
+    free(c.atlas_of);
+    free(c.texel_of);
+    free(rows);
+    free(e);
+    report->seconds = lmb_seconds() - t0;
+    return st;
+}
