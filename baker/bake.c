@@ -16,6 +16,7 @@
 #include "load/textures.h"
 #include "pack/layout.h"
 #include "post/dilate.h"
+#include "post/fireflies.h"
 #include "seams/seams.h"
 #include "texels/texels.h"
 #include "write/gltf_write.h"
@@ -225,6 +226,28 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
                  "are black", s->path);
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, &records, log, err);
+    if (st == LMB_OK && cfg->firefly_spread && !cfg->reference) {
+        lmb_firefly_stats fs = {0, 0, 0};
+        for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
+            uint64_t before = fs.texels, last = ~0ull;
+            /* a spike shared with its neighbours may leave them above the bound: again, a few times */
+            for (int pass = 0; pass < LMB_FIREFLY_PASSES && st == LMB_OK && fs.texels != last; pass++) {
+                last = fs.texels;
+                double total = fs.total;
+                st = lmb_fireflies_spread(cache.irradiance[a], cache.state[a], l.width[a], l.height[a], &fs, err);
+                if (pass)
+                    fs.total = total; /* the atlas's light counts once */
+            }
+            if (st == LMB_OK && fs.texels > before) /* padding follows the texels it was dilated from */
+                st = lmb_dilate(cache.irradiance[a], cache.state[a], l.width[a], l.height[a], err);
+        }
+        stats->firefly_texels = fs.texels;
+        stats->firefly_moved = fs.total > 0 ? fs.moved / fs.total : 0;
+        if (st == LMB_OK && fs.texels)
+            lmb_info(log, "fireflies: %llu texels above %gx the median around them; %.4f%% of the light moved to their "
+                     "neighbours (none removed)", (unsigned long long)fs.texels, LMB_FIREFLY_FACTOR,
+                     100 * stats->firefly_moved);
+    }
     if (st == LMB_OK && cfg->seam_stitch) {
         lmb_seam_report sr;
         st = lmb_seams_stitch(s, &l, cache.irradiance, (const uint8_t *const *)cache.state, &sr, err);

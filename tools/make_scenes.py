@@ -395,6 +395,38 @@ def indirect(out):
     s.write(os.path.join(out, "gap.gltf"))
 
 
+def turn_minus_z_to(d):
+    """The rotation quaternion (x, y, z, w) turning -Z (a light's direction) into unit vector d."""
+    axis = (d[1], -d[0], 0.0)  # (0, 0, -1) x d
+    ln = math.sqrt(sum(x * x for x in axis))
+    th = math.acos(max(-1.0, min(1.0, -d[2])))
+    return [axis[0] / ln * math.sin(th / 2), axis[1] / ln * math.sin(th / 2), 0.0, math.cos(th / 2)]
+
+
+# The directional lightmap test's sun: 50 degrees from the zenith, travelling toward +x and +z
+DIR_SUN = (math.sin(math.radians(50)) * math.cos(math.radians(20)), -math.cos(math.radians(50)),
+           math.sin(math.radians(50)) * math.sin(math.radians(20)))
+DIR_SUN_LUX = 1000.0
+
+
+def bump_normals(size):
+    """A tangent-space normal map (8-bit RGB rows) of one round bump per tile: slope
+    0.94 sin(2 pi r / 0.8) (up to 43 degrees) at distance r < 0.4 from the tile's centre."""
+    rows = []
+    for j in range(size):
+        row = []
+        for i in range(size):
+            x, y = (i + 0.5) / size - 0.5, (j + 0.5) / size - 0.5
+            r = math.hypot(x, y)
+            g = -0.94 * math.sin(2 * math.pi * r / 0.8) if r < 0.4 else 0.0
+            gx, gy = (g * x / r, g * y / r) if r > 0 else (0.0, 0.0)
+            n = (-gx, gy, 1.0)
+            ln = math.sqrt(sum(c * c for c in n))
+            row.append(tuple(int(round((c / ln * 0.5 + 0.5) * 255)) for c in n))
+        rows.append(row)
+    return rows
+
+
 def uv_sphere(r, rings=12, segments=24):
     """Positions, normals, indices of a latitude-longitude sphere (counter-clockwise outside)."""
     pos, nrm, idx = [], [], []
@@ -457,6 +489,22 @@ def artists(out):
     s.mesh("outside_panel", quad((3, 0.5, -0.5), (3, 0.5, 0.5), (3, 1.5, 0.5), (3, 1.5, -0.5)),  # faces -x, both sides
            s.material("panel", (0.8, 0.8, 0.8), emissive=(1, 1, 1), strength=20.0, double_sided=True))
     s.write(os.path.join(out, "sealed-room-double.gltf"))
+
+    # directional lightmaps: a plane lit from one side by a sun
+    s = Scene()
+    s.mesh("plane", plane(4), s.material("grey", (0.5, 0.5, 0.5)))
+    s.light("sun", "directional", DIR_SUN_LUX, rotation=turn_minus_z_to(DIR_SUN))
+    s.write(os.path.join(out, "dir-plane.gltf"))
+
+    # the same plane with a normal map of round bumps (the preview's directional view); the sun
+    # low, 70 degrees from the zenith, so the bumps' sides facing it and away differ a lot
+    s = Scene()
+    grey = s.material("bumpy", (0.6, 0.6, 0.6))
+    s.doc["materials"][grey]["normalTexture"] = {"index": s.texture_pixels(bump_normals(64), {"wrapS": 10497, "wrapT": 10497})}
+    s.mesh("plane", plane(4), grey, uv_sets=[lambda p: ((p[0] + 2) * 1.5, (p[2] + 2) * 1.5)])
+    low = (math.sin(math.radians(70)), -math.cos(math.radians(70)), 0.0)
+    s.light("sun", "directional", DIR_SUN_LUX, rotation=turn_minus_z_to(low))
+    s.write(os.path.join(out, "dir-bumps.gltf"))
 
     # seams: a UV sphere and a smooth-normal cube (its faces are separate charts) in a dim
     # emissive room, a lamp above and to the side: light that varies smoothly over both

@@ -91,6 +91,7 @@ static const key_spec config_keys[] = {
     FLOAT("lights.emissive_scale", OFF(emissive_scale), 0, 1e9, 0),
     ENUM("lights.emission_sides", OFF(emission_sides), emission_sides),
     BOOL("seams.stitch", OFF(seam_stitch)),
+    BOOL("fireflies.spread", OFF(firefly_spread)),
 };
 
 /* One density_overrides entry, filled into an lmb_density_override. */
@@ -138,6 +139,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->emissive_scale = 1.0;
     cfg->emission_sides = LMB_EMIT_FRONT; /* README "Which side of a face counts" */
     cfg->seam_stitch = 1;
+    cfg->firefly_spread = 1;
     cfg->directional = 0;
     cfg->directional_rays = 32;
 }

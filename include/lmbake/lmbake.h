@@ -262,6 +262,7 @@ typedef struct lmb_config {
     lmb_emission_sides emission_sides; /* front only, or as the material's doubleSided */
     uint32_t directional_rays;     /* samples.directional: cosine rays per texel for the indirect light's direction */
     int directional;               /* output.directional: directional lightmaps (lmb_direction.h) */
+    int firefly_spread;            /* fireflies.spread: outlier texels' excess moved to their neighbours */
     /* seams */
     int seam_stitch;               /* least-squares seam stitching after the gather */
 } lmb_config;
@@ -345,6 +346,8 @@ typedef struct lmb_bake_stats {
     uint32_t density_capped; /* auto: instances lowered to fit one atlas */
     uint64_t rim_limited;   /* partly covered texels limited to their neighbours (post/rim.c) */
     double rim_energy;      /* the direct light that removed, as a share of all direct light */
+    uint64_t firefly_texels; /* fireflies spread to their neighbours (post/fireflies.c) */
+    double firefly_moved;   /* the light that moved, as a share of all light */
     uint64_t seam_edges;    /* seam edges stitched */
     double seam_jump_before, seam_jump_after; /* largest relative luminance jump across them */
     char gltf_path[8600];   /* the output glTF */

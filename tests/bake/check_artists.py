@@ -17,7 +17,13 @@ usage: check_artists.py LMBAKE WORKDIR CASE
                        seams, sampled bilinearly from both sides at 8 points along every edge
                        that two triangles share with different lightmap UVs, falls at least 10x
                        against seams.stitch: false and is under 1% of the local value
+  directional          output.directional: on a plane lit from one side by a sun, every texel's
+                       direction (the -dir.exr) points at the sun within 2 degrees, and the decode
+                       from the -dir.png the glTF names, at the surface normal, gives back the
+                       analytic E within 1%; in a furnace (uniform light over each hemisphere)
+                       the mean D.n is 2/3 within 0.02; byte-identical at 1 and 2 threads
 """
+import json
 import math
 import os
 import subprocess
@@ -144,6 +150,73 @@ def seams(lmbake, work):
     return ok
 
 
+def read_image(path):
+    import OpenImageIO as oiio
+    inp = oiio.ImageInput.open(path)
+    img = inp.read_image("float")
+    inp.close()
+    return img
+
+
+def directional_texture(out):
+    """(-dir.exr, -dir.png as D) of atlas 0, found through the glTF's extras.lightmap_directional."""
+    name = [f for f in os.listdir(out) if f.endswith(".gltf")][0]
+    doc = json.load(open(os.path.join(out, name)))
+    refs = {m["extras"]["lightmap_directional"]["index"] for m in doc["materials"]
+            if "lightmap_directional" in m.get("extras", {})}
+    uri = doc["images"][doc["textures"][sorted(refs)[0]]["source"]]["uri"]
+    png = read_image(os.path.join(out, uri))[..., :3] * 2.0 - 1.0  # 8-bit (D + 1) / 2, read as [0, 1]
+    return read_image(os.path.join(out, uri[:-4] + ".exr"))[..., :3], png
+
+
+def decode(e, d, n, m):
+    """The documented decode: E(m) = E max(0, 1 + 1.5 D.m) / (1 + 1.5 D.n)."""
+    return e * max(0.0, 1 + 1.5 * float(np.dot(d, m))) / (1 + 1.5 * float(np.dot(d, n)))
+
+
+def directional(lmbake, work):
+    cfg = "texel_density: 8\noutput:\n  directional: true\n"
+    charts, images = bake(lmbake, work, "dir-plane", "dir-plane", "", cfg)
+    exr, png = directional_texture(os.path.join(work, "out-dir-plane"))
+    to_sun = -np.array(make_scenes.DIR_SUN)
+    e_sun = make_scenes.DIR_SUN_LUX * float(to_sun[1])
+    worst_angle, worst_e, n = 0.0, 0.0, 0
+    up = np.array([0.0, 1.0, 0.0])
+    for node, v, pts, x, y, tex in ca.texels(charts, images):
+        d = exr[y, x]
+        cosang = float(np.dot(d, to_sun) / max(np.linalg.norm(d), 1e-30))
+        worst_angle = max(worst_angle, math.degrees(math.acos(min(1.0, cosang))))
+        worst_e = max(worst_e, abs(decode(lum(v), png[y, x], up, up) / e_sun - 1))
+        n += 1
+    ok = n > 500 and worst_angle <= 2.0 and worst_e <= 0.01
+    print("directional, plane under a sun: %d texels; largest angle between D and the sun %.4f deg (bound 2); "
+          "decode at the normal vs analytic E: largest error %.4f%% (bound 1%%)" % (n, worst_angle, 100 * worst_e))
+    charts, images = bake(lmbake, work, "furnace", "dir-furnace", "", cfg)
+    exr, _ = directional_texture(os.path.join(work, "out-dir-furnace"))
+    dots = []
+    for node, v, pts, x, y, tex in ca.texels(charts, images):
+        c = np.mean(pts, axis=0)
+        normal = np.zeros(3)  # the furnace room: [-1, 1] x [0, 2] x [-1, 1], faces inward
+        for k, (lo, hi) in enumerate(((-1, 1), (0, 2), (-1, 1))):
+            normal[k] = 1 if abs(c[k] - lo) < 1e-4 else -1 if abs(c[k] - hi) < 1e-4 else 0
+        if np.abs(normal).sum() == 1:
+            dots.append(float(np.dot(exr[y, x], normal)))
+    mean = float(np.mean(dots))
+    good = len(dots) > 500 and abs(mean - 2 / 3) <= 0.02
+    print("directional, furnace: mean D.n %.4f over %d texels (2/3 within 0.02), per-texel spread %.4f: %s"
+          % (mean, len(dots), float(np.std(dots)), "ok" if good else "FAIL"))
+    ok &= good
+    out1 = os.path.join(work, "out-dir-furnace")
+    out2 = os.path.join(work, "out-dir-furnace-1thread")
+    cfgf = os.path.join(work, "dir-furnace.yaml")
+    subprocess.run([lmbake, "bake", os.path.join(work, "scenes", "furnace.gltf"), "-c", cfgf, "-o", out2, "-q",
+                    "--threads", "1"], check=True)
+    same = all(open(os.path.join(out1, f), "rb").read() == open(os.path.join(out2, f), "rb").read()
+               for f in ("furnace-lightmap-0-dir.exr", "furnace-lightmap-0.exr"))
+    print("directional, furnace at 1 and 2 threads: %s" % ("byte-identical" if same else "DIFFERENT"))
+    return ok and same
+
+
 def main():
     lmbake, work, case = sys.argv[1:4]
     os.makedirs(work, exist_ok=True)
@@ -154,6 +227,8 @@ def main():
         ok = rim(*bake(lmbake, work, "rim-double", case), case + " (emission: front)")
     elif case == "rim-double-material":
         ok = rim(*bake(lmbake, work, "rim-double", case, material), case)
+    elif case == "directional":
+        ok = directional(lmbake, work)
     elif case == "seams":
         ok = seams(lmbake, work)
     elif case == "sealed-double":

@@ -97,3 +97,40 @@ class LightmapPlugin {
     return tex;
   }
 }
+
+// Directional lightmaps (lmbake's output.directional; README "Directional lightmaps"): a
+// material's extras.lightmap_directional names a PNG holding (D + 1) / 2, D the light's mean
+// direction (world space). The lit view then shades with the material's normal map:
+//   E(n') = E max(0, 1 + 1.5 D.n') / (1 + 1.5 D.n)
+// n' the normal-mapped normal, n the interpolated vertex normal (three's nonPerturbedNormal),
+// both in view space as is D after the view matrix. Returns how many materials use one.
+export async function applyDirectionalLightmaps(gltf) {
+  const materials = new Set();
+  gltf.scene.traverse((o) => {
+    if (!o.isMesh) return;
+    for (const m of Array.isArray(o.material) ? o.material : [o.material]) if (m.userData && m.userData.lightmap_directional && m.lightMap) materials.add(m);
+  });
+  for (const m of materials) {
+    const ref = m.userData.lightmap_directional;
+    const tex = (await gltf.parser.getDependency('texture', ref.index)).clone();
+    tex.channel = ref.texCoord ?? 1;
+    tex.colorSpace = THREE.NoColorSpace; // data, not colour
+    tex.flipY = false;
+    tex.magFilter = THREE.LinearFilter;
+    tex.minFilter = THREE.LinearFilter; // no mipmaps: they would blur across charts
+    tex.generateMipmaps = false;
+    tex.needsUpdate = true;
+    m.onBeforeCompile = (shader) => {
+      shader.uniforms.lightDirectionMap = { value: tex };
+      shader.fragmentShader = 'uniform sampler2D lightDirectionMap;\n' + shader.fragmentShader.replace(
+        '#include <lights_fragment_maps>',
+        THREE.ShaderChunk.lights_fragment_maps.replace('vec3 lightMapIrradiance = lightMapTexel.rgb * lightMapIntensity;', `
+    vec3 lightMapIrradiance = lightMapTexel.rgb * lightMapIntensity;
+    vec3 lmDir = (viewMatrix * vec4(texture2D(lightDirectionMap, vLightMapUv).rgb * 2.0 - 1.0, 0.0)).xyz;
+    lightMapIrradiance *= max(0.0, 1.0 + 1.5 * dot(lmDir, normal)) / max(1e-3, 1.0 + 1.5 * dot(lmDir, nonPerturbedNormal));`));
+    };
+    m.customProgramCacheKey = () => 'lmbake-directional';
+    m.needsUpdate = true;
+  }
+  return materials.size;
+}

@@ -1,11 +1,12 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
 // the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
-// (mode, ev, tonemap, view|cam, atlas, layer, zoom, at, ui) and the page exposes hooks for
+// (mode, ev, tonemap, view|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
+// directional lightmaps) and the page exposes hooks for
 // tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { lightmapPlugin } from './lightmap-plugin.js';
+import { lightmapPlugin, applyDirectionalLightmaps } from './lightmap-plugin.js';
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
@@ -23,6 +24,7 @@ const state = {
   view: q.get('view') || 'front', cam: q.get('cam'), atlas: Number(q.get('atlas') ?? 0),
   layer: q.get('layer') || 'lightmap', zoom: q.get('zoom') ? Number(q.get('zoom')) : null,
   at: q.get('at') ? q.get('at').split(',').map(Number) : null, ui: q.get('ui') !== '0',
+  directional: q.get('directional') !== '0', // directional lightmaps in the lit view, when the bake has them
 };
 const info = (window.lmbInfo = { error: null });
 window.lmbReady = false;
@@ -55,6 +57,7 @@ const atlases = [];
 const loader = new GLTFLoader().register(lightmapPlugin(atlases));
 const gltf = await loader.loadAsync(sceneInfo.gltf);
 const root = gltf.scene;
+const directionalMaterials = state.directional ? await applyDirectionalLightmaps(gltf) : 0;
 const lights = [];
 root.traverse((o) => { if (o.isLight) lights.push(o); });
 for (const l of lights) l.removeFromParent(); // lit = lightmap only, no other lights
@@ -163,6 +166,7 @@ function updateInfo() {
     atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
     meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
     charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),
+    directionalMaterials,
     records: records ? { count: records.count, reachMin: records.reachMin, reachMax: records.reachMax, uri: records.uri } : { count: 0 },
     atlasView: { atlas: atlasView.atlas, layer: atlasView.layer, zoom: atlasView.zoom, originX: atlasView.originX, originY: atlasView.originY },
   });

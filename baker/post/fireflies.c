@@ -1,0 +1,94 @@
+/* Fireflies spread to their neighbours (see fireflies.h). */
+#include "fireflies.h"
+
+#include "dilate.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static float luminance(const float *c)
+{
+    return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+static int float_order(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median luminance of the valid texels of the 5 x 5 window around (x, y), itself left out;
+ * -1 when fewer than 8 are valid (too little to call anything an outlier). */
+static float window_median(const float *lum, const uint8_t *state, uint32_t w, uint32_t h, long x, long y)
+{
+    float v[24];
+    int n = 0;
+    for (long dy = -2; dy <= 2; dy++)
+        for (long dx = -2; dx <= 2; dx++) {
+            long xx = x + dx, yy = y + dy;
+            if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= (long)w || yy >= (long)h)
+                continue;
+            size_t j = (size_t)yy * w + (size_t)xx;
+            if (state[j] == LMB_TEXEL_VALID)
+                v[n++] = lum[j];
+        }
+    if (n < 8)
+        return -1;
+    qsort(v, (size_t)n, sizeof *v, float_order);
+    return n % 2 ? v[n / 2] : 0.5f * (v[n / 2 - 1] + v[n / 2]);
+}
+
+lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, uint32_t h, lmb_firefly_stats *stats,
+                                lmb_error *err)
+{
+    size_t n = (size_t)w * h;
+    float *lum = malloc((n + 1) * sizeof *lum), *before = malloc((3 * n + 1) * sizeof *before);
+    if (!lum || !before) {
+        free(lum);
+        free(before);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "fireflies: out of memory for a %ux%u atlas", w, h);
+    }
+    memcpy(before, rgb, 3 * n * sizeof *rgb);
+    for (size_t i = 0; i < n; i++) {
+        lum[i] = luminance(before + 3 * i);
+        if (state[i] == LMB_TEXEL_VALID)
+            stats->total += lum[i];
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (state[i] != LMB_TEXEL_VALID || !(lum[i] > 0))
+            continue;
+        long x = (long)(i % w), y = (long)(i / w);
+        float median = window_median(lum, state, w, h, x, y);
+        if (median < 0 || lum[i] <= LMB_FIREFLY_FACTOR * median)
+            continue;
+        size_t nb[8];
+        int m = 0;
+        float brightest = 0;
+        for (long dy = -1; dy <= 1; dy++)
+            for (long dx = -1; dx <= 1; dx++) {
+                long xx = x + dx, yy = y + dy;
+                if ((dx || dy) && xx >= 0 && yy >= 0 && xx < (long)w && yy < (long)h &&
+                    state[(size_t)yy * w + (size_t)xx] == LMB_TEXEL_VALID) {
+                    nb[m] = (size_t)yy * w + (size_t)xx;
+                    brightest = lum[nb[m]] > brightest ? lum[nb[m]] : brightest;
+                    m++;
+                }
+            }
+        /* a lone spike: a line of light one texel wide (light through a slit) has neighbours as
+         * bright along it, a lit area beside a shadow has lit neighbours: neither is touched */
+        if (!m || lum[i] <= LMB_FIREFLY_LONE * brightest)
+            continue;
+        float keep = (float)(LMB_FIREFLY_FACTOR * median / lum[i]);
+        for (int c = 0; c < 3; c++) {
+            float moved = before[3 * i + c] * (1.0f - keep);
+            rgb[3 * i + c] -= moved;
+            for (int k = 0; k < m; k++)
+                rgb[3 * nb[k] + c] += moved / (float)m;
+        }
+        stats->texels++;
+        stats->moved += lum[i] * (1.0 - keep);
+    }
+    free(lum);
+    free(before);
+    return LMB_OK;
+}
