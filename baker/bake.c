@@ -250,14 +250,16 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     }
     if (st == LMB_OK && cfg->seam_stitch) {
         lmb_seam_report sr;
-        st = lmb_seams_stitch(s, &l, cache.irradiance, (const uint8_t *const *)cache.state, &sr, err);
+        st = lmb_seams_stitch(s, &l, &rt, cache.irradiance, (const uint8_t *const *)cache.state, &sr, err);
         stats->seam_edges = sr.edges;
         stats->seam_jump_before = sr.jump_before;
         stats->seam_jump_after = sr.jump_after;
         if (st == LMB_OK && sr.edges)
-            lmb_info(log, "seams: %llu edges stitched (%llu points, %llu texels) in %.2fs; largest jump %.2f%% -> %.2f%%",
-                     (unsigned long long)sr.edges, (unsigned long long)sr.samples, (unsigned long long)sr.texels,
-                     sr.seconds, 100 * sr.jump_before, 100 * sr.jump_after);
+            lmb_info(log, "seams: %llu edges stitched (%llu points, %llu left unmatched, %llu texels) in %.2fs; largest "
+                     "jump %.2f%% -> %.2f%%; points over 1%%: %llu -> %llu", (unsigned long long)sr.edges,
+                     (unsigned long long)sr.samples, (unsigned long long)sr.dropped, (unsigned long long)sr.texels,
+                     sr.seconds, 100 * sr.jump_before, 100 * sr.jump_after, (unsigned long long)sr.over_1pct_before,
+                     (unsigned long long)sr.over_1pct);
     }
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],

@@ -19,10 +19,13 @@ typedef struct edge_ref {
     uint8_t swapped; /* corner + 1 holds the smaller endpoint */
 } edge_ref;
 
-/* One side of a seam: where the edge lies in the atlas, from the smaller endpoint. */
+/* One side of a seam: where the edge lies in the atlas, from the smaller endpoint, and in the
+ * world: its endpoints, the unit direction into its triangle across the edge, the triangle's
+ * front normal, and a texel's size there. */
 typedef struct seam_side {
     uint32_t atlas;
     double uv[4];
+    double p[6], inward[3], normal[3], texel;
 } seam_side;
 
 typedef struct solve_ctx {
@@ -147,10 +150,40 @@ static void corner_normal(const lmb_scene *s, const lmb_layout *l, uint32_t inst
         n[r] = len > 0 ? n[r] / len : 0;
 }
 
-/* The side of edge e in the atlas, endpoints in key order (smaller first). */
-static void side_of(const lmb_layout *l, const edge_ref *e, seam_side *side)
+static void normalize(double v[3])
+{
+    double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; k++)
+        v[k] = len > 0 ? v[k] / len : 0;
+}
+
+/* The side of edge e in the atlas and the world, endpoints in key order (smaller first). */
+static void side_of(const lmb_scene *s, const lmb_layout *l, const edge_ref *e, seam_side *side)
 {
     const lmb_layout_instance *li = &l->instances[e->instance];
+    double q[9];
+    lmb_layout_world_triangle(s, l, e->instance, e->triangle, q);
+    int ca = e->corner, cb = (e->corner + 1) % 3, cc = (e->corner + 2) % 3;
+    double ed[3], in[3], e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        side->p[k] = q[3 * (e->swapped ? cb : ca) + k];
+        side->p[3 + k] = q[3 * (e->swapped ? ca : cb) + k];
+        ed[k] = q[3 * cb + k] - q[3 * ca + k];
+        in[k] = q[3 * cc + k] - q[3 * ca + k];
+        e1[k] = q[3 + k] - q[k];
+        e2[k] = q[6 + k] - q[k];
+    }
+    normalize(ed);
+    double along = in[0] * ed[0] + in[1] * ed[1] + in[2] * ed[2];
+    for (int k = 0; k < 3; k++)
+        side->inward[k] = in[k] - along * ed[k];
+    normalize(side->inward);
+    double sg = s->instances[e->instance].flips_winding ? -1 : 1;
+    side->normal[0] = sg * (e1[1] * e2[2] - e1[2] * e2[1]);
+    side->normal[1] = sg * (e1[2] * e2[0] - e1[0] * e2[2]);
+    side->normal[2] = sg * (e1[0] * e2[1] - e1[1] * e2[0]);
+    normalize(side->normal);
+    side->texel = 1.0 / li->texel_density;
     const double *uv = li->uv1 + 6 * (size_t)e->triangle;
     int a = e->corner, b = (e->corner + 1) % 3;
     if (e->swapped) {
@@ -169,8 +202,8 @@ static void side_of(const lmb_layout *l, const edge_ref *e, seam_side *side)
  * about 8 degrees at both ends) and cut in the atlas. */
 static int is_seam(const lmb_scene *s, const lmb_layout *l, const edge_ref *x, const edge_ref *y, seam_side sides[2])
 {
-    side_of(l, x, &sides[0]);
-    side_of(l, y, &sides[1]);
+    side_of(s, l, x, &sides[0]);
+    side_of(s, l, y, &sides[1]);
     if (sides[0].atlas == sides[1].atlas) {
         double d = 0;
         for (int k = 0; k < 4; k++)
@@ -281,9 +314,50 @@ static double jump_at(float *const *rgb, const seam_row *r)
     return m > 0 ? fabs(a - b) / m : 0;
 }
 
-/* Every seam point, in a deterministic order (the sorted edges). rows may be NULL to count. */
-static size_t seam_rows(const lmb_scene *s, const lmb_layout *l, double snap, const edge_ref *e, size_t ne,
-                        seam_row *rows, uint64_t *edges)
+/* Does each side of the point read a valid texel? Where one side lies under other geometry
+ * (a floor's seam running under a wall) its texels hold no light of their own: nothing to
+ * match. */
+static int seen_from_both_sides(const uint8_t *const *state, const seam_row *r)
+{
+    int valid[2] = {0, 0};
+    for (int j = 0; j < 8; j++)
+        if (r->w[j] != 0 && state[r->atlas[j]][r->texel[j]] == LMB_TEXEL_VALID)
+            valid[j / 4] = 1;
+    return valid[0] && valid[1];
+}
+
+/* Is the surface open across the seam at t along it? Nothing stands on the edge there: from a
+ * point a quarter texel above the edge, both sides' surfaces half a texel away are in sight. A
+ * wall standing on a floor's seam (two rooms, one lit, on either side) fails this: its light is
+ * not continuous there and must not be matched. */
+static int open_across(const lmb_rt *rt, const seam_side sides[2], double t)
+{
+    double h = 0.25 * fmin(sides[0].texel, sides[1].texel), up[3], o[3];
+    for (int k = 0; k < 3; k++)
+        up[k] = sides[0].normal[k] + sides[1].normal[k];
+    normalize(up);
+    for (int k = 0; k < 3; k++)
+        o[k] = sides[0].p[k] + t * (sides[0].p[3 + k] - sides[0].p[k]) + h * up[k];
+    for (int side = 0; side < 2; side++) {
+        const seam_side *sd = &sides[side];
+        double q[3], d[3];
+        for (int k = 0; k < 3; k++) {
+            q[k] = sd->p[k] + t * (sd->p[3 + k] - sd->p[k]) + h * sd->normal[k] + 0.5 * sd->texel * sd->inward[k];
+            d[k] = q[k] - o[k];
+        }
+        double dist = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int k = 0; k < 3; k++)
+            d[k] /= dist;
+        if (lmb_rt_occluded(rt, o, d, 0, dist))
+            return 0;
+    }
+    return 1;
+}
+
+/* Every seam point seen from both sides, in a deterministic order (the sorted edges). rows may
+ * be NULL to count. */
+static size_t seam_rows(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, const uint8_t *const *state,
+                        double snap, const edge_ref *e, size_t ne, seam_row *rows, uint64_t *edges)
 {
     size_t m = 0;
     *edges = 0;
@@ -299,9 +373,15 @@ static size_t seam_rows(const lmb_scene *s, const lmb_layout *l, double snap, co
             edge_key(s, l, e[i + 1].instance, e[i + 1].triangle, e[i + 1].corner, snap, kb, &sb);
             if (!memcmp(ka, kb, sizeof ka) && is_seam(s, l, &e[i], &e[i + 1], sides)) {
                 uint32_t n = seam_points(sides);
-                for (uint32_t k = 0; k < n; k++, m++)
+                for (uint32_t k = 0; k < n; k++) {
+                    seam_row r;
+                    row_at(l, sides, (k + 0.5) / n, &r);
+                    if (!seen_from_both_sides(state, &r) || !open_across(rt, sides, (k + 0.5) / n))
+                        continue;
                     if (rows)
-                        row_at(l, sides, (k + 0.5) / n, &rows[m]);
+                        rows[m] = r;
+                    m++;
+                }
                 (*edges)++;
             }
         }
@@ -310,13 +390,11 @@ static size_t seam_rows(const lmb_scene *s, const lmb_layout *l, double snap, co
     return m;
 }
 
-/* The normal equations (upper triangle) and their solution, written back into the atlases. */
-static lmb_status solve(solve_ctx *c, const seam_row *rows, size_t nr, lmb_error *err)
+/* The normal equations (upper triangle) over the active rows, solved into out (3 columns of
+ * c->count: R, G, B). */
+static lmb_status solve(solve_ctx *c, const seam_row *rows, const uint8_t *active, size_t nr, double *out,
+                        lmb_error *err)
 {
-    for (size_t r = 0; r < nr; r++)
-        for (int j = 0; j < 8; j++)
-            if (unknown_of(c, rows[r].atlas[j], rows[r].texel[j]) < 0)
-                return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for the unknowns");
     size_t n = c->count;
     cholmod_common cm;
     cholmod_start(&cm);
@@ -343,7 +421,7 @@ static lmb_status solve(solve_ctx *c, const seam_row *rows, size_t nr, lmb_error
                 bx[u + k * n] = d * c->rgb[a][3 * (size_t)t + k];
         }
         for (size_t r = 0; r < nr; r++)
-            for (int p = 0; p < 8; p++)
+            for (int p = 0; active[r] && p < 8; p++)
                 for (int q = 0; q < 8; q++) {
                     int up = c->unknown[rows[r].atlas[p]][rows[r].texel[p]];
                     int uq = c->unknown[rows[r].atlas[q]][rows[r].texel[q]];
@@ -360,12 +438,7 @@ static lmb_status solve(solve_ctx *c, const seam_row *rows, size_t nr, lmb_error
     if (L && cholmod_factorize(A, L, &cm) && cm.status == CHOLMOD_OK)
         x = cholmod_solve(CHOLMOD_A, L, b, &cm);
     if (x) {
-        const double *xv = x->x;
-        for (size_t u = 0; u < n; u++)
-            for (int k = 0; k < 3; k++) {
-                double v = xv[u + k * n];
-                c->rgb[c->atlas_of[u]][3 * (size_t)c->texel_of[u] + k] = (float)(isfinite(v) && v > 0 ? v : 0);
-            }
+        memcpy(out, x->x, 3 * n * sizeof *out);
     } else {
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: the stitching solve failed (CHOLMOD status %d, %zu unknowns)",
                            cm.status, n);
@@ -379,8 +452,67 @@ static lmb_status solve(solve_ctx *c, const seam_row *rows, size_t nr, lmb_error
     return st;
 }
 
-lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, float *const *rgb, const uint8_t *const *state,
-                            lmb_seam_report *report, lmb_error *err)
+/*
+ * Solves, then drops the points whose texels the solution would make negative (light that
+ * two sides cannot share: where the sides meet other geometry, the match would have to
+ * overshoot) and solves again, at most LMB_SEAM_ROUNDS times; writes the result back.
+ * Reports the largest jump over the points kept, before and after.
+ */
+static lmb_status stitch(solve_ctx *c, const seam_row *rows, size_t nr, lmb_seam_report *report, lmb_error *err)
+{
+    for (size_t r = 0; r < nr; r++)
+        for (int j = 0; j < 8; j++)
+            if (unknown_of(c, rows[r].atlas[j], rows[r].texel[j]) < 0)
+                return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for the unknowns");
+    size_t n = c->count;
+    uint8_t *active = malloc(nr + 1), *negative = calloc(n + 1, 1);
+    double *x = malloc((3 * n + 1) * sizeof *x);
+    lmb_status st = active && negative && x ? LMB_OK
+                                            : lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu unknowns", n);
+    if (st == LMB_OK)
+        memset(active, 1, nr);
+    for (int round = 0; st == LMB_OK && round < LMB_SEAM_ROUNDS; round++) {
+        st = solve(c, rows, active, nr, x, err);
+        size_t dropped = 0;
+        for (size_t u = 0; st == LMB_OK && u < n; u++)
+            negative[u] = x[u] < 0 || x[u + n] < 0 || x[u + 2 * n] < 0;
+        for (size_t r = 0; st == LMB_OK && r < nr; r++)
+            for (int j = 0; active[r] && j < 8; j++)
+                if (negative[c->unknown[rows[r].atlas[j]][rows[r].texel[j]]]) {
+                    active[r] = 0;
+                    dropped++;
+                }
+        if (!dropped)
+            break;
+    }
+    for (size_t r = 0; st == LMB_OK && r < nr; r++)
+        if (active[r]) {
+            double j = jump_at(c->rgb, &rows[r]);
+            report->jump_before = fmax(report->jump_before, j);
+            report->over_1pct_before += j > 0.01;
+            report->samples++;
+        }
+    for (size_t u = 0; st == LMB_OK && u < n; u++)
+        for (int k = 0; k < 3; k++) {
+            double v = x[u + k * n];
+            c->rgb[c->atlas_of[u]][3 * (size_t)c->texel_of[u] + k] = (float)(isfinite(v) && v > 0 ? v : 0);
+        }
+    for (size_t r = 0; st == LMB_OK && r < nr; r++)
+        if (active[r]) {
+            double j = jump_at(c->rgb, &rows[r]);
+            report->jump_after = fmax(report->jump_after, j);
+            report->over_1pct += j > 0.01;
+        }
+    report->dropped = nr - report->samples;
+    report->texels = n;
+    free(active);
+    free(negative);
+    free(x);
+    return st;
+}
+
+lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, float *const *rgb,
+                            const uint8_t *const *state, lmb_seam_report *report, lmb_error *err)
 {
     double t0 = lmb_seconds();
     memset(report, 0, sizeof *report);
@@ -390,7 +522,8 @@ lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, float *cons
     lmb_status st = collect_edges(s, l, snap, &e, &ne, err);
     if (st != LMB_OK)
         return st;
-    size_t nr = seam_rows(s, l, snap, e, ne, NULL, &report->edges);
+    lmb_rt_thread_init();
+    size_t nr = seam_rows(s, l, rt, state, snap, e, ne, NULL, &report->edges);
     seam_row *rows = nr ? malloc(nr * sizeof *rows) : NULL;
     solve_ctx c = {l, rgb, state, calloc((size_t)l->atlas_count + 1, sizeof *c.unknown), NULL, NULL, 0, 0};
     if ((nr && !rows) || !c.unknown)
@@ -404,14 +537,8 @@ lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, float *cons
             memset(c.unknown[a], 0xff, texels * sizeof *c.unknown[a]);
     }
     if (st == LMB_OK && nr) {
-        seam_rows(s, l, snap, e, ne, rows, &report->edges);
-        for (size_t r = 0; r < nr; r++)
-            report->jump_before = fmax(report->jump_before, jump_at(rgb, &rows[r]));
-        st = solve(&c, rows, nr, err);
-        for (size_t r = 0; st == LMB_OK && r < nr; r++)
-            report->jump_after = fmax(report->jump_after, jump_at(rgb, &rows[r]));
-        report->samples = nr;
-        report->texels = c.count;
+        seam_rows(s, l, rt, state, snap, e, ne, rows, &report->edges);
+        st = stitch(&c, rows, nr, report, err);
     }
     for (uint32_t a = 0; c.unknown && a < l->atlas_count; a++)
         free(c.unknown[a]);
