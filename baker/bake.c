@@ -190,6 +190,50 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
     return LMB_OK;
 }
 
+/* The post stage on the final lightmaps (README "What artists see"): fireflies spread to their
+ * neighbours, then seams stitched. */
+static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
+                               lmb_cache *cache, lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
+{
+    lmb_status st = LMB_OK;
+    if (st == LMB_OK && cfg->firefly_spread && !cfg->reference) {
+        lmb_firefly_stats fs = {0, 0, 0};
+        for (uint32_t a = 0; st == LMB_OK && a < l->atlas_count; a++) {
+            uint64_t before = fs.texels, last = ~0ull;
+            /* a spike shared with its neighbours may leave them above the bound: again, a few times */
+            for (int pass = 0; pass < LMB_FIREFLY_PASSES && st == LMB_OK && fs.texels != last; pass++) {
+                last = fs.texels;
+                double total = fs.total;
+                st = lmb_fireflies_spread(cache->irradiance[a], cache->state[a], l->width[a], l->height[a], &fs, err);
+                if (pass)
+                    fs.total = total; /* the atlas's light counts once */
+            }
+            if (st == LMB_OK && fs.texels > before) /* padding follows the texels it was dilated from */
+                st = lmb_dilate(cache->irradiance[a], cache->state[a], l->width[a], l->height[a], err);
+        }
+        stats->firefly_texels = fs.texels;
+        stats->firefly_moved = fs.total > 0 ? fs.moved / fs.total : 0;
+        if (st == LMB_OK && fs.texels)
+            lmb_info(log, "fireflies: %llu texels above %gx the median around them; %.4f%% of the light moved to their "
+                     "neighbours (none removed)", (unsigned long long)fs.texels, LMB_FIREFLY_FACTOR,
+                     100 * stats->firefly_moved);
+    }
+    if (st == LMB_OK && cfg->seam_stitch) {
+        lmb_seam_report sr;
+        st = lmb_seams_stitch(s, l, rt, cache->irradiance, (const uint8_t *const *)cache->state, &sr, err);
+        stats->seam_edges = sr.edges;
+        stats->seam_jump_before = sr.jump_before;
+        stats->seam_jump_after = sr.jump_after;
+        if (st == LMB_OK && sr.edges)
+            lmb_info(log, "seams: %llu edges stitched (%llu points, %llu left unmatched, %llu texels) in %.2fs; largest "
+                     "jump %.2f%% -> %.2f%%; points over 1%%: %llu -> %llu", (unsigned long long)sr.edges,
+                     (unsigned long long)sr.samples, (unsigned long long)sr.dropped, (unsigned long long)sr.texels,
+                     sr.seconds, 100 * sr.jump_before, 100 * sr.jump_after, (unsigned long long)sr.over_1pct_before,
+                     (unsigned long long)sr.over_1pct);
+    }
+    return st;
+}
+
 lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress, void *user,
                     lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
 {
@@ -226,41 +270,8 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
                  "are black", s->path);
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, &records, log, err);
-    if (st == LMB_OK && cfg->firefly_spread && !cfg->reference) {
-        lmb_firefly_stats fs = {0, 0, 0};
-        for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
-            uint64_t before = fs.texels, last = ~0ull;
-            /* a spike shared with its neighbours may leave them above the bound: again, a few times */
-            for (int pass = 0; pass < LMB_FIREFLY_PASSES && st == LMB_OK && fs.texels != last; pass++) {
-                last = fs.texels;
-                double total = fs.total;
-                st = lmb_fireflies_spread(cache.irradiance[a], cache.state[a], l.width[a], l.height[a], &fs, err);
-                if (pass)
-                    fs.total = total; /* the atlas's light counts once */
-            }
-            if (st == LMB_OK && fs.texels > before) /* padding follows the texels it was dilated from */
-                st = lmb_dilate(cache.irradiance[a], cache.state[a], l.width[a], l.height[a], err);
-        }
-        stats->firefly_texels = fs.texels;
-        stats->firefly_moved = fs.total > 0 ? fs.moved / fs.total : 0;
-        if (st == LMB_OK && fs.texels)
-            lmb_info(log, "fireflies: %llu texels above %gx the median around them; %.4f%% of the light moved to their "
-                     "neighbours (none removed)", (unsigned long long)fs.texels, LMB_FIREFLY_FACTOR,
-                     100 * stats->firefly_moved);
-    }
-    if (st == LMB_OK && cfg->seam_stitch) {
-        lmb_seam_report sr;
-        st = lmb_seams_stitch(s, &l, &rt, cache.irradiance, (const uint8_t *const *)cache.state, &sr, err);
-        stats->seam_edges = sr.edges;
-        stats->seam_jump_before = sr.jump_before;
-        stats->seam_jump_after = sr.jump_after;
-        if (st == LMB_OK && sr.edges)
-            lmb_info(log, "seams: %llu edges stitched (%llu points, %llu left unmatched, %llu texels) in %.2fs; largest "
-                     "jump %.2f%% -> %.2f%%; points over 1%%: %llu -> %llu", (unsigned long long)sr.edges,
-                     (unsigned long long)sr.samples, (unsigned long long)sr.dropped, (unsigned long long)sr.texels,
-                     sr.seconds, 100 * sr.jump_before, 100 * sr.jump_after, (unsigned long long)sr.over_1pct_before,
-                     (unsigned long long)sr.over_1pct);
-    }
+    if (st == LMB_OK)
+        st = post_process(s, cfg, &l, &rt, &cache, stats, log, err);
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
                                     l.height[a], err);

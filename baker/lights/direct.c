@@ -20,7 +20,6 @@
 #include "../util/lmb_math.h"
 #include "../util/rng.h"
 
-#include <omp.h>
 
 #include <math.h>
 #include <stdlib.h>
@@ -191,6 +190,11 @@ struct lmb_direct {
     light_set lights;
     uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
 };
+
+const lmb_config *lmb_direct_config(const lmb_direct *d)
+{
+    return d->cfg;
+}
 
 int lmb_direct_any_light(const lmb_direct *d)
 {
@@ -448,41 +452,6 @@ void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t 
     sp->eps = d->rt->eps + 1e-4 * t->texel_size[i];
 }
 
-static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, float *out, uint64_t *rays)
-{
-    double sum[3] = {0, 0, 0}, dir_sum[3] = {0, 0, 0};
-    uint32_t used = 0, r = 0;
-    int near_back = 0;
-    uint64_t key = ((uint64_t)job->atlas << 32) | t->texel[i];
-    t->gather_at[i] = 0;
-    for (uint32_t k = 0; k < t->points_in[i]; k++) {
-        lmb_shading_point sp;
-        lmb_texel_shading_point(job->direct, t, i, k, &sp);
-        lmb_rng rng = lmb_rng_make(job->direct->cfg->seed, key, k);
-        int sees_back;
-        if (lmb_point_inside_geometry(job->direct, &sp, &rng, &r, &sees_back))
-            continue;
-        near_back |= sees_back;
-        if (!used)
-            t->gather_at[i] = (uint8_t)k;
-        double e[3], dir[3];
-        r += lmb_direct_at(job->direct, &sp, 0, &rng, e, dir);
-        for (int d = 0; d < 3; d++) {
-            sum[d] += e[d];
-            dir_sum[d] += dir[d];
-        }
-        used++;
-    }
-    t->valid[i] = used > 0;
-    t->partly_covered[i] = used > 0 && (used < t->points_in[i] || near_back);
-    for (int d = 0; d < 3; d++) {
-        out[3 * i + d] = used ? (float)(sum[d] / used) : 0.0f;
-        if (job->direction)
-            job->direction[3 * (size_t)i + d] = used ? (float)(dir_sum[d] / used) : 0.0f;
-    }
-    *rays += r;
-}
-
 /* Splits the scene's lights into directional and local, with the local lights' power CDF
  * (power ~ 4 pi I for a point light, 2 pi (1 - cos outer) I for a spot, times luminance). */
 static int light_set_build(const lmb_scene *s, light_set *ls)
@@ -568,28 +537,4 @@ void lmb_direct_free(lmb_direct *d)
         free(d->emitter_of[g]);
     free(d->emitter_of);
     free(d);
-}
-
-lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays, lmb_error *err)
-{
-    const uint32_t block = 1024;
-    uint64_t total = 0;
-    int threads = job->direct->cfg->threads ? (int)job->direct->cfg->threads : omp_get_max_threads();
-    for (uint32_t start = 0; start < t->count; start += block) {
-        uint32_t end = start + block < t->count ? start + block : t->count;
-        uint64_t block_rays = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : block_rays)
-        {
-            lmb_rt_thread_init();
-#pragma omp for schedule(dynamic, 16)
-            for (uint32_t i = start; i < end; i++)
-                texel_direct(job, t, i, irradiance, &block_rays);
-        }
-        total += block_rays;
-        if (job->progress)
-            job->progress(job->progress_user, "direct", end, t->count);
-    }
-    *rays += total;
-    (void)err;
-    return LMB_OK;
 }

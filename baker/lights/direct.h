@@ -55,6 +55,9 @@ uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_
 int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays,
                               int *sees_back);
 
+/* The config the lights were made with (borrowed). */
+const lmb_config *lmb_direct_config(const lmb_direct *d);
+
 /* Gather point k of listed texel i of t as a shading point (offset scaled to the texel). */
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp);
 

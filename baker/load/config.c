@@ -140,7 +140,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->emission_sides = LMB_EMIT_FRONT; /* README "Which side of a face counts" */
     cfg->seam_stitch = 1;
     cfg->firefly_spread = 1;
-    cfg->directional = 0;
+    cfg->directional = 1; /* README "Directional lightmaps": +5% time on level-single-10 */
     cfg->directional_rays = 32;
 }
 

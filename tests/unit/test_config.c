@@ -57,6 +57,8 @@ static void test_defaults(void)
     CHECK_NEAR(c.light_intensity_scale, 1.0, 0);
     CHECK_NEAR(c.emissive_scale, 1.0, 0);
     CHECK(c.emission_sides == LMB_EMIT_FRONT);
+    CHECK(c.directional == 1 && c.directional_rays == 32);
+    CHECK(c.seam_stitch == 1 && c.firefly_spread == 1);
 }
 
 /* Every key set away from its default, in block and flow style. */
