@@ -151,6 +151,12 @@ class Scene:
         self.doc["nodes"].append({"name": name, "mesh": len(self.doc["meshes"]) - 1, "translation": list(translation)})
         self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
 
+    def instance(self, name, mesh_name, translation):
+        """Another node of the mesh called mesh_name (an instance: the same mesh, its own lightmap)."""
+        mesh = [m["name"] for m in self.doc["meshes"]].index(mesh_name)
+        self.doc["nodes"].append({"name": name, "mesh": mesh, "translation": list(translation)})
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
     def light(self, name, kind, intensity, color=(1, 1, 1), translation=(0, 0, 0), rotation=None, **spot):
         self._use("KHR_lights_punctual")
         lights = self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
@@ -513,6 +519,10 @@ def artists(out):
     grey = s.material("grey", (0.7, 0.7, 0.7))
     s.smooth_mesh("sphere", *uv_sphere(0.5), grey, translation=(-0.8, 1, 0))
     s.smooth_mesh("cube", *smooth_box(0.4, math.radians(40)), grey, translation=(0.8, 1, 0))  # two faces to the camera
+    # two instances of one floor tile side by side: their shared edge is a seam across instances
+    tile = quad((-0.5, 0, 0.5), (0.5, 0, 0.5), (0.5, 0, -0.5), (-0.5, 0, -0.5))
+    s.mesh("tile", tile, grey, translation=(-0.5, 0, 0))
+    s.instance("tile_b", "tile", (0.5, 0, 0))
     s.light("lamp", "point", 40.0, translation=(-1.5, 3.0, 2.0))
     s.write(os.path.join(out, "seams.gltf"))
 
