@@ -4,8 +4,7 @@
 #include "post/dilate.h"
 #include "texels/texels.h"
 #include "util/clock.h"
-
-#include <cholmod.h>
+#include "util/spd_solve.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -396,22 +395,13 @@ static lmb_status solve(solve_ctx *c, const seam_row *rows, const uint8_t *activ
                         lmb_error *err)
 {
     size_t n = c->count;
-    cholmod_common cm;
-    cholmod_start(&cm);
-    cm.print = 0;
-    cm.supernodal = CHOLMOD_SIMPLICIAL; /* deterministic, no threaded BLAS */
-    cm.nmethods = 1;
-    cm.method[0].ordering = CHOLMOD_AMD;
-    /* at most 8 x 8 pairs per row (its taps may repeat a texel), and the diagonal */
-    cholmod_triplet *T = cholmod_allocate_triplet(n, n, nr * 64 + n, 1, CHOLMOD_REAL, &cm);
-    cholmod_dense *b = cholmod_zeros(n, 3, CHOLMOD_REAL, &cm);
-    cholmod_sparse *A = NULL;
-    cholmod_factor *L = NULL;
-    cholmod_dense *x = NULL;
+    lmb_spd sys;
     lmb_status st = LMB_OK;
-    if (T && b) {
+    /* at most 8 x 8 pairs per row (its taps may repeat a texel), and the diagonal */
+    if (lmb_spd_begin(&sys, n, nr * 64 + n, 3)) {
+        cholmod_triplet *T = sys.a;
         int *ti = T->i, *tj = T->j;
-        double *tx = T->x, *bx = b->x;
+        double *tx = T->x, *bx = sys.b->x;
         for (size_t u = 0; u < n; u++) {
             uint32_t a = c->atlas_of[u], t = c->texel_of[u];
             double d = c->state[a][t] == LMB_TEXEL_VALID ? 1.0 : LMB_SEAM_FREE;
@@ -431,24 +421,13 @@ static lmb_status solve(solve_ctx *c, const seam_row *rows, const uint8_t *activ
                     tj[T->nnz] = uq;
                     tx[T->nnz++] = LMB_SEAM_WEIGHT * rows[r].w[p] * rows[r].w[q];
                 }
-        A = cholmod_triplet_to_sparse(T, T->nnz, &cm);
-    }
-    if (A)
-        L = cholmod_analyze(A, &cm);
-    if (L && cholmod_factorize(A, L, &cm) && cm.status == CHOLMOD_OK)
-        x = cholmod_solve(CHOLMOD_A, L, b, &cm);
-    if (x) {
-        memcpy(out, x->x, 3 * n * sizeof *out);
+        if (!lmb_spd_solve(&sys, out))
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: the stitching solve failed (CHOLMOD status %d, %zu unknowns)",
+                               sys.cm.status, n);
     } else {
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: the stitching solve failed (CHOLMOD status %d, %zu unknowns)",
-                           cm.status, n);
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu unknowns", n);
     }
-    cholmod_free_dense(&x, &cm);
-    cholmod_free_factor(&L, &cm);
-    cholmod_free_sparse(&A, &cm);
-    cholmod_free_dense(&b, &cm);
-    cholmod_free_triplet(&T, &cm);
-    cholmod_finish(&cm);
+    lmb_spd_end(&sys);
     return st;
 }
 

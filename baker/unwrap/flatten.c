@@ -13,7 +13,8 @@
  */
 #include "unwrap_internal.h"
 
-#include <cholmod.h>
+#include "util/spd_solve.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -133,22 +134,13 @@ static int solve_lscm(uint32_t n, chart_verts *c)
     for (uint32_t v = 0; v < m; v++)
         var[v] = (v == pin[0] || v == pin[1]) ? LMB_NONE : 2 * nf++;
     size_t nvar = 2 * (size_t)nf;
-    cholmod_common cm;
-    cholmod_start(&cm);
-    cm.print = 0;
-    cm.supernodal = CHOLMOD_SIMPLICIAL;
-    cm.nmethods = 1;
-    cm.method[0].ordering = CHOLMOD_AMD;
-    cm.postorder = 1;
     int ok = 0;
-    cholmod_triplet *T = cholmod_allocate_triplet(nvar, nvar, (size_t)n * 2 * 21 + 1, 1, CHOLMOD_REAL, &cm);
-    cholmod_dense *b = cholmod_zeros(nvar, 1, CHOLMOD_REAL, &cm);
-    cholmod_sparse *A = NULL;
-    cholmod_factor *L = NULL;
-    cholmod_dense *x = NULL;
-    if (T && b) {
+    lmb_spd sys;
+    double *xv = malloc((nvar + 1) * sizeof *xv);
+    if (lmb_spd_begin(&sys, nvar, (size_t)n * 2 * 21 + 1, 1) && xv) {
+        cholmod_triplet *T = sys.a;
         int *ti = T->i, *tj = T->j;
-        double *tx = T->x, *bx = b->x;
+        double *tx = T->x, *bx = sys.b->x;
         for (uint32_t f = 0; f < n; f++) {
             const uint32_t *lv = c->local + 3 * f;
             double rows[2][6];
@@ -179,28 +171,18 @@ static int solve_lscm(uint32_t n, chart_verts *c)
                 }
             }
         }
-        A = cholmod_triplet_to_sparse(T, T->nnz, &cm);
+        if (lmb_spd_solve(&sys, xv)) {
+            ok = 1;
+            for (uint32_t v = 0; v < m; v++)
+                if (var[v] != LMB_NONE) {
+                    c->uv[2 * v] = xv[var[v]];
+                    c->uv[2 * v + 1] = xv[var[v] + 1];
+                    ok &= isfinite(c->uv[2 * v]) && isfinite(c->uv[2 * v + 1]);
+                }
+        }
     }
-    if (A)
-        L = cholmod_analyze(A, &cm);
-    if (L && cholmod_factorize(A, L, &cm) && cm.status == CHOLMOD_OK)
-        x = cholmod_solve(CHOLMOD_A, L, b, &cm);
-    if (x) {
-        const double *xv = x->x;
-        ok = 1;
-        for (uint32_t v = 0; v < m; v++)
-            if (var[v] != LMB_NONE) {
-                c->uv[2 * v] = xv[var[v]];
-                c->uv[2 * v + 1] = xv[var[v] + 1];
-                ok &= isfinite(c->uv[2 * v]) && isfinite(c->uv[2 * v + 1]);
-            }
-    }
-    cholmod_free_dense(&x, &cm);
-    cholmod_free_factor(&L, &cm);
-    cholmod_free_sparse(&A, &cm);
-    cholmod_free_dense(&b, &cm);
-    cholmod_free_triplet(&T, &cm);
-    cholmod_finish(&cm);
+    lmb_spd_end(&sys);
+    free(xv);
     free(var);
     return ok;
 }
