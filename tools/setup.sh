@@ -20,6 +20,7 @@ packages=(
   libsuitesparse-dev                # CHOLMOD sparse Cholesky for the LSCM flattening
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
   chromium                          # headless browser for the preview's shots and e2e test (playwright-core drives it)
+  strace                            # the hostile-input test checks which files a bake opens
 )
 
 # node and npm: the machine's own if it has them, else Debian's

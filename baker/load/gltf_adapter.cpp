@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "gltf_doc.hpp"
+#include "uri.h"
 
 namespace {
 
@@ -26,6 +27,54 @@ bool skip_image(tinygltf::Image *image, const int, std::string *, std::string *,
     if (image->uri.empty() && image->bufferView < 0 && bytes && size > 0)
         image->image.assign(bytes, bytes + size);
     return true;
+}
+
+/* tinygltf's file access, confined to the input's folder (issue 15; load/uri.h): buffers and
+ * images are read only when the file they name, symbolic links followed, lies inside it;
+ * nothing is expanded (~, $VARS) and nothing is written. */
+struct confined_fs {
+    std::string folder;
+};
+
+bool confined_exists(const std::string &path, void *user)
+{
+    char real[4096];
+    return lmb_path_inside(static_cast<confined_fs *>(user)->folder.c_str(), path.c_str(), real, sizeof real) != 0;
+}
+
+std::string no_expansion(const std::string &path, void *)
+{
+    return path;
+}
+
+bool confined_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
+{
+    char real[4096];
+    if (!lmb_path_inside(static_cast<confined_fs *>(user)->folder.c_str(), path.c_str(), real, sizeof real)) {
+        if (err)
+            *err += "'" + path + "' is not a file inside the input's folder\n";
+        return false;
+    }
+    FILE *f = std::fopen(real, "rb");
+    if (!f) {
+        if (err)
+            *err += "cannot open '" + path + "'\n";
+        return false;
+    }
+    unsigned char chunk[65536];
+    size_t n;
+    while ((n = std::fread(chunk, 1, sizeof chunk, f)) > 0)
+        out->insert(out->end(), chunk, chunk + n);
+    bool ok = !std::ferror(f);
+    std::fclose(f);
+    return ok;
+}
+
+bool no_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
+{
+    if (err)
+        *err += "the loader writes no files\n";
+    return false;
 }
 
 /* Returns obj[key] if obj is an object holding key, else nullptr. */
@@ -379,6 +428,11 @@ extern "C" lmb_status lmb_gltf_open(const char *path, const char *extras_key, lm
         d->extras_key = extras_key ? extras_key : "";
         tinygltf::TinyGLTF loader;
         loader.SetImageLoader(skip_image, nullptr);
+        const char *slash = std::strrchr(path, '/');
+        confined_fs fs_root{slash ? std::string(path, (size_t)(slash - path)) : std::string(".")};
+        if (fs_root.folder.empty())
+            fs_root.folder = "/";
+        loader.SetFsCallbacks(tinygltf::FsCallbacks{confined_exists, no_expansion, confined_read, no_write, &fs_root});
         std::string terr, twarn;
         bool ok = is_glb(path) ? loader.LoadBinaryFromFile(&d->model, &terr, &twarn, path)
                                : loader.LoadASCIIFromFile(&d->model, &terr, &twarn, path);

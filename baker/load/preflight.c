@@ -7,11 +7,13 @@
  *     (extensions.c); an alternative image format (KHR_texture_basisu, EXT_texture_webp, ...)
  *     only if every texture lmbake reads keeps a fallback `source` image;
  *   - compressed geometry (KHR_draco_mesh_compression on a primitive,
- *     EXT_meshopt_compression on a buffer view) is refused, naming the mesh or view.
+ *     EXT_meshopt_compression on a buffer view) is refused, naming the mesh or view;
+ *   - a buffer's uri must name a file inside the input's folder (uri.h).
  * For .glb the JSON chunk is read from the container (glTF 2.0 spec section 4.4).
  */
 #include "preflight.h"
 #include "extensions.h"
+#include "uri.h"
 #include "load_internal.h"
 #include "../util/file.h"
 
@@ -19,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static uint32_t le32(const unsigned char *p)
 {
@@ -181,6 +184,39 @@ static lmb_status check_compression(const char *path, const cJSON *root, lmb_err
     return LMB_OK;
 }
 
+/* Buffers are read only from the input's folder (load/uri.h): a buffer whose uri points
+ * elsewhere is an error (without it there is no geometry). */
+static lmb_status check_buffer_uris(const char *path, const cJSON *root, lmb_error *err)
+{
+    const cJSON *buffer;
+    uint32_t bi = 0;
+    cJSON_ArrayForEach(buffer, cJSON_GetObjectItemCaseSensitive(root, "buffers"))
+    {
+        const cJSON *uri = cJSON_GetObjectItemCaseSensitive(buffer, "uri");
+        char rel[4096];
+        if (!cJSON_IsString(uri)) { /* the .glb's own chunk (or an error tinygltf names) */
+            bi++;
+            continue;
+        }
+        lmb_uri_kind kind = lmb_uri_check(uri->valuestring, rel, sizeof rel);
+        if (kind != LMB_URI_INSIDE && kind != LMB_URI_EMBEDDED)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: buffer %u: uri '%.200s' %s; without it there is no geometry",
+                                 path, bi, uri->valuestring, lmb_uri_refusal(kind));
+        if (kind == LMB_URI_INSIDE) { /* a link out of the folder: there, but not inside */
+            char folder[4096], file[8300], real[4096];
+            const char *slash = strrchr(path, '/');
+            snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - path) : 1, slash ? path : ".");
+            snprintf(file, sizeof file, "%s/%s", folder, rel);
+            if (access(file, F_OK) == 0 && !lmb_path_inside(folder, file, real, sizeof real))
+                return lmb_error_set(err, LMB_ERR_INPUT,
+                                     "%s: buffer %u: uri '%.200s' is not a file inside the input's folder (a link "
+                                     "out of it?); without it there is no geometry", path, bi, uri->valuestring);
+        }
+        bi++;
+    }
+    return LMB_OK;
+}
+
 lmb_status lmb_preflight(const char *path, lmb_error *err)
 {
     char *buf = NULL;
@@ -210,6 +246,8 @@ lmb_status lmb_preflight(const char *path, lmb_error *err)
         st = check_required(path, root, err);
     if (st == LMB_OK)
         st = check_compression(path, root, err);
+    if (st == LMB_OK)
+        st = check_buffer_uris(path, root, err);
     cJSON_Delete(root);
     free(buf);
     return st;

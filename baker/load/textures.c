@@ -1,6 +1,7 @@
 /* Material textures: decoding, sampling, UV transforms and the albedo they give (see textures.h).
  * sRGB decode: IEC 61966-2-1. */
 #include "textures.h"
+#include "uri.h"
 
 #include "gltf_adapter.h"
 #include "write/image_adapter.h"
@@ -45,11 +46,19 @@ static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32
     const lmb_gltf_image *img = &v->images[src];
     if (img->bytes)
         return lmb_image_read_rgb(mem_name(img->mime), img->bytes, img->size, w, h, rgb, err);
-    char path[8192];
+    /* files only from the input's folder and below (issue 15; load/uri.h) */
+    char folder[4096], rel[4096], path[8300], real[4096];
     const char *slash = strrchr(s->path, '/');
-    int dir = slash ? (int)(slash - s->path) : 1;
-    snprintf(path, sizeof path, "%.*s/%s", dir, slash ? s->path : ".", img->uri);
-    return lmb_image_read_rgb(path, NULL, 0, w, h, rgb, err);
+    snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - s->path) : 1, slash ? s->path : ".");
+    lmb_uri_kind kind = lmb_uri_check(img->uri, rel, sizeof rel);
+    if (kind != LMB_URI_INSIDE)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image %d: uri '%s' %s", s->path, src, img->uri,
+                             lmb_uri_refusal(kind));
+    snprintf(path, sizeof path, "%s/%s", folder, rel);
+    if (!lmb_path_inside(folder, path, real, sizeof real))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image %d: '%s' is not a file inside the input's folder", s->path,
+                             src, img->uri);
+    return lmb_image_read_rgb(real, NULL, 0, w, h, rgb, err);
 }
 
 static int wrap_mode(int32_t gl, const char *axis, const lmb_scene *s, uint32_t tex, const lmb_log *log)

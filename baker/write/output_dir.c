@@ -2,6 +2,8 @@
 #define _XOPEN_SOURCE 700
 #include "output_dir.h"
 
+#include "load/uri.h"
+
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -133,19 +135,23 @@ static lmb_status copy_file(const char *from, const char *to, lmb_error *err)
 
 lmb_status lmb_output_dir_copy_input_file(lmb_output_dir *od, const char *input_path, const char *uri, lmb_error *err)
 {
-    if (strstr(uri, "..") || uri[0] == '/' || strchr(uri, ':'))
-        return lmb_error_set(err, LMB_ERR_INPUT, "texture uri '%s' is not inside the input's folder", uri);
-    char in_dir[4096], from[8300], to[8400];
+    char rel[4096], in_dir[4096], from[8300], real[4096], to[8600];
+    lmb_uri_kind kind = lmb_uri_check(uri, rel, sizeof rel);
+    if (kind != LMB_URI_INSIDE)
+        return lmb_error_set(err, LMB_ERR_INPUT, "texture uri '%s' %s", uri, lmb_uri_refusal(kind));
     dirname_of(input_path, in_dir, sizeof in_dir);
-    snprintf(from, sizeof from, "%s/%s", in_dir, uri);
-    snprintf(to, sizeof to, "%s/%s", od->staging, uri);
-    /* sub-folders of the uri */
+    snprintf(from, sizeof from, "%s/%s", in_dir, rel);
+    /* the source first: no folder is made for a file that is not there (or not inside) */
+    if (!lmb_path_inside(in_dir, from, real, sizeof real))
+        return lmb_error_set(err, LMB_ERR_INPUT, "texture uri '%s' is not a file inside the input's folder", uri);
+    snprintf(to, sizeof to, "%s/%s", od->staging, rel);
+    /* sub-folders of the (normalised, relative) path */
     for (char *p = to + strlen(od->staging) + 1; (p = strchr(p, '/')) != NULL; p++) {
         *p = '\0';
         mkdir(to, 0777);
         *p = '/';
     }
-    return copy_file(from, to, err);
+    return copy_file(real, to, err);
 }
 
 /* Moves every file under staging (recursively) to the same place under dir. */
