@@ -5,6 +5,10 @@
  */
 #include "accessor.h"
 
+/* Sizes before memory (issue 15): an accessor without a bufferView (zeros, maybe sparse) may
+ * declare at most this many elements: 16M, 0.4 GB as VEC3 doubles. */
+#define LMB_MAX_UNBACKED_ELEMENTS (1u << 24)
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -132,16 +136,18 @@ static lmb_status read_doubles(const lmb_accessor_ctx *ctx, int32_t index, int c
     if (a->count > (size_t)1 << 31)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: accessor %d count %zu is too large", ctx->path, what, index, a->count);
     size_t csz = component_size(a->component_type);
+    /* sizes before memory (issue 15): the elements must be in the file before they are decoded */
+    span s = {0};
+    if (a->buffer_view >= 0 &&
+        (st = view_span(ctx, a->buffer_view, a->offset, a->count, csz * (size_t)comps, 1, what, &s, err)) != LMB_OK)
+        return st;
+    if (a->buffer_view < 0 && a->count > LMB_MAX_UNBACKED_ELEMENTS)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: accessor %d declares %zu elements with no bufferView (at most %u "
+                             "without data in the file)", ctx->path, what, index, a->count, LMB_MAX_UNBACKED_ELEMENTS);
     double *dst = calloc(a->count * (size_t)comps + 1, sizeof *dst);
     if (!dst)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: %s: out of memory", ctx->path, what);
     if (a->buffer_view >= 0) {
-        span s;
-        st = view_span(ctx, a->buffer_view, a->offset, a->count, csz * (size_t)comps, 1, what, &s, err);
-        if (st != LMB_OK) {
-            free(dst);
-            return st;
-        }
         for (size_t i = 0; i < a->count; i++)
             for (int c = 0; c < comps; c++)
                 dst[i * comps + c] = decode(s.base + i * s.stride + c * csz, a->component_type, a->normalized);

@@ -21,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 static uint32_t le32(const unsigned char *p)
@@ -211,6 +212,19 @@ static lmb_status check_buffer_uris(const char *path, const cJSON *root, lmb_err
                 return lmb_error_set(err, LMB_ERR_INPUT,
                                      "%s: buffer %u: uri '%.200s' is not a file inside the input's folder (a link "
                                      "out of it?); without it there is no geometry", path, bi, uri->valuestring);
+            /* sizes before memory (issue 15): the declared length must be in the file */
+            const cJSON *len = cJSON_GetObjectItemCaseSensitive(buffer, "byteLength");
+            struct stat sb;
+            if (cJSON_IsNumber(len) && stat(file, &sb) == 0 && len->valuedouble > (double)sb.st_size)
+                return lmb_error_set(err, LMB_ERR_INPUT, "%s: buffer %u declares %.0f bytes but '%.200s' holds %lld",
+                                     path, bi, len->valuedouble, uri->valuestring, (long long)sb.st_size);
+        } else { /* data: base64 gives at most 3 bytes per 4 characters */
+            const cJSON *len = cJSON_GetObjectItemCaseSensitive(buffer, "byteLength");
+            const char *comma = strchr(uri->valuestring, ',');
+            double most = comma ? 0.75 * (double)strlen(comma + 1) + 3 : 0;
+            if (cJSON_IsNumber(len) && len->valuedouble > most)
+                return lmb_error_set(err, LMB_ERR_INPUT, "%s: buffer %u declares %.0f bytes but its data uri holds at "
+                                     "most %.0f", path, bi, len->valuedouble, most);
         }
         bi++;
     }

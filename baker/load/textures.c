@@ -36,16 +36,36 @@ static const char *mem_name(const char *mime)
     return "embedded.png";
 }
 
+/* Sizes before memory (issue 15): an image whose header declares more pixels than this is
+ * refused before decoding (8192 x 8192: 0.8 GB as float RGB, 1 GB while decoding). */
+#define LMB_MAX_TEXTURE_PIXELS ((uint64_t)1 << 26)
+
+/* Decodes name (a file, or bytes) after checking its declared size; *fatal: it was too large. */
+static lmb_status decode_checked(const lmb_scene *s, int32_t src, const char *name, const uint8_t *bytes, size_t size,
+                                 uint32_t *w, uint32_t *h, float **rgb, int *fatal, lmb_error *err)
+{
+    lmb_status st = lmb_image_size(name, bytes, size, w, h, err);
+    if (st != LMB_OK)
+        return st;
+    if ((uint64_t)*w * *h > LMB_MAX_TEXTURE_PIXELS) {
+        *fatal = 1;
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image %d is %ux%u: over lmbake's limit of %llu pixels (8192 x "
+                             "8192); refused before decoding", s->path, src, *w, *h,
+                             (unsigned long long)LMB_MAX_TEXTURE_PIXELS);
+    }
+    return lmb_image_read_rgb(name, bytes, size, w, h, rgb, err);
+}
+
 /* Reads texture tex's image as stored (8-bit values come back in [0, 1], still encoded). */
 static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, uint32_t *w, uint32_t *h,
-                              float **rgb, lmb_error *err)
+                              float **rgb, int *fatal, lmb_error *err)
 {
     int32_t src = v->textures[tex].source;
     if (src < 0 || (uint32_t)src >= v->image_count)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: texture %u has no usable image", s->path, tex);
     const lmb_gltf_image *img = &v->images[src];
     if (img->bytes)
-        return lmb_image_read_rgb(mem_name(img->mime), img->bytes, img->size, w, h, rgb, err);
+        return decode_checked(s, src, mem_name(img->mime), img->bytes, img->size, w, h, rgb, fatal, err);
     /* files only from the input's folder and below (issue 15; load/uri.h) */
     char folder[4096], rel[4096], path[8300], real[4096];
     const char *slash = strrchr(s->path, '/');
@@ -58,7 +78,7 @@ static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32
     if (!lmb_path_inside(folder, path, real, sizeof real))
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: image %d: '%s' is not a file inside the input's folder", s->path,
                              src, img->uri);
-    return lmb_image_read_rgb(real, NULL, 0, w, h, rgb, err);
+    return decode_checked(s, src, real, NULL, 0, w, h, rgb, fatal, err);
 }
 
 static int wrap_mode(int32_t gl, const char *axis, const lmb_scene *s, uint32_t tex, const lmb_log *log)
@@ -71,13 +91,13 @@ static int wrap_mode(int32_t gl, const char *axis, const lmb_scene *s, uint32_t 
 
 /* Makes texture tex available in `space` (decoding the image once per space). */
 static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, lmb_tex_space space,
-                           lmb_texture *out, const lmb_log *log, lmb_error *err)
+                           lmb_texture *out, int *fatal, const lmb_log *log, lmb_error *err)
 {
     if (out->pixels[space])
         return LMB_OK;
     float *px = NULL;
     uint32_t w, h;
-    lmb_status st = read_pixels(s, v, tex, &w, &h, &px, err);
+    lmb_status st = read_pixels(s, v, tex, &w, &h, &px, fatal, err);
     if (st != LMB_OK)
         return st;
     size_t n = (size_t)w * h;
@@ -101,12 +121,14 @@ static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t 
     return LMB_OK;
 }
 
-/* Loads the texture of slot `ref` for `role` of material m; a texture that cannot be read is a warning. */
+/* Loads the texture of slot `ref` for `role` of material m; a texture that cannot be read is a
+ * warning, one too large to decode an error (into *st). */
 static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_material *m, const lmb_texture_ref *ref,
-                     lmb_tex_space space, const char *role, lmb_textures *out, const lmb_log *log)
+                     lmb_tex_space space, const char *role, lmb_textures *out, const lmb_log *log, lmb_status *st,
+                     lmb_error *err)
 {
     int32_t tex = ref->texture;
-    if (tex < 0)
+    if (tex < 0 || *st != LMB_OK)
         return;
     if ((uint32_t)tex >= v->texture_count) {
         lmb_warn(log, "%s: material '%s' names %s texture %d, which does not exist; using its factor", s->path,
@@ -114,8 +136,13 @@ static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_mater
         return;
     }
     lmb_error e;
-    if (load_one(s, v, (uint32_t)tex, space, &out->t[tex], log, &e) != LMB_OK)
-        lmb_warn(log, "material '%s': %s texture not used: %s", m->name, role, e.message);
+    int fatal = 0;
+    if (load_one(s, v, (uint32_t)tex, space, &out->t[tex], &fatal, log, &e) != LMB_OK) {
+        if (fatal)
+            *st = lmb_error_set(err, LMB_ERR_INPUT, "material '%s': %s texture: %s", m->name, role, e.message);
+        else
+            lmb_warn(log, "material '%s': %s texture not used: %s", m->name, role, e.message);
+    }
 }
 
 lmb_status lmb_textures_load(const lmb_scene *s, lmb_textures *out, const lmb_log *log, lmb_error *err)
@@ -126,24 +153,25 @@ lmb_status lmb_textures_load(const lmb_scene *s, lmb_textures *out, const lmb_lo
     out->t = calloc((size_t)v->texture_count + 1, sizeof *out->t);
     if (!out->t)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "textures: out of memory");
-    for (uint32_t i = 0; i < s->material_count; i++) {
+    lmb_status st = LMB_OK;
+    for (uint32_t i = 0; i < s->material_count && st == LMB_OK; i++) {
         const lmb_material *m = &s->materials[i];
         if (lmb_material_is_emissive(m))
-            load_for(s, v, m, &m->emissive_texture, LMB_TEX_COLOUR, "emissive", out, log);
+            load_for(s, v, m, &m->emissive_texture, LMB_TEX_COLOUR, "emissive", out, log, &st, err);
         if (m->unlit)
             continue;
         if (m->spec_gloss) {
-            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "diffuse", out, log);
-            load_for(s, v, m, &m->specular_texture, LMB_TEX_COLOUR, "specular-glossiness", out, log);
+            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "diffuse", out, log, &st, err);
+            load_for(s, v, m, &m->specular_texture, LMB_TEX_COLOUR, "specular-glossiness", out, log, &st, err);
             continue;
         }
         /* metalness = metallicFactor x texture blue <= metallicFactor: a texture can only lower it */
         if (m->metallic < 1 || (m->metallic_texture.texture >= 0 && m->metallic > 0))
-            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "base colour", out, log);
+            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "base colour", out, log, &st, err);
         if (m->metallic > 0)
-            load_for(s, v, m, &m->metallic_texture, LMB_TEX_DATA, "metallicRoughness", out, log);
+            load_for(s, v, m, &m->metallic_texture, LMB_TEX_DATA, "metallicRoughness", out, log, &st, err);
     }
-    return LMB_OK;
+    return st;
 }
 
 const lmb_texture *lmb_textures_get(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space)

@@ -87,6 +87,22 @@ extern "C" lmb_status lmb_image_write_f32(const char *path, uint32_t w, uint32_t
     }
 }
 
+extern "C" lmb_status lmb_image_size(const char *name, const uint8_t *bytes, size_t size, uint32_t *w, uint32_t *h,
+                                      lmb_error *err)
+{
+    try {
+        OIIO::Filesystem::IOMemReader mem(bytes, bytes ? size : 0);
+        auto in = OIIO::ImageInput::open(name, nullptr, bytes ? &mem : nullptr);
+        if (!in)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot read image: %s", name, OIIO::geterror().c_str());
+        *w = (uint32_t)(in->spec().width > 0 ? in->spec().width : 0);
+        *h = (uint32_t)(in->spec().height > 0 ? in->spec().height : 0);
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot read image: %s", name, e.what());
+    }
+}
+
 extern "C" lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t size, uint32_t *w, uint32_t *h,
                                          float **rgb, lmb_error *err)
 {

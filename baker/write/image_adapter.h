@@ -26,6 +26,10 @@ lmb_status lmb_image_write_f32(const char *path, uint32_t width, uint32_t height
  * values as stored: 8-bit formats come back sRGB-encoded in [0, 1]. From the file `name`,
  * or from memory when bytes != NULL (then `name` only picks the format by its extension).
  * The caller frees *rgb. */
+/* The size of an image from its header alone (nothing decoded): name is a file, or with bytes
+ * the format hint of an in-memory image. */
+lmb_status lmb_image_size(const char *name, const uint8_t *bytes, size_t size, uint32_t *w, uint32_t *h, lmb_error *err);
+
 lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t size, uint32_t *width, uint32_t *height,
                               float **rgb, lmb_error *err);
 
