@@ -274,7 +274,7 @@ static lmb_status light_directions(const lmb_config *cfg, lmb_gather_job *job, a
         if (!d)
             return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u's directions", a);
         lmb_gather_stats gs = {0, 0, 0, 0};
-        if (!stats->no_light)
+        if (!stats->no_light && stats->bounces > 0) /* bounces: 0 has no indirect light to point to */
             st = lmb_gather_directions(job, a, t, cfg->directional_rays, d, &gs);
         stats->rays += gs.rays;
         for (uint32_t i = 0; st == LMB_OK && i < t->count; i++) {
