@@ -5,6 +5,7 @@
 #include "irradiance_cache/ic_pass.h"
 #include "post/rim.h"
 #include "util/clock.h"
+#include "util/lmb_math.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -156,11 +157,6 @@ static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3
         out[c] = count ? sum[c] / (double)count : 0;
 }
 
-static double luminance(const double c[3])
-{
-    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-}
-
 /*
  * bounces: auto (README "Bounces"). Pass b sets the cache to E_b = E_direct + gather(E_{b-1});
  * what it added, D_b = mean(E_b - E_{b-1}), shrinks by the scene's bounce ratio r = D_b / D_{b-1}
@@ -188,7 +184,7 @@ static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error 
     double before[3], after[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
     lmb_status st = LMB_OK;
     mean_rgb(w, n, offsetof(atlas_work, direct), before);
-    stats->bounce_energy[0] = luminance(before);
+    stats->bounce_energy[0] = lmb_luminance(before);
     char stage[64];
     int converged = 0;
     uint32_t done = 0;
@@ -209,14 +205,14 @@ static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error 
             ratio[c] = ratio[c] < 0 ? 0 : ratio[c] > 0.98 ? 0.98 : ratio[c];
         }
         if (b < LMB_MAX_REPORTED_BOUNCES)
-            stats->bounce_energy[b] = luminance(added);
-        double r = luminance(ratio), total = luminance(after), tail[3];
+            stats->bounce_energy[b] = lmb_luminance(added);
+        double r = lmb_luminance(ratio), total = lmb_luminance(after), tail[3];
         for (int c = 0; c < 3; c++)
             tail[c] = added[c] * ratio[c] / (1 - ratio[c]);
-        double tail_share = total + luminance(tail) > 0 ? luminance(tail) / (total + luminance(tail)) : 0;
+        double tail_share = total + lmb_luminance(tail) > 0 ? lmb_luminance(tail) / (total + lmb_luminance(tail)) : 0;
         int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
         /* a pass that adds under 0.1% of the light is at the passes' noise level: stop there */
-        int small = luminance(added) <= 1e-3 * total;
+        int small = lmb_luminance(added) <= 1e-3 * total;
         converged = small || (settled && tail_share < cfg->bounces_tail);
         stats->bounce_stop = small ? LMB_BOUNCES_SMALL_PASS : converged ? LMB_BOUNCES_TAIL : LMB_BOUNCES_MAX;
         stats->tail_share = b >= 2 ? tail_share : 0;
@@ -228,7 +224,7 @@ static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error 
             before[c] = after[c];
         }
         int last_pass = converged || b == max_passes;
-        if (last_pass && luminance(added) > 0 && b >= 2) {
+        if (last_pass && lmb_luminance(added) > 0 && b >= 2) {
             /* the geometric tail, texel by texel, from E_b - E_{b-1} (E_{b-1} is what the cache
              * holds at valid texels; invalid ones are stored as 0 whatever they hold) */
             for (uint32_t a = 0; a < n; a++) {

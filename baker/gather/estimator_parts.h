@@ -8,6 +8,7 @@
 #define LMBAKE_ESTIMATOR_PARTS_H
 
 #include "gather/estimator.h"
+#include "util/lmb_math.h"
 
 #include <string.h>
 
@@ -16,7 +17,7 @@ int lmb_estimator_scratch_reserve(lmb_estimator_scratch *s, uint32_t n);
 
 static inline double luminance(const double c[3])
 {
-    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    return lmb_luminance(c);
 }
 
 /* The numbers of sample j: counter-based, whatever the method. */

@@ -2,6 +2,7 @@
 #include "gather.h"
 
 #include "gather/guide.h"
+#include "util/lmb_math.h"
 
 #include <omp.h>
 
@@ -231,7 +232,7 @@ static void texel_direction(const lmb_gather_job *job, uint32_t atlas, const lmb
         if (lmb_dot3(w, pr.sp.ng) <= 0)
             continue;
         cached_radiance(&pr, w, s, l);
-        double lum = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+        double lum = lmb_luminance(l);
         for (int k = 0; k < 3; k++)
             v[k] += lum * w[k];
     }

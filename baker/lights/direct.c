@@ -214,7 +214,7 @@ typedef struct point_ctx {
 /* Adds one light's contribution rgb, arriving from unit direction d, to e (and to c->dir). */
 static void add_light(point_ctx *c, const double d[3], const double rgb[3], double e[3])
 {
-    double lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    double lum = lmb_luminance(rgb);
     for (int k = 0; k < 3; k++) {
         e[k] += rgb[k];
         c->dir[k] += lum * d[k];

@@ -4,6 +4,7 @@
 #include "post/dilate.h"
 #include "texels/texels.h"
 #include "util/clock.h"
+#include "util/lmb_math.h"
 #include "util/spd_solve.h"
 
 #include <math.h>
@@ -295,11 +296,6 @@ static void row_at(const lmb_layout *l, const seam_side sides[2], double t, seam
     }
 }
 
-static double luminance(const double c[3])
-{
-    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-}
-
 /* |lum A - lum B| / their mean at a seam point, from the atlases as they are. */
 static double jump_at(float *const *rgb, const seam_row *r)
 {
@@ -309,7 +305,7 @@ static double jump_at(float *const *rgb, const seam_row *r)
         for (int c = 0; c < 3; c++)
             side[j / 4][c] += fabs(r->w[j]) * p[c];
     }
-    double a = luminance(side[0]), b = luminance(side[1]), m = 0.5 * (a + b);
+    double a = lmb_luminance(side[0]), b = lmb_luminance(side[1]), m = 0.5 * (a + b);
     return m > 0 ? fabs(a - b) / m : 0;
 }
 
