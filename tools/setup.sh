@@ -2,6 +2,8 @@
 # Installs what lmbake needs (Debian packages; later npm pieces), only what is missing,
 # then configures and builds one build tree. Idempotent and quiet when nothing is missing.
 #   usage: tools/setup.sh [BUILD_DIR] [extra cmake args...]   (default: build, Release)
+#   LMB_SETUP_PACKAGES: more Debian packages a caller needs (tools/fuzz.sh: clang-14, libFuzzer)
+#   LMB_BUILD_TARGETS: build only these targets (default: all)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,6 +24,9 @@ packages=(
   chromium                          # headless browser for the preview's shots and e2e test (playwright-core drives it)
   strace                            # the hostile-input test checks which files a bake opens
 )
+
+read -r -a extra <<<"${LMB_SETUP_PACKAGES:-}"
+packages+=("${extra[@]}")
 
 # node and npm: the machine's own if it has them, else Debian's
 command -v npm >/dev/null || packages+=(nodejs npm)
@@ -52,7 +57,9 @@ mkdir -p "$build_dir"
 if ! cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "$@" >"$log" 2>&1; then
   cat "$log"; echo "setup: cmake configure failed"; exit 1
 fi
-if ! cmake --build "$build_dir" -j"$(nproc)" >>"$log" 2>&1; then
+targets=()
+for t in ${LMB_BUILD_TARGETS:-}; do targets+=(--target "$t"); done
+if ! cmake --build "$build_dir" -j"$(nproc)" "${targets[@]}" >>"$log" 2>&1; then
   grep -E "error|Error" "$log" | head -n 40; echo "setup: build failed (full log: $log)"; exit 1
 fi
 if grep -q "warning:" "$log"; then

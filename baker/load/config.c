@@ -172,8 +172,9 @@ static lmb_status override_item(parse_ctx *c, const key_spec *k, const yaml_node
 
 static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    uint32_t count;
-    return lmb_cfg_set_count(k, base, count, lmb_cfg_each_item(c, k, n, base, override_item, &count));
+    uint32_t count = 0;
+    lmb_status st = lmb_cfg_each_item(c, k, n, base, override_item, &count); /* before count is read: argument order is unspecified */
+    return lmb_cfg_set_count(k, base, count, st);
 }
 
 

@@ -353,7 +353,8 @@ static lmb_status glob_item(parse_ctx *c, const key_spec *k, const yaml_node_t *
 /* Into char[LMB_MAX_PATTERNS][LMB_PATTERN_LEN] and its count; replaces the default. */
 lmb_status lmb_cfg_set_globs(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
 {
-    uint32_t count;
-    return lmb_cfg_set_count(k, base, count, lmb_cfg_each_item(c, k, n, base, glob_item, &count));
+    uint32_t count = 0;
+    lmb_status st = lmb_cfg_each_item(c, k, n, base, glob_item, &count); /* before count is read: argument order is unspecified */
+    return lmb_cfg_set_count(k, base, count, st);
 }
 

@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# Fuzzes lmbake's front door (issue 15) with libFuzzer: glTF load, the YAML config and texture
+# decoding (tests/fuzz/fuzz_*.c), built with Debian's clang-14, ASan and UBSan.
+#   usage: tools/fuzz.sh [SECONDS] [TARGET...]   (default: 60 s; targets gltf config image)
+# All targets run at once, each for SECONDS of wall time, one process each (the machine's cores
+# are shared). Seeds come from assets/ and tests/data (tests/fuzz/CMakeLists.txt has the same
+# patterns); what a run adds stays in build-fuzz/corpus/<target> for the next run. A crash, leak,
+# timeout (> 10 s per input) or out-of-memory (> 2 GiB) leaves its input in
+# build-fuzz/artifacts/<target>/ and fails the run: copy it to tests/fuzz/regressions/<target>/,
+# where ctest replays it in every test build, then fix the bug.
+# Prints executions, coverage (edges, features) and corpus size per target, and writes
+# build-fuzz/fuzz-summary.csv.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+shift || true
+targets=("$@")
+((${#targets[@]})) || targets=(gltf config image)
+
+# clang-14 with libFuzzer's runtime; libomp for clang's OpenMP
+LMB_SETUP_PACKAGES="clang-14 libclang-rt-14-dev libomp-14-dev" \
+LMB_BUILD_TARGETS="${targets[*]/#/fuzz_}" CC=clang-14 CXX=clang++-14 \
+  tools/setup.sh build-fuzz -DLMB_FUZZ=ON -DBUILD_TESTING=OFF
+
+out=build-fuzz
+seed_files() { # the seeds of one target, as in tests/fuzz/CMakeLists.txt
+  case $1 in
+    gltf) find assets tests/data -type f \( -name '*.gltf' -o -name '*.glb' \) ;;
+    config) find assets tests/preview -type f -name '*.yaml' ;;
+    image) find assets -type f \( -name '*.png' -o -name '*.jpg' \) -size -256k ;;
+  esac
+}
+max_len() { case $1 in gltf) echo 65536 ;; config) echo 16384 ;; image) echo 131072 ;; esac; }
+
+for t in "${targets[@]}"; do
+  rm -rf "$out/seeds/$t" "$out/artifacts/$t" "$out/logs/$t.log"
+  mkdir -p "$out/seeds/$t" "$out/corpus/$t" "$out/artifacts/$t" "$out/logs"
+  n=0
+  while IFS= read -r f; do cp "$f" "$out/seeds/$t/$n-$(basename "$f")"; n=$((n + 1)); done < <(seed_files "$t")
+  cp tests/fuzz/regressions/"$t"/* "$out/seeds/$t/" 2>/dev/null || true
+done
+
+echo "fuzz: ${targets[*]} for ${seconds} s each (ASan+UBSan; logs in $out/logs)"
+pids=()
+for t in "${targets[@]}"; do
+  dict=()
+  [ -f "tests/fuzz/$t.dict" ] && dict=(-dict="tests/fuzz/$t.dict")
+  # leaks are checked after every input; a slow input (> 10 s) is a timeout; 2 GiB is the cap
+  LSAN_OPTIONS=suppressions="$PWD/tests/fuzz/lsan.supp":print_suppressions=0 \
+  ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1:fast_unwind_on_malloc=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$out/tests/fuzz/fuzz_$t" "$out/corpus/$t" "$out/seeds/$t" "${dict[@]}" \
+      -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$(max_len "$t")" \
+      -print_final_stats=1 -artifact_prefix="$out/artifacts/$t/" >"$out/logs/$t.log" 2>&1 &
+  pids+=($!)
+done
+status=0
+for i in "${!pids[@]}"; do wait "${pids[$i]}" || status=1; done
+
+# Summary from each log: libFuzzer's final stats and its last coverage line.
+printf 'target,seconds,executions,execs_per_s,edges,features,corpus,crashes,leaks,timeouts,ooms\n' >"$out/fuzz-summary.csv"
+printf '%-7s %9s %12s %9s %7s %9s %7s %s\n' target seconds executions exec/s edges features corpus "crash/leak/timeout/oom"
+for t in "${targets[@]}"; do
+  log="$out/logs/$t.log"
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n1)
+  rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -n1)
+  cov=$({ grep -oE 'cov: [0-9]+ ft: [0-9]+ corp: [0-9]+' "$log" || true; } | tail -n1)
+  edges=$(awk '{print $2}' <<<"$cov"); features=$(awk '{print $4}' <<<"$cov"); corpus=$(awk '{print $6}' <<<"$cov")
+  art="$out/artifacts/$t"
+  crashes=$(find "$art" -name 'crash-*' | wc -l); leaks=$(find "$art" -name 'leak-*' | wc -l)
+  timeouts=$(find "$art" -name 'timeout-*' | wc -l); ooms=$(find "$art" -name 'oom-*' | wc -l)
+  printf '%s,%s,%s,%s,%s,%s,%s,%s,%s,%s,%s\n' "$t" "$seconds" "${runs:-0}" "${rate:-0}" "${edges:-0}" \
+    "${features:-0}" "${corpus:-0}" "$crashes" "$leaks" "$timeouts" "$ooms" >>"$out/fuzz-summary.csv"
+  printf '%-7s %9s %12s %9s %7s %9s %7s %s/%s/%s/%s\n' "$t" "$seconds" "${runs:-0}" "${rate:-0}" "${edges:-0}" \
+    "${features:-0}" "${corpus:-0}" "$crashes" "$leaks" "$timeouts" "$ooms"
+  if ((crashes + leaks + timeouts + ooms)); then
+    status=1
+    echo "fuzz: $t found a problem; its input is in $art/ (last lines of $log):"
+    { grep -E 'ERROR|SUMMARY|==[0-9]+==' "$log" || true; } | head -n 8
+  fi
+done
+echo "fuzz: summary in $out/fuzz-summary.csv"
+if ((status)); then echo "fuzz: FAILED"; exit 1; fi
+echo "fuzz: 0 crashes, 0 leaks, 0 timeouts, 0 out-of-memory"
