@@ -3,8 +3,8 @@
  * lighting (lighting.h: texels, direct light, bounce passes, final gather, dilation) ->
  * images (write/atlas_images.h); then the final gather's irradiance-cache records
  * (write/records_file.h) and the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written
- * into a staging folder inside outdir and moved into
- * place only when everything succeeded, so a failed bake leaves nothing behind; outdir may
+ * into a staging folder beside outdir and swapped into place only when everything succeeded
+ * (write/output_dir.h), so a failed or killed bake leaves nothing behind; outdir may
  * not be the input's own folder (the input and its .bin files are never written over).
  */
 #include <lmbake/lmbake.h>

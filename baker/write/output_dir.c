@@ -1,11 +1,13 @@
-/* Staged, all-or-nothing output folder (see output_dir.h). POSIX file calls. */
-#define _XOPEN_SOURCE 700
+/* Staged, all-or-nothing output folder, safe under kill -9 (see output_dir.h). Linux file
+ * calls: renameat2(RENAME_EXCHANGE) swaps two folders in one step. */
+#define _GNU_SOURCE
 #include "output_dir.h"
 
 #include "load/uri.h"
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <signal.h>
 #include <stdio.h>
@@ -13,6 +15,10 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* How many characters of the output folder's name the sibling staging folder carries (the
+ * whole name stays under NAME_MAX with the host and pid). */
+#define STAGING_NAME_CHARS 64
 
 static void dirname_of(const char *path, char *out, size_t size)
 {
@@ -26,7 +32,28 @@ static void dirname_of(const char *path, char *out, size_t size)
         *slash = '\0';
 }
 
-static void remove_tree(const char *path);
+/* Removes a folder and everything in it. Symbolic links are removed, never followed: the old
+ * output folder may hold a user's links to folders elsewhere. */
+static void remove_tree(const char *path)
+{
+    DIR *d = opendir(path);
+    if (d) {
+        struct dirent *e;
+        while ((e = readdir(d)) != NULL) {
+            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+                continue;
+            char a[8400];
+            struct stat sb;
+            snprintf(a, sizeof a, "%s/%s", path, e->d_name);
+            if (lstat(a, &sb) == 0 && S_ISDIR(sb.st_mode))
+                remove_tree(a);
+            else
+                unlink(a);
+        }
+        closedir(d);
+    }
+    rmdir(path);
+}
 
 /* This host's name, as staging folders carry it ('-' and '/' would confuse the parse). */
 static void host_name(char *out, size_t size)
@@ -39,23 +66,24 @@ static void host_name(char *out, size_t size)
             *p = '_';
 }
 
-/* Removes dir/.lmbake-staging-HOST-PID folders of this host whose process is gone (and the
- * older .lmbake-staging-PID form), naming each in a warning. */
-static void remove_stale_staging(const char *dir, const lmb_log *log)
+/* In folder `dir`, removes the entries named PREFIX HOST-PID (or the older PREFIX PID) of this
+ * host whose process is gone, naming each in a warning. */
+static void remove_stale_staging(const char *dir, const char *prefix, const lmb_log *log)
 {
-    char host[256], prefix[300];
+    char host[256], mine[600];
     host_name(host, sizeof host);
-    snprintf(prefix, sizeof prefix, ".lmbake-staging-%s-", host);
+    snprintf(mine, sizeof mine, "%s%s-", prefix, host);
+    size_t plen = strlen(prefix), mlen = strlen(mine);
     DIR *d = opendir(dir);
     if (!d)
         return;
     struct dirent *e;
     while ((e = readdir(d)) != NULL) {
         const char *pid_text = NULL;
-        if (!strncmp(e->d_name, prefix, strlen(prefix)))
-            pid_text = e->d_name + strlen(prefix);
-        else if (!strncmp(e->d_name, ".lmbake-staging-", 16) && strspn(e->d_name + 16, "0123456789") == strlen(e->d_name + 16))
-            pid_text = e->d_name + 16;
+        if (!strncmp(e->d_name, mine, mlen))
+            pid_text = e->d_name + mlen;
+        else if (!strncmp(e->d_name, prefix, plen))
+            pid_text = e->d_name + plen;
         if (!pid_text || !*pid_text || strspn(pid_text, "0123456789") != strlen(pid_text))
             continue;
         long pid = strtol(pid_text, NULL, 10);
@@ -64,16 +92,23 @@ static void remove_stale_staging(const char *dir, const lmb_log *log)
         char path[8400];
         snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
         remove_tree(path);
-        lmb_warn(log, "removed '%s', left by a bake that was stopped (process %ld is gone); its files were never "
-                 "part of the output", path, pid);
+        lmb_warn(log, "removed '%s', left by a bake that was stopped (process %ld is gone); its files are not "
+                 "part of the output folder", path, pid);
     }
     closedir(d);
+}
+
+/* The sibling staging folder's name prefix for output folder `name`: ".NAME.lmbake-staging-". */
+static void sibling_prefix(const char *name, char *out, size_t size)
+{
+    snprintf(out, size, ".%.*s.lmbake-staging-", STAGING_NAME_CHARS, name);
 }
 
 lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, const lmb_log *log,
                                lmb_error *err)
 {
     memset(od, 0, sizeof *od);
+    od->log = log;
     snprintf(od->dir, sizeof od->dir, "%s", dir);
     const char *base = strrchr(input_path, '/');
     snprintf(od->stem, sizeof od->stem, "%s", base ? base + 1 : input_path);
@@ -89,19 +124,37 @@ lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *
     } else {
         od->created_dir = 1;
     }
-    char in_dir[4096], real_in[PATH_MAX], real_out[PATH_MAX];
+    char in_dir[4096], real_in[PATH_MAX];
     dirname_of(input_path, in_dir, sizeof in_dir);
-    if (realpath(in_dir, real_in) && realpath(dir, real_out) && strcmp(real_in, real_out) == 0) {
+    if (!realpath(dir, od->real)) {
+        lmb_status st = lmb_error_set(err, LMB_ERR_INPUT, "cannot resolve output folder '%s': %s", dir, strerror(errno));
+        lmb_output_dir_abort(od);
+        return st;
+    }
+    if (realpath(in_dir, real_in) && strcmp(real_in, od->real) == 0) {
         lmb_output_dir_abort(od);
         return lmb_error_set(err, LMB_ERR_INPUT,
                              "output folder '%s' is the folder of the input '%s': choose another with -o, so the "
                              "input and its files are never written over",
                              dir, input_path);
     }
-    if (!od->created_dir)
-        remove_stale_staging(dir, log);
-    char host[256];
+    char parent[4096], prefix[STAGING_NAME_CHARS + 32], host[256];
+    dirname_of(od->real, parent, sizeof parent);
+    const char *name = strrchr(od->real, '/') + 1; /* realpath is absolute */
+    sibling_prefix(name, prefix, sizeof prefix);
     host_name(host, sizeof host);
+    remove_stale_staging(parent, prefix, log);
+    if (!od->created_dir)
+        remove_stale_staging(dir, ".lmbake-staging-", log);
+    if (*name) {
+        snprintf(od->staging, sizeof od->staging, "%s/%s%s-%ld", strcmp(parent, "/") ? parent : "", prefix, host,
+                 (long)getpid());
+        if (mkdir(od->staging, 0777) == 0)
+            return LMB_OK;
+        lmb_warn(log, "cannot stage beside the output folder ('%s': %s): staging inside it; a bake killed while "
+                 "its files move into place would leave old and new files mixed", od->staging, strerror(errno));
+    }
+    od->inside = 1;
     snprintf(od->staging, sizeof od->staging, "%s/.lmbake-staging-%s-%ld", dir, host, (long)getpid());
     if (mkdir(od->staging, 0777) != 0) {
         lmb_status st = lmb_error_set(err, LMB_ERR_INTERNAL, "cannot create '%s': %s", od->staging, strerror(errno));
@@ -135,7 +188,7 @@ static lmb_status copy_file(const char *from, const char *to, lmb_error *err)
 
 lmb_status lmb_output_dir_copy_input_file(lmb_output_dir *od, const char *input_path, const char *uri, lmb_error *err)
 {
-    char rel[4096], in_dir[4096], from[8300], real[4096], to[8600];
+    char rel[4096], in_dir[4096], from[8300], real[4096], to[8800];
     lmb_uri_kind kind = lmb_uri_check(uri, rel, sizeof rel);
     if (kind != LMB_URI_INSIDE)
         return lmb_error_set(err, LMB_ERR_INPUT, "texture uri '%s' %s", uri, lmb_uri_refusal(kind));
@@ -154,7 +207,8 @@ lmb_status lmb_output_dir_copy_input_file(lmb_output_dir *od, const char *input_
     return copy_file(real, to, err);
 }
 
-/* Moves every file under staging (recursively) to the same place under dir. */
+/* Moves every file under staging (recursively) to the same place under dir: the fallback
+ * commit, one rename per file. */
 static lmb_status move_tree(const char *from, const char *to, lmb_error *err)
 {
     DIR *d = opendir(from);
@@ -169,7 +223,7 @@ static lmb_status move_tree(const char *from, const char *to, lmb_error *err)
         struct stat sb;
         snprintf(a, sizeof a, "%s/%s", from, e->d_name);
         snprintf(b, sizeof b, "%s/%s", to, e->d_name);
-        if (stat(a, &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        if (lstat(a, &sb) == 0 && S_ISDIR(sb.st_mode)) {
             mkdir(b, 0777);
             st = move_tree(a, b, err);
             rmdir(a);
@@ -181,31 +235,74 @@ static lmb_status move_tree(const char *from, const char *to, lmb_error *err)
     return st;
 }
 
-static void remove_tree(const char *path)
+/* Puts into staging a hard link to every entry of the output folder that the bake does not
+ * write again (earlier outputs, a user's files), folders recursively, so that after the swap
+ * the output folder holds them as before. Other bakes' staging folders are left out. */
+static lmb_status link_others(const char *from, const char *to, lmb_error *err)
 {
-    DIR *d = opendir(path);
-    if (d) {
-        struct dirent *e;
-        while ((e = readdir(d)) != NULL) {
-            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
-                continue;
-            char a[8400];
-            struct stat sb;
-            snprintf(a, sizeof a, "%s/%s", path, e->d_name);
-            if (stat(a, &sb) == 0 && S_ISDIR(sb.st_mode))
-                remove_tree(a);
+    DIR *d = opendir(from);
+    if (!d)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "cannot read '%s': %s", from, strerror(errno));
+    lmb_status st = LMB_OK;
+    struct dirent *e;
+    while (st == LMB_OK && (e = readdir(d)) != NULL) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..") || !strncmp(e->d_name, ".lmbake-staging-", 16))
+            continue;
+        char a[8400], b[8400];
+        struct stat sa, sb;
+        snprintf(a, sizeof a, "%s/%s", from, e->d_name);
+        snprintf(b, sizeof b, "%s/%s", to, e->d_name);
+        if (lstat(a, &sa) != 0)
+            continue; /* gone meanwhile */
+        int staged = lstat(b, &sb) == 0;
+        if (S_ISDIR(sa.st_mode)) {
+            if (staged && !S_ISDIR(sb.st_mode))
+                continue; /* the bake writes a file where a folder was: the bake's wins */
+            if (!staged && mkdir(b, sa.st_mode & 07777) != 0)
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "cannot create '%s': %s", b, strerror(errno));
             else
-                unlink(a);
+                st = link_others(a, b, err);
+        } else if (!staged && linkat(AT_FDCWD, a, AT_FDCWD, b, 0) != 0) {
+            /* a file system without hard links: a copy keeps the file just as well */
+            if (!S_ISREG(sa.st_mode))
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "cannot keep '%s' in the output folder: %s", a,
+                                   strerror(errno));
+            else
+                st = copy_file(a, b, err);
         }
-        closedir(d);
     }
-    rmdir(path);
+    closedir(d);
+    return st;
 }
 
 lmb_status lmb_output_dir_commit(lmb_output_dir *od, lmb_error *err)
 {
-    lmb_status st = move_tree(od->staging, od->dir, err);
+    lmb_status st;
+    if (!od->inside) {
+        struct stat sb;
+        st = link_others(od->real, od->staging, err);
+        if (st == LMB_OK && stat(od->real, &sb) == 0)
+            chmod(od->staging, sb.st_mode & 07777);
+        if (st == LMB_OK && renameat2(AT_FDCWD, od->staging, AT_FDCWD, od->real, RENAME_EXCHANGE) == 0) {
+            remove_tree(od->staging); /* now the old output folder */
+            od->staging[0] = '\0';
+            return LMB_OK;
+        }
+        if (st != LMB_OK) {
+            lmb_output_dir_abort(od);
+            return st;
+        }
+        if (errno != EINVAL && errno != ENOSYS && errno != EXDEV && errno != ENOTSUP && errno != EBUSY) {
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "cannot swap '%s' into place: %s", od->staging, strerror(errno));
+            lmb_output_dir_abort(od);
+            return st;
+        }
+        lmb_warn(od->log, "'%s': the file system cannot swap folders (%s); moving the new files in one by one (a "
+                 "kill meanwhile would leave old and new files mixed)", od->dir, strerror(errno));
+    }
+    st = move_tree(od->staging, od->dir, err);
     remove_tree(od->staging);
+    od->staging[0] = '\0';
     return st;
 }
 
@@ -213,6 +310,7 @@ void lmb_output_dir_abort(lmb_output_dir *od)
 {
     if (od->staging[0])
         remove_tree(od->staging);
+    od->staging[0] = '\0';
     if (od->created_dir)
         rmdir(od->dir);
 }

@@ -84,7 +84,9 @@ def scene(work):
 
 def opened_outside(trace, cwd, work, indir, out):
     """Paths strace saw opened (successfully or not) that the bake must not touch: what the
-    hostile URIs aim at, and anything of WORKDIR outside the input, output and config folders."""
+    hostile URIs aim at, and anything of WORKDIR outside the input, output and config folders
+    and the bake's own staging folder beside the output (.OUT.lmbake-staging-HOST-PID)."""
+    staging = os.path.join(os.path.dirname(out), "." + os.path.basename(out) + ".lmbake-staging-")
     bad = []
     for line in open(trace, errors="replace"):
         m = re.search(r'open(?:at)?\((?:AT_FDCWD, )?"([^"]*)"', line)
@@ -93,6 +95,7 @@ def opened_outside(trace, cwd, work, indir, out):
         p = os.path.normpath(os.path.join(cwd, m.group(1)))
         real = os.path.realpath(p)
         inside = any(x == d or x.startswith(d + "/") for x in (p, real) for d in (indir, out, work + "/config"))
+        inside = inside or any(x.startswith(staging) for x in (p, real))
         if real in TARGETS or p in TARGETS or ((p.startswith(work + "/") or real.startswith(work + "/")) and not inside):
             bad.append(p)
     return sorted(set(bad))
