@@ -10,6 +10,8 @@
 #include "progress.h"
 
 #include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char help[] =
@@ -27,6 +29,8 @@ static const char help[] =
     "                      invalid, atlases) headless to OUTDIR/preview-<view>.png\n"
     "      --reference     path-trace indirect light with no cache (ground truth for error\n"
     "                      measurement; --rays paths per texel: use many)\n"
+    "      --print-config  print the effective config (every key, after -c and the options\n"
+    "                      above) as YAML that -c reads back, and exit; SCENE may be left out\n"
     "  -q, --quiet         no progress or warnings\n"
     "  -h, --help          this help\n"
     "\n"
@@ -40,7 +44,7 @@ static const char help[] =
 typedef struct bake_args {
     const char *scene, *config, *outdir;
     long long threads, seed, rays, method; /* -1: from the config */
-    int quiet, reference, preview;
+    int quiet, reference, preview, print_config;
 } bake_args;
 
 static int parse_args(int argc, char **argv, bake_args *a)
@@ -87,6 +91,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->preview = 1;
         } else if (cli_is_flag(argv[i], "--reference", NULL)) {
             a->reference = 1;
+        } else if (cli_is_flag(argv[i], "--print-config", NULL)) {
+            a->print_config = 1;
         } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
             a->quiet = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
@@ -97,7 +103,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->scene = argv[i];
         }
     }
-    if (!a->scene)
+    if (!a->scene && !a->print_config)
         return cli_usage_error("bake", "no SCENE given");
     return 0;
 }
@@ -147,6 +153,16 @@ int cmd_bake(int argc, char **argv)
     if (a.method >= 0)
         cfg.gather_method = (lmb_gather_method)a.method;
     cfg.reference = a.reference;
+    if (a.print_config) {
+        size_t n = lmb_config_write(&cfg, NULL, 0);
+        char *text = malloc(n + 1);
+        if (!text)
+            return cli_fail(&(lmb_error){LMB_ERR_INTERNAL, "out of memory"});
+        lmb_config_write(&cfg, text, n + 1);
+        fputs(text, stdout);
+        free(text);
+        return 0;
+    }
     cli_warnings warnings = {0, a.quiet};
     lmb_log log = cli_log(&warnings);
     double t0 = cli_now();

@@ -103,6 +103,16 @@ static const key_spec override_keys[] = {
 static const schema config_schema = {config_keys, sizeof config_keys / sizeof *config_keys};
 static const schema override_schema = {override_keys, sizeof override_keys / sizeof *override_keys};
 
+const schema *lmb_cfg_schema(void)
+{
+    return &config_schema;
+}
+
+const schema *lmb_cfg_override_schema(void)
+{
+    return &override_schema;
+}
+
 void lmb_config_default(lmb_config *cfg)
 {
     memset(cfg, 0, sizeof *cfg); /* also the padding bytes, so configs compare with memcmp */

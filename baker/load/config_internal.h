@@ -47,6 +47,10 @@ typedef struct schema {
     size_t count;
 } schema;
 
+/* The schema tables (config.c), for the writer (config_write.c). */
+const schema *lmb_cfg_schema(void);
+const schema *lmb_cfg_override_schema(void);
+
 /* Nodes and messages (config_values.c). */
 size_t lmb_cfg_line_of(const yaml_node_t *n);
 const yaml_node_t *lmb_cfg_node(const parse_ctx *c, int id);

@@ -282,6 +282,11 @@ lmb_status lmb_config_load(const char *path, lmb_config *cfg, lmb_error *err);
 lmb_status lmb_config_parse(const char *name, const char *text, size_t length, lmb_config *cfg,
                             lmb_error *err);
 
+/* The effective config as YAML (every key, grouped by section) that lmb_config_parse reads back
+ * to the same lmb_config; like snprintf, writes at most size bytes (NUL included) and returns the
+ * length the whole text needs. Two configs that bake the same give the same text. */
+size_t lmb_config_write(const lmb_config *cfg, char *buf, size_t size);
+
 /* glob match with '*' and '?', used for node/mesh name patterns. */
 int lmb_glob_match(const char *pattern, const char *name);
 

@@ -344,6 +344,56 @@ static void test_example(const char *path)
     CHECK(same_as_defaults(&c));
 }
 
+/* The written config reads back to the same struct (memcmp: defaults zero the padding), and
+ * two configs that differ in one key differ in that key's line. */
+static void round_trip(const char *text)
+{
+    lmb_config a, b;
+    lmb_error err = {LMB_OK, ""};
+    lmb_config_default(&a);
+    CHECK_INT(lmb_config_parse("rt.yaml", text, strlen(text), &a, &err), LMB_OK);
+    char written[16384];
+    size_t n = lmb_config_write(&a, written, sizeof written);
+    CHECK(n > 0 && n < sizeof written);
+    CHECK_INT(strlen(written), n);
+    lmb_config_default(&b);
+    b.seed = 77; /* overwritten by the text: every key is there */
+    b.gather_rays = 3;
+    err.message[0] = 0;
+    CHECK_INT(lmb_config_parse("written.yaml", written, n, &b, &err), LMB_OK);
+    if (err.message[0])
+        fprintf(stderr, "%s\n%s\n", err.message, written);
+    CHECK(memcmp(&a, &b, sizeof a) == 0);
+    char small[8];
+    CHECK_INT(lmb_config_write(&a, small, sizeof small), n); /* the length it needs, truncated */
+    CHECK_INT(strlen(small), 7);
+}
+
+static void test_write(void)
+{
+    round_trip("");
+    round_trip("texel_density: 12.5\n"
+               "density_overrides: [{match: \"Floor \\\"*\", texel_density: 32}, {match: P?, texel_density: 0.1}]\n"
+               "atlas: {texels: 70000, max_size: 2048, padding: 4, keep_uv1: yes}\n"
+               "samples: {gather: 1024, bounce_high: 0}\n"
+               "bounces: 3\n"
+               "gather: {method: amis, amis_weights: balance, defensive: 0.3333333333333333}\n"
+               "irradiance_cache: {error: 0, records: per_pass}\n"
+               "seed: 9000000000\n"
+               "output: {formats: [png, exr, mask], directional: false}\n"
+               "lightmap: {include: [\"Room*\", \"Prop?\"], exclude: [], extras_key: bake}\n"
+               "lights: {intensity_scale: 0.1, emission_sides: material}\n"
+               "seams: {stitch: false}\n");
+    lmb_config a, b;
+    lmb_config_default(&a);
+    lmb_config_default(&b);
+    b.gather_rays = 512;
+    char ta[16384], tb[16384];
+    lmb_config_write(&a, ta, sizeof ta);
+    lmb_config_write(&b, tb, sizeof tb);
+    CHECK(strstr(ta, "\n  gather: 256\n") && strstr(tb, "\n  gather: 512\n"));
+}
+
 static void test_glob(void)
 {
     CHECK(lmb_glob_match("*", ""));
@@ -391,5 +441,6 @@ int main(int argc, char **argv)
         check_failed_count++;
     }
     test_glob();
+    test_write();
     return check_failures();
 }
