@@ -16,6 +16,7 @@ packages=(
   libyaml-dev                       # bake config (YAML with line numbers for errors)
   libtinygltf-dev                   # glTF 2.0 reading and writing
   libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
+  nettle-dev                        # SHA-256 of the staged bake's plan and part files
   libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
   libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
   libopenmesh-dev                   # the unwrapper's half-edge mesh (OpenMesh, behind baker/unwrap/halfedge_adapter.cpp)

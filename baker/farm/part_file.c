@@ -1,0 +1,268 @@
+/* The staged bake's file container (part_file.h), SHA-256 by nettle. */
+#define _GNU_SOURCE
+#include "part_file.h"
+
+#include "load/gltf_adapter.h"
+#include "util/file.h"
+
+#include <errno.h>
+#include <nettle/sha2.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char magic[8] = {'L', 'M', 'B', 'A', 'K', 'E', 1, '\n'};
+/* magic, 5 x u32, version, 3 hashes, 2 x u64 */
+#define HEADER_BYTES (8 + 5 * 4 + 32 + 3 * 32 + 2 * 8)
+
+void lmb_sha256_hex(const void *data, size_t n, char hex[65])
+{
+    struct sha256_ctx c;
+    uint8_t d[SHA256_DIGEST_SIZE];
+    sha256_init(&c);
+    sha256_update(&c, n, data);
+    sha256_digest(&c, sizeof d, d);
+    for (int i = 0; i < 32; i++)
+        snprintf(hex + 2 * i, 3, "%02x", d[i]);
+}
+
+static void hex8(const uint8_t *sha, char out[17])
+{
+    for (int i = 0; i < 8; i++)
+        snprintf(out + 2 * i, 3, "%02x", sha[i]);
+}
+
+lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg, lmb_part_identity *id,
+                                  lmb_error *err)
+{
+    memset(id, 0, sizeof *id);
+    snprintf(id->version, sizeof id->version, "%s", LMB_VERSION_STRING);
+    char *file;
+    size_t size;
+    lmb_status st = lmb_read_file(scene->path, "input", &file, &size, err);
+    if (st != LMB_OK)
+        return st;
+    struct sha256_ctx c;
+    sha256_init(&c);
+    sha256_update(&c, size, (const uint8_t *)file);
+    free(file);
+    const lmb_gltf_view *v = lmb_gltf_get_view(scene->doc);
+    for (uint32_t b = 0; b < v->buffer_count; b++) { /* as loaded: external files and data URIs */
+        uint64_t n = v->buffers[b].size;
+        sha256_update(&c, sizeof n, (const uint8_t *)&n);
+        if (n)
+            sha256_update(&c, n, v->buffers[b].data);
+    }
+    sha256_digest(&c, 32, id->input);
+    lmb_config bare = *cfg;
+    bare.threads = 0;
+    size_t n = lmb_config_write(&bare, NULL, 0);
+    id->config_text = malloc(n + 1);
+    if (!id->config_text)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory");
+    lmb_config_write(&bare, id->config_text, n + 1);
+    sha256_init(&c);
+    sha256_update(&c, n, (const uint8_t *)id->config_text);
+    sha256_digest(&c, 32, id->config);
+    return LMB_OK;
+}
+
+void lmb_part_identity_free(lmb_part_identity *id)
+{
+    free(id->config_text);
+    id->config_text = NULL;
+}
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static void put_u64(uint8_t *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++)
+        p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static uint32_t get_u32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static uint64_t get_u64(const uint8_t *p)
+{
+    return (uint64_t)get_u32(p) | (uint64_t)get_u32(p + 4) << 32;
+}
+
+lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
+                          const void *body, size_t body_length, lmb_error *err)
+{
+    uint8_t h[HEADER_BYTES], *p = h;
+    size_t config_length = id->config_text ? strlen(id->config_text) : 0;
+    memcpy(p, magic, 8), p += 8;
+    put_u32(p, LMB_PART_FORMAT), p += 4;
+    put_u32(p, place->kind), p += 4;
+    put_u32(p, place->step), p += 4;
+    put_u32(p, place->shard), p += 4;
+    put_u32(p, place->shards), p += 4;
+    memset(p, 0, 32);
+    memcpy(p, id->version, strnlen(id->version, 31)), p += 32;
+    memcpy(p, id->input, 32), p += 32;
+    memcpy(p, id->config, 32), p += 32;
+    memcpy(p, id->plan, 32), p += 32;
+    put_u64(p, config_length), p += 8;
+    put_u64(p, body_length);
+    struct sha256_ctx c;
+    uint8_t sum[32];
+    sha256_init(&c);
+    sha256_update(&c, sizeof h, h);
+    sha256_update(&c, config_length, (const uint8_t *)id->config_text);
+    sha256_update(&c, body_length, body);
+    sha256_digest(&c, 32, sum);
+
+    char host[256], tmp[4600];
+    if (gethostname(host, sizeof host) != 0)
+        snprintf(host, sizeof host, "localhost");
+    host[sizeof host - 1] = '\0';
+    snprintf(tmp, sizeof tmp, "%s.tmp-%s-%ld", path, host, (long)getpid());
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "cannot write '%s': %s", tmp, strerror(errno));
+    int bad = fwrite(h, 1, sizeof h, f) != sizeof h;
+    bad |= config_length && fwrite(id->config_text, 1, config_length, f) != config_length;
+    bad |= body_length && fwrite(body, 1, body_length, f) != body_length;
+    bad |= fwrite(sum, 1, 32, f) != 32;
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        lmb_status st = lmb_error_set(err, LMB_ERR_INTERNAL, "cannot write '%s': %s", path, strerror(errno));
+        remove(tmp);
+        return st;
+    }
+    return LMB_OK;
+}
+
+/* One line of a config text (lmb_config_write): its key (after any indent) and value. */
+static void split_line(const char *line, size_t length, const char **key, size_t *key_length, const char **value,
+                       size_t *value_length)
+{
+    size_t indent = strspn(line, " ");
+    const char *colon = memchr(line, ':', length);
+    *key = line + indent;
+    *key_length = colon ? (size_t)(colon - *key) : length - indent;
+    *value = colon ? colon + 1 + (colon + 1 < line + length && colon[1] == ' ') : line + length;
+    *value_length = (size_t)(line + length - *value);
+}
+
+/* The first key whose line differs in two config texts: "config key 'samples.gather' is 512
+ * there, 256 here" (a section's keys are named with the section). */
+static void config_difference(const char *there, const char *here, char *out, size_t size)
+{
+    char section[128] = "";
+    snprintf(out, size, "the config differs");
+    while (*there || *here) {
+        size_t a = strcspn(there, "\n"), b = strcspn(here, "\n");
+        const char *ka, *va, *kb, *vb;
+        size_t kal, val, kbl, vbl;
+        split_line(there, a, &ka, &kal, &va, &val);
+        split_line(here, b, &kb, &kbl, &vb, &vbl);
+        int indented = here[0] == ' ';
+        if (a != b || memcmp(there, here, a)) {
+            if (kal == kbl && !memcmp(ka, kb, kal))
+                snprintf(out, size, "config key '%s%.*s' is %.*s there, %.*s here", indented ? section : "", (int)kbl,
+                         kb, (int)val, va, (int)vbl, vb);
+            return;
+        }
+        if (!indented && here[0] != '#' && vbl == 0)
+            snprintf(section, sizeof section, "%.*s.", (int)kbl, kb);
+        there += a + (there[a] == '\n');
+        here += b + (here[b] == '\n');
+    }
+}
+
+static lmb_status refuse(const char *path, lmb_error *err, const char *what)
+{
+    return lmb_error_set(err, LMB_ERR_INPUT, "'%s': %s", path, what);
+}
+
+lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
+                         lmb_part_place *got, void **body, size_t *body_length, lmb_error *err)
+{
+    *body = NULL;
+    *body_length = 0;
+    char *file;
+    size_t size;
+    lmb_status st = lmb_read_file(path, "part", &file, &size, err);
+    if (st != LMB_OK)
+        return st;
+    const uint8_t *h = (const uint8_t *)file;
+    char why[600];
+    if (size < HEADER_BYTES + 32 || memcmp(h, magic, 8)) {
+        int ours = size >= 8 && !memcmp(h, magic, 8);
+        free(file);
+        return refuse(path, err, ours ? "truncated (shorter than its header)" : "not an lmbake plan or part file");
+    }
+    uint32_t format = get_u32(h + 8);
+    uint64_t config_length = get_u64(h + 8 + 20 + 32 + 96), length = get_u64(h + 8 + 20 + 32 + 96 + 8);
+    if (format != LMB_PART_FORMAT) {
+        snprintf(why, sizeof why, "file format %u; this lmbake reads format %u", format, LMB_PART_FORMAT);
+        free(file);
+        return refuse(path, err, why);
+    }
+    if (config_length > size || length > size || HEADER_BYTES + config_length + length + 32 != size) {
+        free(file);
+        return refuse(path, err, "truncated or padded: its length is not what its header says");
+    }
+    uint8_t sum[32];
+    struct sha256_ctx c;
+    sha256_init(&c);
+    sha256_update(&c, size - 32, h);
+    sha256_digest(&c, 32, sum);
+    if (memcmp(sum, h + size - 32, 32)) {
+        free(file);
+        return refuse(path, err, "damaged: its SHA-256 does not match its contents");
+    }
+    lmb_part_place place = {get_u32(h + 12), get_u32(h + 16), get_u32(h + 20), get_u32(h + 24)};
+    const uint8_t *version = h + 28, *input = h + 60, *config = h + 92, *plan = h + 124;
+    const char *config_text = file + HEADER_BYTES;
+    char a[17], b[17];
+    why[0] = '\0';
+    if (strncmp((const char *)version, expect->version, 32))
+        snprintf(why, sizeof why, "made by lmbake %.32s; this is lmbake %s", (const char *)version, expect->version);
+    else if (memcmp(input, expect->input, 32))
+        hex8(input, a), hex8(expect->input, b),
+            snprintf(why, sizeof why, "made from another input (SHA-256 %s..., the plan's is %s...)", a, b);
+    else if (memcmp(config, expect->config, 32)) {
+        char *there = strndup(config_text, config_length);
+        char diff[400];
+        config_difference(there ? there : "", expect->config_text ? expect->config_text : "", diff, sizeof diff);
+        free(there);
+        snprintf(why, sizeof why, "made with another config: %s", diff);
+    } else if (memcmp(plan, expect->plan, 32))
+        hex8(plan, a), hex8(expect->plan, b),
+            snprintf(why, sizeof why, "belongs to another plan (%s..., this one is %s...)", a, b);
+    else if (place.kind != want->kind)
+        snprintf(why, sizeof why, "is a %s file, not a %s file",
+                 place.kind == LMB_PART_PLAN ? "plan" : place.kind == LMB_PART_SHARD ? "shard" : "state",
+                 want->kind == LMB_PART_PLAN ? "plan" : want->kind == LMB_PART_SHARD ? "shard" : "state");
+    else if (place.step != want->step)
+        snprintf(why, sizeof why, "is of step %u, not step %u", place.step, want->step);
+    else if (want->shards && (place.shard != want->shard || place.shards != want->shards))
+        snprintf(why, sizeof why, "is shard %u/%u, not %u/%u", place.shard + 1, place.shards, want->shard + 1,
+                 want->shards);
+    if (why[0]) {
+        free(file);
+        return refuse(path, err, why);
+    }
+    *got = place;
+    *body_length = (size_t)length;
+    *body = malloc((size_t)length + 1);
+    if (!*body) {
+        free(file);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "'%s': out of memory", path);
+    }
+    memcpy(*body, file + HEADER_BYTES + config_length, (size_t)length);
+    free(file);
+    return LMB_OK;
+}
