@@ -10,6 +10,7 @@
 #include <lmbake/lmbake.h>
 
 #include "util/clock.h"
+#include "farm/plan.h"
 #include "lighting.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
@@ -237,6 +238,13 @@ static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const 
 lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress, void *user,
                     lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
 {
+    return lmb_bake_planned(s, cfg, NULL, outdir, progress, user, stats, log, err);
+}
+
+lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *plan_path, const char *outdir,
+                            lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
+                            lmb_error *err)
+{
     double t0 = lmb_seconds();
     memset(stats, 0, sizeof *stats);
     lmb_output_dir od;
@@ -253,7 +261,10 @@ lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
-    st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
+    if (plan_path) /* the plan stage's layout (farm/plan.h), checked against this scene and config */
+        st = lmb_plan_read(plan_path, s, cfg, &l, err);
+    else
+        st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
     if (st == LMB_OK)

@@ -29,6 +29,8 @@ static const char help[] =
     "                      invalid, atlases) headless to OUTDIR/preview-<view>.png\n"
     "      --reference     path-trace indirect light with no cache (ground truth for error\n"
     "                      measurement; --rays paths per texel: use many)\n"
+    "      --plan PLAN     start from a plan written by 'lmbake plan' (same input and config,\n"
+    "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
     "      --print-config  print the effective config (every key, after -c and the options\n"
     "                      above) as YAML that -c reads back, and exit; SCENE may be left out\n"
     "  -q, --quiet         no progress or warnings\n"
@@ -42,7 +44,7 @@ static const char help[] =
     "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
 
 typedef struct bake_args {
-    const char *scene, *config, *outdir;
+    const char *scene, *config, *outdir, *plan;
     long long threads, seed, rays, method; /* -1: from the config */
     int quiet, reference, preview, print_config;
 } bake_args;
@@ -91,6 +93,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->preview = 1;
         } else if (cli_is_flag(argv[i], "--reference", NULL)) {
             a->reference = 1;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--plan", NULL, &v)) != 0) {
+            if (r < 0)
+                return cli_usage_error("bake", "%s needs a file", argv[i]);
+            a->plan = v;
         } else if (cli_is_flag(argv[i], "--print-config", NULL)) {
             a->print_config = 1;
         } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
@@ -133,12 +139,46 @@ static void print_bounces(const lmb_config *cfg, const lmb_bake_stats *bs)
     printf("\n");
 }
 
+static const char plan_help[] =
+    "usage: lmbake plan SCENE [-c CONFIG] -o PLAN [options]\n"
+    "\n"
+    "The staged bake's first stage (docs/farm.md): loads SCENE, unwraps and packs it as\n"
+    "'lmbake bake' would with CONFIG, and writes the layout to PLAN with the identity of the\n"
+    "input, the config and lmbake (SHA-256, checked when the plan is read). Then\n"
+    "'lmbake bake SCENE -c CONFIG --plan PLAN -o OUTDIR' bakes from it: the same files, byte for byte.\n"
+    "\n"
+    "options: -c, --config, --threads, --seed, --method, --rays, -q as for 'lmbake bake';\n"
+    "  -o, --output PLAN   the plan file to write (default: ./lmbake.plan)\n"
+    "\n"
+    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
+
+static int run(int argc, char **argv, int plan_stage);
+
 int cmd_bake(int argc, char **argv)
+{
+    return run(argc, argv, 0);
+}
+
+int cmd_plan(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++)
+        if (cli_is_flag(argv[i], "--help", "-h")) {
+            fputs(plan_help, stdout);
+            return 0;
+        }
+    return run(argc, argv, 1);
+}
+
+static int run(int argc, char **argv, int plan_stage)
 {
     bake_args a;
     int r = parse_args(argc, argv, &a);
     if (r)
         return r < 0 ? LMB_OK : r;
+    if (plan_stage && (a.plan || a.preview || a.reference || a.print_config))
+        return cli_usage_error("plan", "--plan, --preview, --reference and --print-config are 'lmbake bake' options");
+    if (plan_stage && !strcmp(a.outdir, "lmbake-out"))
+        a.outdir = "lmbake.plan";
     lmb_config cfg;
     lmb_error err = {LMB_OK, ""};
     lmb_config_default(&cfg);
@@ -187,8 +227,17 @@ int cmd_bake(int argc, char **argv)
     }
     cli_progress progress;
     cli_progress_init(&progress, stderr, a.quiet);
+    if (plan_stage) {
+        lmb_status rc = lmb_plan_write(scene, &cfg, a.outdir, cli_progress_update, &progress, &log, &err);
+        lmb_scene_free(scene);
+        if (rc != LMB_OK)
+            return cli_fail(&err);
+        if (!a.quiet)
+            printf("plan: %s\n", a.outdir);
+        return LMB_OK;
+    }
     lmb_bake_stats bs;
-    lmb_status rc = lmb_bake(scene, &cfg, a.outdir, cli_progress_update, &progress, &bs, &log, &err);
+    lmb_status rc = lmb_bake_planned(scene, &cfg, a.plan, a.outdir, cli_progress_update, &progress, &bs, &log, &err);
     lmb_scene_free(scene);
     if (rc != LMB_OK)
         return cli_fail(&err);

@@ -5,6 +5,7 @@
 
 int cmd_inspect(int argc, char **argv);
 int cmd_bake(int argc, char **argv);
+int cmd_plan(int argc, char **argv); /* cmd_bake.c: the staged bake's plan stage */
 int cmd_unwrap(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
 

@@ -16,6 +16,8 @@ static const char usage[] =
     "\n"
     "commands:\n"
     "  bake SCENE [-c CONFIG] [-o OUTDIR]   bake lightmaps for a .gltf/.glb level\n"
+    "  plan SCENE [-c CONFIG] -o PLAN       the staged bake's plan stage: layout to a file\n"
+    "                                       ('bake --plan PLAN' starts from it; docs/farm.md)\n"
     "  inspect SCENE [-c CONFIG] [--json]   list meshes, instances, materials, lights and\n"
     "                                       what will be lightmapped (and why not)\n"
     "  unwrap SCENE [-c CONFIG] [--png DIR] lightmap UV layout and its quality report\n"
@@ -50,6 +52,8 @@ int main(int argc, char **argv)
         return cmd_preview(argc - 1, argv + 1);
     if (!strcmp(cmd, "bake"))
         return cmd_bake(argc - 1, argv + 1);
+    if (!strcmp(cmd, "plan"))
+        return cmd_plan(argc - 1, argv + 1);
     fprintf(stderr, "lmbake: unknown command '%s'\n\n%s", cmd, usage);
     return LMB_ERR_USAGE;
 }

@@ -312,7 +312,8 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
         lmb_layout_instance *li = &l->instances[list[j]];
         li->lightmapped = 1;
-        li->uv1 = calloc((size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6 + 1, sizeof *li->uv1);
+        li->uv1_count = (size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6;
+        li->uv1 = calloc(li->uv1_count + 1, sizeof *li->uv1);
         if (!li->uv1)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
         else if (!l->meshes[s->instances[list[j]].mesh].kept_uv1)

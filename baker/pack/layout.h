@@ -43,6 +43,7 @@ typedef struct lmb_layout_instance {
     uint32_t atlas;
     double texel_density; /* texels per world unit used for it */
     double *uv1;          /* 6 per mesh triangle, atlas texel coordinates; 0 for skipped triangles */
+    size_t uv1_count;     /* doubles in uv1 */
 } lmb_layout_instance;
 
 typedef struct lmb_layout {

@@ -366,6 +366,19 @@ typedef struct lmb_bake_stats {
 lmb_status lmb_bake(lmb_scene *scene, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress,
                     void *progress_user, lmb_bake_stats *stats, const lmb_log *log, lmb_error *err);
 
+/* The staged bake's plan stage (docs/farm.md): lays out scene (unwrap, pack) as lmb_bake
+ * would and writes the layout to plan_path with the identity of the input and the config
+ * (baker/farm/part_file.h), all-or-nothing. */
+lmb_status lmb_plan_write(const lmb_scene *scene, const lmb_config *cfg, const char *plan_path,
+                          lmb_progress_fn progress, void *progress_user, const lmb_log *log, lmb_error *err);
+
+/* lmb_bake with the layout read from a plan file instead of built: the same files, byte for
+ * byte. A plan made from another input, config or lmbake version is refused (LMB_ERR_INPUT),
+ * naming what differs. plan_path NULL: lmb_bake. */
+lmb_status lmb_bake_planned(lmb_scene *scene, const lmb_config *cfg, const char *plan_path, const char *outdir,
+                            lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats, const lmb_log *log,
+                            lmb_error *err);
+
 /* 1 if the material emits (emissive factor x strength > 0 in any channel). */
 int lmb_material_is_emissive(const lmb_material *m);
 
