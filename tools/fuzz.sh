@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Fuzzes lmbake's front door (issue 15) with libFuzzer: glTF load, the YAML config and texture
-# decoding (tests/fuzz/fuzz_*.c), built with Debian's clang-14, ASan and UBSan.
-#   usage: tools/fuzz.sh [SECONDS] [TARGET...]   (default: 60 s; targets gltf config image)
+# Fuzzes lmbake's front door (issue 15) with libFuzzer: glTF load, the YAML config, texture
+# decoding and the farm's plan decoder (tests/fuzz/fuzz_*.c), built with Debian's clang-14,
+# ASan and UBSan.
+#   usage: tools/fuzz.sh [SECONDS] [TARGET...]   (default: 60 s; targets gltf config image plan)
 # All targets run at once, each for SECONDS of wall time, one process each (the machine's cores
 # are shared). Seeds come from assets/ and tests/data (tests/fuzz/CMakeLists.txt has the same
 # patterns); what a run adds stays in build-fuzz/corpus/<target> for the next run. A crash, leak,
@@ -15,7 +16,8 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(gltf config image)
+((${#targets[@]})) || targets=(gltf config image plan)
+export LMB_FUZZ_PLAN_SCENE="$PWD/assets/scenes/cornell-box-bevy/CornellBox.glb" # fuzz_plan's scene
 
 # clang-14 with libFuzzer's runtime; libomp for clang's OpenMP
 LMB_SETUP_PACKAGES="clang-14 libclang-rt-14-dev libomp-14-dev" \
@@ -30,7 +32,7 @@ seed_files() { # the seeds of one target, as in tests/fuzz/CMakeLists.txt
     image) find assets -type f \( -name '*.png' -o -name '*.jpg' \) -size -256k ;;
   esac
 }
-max_len() { case $1 in gltf) echo 65536 ;; config) echo 16384 ;; image) echo 131072 ;; esac; }
+max_len() { case $1 in gltf) echo 65536 ;; config) echo 16384 ;; image) echo 131072 ;; plan) echo 65536 ;; esac; }
 
 for t in "${targets[@]}"; do
   rm -rf "$out/seeds/$t" "$out/artifacts/$t" "$out/logs/$t.log"
@@ -38,6 +40,9 @@ for t in "${targets[@]}"; do
   n=0
   while IFS= read -r f; do cp "$f" "$out/seeds/$t/$n-$(basename "$f")"; n=$((n + 1)); done < <(seed_files "$t")
   cp tests/fuzz/regressions/"$t"/* "$out/seeds/$t/" 2>/dev/null || true
+  if [ "$t" = plan ]; then # the scene's own layout, written by the target
+    LMB_FUZZ_PLAN_SEED="$out/seeds/plan/cornell-layout" ASAN_OPTIONS=detect_leaks=0 "$out/tests/fuzz/fuzz_plan"
+  fi
 done
 
 echo "fuzz: ${targets[*]} for ${seconds} s each (ASan+UBSan; logs in $out/logs)"
