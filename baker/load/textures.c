@@ -102,8 +102,27 @@ static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t 
         return st;
     size_t n = (size_t)w * h;
     if (space == LMB_TEX_COLOUR) {
-        for (size_t i = 0; i < 3 * n; i++)
-            px[i] = srgb_to_linear(px[i]);
+        /* Decoded 8-bit images hold at most 256 distinct values: each value's conversion is
+         * kept in the slot of its nearest 8-bit code and reused when the same float comes again
+         * (the same function of the same input: results are unchanged), so a 64-Mpixel texture
+         * costs 256 powf, not 200 million (issue 15: a 1.6 KB JPEG declaring 63488 x 767 took
+         * 12 s under the sanitizers). */
+        float seen_in[256], seen_out[256];
+        for (int k = 0; k < 256; k++)
+            seen_in[k] = -1.0f; /* no decoded value is negative */
+        for (size_t i = 0; i < 3 * n; i++) {
+            float v = px[i];
+            int k = v >= 0.0f && v <= 1.0f ? (int)(v * 255.0f + 0.5f) : -1;
+            if (k >= 0 && seen_in[k] == v) {
+                px[i] = seen_out[k];
+                continue;
+            }
+            px[i] = srgb_to_linear(v);
+            if (k >= 0) {
+                seen_in[k] = v;
+                seen_out[k] = px[i];
+            }
+        }
         for (int c = 0; c < 3; c++) {
             double sum = 0;
             for (size_t i = 0; i < n; i++)
