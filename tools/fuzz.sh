@@ -41,7 +41,7 @@ for t in "${targets[@]}"; do
   while IFS= read -r f; do cp "$f" "$out/seeds/$t/$n-$(basename "$f")"; n=$((n + 1)); done < <(seed_files "$t")
   cp tests/fuzz/regressions/"$t"/* "$out/seeds/$t/" 2>/dev/null || true
   if [ "$t" = plan ]; then # the scene's own layout, written by the target
-    LMB_FUZZ_PLAN_SEED="$out/seeds/plan/cornell-layout" ASAN_OPTIONS=detect_leaks=0 "$out/tests/fuzz/fuzz_plan"
+    LMB_FUZZ_PLAN_SEED="$out/seeds/plan/cornell-layout" ASAN_OPTIONS=detect_leaks=0 "$out/tests/fuzz/fuzz_plan" -runs=0 >/dev/null 2>&1
   fi
 done
 

@@ -3,8 +3,8 @@
  * farm's shared folder, so their bodies are input too: the checksum catches damage, not
  * malice. Each input is decoded as a plan body for one scene (LMB_FUZZ_PLAN_SCENE, loaded
  * once); a decoded layout is encoded again and must give the same bytes.
- * Seed: `LMB_FUZZ_PLAN_SEED=FILE fuzz_plan` writes the scene's own layout to FILE and exits
- * (tools/fuzz.sh does this).
+ * Seed: `LMB_FUZZ_PLAN_SEED=FILE fuzz_plan -runs=0` writes the scene's own layout to FILE
+ * (tools/fuzz.sh does this; exiting inside a callback would count as a crash).
  */
 #include "farm/plan_codec.h"
 #include "fuzz_common.h"
@@ -16,6 +16,7 @@
 #include <string.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+int LLVMFuzzerInitialize(int *argc, char ***argv);
 
 /* The scene, loaded on the first input and kept for the process (harness state). */
 static lmb_scene *scene;
@@ -45,8 +46,16 @@ static void load_scene(void)
             abort();
         free(bytes);
         lmb_layout_free(&l);
-        exit(0);
     }
+}
+
+/* libFuzzer calls this once before any input (the replay driver does not: the first input loads). */
+int LLVMFuzzerInitialize(int *argc, char ***argv)
+{
+    (void)argc;
+    (void)argv;
+    load_scene();
+    return 0;
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
