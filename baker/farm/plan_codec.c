@@ -197,16 +197,13 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
         for (uint64_t k = 0; s->indices && !r.failed && k < 3 * (uint64_t)s->triangle_count; k++)
             r.failed = s->indices[k] >= s->vertex_count;
         for (uint64_t k = 0; c->first && !r.failed && k <= c->chart_count; k++)
-            r.failed = c->first[k] > c->triangle_count || (k && c->first[k] < c->first[k - 1]);
+            r.failed = c->first[k] > c->triangle_count;
         /* chart numbers and the chart order must name charts and triangles */
         for (uint64_t k = 0; c->chart_of && !r.failed && k < c->triangle_count; k++)
             r.failed = c->chart_of[k] != UINT32_MAX && c->chart_of[k] >= c->chart_count;
-        for (uint64_t k = 0; c->order && !r.failed && k < c->triangle_count; k++)
+        for (uint64_t k = 0; c->order && !r.failed && c->first && k < c->first[c->chart_count]; k++)
             r.failed = c->order[k] >= c->triangle_count;
-        /* a mesh an instance lights has all its arrays, and charts for each of its triangles */
-        if (!r.failed && lm->used)
-            r.failed = !s->positions || !s->indices || !s->skip || !s->flat || !c->chart_of || !c->uv || !c->first ||
-                       !c->order || c->triangle_count != s->triangle_count;
+
     }
     for (uint32_t i = 0; i < l->instance_count && !r.failed; i++) {
         lmb_layout_instance *in = &l->instances[i];
