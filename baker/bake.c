@@ -11,6 +11,7 @@
 
 #include "util/clock.h"
 #include "farm/plan.h"
+#include "farm/steps.h"
 #include "lighting.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
@@ -245,12 +246,33 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err)
 {
+    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0};
+    return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
+}
+
+lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_path, lmb_farm_run *run,
+                         const char *outdir, lmb_progress_fn progress, void *user, lmb_bake_stats *stats,
+                         const lmb_log *log, lmb_error *err)
+{
+    lmb_bake_stats unused;
+    if (!stats)
+        stats = &unused;
+    int shard = run->mode == LMB_FARM_STEP, writes = !shard;
+    if (run->mode != LMB_FARM_LOCAL && !plan_path)
+        return lmb_error_set(err, LMB_ERR_USAGE, "a farm step or finish needs the plan ('lmbake plan')");
+    if (shard && (run->shards == 0 || run->shard >= run->shards))
+        return lmb_error_set(err, LMB_ERR_USAGE, "shard %u of %u: out of range", run->shard + 1, run->shards);
+    run->ended = 0;
     double t0 = lmb_seconds();
     memset(stats, 0, sizeof *stats);
     lmb_output_dir od;
-    lmb_status st = lmb_output_dir_open(&od, outdir, s->path, log, err);
+    memset(&od, 0, sizeof od);
+    lmb_status st = writes ? lmb_output_dir_open(&od, outdir, s->path, log, err) : LMB_OK;
     if (st != LMB_OK)
         return st;
+    lmb_part_identity id;
+    memset(&id, 0, sizeof id);
+    lmb_steps *steps = NULL;
     lmb_layout l;
     lmb_rt rt;
     lmb_emitters *em = NULL;
@@ -262,7 +284,7 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
     if (plan_path) /* the plan stage's layout (farm/plan.h), checked against this scene and config */
-        st = lmb_plan_read(plan_path, s, cfg, &l, err);
+        st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
     else
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK)
@@ -275,12 +297,28 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
         st = lmb_direct_create(s, cfg, &rt, em, &direct, err);
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
+    lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
+                                                                                                   : LMB_STEPS_LOCAL;
+    if (st == LMB_OK)
+        st = lmb_steps_create(mode, run->farm_dir, &id, run->step, run->shard, run->shards,
+                              (double)cfg->farm_min_step_rays, log, &steps, err);
     double tl = lmb_seconds();
-    if (st == LMB_OK && !lmb_direct_any_light(direct))
+    if (st == LMB_OK && !shard && !lmb_direct_any_light(direct))
         lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material): the lightmaps "
                  "are black", s->path);
     if (st == LMB_OK)
-        st = lmb_light_atlases(cfg, direct, &cache, progress, user, stats, &records, log, err);
+        st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
+    if (shard) { /* the shard's part is written (stopped), or the bake ended before its step */
+        if (st == LMB_OK) {
+            st = lmb_steps_write_end(steps, err);
+            run->ended = 1;
+        } else if (st == LMB_STEP_STOPPED) {
+            st = LMB_OK;
+        }
+        run->steps = lmb_steps_count(steps);
+        goto done;
+    }
+    run->steps = lmb_steps_count(steps);
     if (st == LMB_OK)
         st = post_process(s, cfg, &l, &rt, &cache, stats, log, err);
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
@@ -303,6 +341,9 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
         lmb_output_dir_abort(&od);
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
+done:
+    lmb_steps_free(steps);
+    lmb_part_identity_free(&id);
     lmb_cache_free(&cache);
     free(records.xyzr);
     lmb_direct_free(direct);

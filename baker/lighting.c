@@ -1,7 +1,9 @@
 /* The lighting passes over all atlases (see lighting.h). */
 #include "lighting.h"
 
+#include "farm/steps.h"
 #include "gather/gather.h"
+#include "lights/direct_step.h"
 #include "irradiance_cache/ic_pass.h"
 #include "post/rim.h"
 #include "util/clock.h"
@@ -18,6 +20,7 @@ typedef struct atlas_work {
     float *direct;   /* 3 per listed texel */
     float *result;   /* 3 per listed texel: the pass being computed */
     float *direct_dir; /* output.directional: 3 per listed texel, direct light's direction sum */
+    float *indirect_dir; /* output.directional: 3 per listed texel, the indirect part, then the direction */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -27,6 +30,7 @@ static void work_free(atlas_work *w, uint32_t n)
         free(w[a].direct);
         free(w[a].result);
         free(w[a].direct_dir);
+        free(w[a].indirect_dir);
     }
     free(w);
 }
@@ -105,6 +109,90 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     return st;
 }
 
+/* A pass over every atlas's listed texels as a step (farm/steps.h): items are the texels in
+ * atlas order, or whole atlases when the gather is guided (pilots first, lmb_gather_texels). */
+typedef struct texel_pass {
+    const pass_env *env;
+    uint32_t direction_rays;  /* > 0: light directions (lmb_gather_directions); 0: the gather */
+    uint64_t *first;          /* per atlas (+1): its first item */
+    int per_atlas;
+} texel_pass;
+
+static lmb_status texel_pass_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                                   uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    const texel_pass *tp = user;
+    lmb_gather_job *job = tp->env->job;
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < tp->env->cache->atlas_count && st == LMB_OK; a++) {
+        const lmb_texels *t = &tp->env->w[a].t;
+        uint64_t a0 = tp->first[a], a1 = tp->first[a + 1];
+        if (a1 <= first || a0 >= last || !t->count)
+            continue;
+        uint32_t i0 = tp->per_atlas ? 0 : (uint32_t)((first > a0 ? first : a0) - a0);
+        uint32_t i1 = tp->per_atlas ? t->count : (uint32_t)((last < a1 ? last : a1) - a0);
+        float *e = calloc(3 * (size_t)t->count + 1, sizeof *e);
+        if (!e)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+        lmb_gather_stats gs = {0, 0, 0, 0};
+        uint64_t before = 0;
+        for (uint32_t b = 0; b < a; b++)
+            before += tp->env->w[b].t.count;
+        job->progress_done = before;
+        if (tp->direction_rays)
+            st = lmb_gather_directions(job, a, t, i0, i1, tp->direction_rays, e, &gs);
+        else
+            st = lmb_gather_texels(job, a, t, i0, i1, e, &gs, err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, e + 3 * (size_t)i0, 3 * sizeof *e * (i1 - i0), err);
+        counters[0] += gs.rays;
+        counters[1] += gs.texels;
+        counters[2] += gs.adapted;
+        free(e);
+    }
+    return st;
+}
+
+/* Runs the pass as one step; each atlas's 3 floats per texel go to the float array at `field`
+ * of its atlas_work (result or a direction array). */
+static lmb_status texel_step(const pass_env *env, const char *name, uint32_t direction_rays, size_t field,
+                             lmb_gather_stats *gs, lmb_error *err)
+{
+    uint32_t n = env->cache->atlas_count;
+    texel_pass tp = {env, direction_rays, calloc((size_t)n + 2, sizeof(uint64_t)), 0};
+    tp.per_atlas = !direction_rays && lmb_gather_is_guided(env->job);
+    double *cost = tp.per_atlas ? calloc((size_t)n + 1, sizeof *cost) : NULL;
+    if (!tp.first || (tp.per_atlas && !cost)) {
+        free(tp.first);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
+    }
+    for (uint32_t a = 0; a < n; a++) {
+        tp.first[a + 1] = tp.first[a] + (tp.per_atlas ? 1 : env->w[a].t.count);
+        if (cost)
+            cost[a] = env->w[a].t.count;
+    }
+    uint64_t texels = 0;
+    for (uint32_t a = 0; a < n; a++)
+        texels += env->w[a].t.count;
+    double rays = (double)texels * (direction_rays ? direction_rays : env->job->estimator.rays);
+    lmb_step_desc d = {name, tp.first[n], cost, rays, texel_pass_range, &tp};
+    lmb_buf bytes = {0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run(env->job->steps, &d, &bytes, counters, err);
+    gs->rays += counters[0];
+    gs->texels += counters[1];
+    gs->adapted += counters[2];
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+        float *dst = *(float **)(void *)((char *)&env->w[a] + field);
+        if (!lmb_buf_take(&bytes, dst, 3 * sizeof *dst * env->w[a].t.count))
+            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels for atlas %u", name, a);
+    }
+    lmb_buf_free(&bytes);
+    free(tp.first);
+    free(cost);
+    return st;
+}
+
 /* One gather pass over every atlas: result = direct + gather(cache), then (store) the cache :=
  * result; without store the cache keeps the previous pass (bounces: auto reads it). The
  * gather runs at every texel, or at irradiance-cache records (irradiance_cache.error > 0). */
@@ -119,13 +207,11 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int sto
     int through_cache = env->cfg->ic_error > 0 && !job->reference;
     if (through_cache)
         st = cached_gather(env, gs, err);
-    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
-        if (!through_cache)
-            st = lmb_gather_atlas(job, a, &w[a].t, w[a].result, gs, err);
-        for (size_t k = 0; st == LMB_OK && k < 3 * (size_t)w[a].t.count; k++)
+    else
+        st = texel_step(env, job->stage, 0, offsetof(atlas_work, result), gs, err);
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
+        for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++)
             w[a].result[k] += w[a].direct[k];
-        job->progress_done += w[a].t.count;
-    }
     if (st == LMB_OK && store)
         st = store_pass(w, cache, err);
     stats->rays += gs->rays;
@@ -257,23 +343,30 @@ static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error 
  * rays reading the finished cache (lmb_gather_directions). |D| <= 1: 1 when all light comes
  * from one direction, 2/3 under a uniform sky. Noise can push |D| past 1: it is clamped.
  */
-static lmb_status light_directions(const lmb_config *cfg, lmb_gather_job *job, atlas_work *w, lmb_cache *cache,
-                                   lmb_bake_stats *stats, lmb_error *err)
+static lmb_status light_directions(const pass_env *env, lmb_error *err)
 {
+    const lmb_config *cfg = env->cfg;
+    lmb_gather_job *job = env->job;
+    atlas_work *w = env->w;
+    lmb_cache *cache = env->cache;
+    lmb_bake_stats *stats = env->stats;
     lmb_status st = LMB_OK;
     job->pass = 2000;
     job->direct_at_hits = 0; /* the cache holds all the light now */
     job->stage = "directions";
+    for (uint32_t a = 0; a < cache->atlas_count; a++) {
+        w[a].indirect_dir = calloc(3 * (size_t)w[a].t.count + 1, sizeof *w[a].indirect_dir);
+        if (!w[a].indirect_dir)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u's directions", a);
+    }
+    lmb_gather_stats gs = {0, 0, 0, 0};
+    if (!stats->no_light && stats->bounces > 0) /* bounces: 0 has no indirect light to point to */
+        st = texel_step(env, "directions", cfg->directional_rays, offsetof(atlas_work, indirect_dir), &gs, err);
+    stats->rays += gs.rays;
     for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
         const lmb_texels *t = &w[a].t;
-        float *d = calloc(3 * (size_t)t->count + 1, sizeof *d);
-        if (!d)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u's directions", a);
-        lmb_gather_stats gs = {0, 0, 0, 0};
-        if (!stats->no_light && stats->bounces > 0) /* bounces: 0 has no indirect light to point to */
-            st = lmb_gather_directions(job, a, t, cfg->directional_rays, d, &gs);
-        stats->rays += gs.rays;
-        for (uint32_t i = 0; st == LMB_OK && i < t->count; i++) {
+        float *d = w[a].indirect_dir;
+        for (uint32_t i = 0; i < t->count; i++) {
             const float *e = (stats->bounces ? w[a].result : w[a].direct) + 3 * (size_t)i;
             double lum = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2], v[3], len = 0;
             for (int k = 0; k < 3; k++) {
@@ -285,88 +378,12 @@ static lmb_status light_directions(const lmb_config *cfg, lmb_gather_job *job, a
             for (int k = 0; k < 3; k++)
                 d[3 * (size_t)i + k] = (float)(len > 1 ? v[k] / len : v[k]);
         }
-        if (st == LMB_OK)
-            st = lmb_cache_store_direction(cache, a, t, d, err);
-        free(d);
+        st = lmb_cache_store_direction(cache, a, t, d, err);
     }
     return st;
 }
 
-/* Progress of one band's direct light, reported as a share of the whole atlas's rows. */
-typedef struct band_progress {
-    lmb_progress_fn fn;
-    void *user;
-    uint64_t row0, rows, height, width;
-} band_progress;
-
-/* In atlas texels: the band's rows before it, plus its share of its own rows. */
-static void band_progress_update(void *user, const char *stage, uint64_t done, uint64_t total)
-{
-    const band_progress *b = user;
-    b->fn(b->user, stage, b->row0 * b->width + (total ? done * b->rows * b->width / total : 0), b->height * b->width);
-}
-
-/*
- * Gather points and direct light of atlas a, band of rows by band (memory, issue 10): a
- * band's sub-sampled points (samples.texel per texel, 56 bytes each) live only while its
- * direct light is computed; the atlas keeps one point per texel, where indirect light is
- * gathered, and its direct light. Results are the same as one pass over the atlas: random
- * streams are keyed by (atlas, texel), not by band.
- */
-static lmb_status direct_by_bands(const lmb_config *cfg, const lmb_direct *direct, const lmb_cache *cache, uint32_t a,
-                                  atlas_work *w, lmb_progress_fn progress, void *user, uint64_t *rays, lmb_error *err)
-{
-    uint32_t width = cache->layout->width[a], height = cache->layout->height[a];
-    uint32_t rows = width ? (65536 + width - 1) / width : height; /* ~64k texels per band */
-    lmb_status st = LMB_OK;
-    for (uint32_t y0 = 0; y0 < height && st == LMB_OK; y0 += rows) {
-        uint32_t y1 = y0 + rows < height ? y0 + rows : height;
-        lmb_texels band;
-        st = lmb_texels_build_rows(cache->scene, cache->layout, a, cfg->texel_samples, y0, y1, &band, err);
-        float *e = st == LMB_OK ? calloc(3 * (size_t)band.count + 1, sizeof *e) : NULL;
-        float *dir = st == LMB_OK && cfg->directional ? calloc(3 * (size_t)band.count + 1, sizeof *dir) : NULL;
-        if (st == LMB_OK && (!e || (cfg->directional && !dir)))
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-        band_progress bp = {progress, user, y0, y1 - y0, height, width};
-        lmb_direct_job job = {direct, a, progress ? band_progress_update : NULL, &bp, dir};
-        if (st == LMB_OK)
-            st = lmb_direct_compute(&job, &band, e, rays, err);
-        if (st == LMB_OK) { /* exact growth, as lmb_texels_append */
-            float *d = realloc(w->direct, (3 * (w->t.count + (size_t)band.count) + 1) * sizeof *d);
-            if (!d)
-                st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-            else
-                w->direct = d;
-        }
-        if (st == LMB_OK && dir) {
-            float *d = realloc(w->direct_dir, (3 * (w->t.count + (size_t)band.count) + 1) * sizeof *d);
-            if (!d)
-                st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-            else
-                w->direct_dir = d;
-        }
-        if (st == LMB_OK) {
-            memcpy(w->direct + 3 * (size_t)w->t.count, e, 3 * (size_t)band.count * sizeof *e);
-            if (dir)
-                memcpy(w->direct_dir + 3 * (size_t)w->t.count, dir, 3 * (size_t)band.count * sizeof *dir);
-            st = lmb_texels_append(&w->t, &band, err);
-        }
-        free(e);
-        free(dir);
-        lmb_texels_free(&band);
-    }
-    if (st == LMB_OK && !w->t.texel) { /* an atlas without texels: empty arrays, not NULL */
-        lmb_texels empty;
-        memset(&empty, 0, sizeof empty);
-        empty.width = width;
-        empty.height = height;
-        empty.samples = 1;
-        st = lmb_texels_append(&w->t, &empty, err);
-    }
-    return st;
-}
-
-lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
+lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache, lmb_steps *steps,
                              lmb_progress_fn progress, void *user, lmb_bake_stats *stats, lmb_ic_points *records,
                              const lmb_log *log, lmb_error *err)
 {
@@ -379,7 +396,12 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     lmb_rim_stats rim = {0, 0, 0};
     /* gather points and direct light, atlas by atlas */
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        st = direct_by_bands(cfg, direct, cache, a, &w[a], progress, user, &stats->rays, err);
+        lmb_direct_atlas da;
+        st = lmb_direct_atlas_step(steps, cfg, direct, cache->scene, cache->layout, a, progress, user, &da, &stats->rays,
+                                   err);
+        w[a].t = da.t;
+        w[a].direct = da.direct;
+        w[a].direct_dir = da.direction;
         if (st == LMB_OK)
             st = lmb_rim_limit(&w[a].t, w[a].direct, &rim, err);
         if (st != LMB_OK)
@@ -412,6 +434,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.progress = progress;
     job.progress_user = user;
     job.progress_total = total;
+    job.steps = steps;
     lmb_ic_records shared;
     lmb_ic_records_init(&shared, cfg->ic_error > 0 ? cfg->ic_error : 1);
     pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL};
@@ -465,7 +488,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         stats->amis_adapted = gs.adapted;
     }
     if (st == LMB_OK && cfg->directional)
-        st = light_directions(cfg, &job, w, cache, stats, err);
+        st = light_directions(&env, err);
     lmb_ic_records_free(&shared);
     work_free(w, n);
     return st;

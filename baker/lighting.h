@@ -13,6 +13,9 @@
  *   --reference: E = E_direct + path-traced indirect light of depth k, no cache.
  * The result is left in the cache (its images, dilated), which the writer saves; `records`
  * (may be NULL) receives the final gather's irradiance-cache records (none without the cache).
+ * Every expensive loop runs as a step of `steps` (farm/steps.h): in this process, or as a
+ * farm shard (which stops the bake with LMB_STEP_STOPPED once its part is written), or read
+ * from the farm's merged states.
  */
 #ifndef LMBAKE_LIGHTING_H
 #define LMBAKE_LIGHTING_H
@@ -20,10 +23,11 @@
 #include <lmbake/lmbake.h>
 
 #include "cache/bounce_cache.h"
+#include "farm/steps.h"
 #include "irradiance_cache/ic_pass.h"
 #include "lights/direct.h"
 
-lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache,
+lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache, lmb_steps *steps,
                              lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats,
                              lmb_ic_points *records, const lmb_log *log, lmb_error *err);
 

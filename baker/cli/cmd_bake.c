@@ -44,16 +44,18 @@ static const char help[] =
     "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
 
 typedef struct bake_args {
-    const char *scene, *config, *outdir, *plan;
+    const char *scene, *config, *outdir, *plan, *farm;
     long long threads, seed, rays, method; /* -1: from the config */
     int quiet, reference, preview, print_config;
+    long long step;               /* -1: not given */
+    unsigned long long shard, shards; /* --shard K/N (K 1-based), --shards N */
 } bake_args;
 
 static int parse_args(int argc, char **argv, bake_args *a)
 {
     memset(a, 0, sizeof *a);
     a->outdir = "lmbake-out";
-    a->threads = a->seed = a->rays = a->method = -1;
+    a->threads = a->seed = a->rays = a->method = a->step = -1;
     for (int i = 1; i < argc; i++) {
         const char *v;
         int r;
@@ -97,6 +99,27 @@ static int parse_args(int argc, char **argv, bake_args *a)
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a file", argv[i]);
             a->plan = v;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--farm", NULL, &v)) != 0) {
+            if (r < 0)
+                return cli_usage_error("bake", "%s needs a folder", argv[i]);
+            a->farm = v;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--step", NULL, &v)) != 0) {
+            if (r < 0 || !cli_parse_uint(v, 1000000, &n))
+                return cli_usage_error("bake", "--step needs a number 0..1000000");
+            a->step = (long long)n;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--shard", NULL, &v)) != 0) {
+            char k[32];
+            const char *slash = r > 0 ? strchr(v, '/') : NULL;
+            if (slash && (size_t)(slash - v) < sizeof k) {
+                memcpy(k, v, (size_t)(slash - v));
+                k[slash - v] = 0;
+            }
+            if (!slash || (size_t)(slash - v) >= sizeof k || !cli_parse_uint(k, 100000, &a->shard) ||
+                !cli_parse_uint(slash + 1, 100000, &a->shards) || a->shard < 1 || a->shard > a->shards)
+                return cli_usage_error("bake", "--shard needs K/N with 1 <= K <= N <= 100000, e.g. 2/4");
+        } else if ((r = cli_opt_value(argc, argv, &i, "--shards", NULL, &v)) != 0) {
+            if (r < 0 || !cli_parse_uint(v, 100000, &a->shards) || a->shards < 1)
+                return cli_usage_error("bake", "--shards needs a number 1..100000");
         } else if (cli_is_flag(argv[i], "--print-config", NULL)) {
             a->print_config = 1;
         } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
@@ -152,33 +175,124 @@ static const char plan_help[] =
     "\n"
     "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
 
-static int run(int argc, char **argv, int plan_stage);
+static const char step_help[] =
+    "usage: lmbake step SCENE [-c CONFIG] --farm DIR --step S --shard K/N [options]\n"
+    "\n"
+    "Runs shard K of N of step S of the staged bake in DIR (made by 'lmbake plan --farm DIR'),\n"
+    "reading steps 0..S-1 from their merged states, and writes DIR/parts/SSSS.K-of-N.part\n"
+    "(atomically: a killed shard leaves nothing; rerunning one writes the same bytes). A step\n"
+    "past the bake's last one does nothing. SCENE and CONFIG must be the plan's.\n"
+    "\n"
+    "options: --threads N, -q as for 'lmbake bake'\n"
+    "\n"
+    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
+
+static const char merge_help[] =
+    "usage: lmbake merge SCENE [-c CONFIG] --farm DIR --step S --shards N\n"
+    "\n"
+    "Merges the N parts of step S in DIR into DIR/steps/SSSS.state, which later steps and\n"
+    "'lmbake finish' read. Refuses a part made from another plan, input, config or lmbake\n"
+    "version, naming the part and what differs, and a missing part, naming the shard to rerun.\n"
+    "When the bake has no step S, writes DIR/end: the drivers stop there.\n"
+    "\n"
+    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
+
+static const char finish_help[] =
+    "usage: lmbake finish SCENE [-c CONFIG] --farm DIR -o OUTDIR [options]\n"
+    "\n"
+    "The staged bake's last stage: reads every step's merged state from DIR, post-processes\n"
+    "(seams, fireflies, dilation) and writes OUTDIR exactly as 'lmbake bake' does, byte for\n"
+    "byte, all-or-nothing. Refuses to start while a step is not merged.\n"
+    "\n"
+    "options: --threads N, --preview, -q as for 'lmbake bake'\n"
+    "\n"
+    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
+
+typedef enum stage_kind { STAGE_BAKE, STAGE_PLAN, STAGE_STEP, STAGE_MERGE, STAGE_FINISH } stage_kind;
+
+static int run(int argc, char **argv, stage_kind stage);
+
+static int with_help(int argc, char **argv, const char *text, stage_kind stage)
+{
+    for (int i = 1; i < argc; i++)
+        if (cli_is_flag(argv[i], "--help", "-h")) {
+            fputs(text, stdout);
+            return 0;
+        }
+    return run(argc, argv, stage);
+}
 
 int cmd_bake(int argc, char **argv)
 {
-    return run(argc, argv, 0);
+    return run(argc, argv, STAGE_BAKE);
 }
 
 int cmd_plan(int argc, char **argv)
 {
-    for (int i = 1; i < argc; i++)
-        if (cli_is_flag(argv[i], "--help", "-h")) {
-            fputs(plan_help, stdout);
-            return 0;
-        }
-    return run(argc, argv, 1);
+    return with_help(argc, argv, plan_help, STAGE_PLAN);
 }
 
-static int run(int argc, char **argv, int plan_stage)
+int cmd_step(int argc, char **argv)
+{
+    return with_help(argc, argv, step_help, STAGE_STEP);
+}
+
+int cmd_merge(int argc, char **argv)
+{
+    return with_help(argc, argv, merge_help, STAGE_MERGE);
+}
+
+int cmd_finish(int argc, char **argv)
+{
+    return with_help(argc, argv, finish_help, STAGE_FINISH);
+}
+
+/* The farm stages' checks of their options; returns 0 when fine. */
+static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, size_t size)
+{
+    static const char *const names[] = {"bake", "plan", "step", "merge", "finish"};
+    const char *name = names[stage];
+    int farm_stage = stage == STAGE_STEP || stage == STAGE_MERGE || stage == STAGE_FINISH;
+    if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config))
+        return cli_usage_error(name, "--plan, --reference and --print-config are 'lmbake bake' options");
+    if (stage != STAGE_BAKE && stage != STAGE_FINISH && a->preview)
+        return cli_usage_error(name, "--preview is an option of 'lmbake bake' and 'lmbake finish'");
+    if (farm_stage && !a->farm)
+        return cli_usage_error(name, "--farm DIR is needed (the folder 'lmbake plan --farm DIR' made)");
+    if ((stage == STAGE_BAKE || stage == STAGE_PLAN) && (a->step >= 0 || a->shards))
+        return cli_usage_error(name, "--step, --shard and --shards are options of 'lmbake step' and 'lmbake merge'");
+    if ((stage == STAGE_STEP || stage == STAGE_MERGE) && (a->step < 0 || !a->shards))
+        return cli_usage_error(name, "--step S and %s are needed", stage == STAGE_STEP ? "--shard K/N" : "--shards N");
+    if (stage == STAGE_STEP && !a->shard)
+        return cli_usage_error(name, "--shard K/N is needed");
+    if (stage == STAGE_MERGE && a->shard)
+        return cli_usage_error(name, "merge takes --shards N, not --shard");
+    if (stage == STAGE_BAKE && a->farm)
+        return cli_usage_error(name, "--farm is an option of the farm stages (lmbake plan, step, merge, finish)");
+    if (a->farm)
+        snprintf(plan_path, size, "%s/plan.lmbp", a->farm);
+    if (stage == STAGE_PLAN && a->farm)
+        a->outdir = plan_path;
+    else if (stage == STAGE_PLAN && !strcmp(a->outdir, "lmbake-out"))
+        a->outdir = "lmbake.plan";
+    return 0;
+}
+
+static int run(int argc, char **argv, stage_kind stage)
 {
     bake_args a;
     int r = parse_args(argc, argv, &a);
     if (r)
         return r < 0 ? LMB_OK : r;
-    if (plan_stage && (a.plan || a.preview || a.reference || a.print_config))
-        return cli_usage_error("plan", "--plan, --preview, --reference and --print-config are 'lmbake bake' options");
-    if (plan_stage && !strcmp(a.outdir, "lmbake-out"))
-        a.outdir = "lmbake.plan";
+    char plan_path[PATH_MAX + 16] = "";
+    if ((r = check_stage_args(stage, &a, plan_path, sizeof plan_path)) != 0)
+        return r;
+    int plan_stage = stage == STAGE_PLAN;
+    if ((stage == STAGE_STEP || stage == STAGE_MERGE) && lmb_farm_end_step(a.farm) < (uint64_t)a.step) {
+        if (!a.quiet) /* the bake ended before this step: a no-op, before any loading */
+            printf("step %lld: the bake ended at step %u: nothing to do\n", a.step, lmb_farm_end_step(a.farm));
+        return LMB_OK;
+    }
     lmb_config cfg;
     lmb_error err = {LMB_OK, ""};
     lmb_config_default(&cfg);
@@ -228,7 +342,9 @@ static int run(int argc, char **argv, int plan_stage)
     cli_progress progress;
     cli_progress_init(&progress, stderr, a.quiet);
     if (plan_stage) {
-        lmb_status rc = lmb_plan_write(scene, &cfg, a.outdir, cli_progress_update, &progress, &log, &err);
+        lmb_status rc = a.farm ? lmb_farm_make_dirs(a.farm, &err) : LMB_OK;
+        if (rc == LMB_OK)
+            rc = lmb_plan_write(scene, &cfg, a.outdir, cli_progress_update, &progress, &log, &err);
         lmb_scene_free(scene);
         if (rc != LMB_OK)
             return cli_fail(&err);
@@ -236,11 +352,36 @@ static int run(int argc, char **argv, int plan_stage)
             printf("plan: %s\n", a.outdir);
         return LMB_OK;
     }
+    if (stage == STAGE_MERGE) {
+        lmb_farm_merge_report mr;
+        lmb_status rc = lmb_farm_merge(scene, &cfg, plan_path, a.farm, (uint32_t)a.step, (uint32_t)a.shards, &mr, &err);
+        lmb_scene_free(scene);
+        if (rc != LMB_OK)
+            return cli_fail(&err);
+        if (!a.quiet && mr.end)
+            printf("merge: the bake has %lld steps: step %lld does not exist (%s/end written)\n", a.step, a.step, a.farm);
+        else if (!a.quiet && !mr.noop)
+            printf("merge: step %lld (%s): %llu parts, %llu items\n", a.step, mr.name, a.shards,
+                   (unsigned long long)mr.items);
+        return LMB_OK;
+    }
+    lmb_farm_run fr = {stage == STAGE_STEP ? LMB_FARM_STEP : stage == STAGE_FINISH ? LMB_FARM_FINISH : LMB_FARM_LOCAL,
+                       a.farm, (uint32_t)(a.step > 0 ? a.step : 0), (uint32_t)(a.shard ? a.shard - 1 : 0),
+                       (uint32_t)(a.shards ? a.shards : 1), 0, 0};
     lmb_bake_stats bs;
-    lmb_status rc = lmb_bake_planned(scene, &cfg, a.plan, a.outdir, cli_progress_update, &progress, &bs, &log, &err);
+    double ts = cli_now();
+    lmb_status rc = lmb_bake_farm(scene, &cfg, a.farm ? plan_path : a.plan, &fr, a.outdir, cli_progress_update,
+                                  &progress, &bs, &log, &err);
     lmb_scene_free(scene);
     if (rc != LMB_OK)
         return cli_fail(&err);
+    if (stage == STAGE_STEP) {
+        if (!a.quiet && fr.ended)
+            printf("step %lld: the bake has %u steps: nothing to do (an end part was written)\n", a.step, fr.steps);
+        else if (!a.quiet)
+            printf("step %lld, shard %llu/%llu: %.2f s\n", a.step, a.shard, a.shards, cli_now() - ts);
+        return LMB_OK;
+    }
     char script[PATH_MAX + 64];
     /* the preview script is looked up before the bake's summary, so a missing one is said first */
     if (a.preview && !node_tool_path("render.mjs", script, sizeof script))

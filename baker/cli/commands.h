@@ -5,7 +5,11 @@
 
 int cmd_inspect(int argc, char **argv);
 int cmd_bake(int argc, char **argv);
-int cmd_plan(int argc, char **argv); /* cmd_bake.c: the staged bake's plan stage */
+int cmd_plan(int argc, char **argv);   /* cmd_bake.c: the staged bake's stages (docs/farm.md) */
+int cmd_step(int argc, char **argv);
+int cmd_merge(int argc, char **argv);
+int cmd_finish(int argc, char **argv);
+int cmd_farm(int argc, char **argv);   /* cmd_farm.c: scripts for GNU parallel and Slurm */
 int cmd_unwrap(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
 

@@ -16,8 +16,13 @@ static const char usage[] =
     "\n"
     "commands:\n"
     "  bake SCENE [-c CONFIG] [-o OUTDIR]   bake lightmaps for a .gltf/.glb level\n"
-    "  plan SCENE [-c CONFIG] -o PLAN       the staged bake's plan stage: layout to a file\n"
-    "                                       ('bake --plan PLAN' starts from it; docs/farm.md)\n"
+    "  farm parallel|slurm SCENE --farm DIR -o OUTDIR --shards N\n"
+    "                                       bake on many cores or machines through GNU\n"
+    "                                       parallel or Slurm (docs/farm.md); the stages:\n"
+    "  plan SCENE [-c CONFIG] --farm DIR    layout to DIR/plan.lmbp (or -o PLAN)\n"
+    "  step SCENE --farm DIR --step S --shard K/N   one shard of one step\n"
+    "  merge SCENE --farm DIR --step S --shards N   a step's parts into its state\n"
+    "  finish SCENE --farm DIR -o OUTDIR    the outputs, byte for byte as 'bake' writes them\n"
     "  inspect SCENE [-c CONFIG] [--json]   list meshes, instances, materials, lights and\n"
     "                                       what will be lightmapped (and why not)\n"
     "  unwrap SCENE [-c CONFIG] [--png DIR] lightmap UV layout and its quality report\n"
@@ -54,6 +59,14 @@ int main(int argc, char **argv)
         return cmd_bake(argc - 1, argv + 1);
     if (!strcmp(cmd, "plan"))
         return cmd_plan(argc - 1, argv + 1);
+    if (!strcmp(cmd, "step"))
+        return cmd_step(argc - 1, argv + 1);
+    if (!strcmp(cmd, "merge"))
+        return cmd_merge(argc - 1, argv + 1);
+    if (!strcmp(cmd, "finish"))
+        return cmd_finish(argc - 1, argv + 1);
+    if (!strcmp(cmd, "farm"))
+        return cmd_farm(argc - 1, argv + 1);
     fprintf(stderr, "lmbake: unknown command '%s'\n\n%s", cmd, usage);
     return LMB_ERR_USAGE;
 }

@@ -16,13 +16,18 @@ static const char magic[8] = {'L', 'M', 'B', 'A', 'K', 'E', 1, '\n'};
 /* magic, 5 x u32, version, 3 hashes, 2 x u64 */
 #define HEADER_BYTES (8 + 5 * 4 + 32 + 3 * 32 + 2 * 8)
 
-void lmb_sha256_hex(const void *data, size_t n, char hex[65])
+void lmb_sha256(const void *data, size_t n, uint8_t out[32])
 {
     struct sha256_ctx c;
-    uint8_t d[SHA256_DIGEST_SIZE];
     sha256_init(&c);
     sha256_update(&c, n, data);
-    sha256_digest(&c, sizeof d, d);
+    sha256_digest(&c, 32, out);
+}
+
+void lmb_sha256_hex(const void *data, size_t n, char hex[65])
+{
+    uint8_t d[32];
+    lmb_sha256(data, n, d);
     for (int i = 0; i < 32; i++)
         snprintf(hex + 2 * i, 3, "%02x", d[i]);
 }

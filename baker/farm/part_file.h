@@ -59,6 +59,9 @@ lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const l
 lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
                          lmb_part_place *got, void **body, size_t *body_length, lmb_error *err);
 
+/* SHA-256 of n bytes. */
+void lmb_sha256(const void *data, size_t n, uint8_t out[32]);
+
 /* SHA-256 of n bytes, as lowercase hex (65 bytes with the NUL). */
 void lmb_sha256_hex(const void *data, size_t n, char hex[65]);
 

@@ -241,8 +241,8 @@ static void texel_direction(const lmb_gather_job *job, uint32_t atlas, const lmb
     *traced += pr.rays;
 }
 
-lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t rays,
-                                 float *out, lmb_gather_stats *stats)
+lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t first,
+                                 uint32_t last, uint32_t rays, float *out, lmb_gather_stats *stats)
 {
     int threads = job->threads ? (int)job->threads : omp_get_max_threads();
     uint64_t traced = 0;
@@ -250,22 +250,22 @@ lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, cons
     {
         lmb_rt_thread_init();
 #pragma omp for schedule(dynamic, 64)
-        for (uint32_t i = 0; i < t->count; i++)
+        for (uint32_t i = first; i < last; i++)
             texel_direction(job, atlas, t, i, rays, out, &traced);
     }
     stats->rays += traced;
-    stats->texels += t->count;
+    stats->texels += last - first;
     return LMB_OK;
 }
 
 /* One sweep over the atlas's texels in blocks (progress after each block when `report`). */
-static int sweep(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, const guide_phase *gp, int report,
-                 float *out, lmb_gather_stats *stats)
+static int sweep(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t first, uint32_t last,
+                 const guide_phase *gp, int report, float *out, lmb_gather_stats *stats)
 {
     const uint32_t block = 256;
     int threads = job->threads ? (int)job->threads : omp_get_max_threads(), failed = 0;
-    for (uint32_t start = 0; start < t->count && !failed; start += block) {
-        uint32_t end = start + block < t->count ? start + block : t->count;
+    for (uint32_t start = first; start < last && !failed; start += block) {
+        uint32_t end = start + block < last ? start + block : last;
         uint64_t rays = 0, texels = 0, adapted = 0;
 #pragma omp parallel num_threads(threads) reduction(+ : rays, texels, adapted, failed)
         {
@@ -290,12 +290,25 @@ static int sweep(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t,
     return !failed;
 }
 
+int lmb_gather_is_guided(const lmb_gather_job *job)
+{
+    return !job->reference && job->guide_stride > 0 && lmb_estimator_can_guide(&job->estimator);
+}
+
 lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,
                             lmb_gather_stats *stats, lmb_error *err)
 {
+    return lmb_gather_texels(job, atlas, t, 0, t->count, out, stats, err);
+}
+
+lmb_status lmb_gather_texels(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t first,
+                             uint32_t last, float *out, lmb_gather_stats *stats, lmb_error *err)
+{
     lmb_guide guide;
     guide_phase gp = {NULL, 0, job->guide_lobes};
-    if (!job->reference && job->guide_stride > 0 && lmb_estimator_can_guide(&job->estimator)) {
+    if (lmb_gather_is_guided(job) && (first != 0 || last != t->count))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: a guided gather runs over whole atlases", job->stage);
+    if (lmb_gather_is_guided(job)) {
         if (!lmb_guide_init(&guide, t, job->guide_stride))
             return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for the guide of atlas %u", job->stage,
                                  atlas);
@@ -304,10 +317,10 @@ lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb
     }
     int ok = 1;
     if (gp.guide) { /* the pilots first: every guided texel reads a finished mixture */
-        ok = sweep(job, atlas, t, &gp, 0, out, stats);
+        ok = sweep(job, atlas, t, first, last, &gp, 0, out, stats);
         gp.pilots = 0;
     }
-    ok = ok && sweep(job, atlas, t, &gp, 1, out, stats);
+    ok = ok && sweep(job, atlas, t, first, last, &gp, 1, out, stats);
     if (gp.guide)
         lmb_guide_free(&guide);
     if (!ok)

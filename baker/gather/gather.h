@@ -39,6 +39,7 @@ typedef struct lmb_gather_job {
     lmb_progress_fn progress;
     void *progress_user;
     uint64_t progress_done, progress_total; /* texels before this atlas, texels of the whole pass */
+    struct lmb_steps *steps;    /* where the pass's gathers run (farm/steps.h) */
 } lmb_gather_job;
 
 typedef struct lmb_gather_stats {
@@ -67,13 +68,20 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
 /* The indirect part of every listed texel's light direction (directional lightmaps): the
  * irradiance-weighted sum of incoming directions, sum lum(L) w cos over the hemisphere (lux),
  * from `rays` cosine rays that read the finished cache (job->direct_at_hits must be off: the
- * cache then holds all the light). 3 floats per texel into out; 0 for invalid texels. */
-lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t rays,
-                                 float *out, lmb_gather_stats *stats);
+ * cache then holds all the light). Listed texels [first, last): 3 floats per texel into out
+ * (indexed by texel); 0 for invalid texels. */
+lmb_status lmb_gather_directions(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t first,
+                                 uint32_t last, uint32_t rays, float *out, lmb_gather_stats *stats);
 
 /* Indirect irradiance of every listed texel of t (atlas `atlas`) into out (3 floats per texel;
  * 0 for invalid texels). */
 lmb_status lmb_gather_atlas(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, float *out,
                             lmb_gather_stats *stats, lmb_error *err);
+
+/* The same for listed texels [first, last) only (out indexed by texel). A guided gather
+ * (lmb_gather_is_guided: pilots first, then the texels they guide) takes whole atlases only. */
+lmb_status lmb_gather_texels(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t first,
+                             uint32_t last, float *out, lmb_gather_stats *stats, lmb_error *err);
+int lmb_gather_is_guided(const lmb_gather_job *job);
 
 #endif

@@ -1,12 +1,14 @@
 /* A gather pass through the irradiance cache: placement, gradients, interpolation (ic_pass.h). */
 #include "ic_pass.h"
 
+#include "farm/steps.h"
 #include "gather/guide.h"
 #include "irradiance_cache/records.h"
 #include "util/frame.h"
 
 #include <math.h>
 #include <omp.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,6 +33,7 @@ typedef struct pass_ctx {
     uint64_t reported;            /* progress never goes back (the last level may run several rounds) */
     char stage[96];
     uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
+    uint32_t regather_group;      /* the group being gathered again (step names) */
     /* guided gathering (gather/guide.h): per record, the mixture it gathered by or learned in
      * this pass; has_mix[k] is set once record k's whole group is gathered, so a record is
      * guided only by records of earlier groups (deterministic at any thread count) */
@@ -139,22 +142,96 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     r->texel = x.index;
 }
 
-/*
- * Gathers at the m texels at[], in parallel blocks. slots == NULL: new records, made in rec[k],
- * record index records.count + k. slots != NULL: records placed by an earlier pass
- * (`irradiance_cache.records: shared`), record slots[k], updated with this pass's irradiance
- * and rotation gradient, keeping position and reach. Guided: each gathers by the nearest
- * record of an earlier group on the same surface (its mixture re-aimed), or learns one.
- */
-static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, lmb_ic_record *rec,
-                                 uint64_t done_before, uint64_t total, lmb_gather_stats *stats, lmb_error *err)
+/* A record's bytes in a step (farm/steps.h): its doubles p .. r (31, contiguous), atlas, texel. */
+#define RECORD_DOUBLES 31
+_Static_assert(offsetof(lmb_ic_record, r) - offsetof(lmb_ic_record, p) == (RECORD_DOUBLES - 1) * sizeof(double),
+               "lmb_ic_record: p .. r are contiguous doubles");
+
+static lmb_status put_record(lmb_buf *out, const lmb_ic_record *r, lmb_error *err)
 {
+    lmb_status st = lmb_buf_append(out, r->p, RECORD_DOUBLES * sizeof(double), err);
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, &r->atlas, 4, err);
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, &r->texel, 4, err);
+    return st;
+}
+
+static int take_record(lmb_buf *in, lmb_ic_record *r)
+{
+    memset(r, 0, sizeof *r);
+    return lmb_buf_take(in, r->p, RECORD_DOUBLES * sizeof(double)) && lmb_buf_take(in, &r->atlas, 4) &&
+           lmb_buf_take(in, &r->texel, 4);
+}
+
+/* A mixture's bytes: count, diffuse, then per lobe its 14 doubles and `aimed` (unused lobes
+ * are not written: a part's bytes do not depend on memory left over). */
+static lmb_status put_mixture(lmb_buf *out, const lmb_mixture *m, lmb_error *err)
+{
+    lmb_status st = lmb_buf_append(out, &m->count, 4, err);
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, &m->diffuse, 8, err);
+    for (uint32_t k = 0; k < m->count && k < LMB_MIXTURE_MAX_LOBES && st == LMB_OK; k++) {
+        double v[14];
+        memcpy(v, m->lobe[k].axis, 24);
+        v[3] = m->lobe[k].a;
+        v[4] = m->weight[k];
+        memcpy(v + 5, m->tangent[k], 24);
+        memcpy(v + 8, m->bitangent[k], 24);
+        memcpy(v + 11, m->target[k], 24);
+        int32_t aimed = m->aimed[k];
+        st = lmb_buf_append(out, v, sizeof v, err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, &aimed, 4, err);
+    }
+    return st;
+}
+
+static int take_mixture(lmb_buf *in, lmb_mixture *m)
+{
+    memset(m, 0, sizeof *m);
+    if (!lmb_buf_take(in, &m->count, 4) || !lmb_buf_take(in, &m->diffuse, 8) || m->count > LMB_MIXTURE_MAX_LOBES)
+        return 0;
+    for (uint32_t k = 0; k < m->count; k++) {
+        double v[14];
+        int32_t aimed;
+        if (!lmb_buf_take(in, v, sizeof v) || !lmb_buf_take(in, &aimed, 4))
+            return 0;
+        memcpy(m->lobe[k].axis, v, 24);
+        m->lobe[k].a = v[3];
+        m->weight[k] = v[4];
+        memcpy(m->tangent[k], v + 5, 24);
+        memcpy(m->bitangent[k], v + 8, 24);
+        memcpy(m->target[k], v + 11, 24);
+        m->aimed[k] = aimed;
+    }
+    return 1;
+}
+
+/* A gather_records call as a step: its items are the texels at[]. */
+typedef struct records_step {
+    pass_ctx *c;
+    const texel_at *at;
+    const uint32_t *slots;
+    uint64_t done_before, total; /* progress */
+} records_step;
+
+/* Gathers at items [first, last) in parallel blocks: per item its record (and, guided, the
+ * mixture it gathered by or learned). Reads earlier groups' records and mixtures only. */
+static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                                       uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    const records_step *rs = user;
+    pass_ctx *c = rs->c;
     const uint64_t block = 64;
     int failed = 0;
-    if (!reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for guides");
-    for (uint64_t start = 0; start < m && !failed; start += block) {
-        uint64_t end = start + block < m ? start + block : m, rays = 0, texels = 0, adapted = 0;
+    lmb_status st = LMB_OK;
+    lmb_ic_record *rec = malloc(block * sizeof *rec);
+    lmb_mixture *mix = c->guided ? malloc(block * sizeof *mix) : NULL;
+    if (!rec || (c->guided && !mix))
+        failed = 1;
+    for (uint64_t start = first; start < last && !failed && st == LMB_OK; start += block) {
+        uint64_t end = start + block < last ? start + block : last, rays = 0, texels = 0, adapted = 0;
 #pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
         {
             lmb_rt_thread_init();
@@ -162,12 +239,12 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
             lmb_gather_stats gs = {0, 0, 0, 0};
 #pragma omp for schedule(dynamic, 1)
             for (uint64_t k = start; k < end; k++) {
-                uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)k;
                 lmb_mixture guide;
                 const lmb_mixture *by = NULL;
+                const texel_at x = rs->at[k];
                 if (c->guided) {
                     double p[3], n[3];
-                    texel_point(c, at[k], p, n);
+                    texel_point(c, x, p, n);
                     int64_t j = lmb_ic_records_nearest(&c->records, p, n, LMB_GUIDE_SAME_SURFACE_COS, c->has_mix);
                     if (j >= 0) {
                         lmb_mixture_reaim(&c->mix[j], c->records.rec[j].p, p, &guide);
@@ -175,33 +252,82 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
                     }
                 }
                 lmb_gather_point_result g;
-                lmb_ic_record fresh;
-                if (lmb_gather_record(c->job, at[k].atlas, c->t[at[k].atlas], at[k].index, by, c->lobes, &scratch,
-                                      &g, &gs) != LMB_OK) {
+                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, &scratch, &g, &gs) !=
+                    LMB_OK) {
                     failed = 1;
                     continue;
                 }
                 if (c->guided)
-                    c->mix[slot] = by ? guide : g.learned;
-                make_record(c, at[k], &g, slots ? &fresh : &rec[k]);
-                if (slots) {
-                    memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
-                    memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
-                }
+                    mix[k - start] = by ? guide : g.learned;
+                make_record(c, x, &g, &rec[k - start]);
             }
             lmb_estimator_scratch_free(&scratch);
             rays += gs.rays;
             texels += gs.texels;
             adapted += gs.adapted;
         }
-        stats->rays += rays;
-        stats->texels += texels;
-        stats->adapted += adapted;
-        report(c, done_before + end, total);
+        counters[0] += rays;
+        counters[1] += texels;
+        counters[2] += adapted;
+        for (uint64_t k = start; k < end && !failed && st == LMB_OK; k++) {
+            st = put_record(out, &rec[k - start], err);
+            if (st == LMB_OK && c->guided)
+                st = put_mixture(out, &mix[k - start], err);
+        }
+        report(c, rs->done_before + end, rs->total);
     }
+    free(rec);
+    free(mix);
     if (failed)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", c->job->stage,
                              c->job->estimator.rays);
+    return st;
+}
+
+/*
+ * Gathers at the m texels at[] (one step of the bake). slots == NULL: new records, made in
+ * rec[k], record index records.count + k. slots != NULL: records placed by an earlier pass
+ * (`irradiance_cache.records: shared`), record slots[k], updated with this pass's irradiance
+ * and rotation gradient, keeping position and reach. Guided: each gathers by the nearest
+ * record of an earlier group on the same surface (its mixture re-aimed), or learns one.
+ */
+static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, lmb_ic_record *rec,
+                                 uint64_t done_before, uint64_t total, lmb_gather_stats *stats, lmb_error *err)
+{
+    if (!reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for guides");
+    records_step rs = {c, at, slots, done_before, total};
+    char name[160];
+    snprintf(name, sizeof name, "%s: %s %u", c->stage, slots ? "records gathered again, group" : "records placed, level",
+             slots ? c->regather_group : c->group);
+    lmb_step_desc d = {name, m, NULL, (double)m * c->job->estimator.rays, gather_records_range, &rs};
+    lmb_buf bytes = {0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run(c->job->steps, &d, &bytes, counters, err);
+    stats->rays += counters[0];
+    stats->texels += counters[1];
+    stats->adapted += counters[2];
+    for (uint64_t k = 0; k < m && st == LMB_OK; k++) {
+        uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)k;
+        lmb_ic_record fresh;
+        lmb_mixture mix;
+        if (!take_record(&bytes, &fresh) || (c->guided && !take_mixture(&bytes, &mix))) {
+            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step '%s' holds fewer records than %llu", c->job->stage, name,
+                               (unsigned long long)m);
+            break;
+        }
+        if (c->guided)
+            c->mix[slot] = mix;
+        if (slots) {
+            memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
+            memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
+        } else {
+            rec[k] = fresh;
+        }
+    }
+    lmb_buf_free(&bytes);
+    if (st != LMB_OK)
+        return st;
     for (uint64_t k = 0; c->guided && k < m; k++)
         c->has_mix[slots ? slots[k] : c->records.count + (uint32_t)k] = 1;
     return LMB_OK;
@@ -226,13 +352,16 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
     c->level = c->levels - 1;
     lmb_status st = LMB_OK;
     uint64_t done = 0;
-    for (uint32_t g = 0; g < groups && st == LMB_OK; g++) {
+    /* unguided, a record's gather reads no other record: all groups in one step */
+    uint32_t step_groups = c->guided ? groups : 1;
+    for (uint32_t g = 0; g < step_groups && st == LMB_OK; g++) {
         uint32_t n = 0;
         for (uint32_t k = 0; k < m; k++)
-            if (c->records.rec[k].group == g) {
+            if (!c->guided || c->records.rec[k].group == g) {
                 slots[n] = k;
                 at[n++] = (texel_at){c->records.rec[k].atlas, c->records.rec[k].texel};
             }
+        c->regather_group = g;
         if (n)
             st = gather_records(c, at, n, slots, NULL, done, m, stats, err);
         done += n;

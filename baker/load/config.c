@@ -80,6 +80,7 @@ static const key_spec config_keys[] = {
     FLOAT("irradiance_cache.max_spacing", OFF(ic_max_spacing), 1, 4096, 0),
     U32("irradiance_cache.ray_scale", OFF(ic_ray_scale), 1, 1024),
     ENUM("irradiance_cache.records", OFF(ic_records), ic_records_modes),
+    U64("farm.min_step_rays", OFF(farm_min_step_rays), 0, 1000000000000000LL),
     U64("seed", OFF(seed), 0, 9223372036854775807LL),
     U32("threads", OFF(threads), 0, 1024),
     FLAGS("output.formats", OFF(output_formats), output_formats),
@@ -138,6 +139,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->ic_min_spacing = 4;
     cfg->ic_max_spacing = 32;
     cfg->ic_ray_scale = 4;
+    cfg->farm_min_step_rays = 20000000; /* ~1.5 s of one core: less than a shard's start on a real level */
     cfg->ic_records = LMB_IC_RECORDS_SHARED; /* README "Irradiance cache": as accurate, 1.0-1.4x faster */
     cfg->seed = 1;
     cfg->threads = 0;

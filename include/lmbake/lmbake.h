@@ -247,6 +247,8 @@ typedef struct lmb_config {
     double ic_max_spacing;         /* texels: the largest record reach */
     uint32_t ic_ray_scale;         /* a record gathers with this many times the per-texel rays */
     lmb_ic_records_mode ic_records; /* records per pass, or one set refined pass by pass */
+    uint64_t farm_min_step_rays;   /* farm: a step estimated under this many rays runs in every process
+                                      instead of as shards (it costs less than a shard's start) */
     uint64_t seed;
     uint32_t threads;              /* 0: all cores */
     unsigned output_formats;       /* LMB_OUTPUT_* bits */
@@ -378,6 +380,51 @@ lmb_status lmb_plan_write(const lmb_scene *scene, const lmb_config *cfg, const c
 lmb_status lmb_bake_planned(lmb_scene *scene, const lmb_config *cfg, const char *plan_path, const char *outdir,
                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err);
+
+/* The staged bake on a farm (docs/farm.md, baker/farm/steps.h). The bake is a sequence of
+ * steps; each step's items can be split into shards that run anywhere, and merged. */
+typedef enum lmb_farm_mode {
+    LMB_FARM_LOCAL = 0,  /* every step in this process: lmb_bake */
+    LMB_FARM_STEP = 1,   /* one shard of one step: reads earlier steps' states from farm_dir, writes its part */
+    LMB_FARM_FINISH = 2  /* every step from farm_dir's states, then post-processing and the outputs */
+} lmb_farm_mode;
+
+typedef struct lmb_farm_run {
+    lmb_farm_mode mode;
+    const char *farm_dir;     /* the shared folder (lmbake plan --farm) */
+    uint32_t step;            /* LMB_FARM_STEP: the step to run */
+    uint32_t shard, shards;   /* LMB_FARM_STEP: shard (0-based) of shards */
+    int ended;                /* out, LMB_FARM_STEP: the bake has fewer steps (an "end" part was written) */
+    uint32_t steps;           /* out: steps met */
+} lmb_farm_run;
+
+/* lmb_bake_planned through the farm: plan_path is required unless mode is LMB_FARM_LOCAL.
+ * LMB_FARM_STEP writes no outputs (outdir, stats unused; stats may be NULL). LMB_FARM_FINISH
+ * writes outdir exactly as lmb_bake would, all-or-nothing, once every step is merged. */
+lmb_status lmb_bake_farm(lmb_scene *scene, const lmb_config *cfg, const char *plan_path, lmb_farm_run *run,
+                         const char *outdir, lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats,
+                         const lmb_log *log, lmb_error *err);
+
+/* What lmb_farm_merge did. */
+typedef struct lmb_farm_merge_report {
+    int end;                  /* the bake has `step` steps: no later step exists (farm_dir/end written) */
+    int noop;                 /* the step lies past the end: nothing to merge */
+    uint64_t items;
+    char name[96];            /* what the step computes */
+} lmb_farm_merge_report;
+
+/* Merges the `shards` parts of step `step` in farm_dir into its state, refusing any part not
+ * made from this plan (plan_path), input, config and lmbake version, and naming the part and
+ * the difference. */
+lmb_status lmb_farm_merge(const lmb_scene *scene, const lmb_config *cfg, const char *plan_path, const char *farm_dir,
+                          uint32_t step, uint32_t shards, lmb_farm_merge_report *report, lmb_error *err);
+
+/* The step the farm's bake ended at (farm_dir/end, written by the merge of the first step
+ * that does not exist), or UINT32_MAX while not known. */
+uint32_t lmb_farm_end_step(const char *farm_dir);
+
+/* Creates farm_dir and its parts/ and steps/ folders (existing ones are fine). */
+lmb_status lmb_farm_make_dirs(const char *farm_dir, lmb_error *err);
 
 /* 1 if the material emits (emissive factor x strength > 0 in any channel). */
 int lmb_material_is_emissive(const lmb_material *m);

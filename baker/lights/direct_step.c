@@ -1,0 +1,175 @@
+/* An atlas's gather points and direct light as a step of bands (direct_step.h). */
+#include "direct_step.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define BAND_TEXELS 16384
+
+typedef struct band_ctx {
+    const lmb_config *cfg;
+    const lmb_direct *direct;
+    const lmb_scene *scene;
+    const lmb_layout *layout;
+    uint32_t atlas, width, height, rows; /* rows per band */
+    lmb_progress_fn progress;
+    void *progress_user;
+    uint64_t row0, band_rows;            /* the band being computed, for progress */
+} band_ctx;
+
+/* In atlas texels: the band's rows before it, plus its share of its own rows. */
+static void band_progress(void *user, const char *stage, uint64_t done, uint64_t total)
+{
+    const band_ctx *b = user;
+    b->progress(b->progress_user, stage, b->row0 * b->width + (total ? done * b->band_rows * b->width / total : 0),
+                (uint64_t)b->height * b->width);
+}
+
+/* A band's bytes: u32 count; per texel u32 texel, f32 size, lmb_point_ref, u8 valid, u8 partly;
+ * then 3 f32 direct light per texel, and 3 f32 direction sum per texel when directional. */
+static lmb_status put_band(const lmb_texels *t, const float *e, const float *dir, lmb_buf *out, lmb_error *err)
+{
+    lmb_status st = lmb_buf_append(out, &t->count, 4, err);
+    for (uint32_t i = 0; i < t->count && st == LMB_OK; i++) {
+        uint8_t flags[2] = {t->valid[i], t->partly_covered[i]};
+        st = lmb_buf_append(out, &t->texel[i], 4, err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, &t->texel_size[i], 4, err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, &t->refs[(size_t)i * t->samples + t->gather_at[i]], sizeof(lmb_point_ref), err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, flags, 2, err);
+    }
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, e, 3 * sizeof *e * t->count, err);
+    if (st == LMB_OK && dir)
+        st = lmb_buf_append(out, dir, 3 * sizeof *dir * t->count, err);
+    return st;
+}
+
+static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    band_ctx *c = user;
+    lmb_status st = LMB_OK;
+    for (uint64_t b = first; b < last && st == LMB_OK; b++) {
+        uint32_t y0 = (uint32_t)b * c->rows, y1 = y0 + c->rows < c->height ? y0 + c->rows : c->height;
+        lmb_texels band;
+        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &band, err);
+        if (st != LMB_OK)
+            break;
+        float *e = calloc(3 * (size_t)band.count + 1, sizeof *e);
+        float *dir = c->cfg->directional ? calloc(3 * (size_t)band.count + 1, sizeof *dir) : NULL;
+        if (!e || (c->cfg->directional && !dir))
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
+        c->row0 = y0;
+        c->band_rows = y1 - y0;
+        lmb_direct_job job = {c->direct, c->atlas, c->progress ? band_progress : NULL, c, dir};
+        if (st == LMB_OK)
+            st = lmb_direct_compute(&job, &band, e, &counters[0], err);
+        if (st == LMB_OK)
+            st = put_band(&band, e, dir, out, err);
+        free(e);
+        free(dir);
+        lmb_texels_free(&band);
+    }
+    return st;
+}
+
+/* Appends the next band of `in` to out (exact growth, as lmb_texels_append). */
+static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out, const band_ctx *c, lmb_error *err)
+{
+    uint32_t n;
+    if (!lmb_buf_take(in, &n, 4) || (uint64_t)n * 26 > in->size - in->read)
+        return lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
+    lmb_texels band;
+    memset(&band, 0, sizeof band);
+    band.width = c->width;
+    band.height = c->height;
+    band.samples = 1;
+    band.scene = c->scene;
+    band.layout = c->layout;
+    band.count = n;
+    band.texel = malloc(((size_t)n + 1) * sizeof *band.texel);
+    band.texel_size = malloc(((size_t)n + 1) * sizeof *band.texel_size);
+    band.refs = malloc(((size_t)n + 1) * sizeof *band.refs);
+    band.valid = malloc((size_t)n + 1);
+    band.partly_covered = malloc((size_t)n + 1);
+    band.gather_at = calloc((size_t)n + 1, 1);
+    size_t total = (size_t)out->t.count + n;
+    float *d = realloc(out->direct, (3 * total + 1) * sizeof *d);
+    if (d)
+        out->direct = d;
+    float *dd = directional ? realloc(out->direction, (3 * total + 1) * sizeof *dd) : NULL;
+    if (dd)
+        out->direction = dd;
+    lmb_status st = LMB_OK;
+    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.partly_covered || !band.gather_at || !d ||
+        (directional && !dd))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
+    for (uint32_t i = 0; i < n && st == LMB_OK; i++) {
+        uint8_t flags[2];
+        lmb_buf_take(in, &band.texel[i], 4);
+        lmb_buf_take(in, &band.texel_size[i], 4);
+        lmb_buf_take(in, &band.refs[i], sizeof band.refs[i]);
+        lmb_buf_take(in, flags, 2);
+        band.valid[i] = flags[0];
+        band.partly_covered[i] = flags[1];
+    }
+    if (st == LMB_OK && (!lmb_buf_take(in, out->direct + 3 * (size_t)out->t.count, 3 * sizeof(float) * n) ||
+                         (directional && !lmb_buf_take(in, out->direction + 3 * (size_t)out->t.count,
+                                                       3 * sizeof(float) * n))))
+        st = lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
+    if (st == LMB_OK)
+        st = lmb_texels_append(&out->t, &band, err);
+    lmb_texels_free(&band);
+    return st;
+}
+
+lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
+                                 const lmb_scene *scene, const lmb_layout *layout, uint32_t a, lmb_progress_fn progress,
+                                 void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user, 0, 0};
+    c.rows = c.width ? (BAND_TEXELS + c.width - 1) / c.width : c.height;
+    if (!c.rows)
+        c.rows = 1;
+    uint64_t bands = c.height ? (c.height + (uint64_t)c.rows - 1) / c.rows : 0;
+    double *cost = malloc((bands + 1) * sizeof *cost);
+    if (!cost)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+    for (uint64_t b = 0; b < bands; b++) { /* texels x sub-samples: each casts the same rays */
+        uint64_t y0 = b * c.rows, y1 = y0 + c.rows < c.height ? y0 + c.rows : c.height;
+        cost[b] = (double)((y1 - y0) * c.width);
+    }
+    char name[64];
+    snprintf(name, sizeof name, "direct, atlas %u", a);
+    /* rays: sub-samples x shadow rays, over the atlas's area (an upper bound: not every texel is used) */
+    lmb_step_desc d = {name, bands, cost, (double)c.width * c.height * cfg->texel_samples * cfg->direct_samples,
+                       compute_bands, &c};
+    lmb_buf bytes = {0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run(steps, &d, &bytes, counters, err);
+    *rays += counters[0];
+    for (uint64_t b = 0; b < bands && st == LMB_OK; b++)
+        st = take_band(&bytes, cfg->directional, out, &c, err);
+    if (st == LMB_OK && !out->t.texel) { /* an atlas without texels: empty arrays, not NULL */
+        lmb_texels empty;
+        memset(&empty, 0, sizeof empty);
+        empty.width = c.width;
+        empty.height = c.height;
+        empty.samples = 1;
+        st = lmb_texels_append(&out->t, &empty, err);
+    }
+    if (st == LMB_OK && !out->direct)
+        out->direct = calloc(1, sizeof *out->direct);
+    if (st == LMB_OK && cfg->directional && !out->direction)
+        out->direction = calloc(1, sizeof *out->direction);
+    if (st == LMB_OK && (!out->direct || (cfg->directional && !out->direction)))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+    free(cost);
+    lmb_buf_free(&bytes);
+    return st;
+}

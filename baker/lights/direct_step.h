@@ -1,0 +1,26 @@
+/*
+ * Gather points and direct light of one atlas as a step of the bake (farm/steps.h): its items
+ * are bands of ~16k texels (rows), each built and lit on its own (memory, issue 10: a band's
+ * sub-sampled points live only while its direct light is computed). A band's bytes are its
+ * texels as the atlas keeps them (one gather point each) and their direct light; results do
+ * not depend on the bands: random streams are keyed by (atlas, texel).
+ */
+#ifndef LMBAKE_DIRECT_STEP_H
+#define LMBAKE_DIRECT_STEP_H
+
+#include "farm/steps.h"
+#include "lights/direct.h"
+#include "texels/texels.h"
+
+typedef struct lmb_direct_atlas {
+    lmb_texels t;        /* the atlas's listed texels, one gather point each */
+    float *direct;       /* 3 per listed texel */
+    float *direction;    /* output.directional: 3 per listed texel, direct light's direction sum; else NULL */
+} lmb_direct_atlas;
+
+/* *out := atlas a's texels and direct light (owned: free its arrays and lmb_texels_free). */
+lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
+                                 const lmb_scene *scene, const lmb_layout *layout, uint32_t a, lmb_progress_fn progress,
+                                 void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err);
+
+#endif
