@@ -24,6 +24,7 @@ packages=(
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
   chromium                          # headless browser for the preview's shots and e2e test (playwright-core drives it)
   strace                            # the hostile-input test checks which files a bake opens
+  parallel                          # GNU parallel: 'lmbake farm parallel' and its test
 )
 
 read -r -a extra <<<"${LMB_SETUP_PACKAGES:-}"
