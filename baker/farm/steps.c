@@ -115,7 +115,7 @@ void lmb_steps_free(lmb_steps *s)
 
 uint32_t lmb_steps_count(const lmb_steps *s)
 {
-    return s->next;
+    return s ? s->next : 0;
 }
 
 static void put(uint8_t **p, const void *v, size_t n)
