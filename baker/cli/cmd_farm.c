@@ -175,7 +175,10 @@ static void script_head(FILE *f, const farm_args *a, const char *exe, const char
 static const char parallel_body[] =
     "command -v parallel >/dev/null || { echo \"lmbake farm parallel: GNU parallel is not installed (Debian: apt-get install parallel)\" >&2; exit 3; }\n"
     "mkdir -p \"$FARM/logs\"\n"
+    "stamp() { printf '%s\\t%s\\n' \"$1\" \"$(date +%s.%N)\" >>\"$FARM/logs/times.tsv\"; }  # what each stage took\n"
+    "stamp start\n"
     "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" \"${QUIET[@]}\"\n"
+    "stamp plan\n"
     "step=0\n"
     "while [ ! -f \"$FARM/end\" ]; do\n"
     "  if [ ! -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$step\")\" ]; then\n"
@@ -188,11 +191,14 @@ static const char parallel_body[] =
     "        \"$LMBAKE\" step \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --step \"$step\" --shard \"{}/$SHARDS\" -q \\\n"
     "        ::: \"${todo[@]}\"\n"
     "    fi\n"
+    "    stamp \"shards $step\"\n"
     "    \"$LMBAKE\" merge \"$SCENE\" \"${CONFIG[@]}\" --farm \"$FARM\" --step \"$step\" --shards \"$SHARDS\" -q\n"
+    "    stamp \"merge $step\"\n"
     "  fi\n"
     "  step=$((step + 1))\n"
     "done\n"
-    "\"$LMBAKE\" finish \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" -o \"$OUT\" \"${QUIET[@]}\"\n";
+    "\"$LMBAKE\" finish \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" -o \"$OUT\" \"${QUIET[@]}\"\n"
+    "stamp finish\n";
 
 static const char slurm_body[] =
     "SELF=\"$FARM/slurm.sh\"\n"

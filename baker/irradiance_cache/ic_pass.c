@@ -213,6 +213,8 @@ typedef struct records_step {
     pass_ctx *c;
     const texel_at *at;
     const uint32_t *slots;
+    int candidates;              /* at[] are a level's candidates: each is first tested for coverage
+                                    by the records so far, and gathered only when uncovered */
     uint64_t done_before, total; /* progress */
 } records_step;
 
@@ -228,6 +230,7 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
     lmb_status st = LMB_OK;
     lmb_ic_record *rec = malloc(block * sizeof *rec);
     lmb_mixture *mix = c->guided ? malloc(block * sizeof *mix) : NULL;
+    uint8_t covered[64] = {0};
     if (!rec || (c->guided && !mix))
         failed = 1;
     for (uint64_t start = first; start < last && !failed && st == LMB_OK; start += block) {
@@ -242,6 +245,13 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                 lmb_mixture guide;
                 const lmb_mixture *by = NULL;
                 const texel_at x = rs->at[k];
+                if (rs->candidates) {
+                    double p[3], nn[3];
+                    texel_point(c, x, p, nn);
+                    covered[k - start] = lmb_ic_interpolate(&c->records, p, nn, NULL) >= LMB_IC_COVERED;
+                    if (covered[k - start])
+                        continue;
+                }
                 if (c->guided) {
                     double p[3], n[3];
                     texel_point(c, x, p, n);
@@ -270,6 +280,12 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
         counters[1] += texels;
         counters[2] += adapted;
         for (uint64_t k = start; k < end && !failed && st == LMB_OK; k++) {
+            if (rs->candidates) { /* a flag byte: covered (nothing follows) or a record */
+                uint8_t flag = !covered[k - start];
+                st = lmb_buf_append(out, &flag, 1, err);
+                if (!flag || st != LMB_OK)
+                    continue;
+            }
             st = put_record(out, &rec[k - start], err);
             if (st == LMB_OK && c->guided)
                 st = put_mixture(out, &mix[k - start], err);
@@ -285,18 +301,21 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
 }
 
 /*
- * Gathers at the m texels at[] (one step of the bake). slots == NULL: new records, made in
- * rec[k], record index records.count + k. slots != NULL: records placed by an earlier pass
- * (`irradiance_cache.records: shared`), record slots[k], updated with this pass's irradiance
- * and rotation gradient, keeping position and reach. Guided: each gathers by the nearest
- * record of an earlier group on the same surface (its mixture re-aimed), or learns one.
+ * Gathers at the m texels at[] (one step of the bake). slots == NULL: new records, appended
+ * to rec[] (*made of them; NULL made: every texel makes one); with `candidates`, a texel the
+ * records so far cover makes none (level placement: the test runs in the step, beside the
+ * gathers). slots != NULL: records placed by an earlier pass (`irradiance_cache.records:
+ * shared`), record slots[k], updated with this pass's irradiance and rotation gradient,
+ * keeping position and reach. Guided: each gathers by the nearest record of an earlier group
+ * on the same surface (its mixture re-aimed), or learns one.
  */
-static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, lmb_ic_record *rec,
-                                 uint64_t done_before, uint64_t total, lmb_gather_stats *stats, lmb_error *err)
+static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, int candidates,
+                                 lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
+                                 lmb_gather_stats *stats, lmb_error *err)
 {
     if (!reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for guides");
-    records_step rs = {c, at, slots, done_before, total};
+    records_step rs = {c, at, slots, candidates, done_before, total};
     char name[160];
     snprintf(name, sizeof name, "%s: %s %u", c->stage, slots ? "records gathered again, group" : "records placed, level",
              slots ? c->regather_group : c->group);
@@ -307,11 +326,17 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
     stats->rays += counters[0];
     stats->texels += counters[1];
     stats->adapted += counters[2];
+    uint64_t n = 0; /* records made */
     for (uint64_t k = 0; k < m && st == LMB_OK; k++) {
-        uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)k;
+        uint8_t flag = 1;
+        if (candidates && !lmb_buf_take(&bytes, &flag, 1))
+            flag = 2;
+        if (!flag)
+            continue;
+        uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)n;
         lmb_ic_record fresh;
         lmb_mixture mix;
-        if (!take_record(&bytes, &fresh) || (c->guided && !take_mixture(&bytes, &mix))) {
+        if (flag == 2 || !take_record(&bytes, &fresh) || (c->guided && !take_mixture(&bytes, &mix))) {
             st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step '%s' holds fewer records than %llu", c->job->stage, name,
                                (unsigned long long)m);
             break;
@@ -322,13 +347,16 @@ static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
             memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
             memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
         } else {
-            rec[k] = fresh;
+            rec[n] = fresh;
         }
+        n++;
     }
     lmb_buf_free(&bytes);
+    if (made)
+        *made = n;
     if (st != LMB_OK)
         return st;
-    for (uint64_t k = 0; c->guided && k < m; k++)
+    for (uint64_t k = 0; c->guided && k < n; k++) /* the group is in: later groups may be guided by it */
         c->has_mix[slots ? slots[k] : c->records.count + (uint32_t)k] = 1;
     return LMB_OK;
 }
@@ -363,7 +391,7 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
             }
         c->regather_group = g;
         if (n)
-            st = gather_records(c, at, n, slots, NULL, done, m, stats, err);
+            st = gather_records(c, at, n, slots, 0, NULL, NULL, done, m, stats, err);
         done += n;
     }
     free(at);
@@ -375,36 +403,21 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
 static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t *placed, lmb_gather_stats *stats,
                               lmb_error *err)
 {
-    texel_at *cand;
-    uint64_t n;
+    texel_at *cand = NULL;
+    uint64_t n = 0;
     lmb_status st = level_candidates(c, spacing, &cand, &n, err);
     if (st != LMB_OK)
         return st;
-    uint8_t *uncovered = calloc((size_t)n + 1, 1);
-    if (!uncovered) {
-        free(cand);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
-    }
-#pragma omp parallel for num_threads(c->threads) schedule(dynamic, 256)
-    for (uint64_t k = 0; k < n; k++) {
-        double p[3], nn[3];
-        texel_point(c, cand[k], p, nn);
-        uncovered[k] = lmb_ic_interpolate(&c->records, p, nn, NULL) < LMB_IC_COVERED;
-    }
-    uint64_t m = 0;
-    for (uint64_t k = 0; k < n; k++)
-        if (uncovered[k])
-            cand[m++] = cand[k];
-    free(uncovered);
-    lmb_ic_record *fresh = malloc((size_t)(m + 1) * sizeof *fresh);
+    lmb_ic_record *fresh = malloc((size_t)(n + 1) * sizeof *fresh);
     if (!fresh) {
         free(cand);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu records",
-                             (unsigned long long)m);
+                             (unsigned long long)n);
     }
-    st = gather_records(c, cand, m, NULL, fresh, 0, m, stats, err);
+    uint64_t m = 0;
+    st = gather_records(c, cand, n, NULL, 1, fresh, &m, 0, n, stats, err);
     for (uint64_t k = 0; st == LMB_OK && k < m; k++) {
-        c->is_record[cand[k].atlas][cand[k].index] = 1;
+        c->is_record[fresh[k].atlas][fresh[k].texel] = 1;
         fresh[k].group = c->group;
     }
     c->group++;
@@ -412,7 +425,7 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
         st = lmb_ic_records_append(&c->records, fresh, (uint32_t)m, err);
     free(fresh);
     free(cand);
-    if (st == LMB_OK)
+    if (st == LMB_OK && m) /* no new record: the index stands */
         st = lmb_ic_records_index(&c->records, err);
     *placed = m;
     if (st == LMB_OK && m && clamp)
@@ -421,22 +434,100 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
 }
 
 /* Every valid texel := the interpolation at its gather point (invalid: 0). */
-static void interpolate_all(const pass_ctx *c, float *const *out)
+/* The translation-gradient fit as a step: items are records, 9 doubles each. */
+static lmb_status fit_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                            uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
+    const pass_ctx *c = user;
+    (void)counters;
+    double (*g)[3][3] = malloc(((size_t)(last - first) + 1) * sizeof *g);
+    if (!g)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for gradients");
+    lmb_ic_records_fit_range(&c->records, (uint32_t)first, (uint32_t)last, (uint32_t)c->threads, g);
+    lmb_status st = lmb_buf_append(out, g, (size_t)(last - first) * sizeof *g, err);
+    free(g);
+    return st;
+}
+
+static lmb_status fit_gradients(pass_ctx *c, lmb_error *err)
+{
+    char name[160];
+    snprintf(name, sizeof name, "%s: gradients", c->stage);
+    /* rays: a fit visits the records within twice its reach; counted as 64 rays per record */
+    lmb_step_desc d = {name, c->records.count, NULL, 64.0 * c->records.count, fit_range, c};
+    lmb_buf bytes = {0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run(c->job->steps, &d, &bytes, counters, err);
+    for (uint32_t i = 0; i < c->records.count && st == LMB_OK; i++)
+        if (!lmb_buf_take(&bytes, c->records.rec[i].grad_t, sizeof c->records.rec[i].grad_t))
+            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few records", name);
+    lmb_buf_free(&bytes);
+    return st;
+}
+
+/* Interpolation as a step (farm/steps.h): items are every atlas's listed texels in order. */
+typedef struct interp_step {
+    const pass_ctx *c;
+    uint64_t *first; /* per atlas (+1): its first item */
+} interp_step;
+
+static lmb_status interpolate_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                                    uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    const interp_step *is = user;
+    const pass_ctx *c = is->c;
+    (void)counters;
     for (uint32_t a = 0; a < c->atlas_count; a++) {
         const lmb_texels *t = c->t[a];
-        float *o = out[a];
+        uint64_t a0 = is->first[a], a1 = is->first[a + 1];
+        if (a1 <= first || a0 >= last)
+            continue;
+        uint32_t i0 = (uint32_t)((first > a0 ? first : a0) - a0), i1 = (uint32_t)((last < a1 ? last : a1) - a0);
+        float *o = malloc(3 * sizeof *o * ((size_t)(i1 - i0) + 1));
+        if (!o)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
 #pragma omp parallel for num_threads(c->threads) schedule(dynamic, 1024)
-        for (uint32_t i = 0; i < t->count; i++) {
+        for (uint32_t i = i0; i < i1; i++) {
             double e[3] = {0, 0, 0}, p[3], n[3];
             if (t->valid[i]) {
                 texel_point(c, (texel_at){a, i}, p, n);
                 lmb_ic_interpolate(&c->records, p, n, e);
             }
             for (int k = 0; k < 3; k++)
-                o[3 * (size_t)i + k] = (float)e[k];
+                o[3 * (size_t)(i - i0) + k] = (float)e[k];
         }
+        lmb_status st = lmb_buf_append(out, o, 3 * sizeof *o * (i1 - i0), err);
+        free(o);
+        if (st != LMB_OK)
+            return st;
     }
+    return LMB_OK;
+}
+
+/* Every valid texel := the interpolation at its gather point (invalid: 0). A step: the
+ * lookups cost about as much as a few gather rays per texel, too much to repeat in every
+ * farm process that replays this pass. */
+static lmb_status interpolate_all(const pass_ctx *c, float *const *out, lmb_error *err)
+{
+    interp_step is = {c, calloc((size_t)c->atlas_count + 2, sizeof(uint64_t))};
+    if (!is.first)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    for (uint32_t a = 0; a < c->atlas_count; a++)
+        is.first[a + 1] = is.first[a] + c->t[a]->count;
+    char name[160];
+    snprintf(name, sizeof name, "%s: interpolation", c->stage);
+    /* rays: a lookup visits tens of records; counted as 8 rays per texel for farm.min_step_rays */
+    lmb_step_desc d = {name, is.first[c->atlas_count], NULL, 8.0 * (double)is.first[c->atlas_count],
+                       interpolate_range, &is};
+    lmb_buf bytes = {0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run(c->job->steps, &d, &bytes, counters, err);
+    for (uint32_t a = 0; a < c->atlas_count && st == LMB_OK; a++)
+        if (!lmb_buf_take(&bytes, out[a], 3 * sizeof(float) * c->t[a]->count))
+            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", name);
+    lmb_buf_free(&bytes);
+    free(is.first);
+    return st;
 }
 
 static lmb_status export_points(const lmb_ic_records *s, lmb_ic_points *out, lmb_error *err)
@@ -514,9 +605,10 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
             break;
     }
     if (st == LMB_OK)
-        st = lmb_ic_records_fit_gradients(&c.records, (uint32_t)c.threads, err);
+        st = fit_gradients(&c, err);
+    if (st == LMB_OK)
+        st = interpolate_all(&c, out, err);
     if (st == LMB_OK) {
-        interpolate_all(&c, out);
         if (job->progress) /* done (report() stops short of the total until here) */
             job->progress(job->progress_user, c.stage, c.valid_total * (c.levels + 1), c.valid_total * (c.levels + 1));
     }

@@ -90,18 +90,18 @@ static void select_kth(const lmb_ic_records *s, int axis, uint32_t *o, uint32_t 
     }
 }
 
-static void build(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32_t hi)
+/* point[i]: record i's position as a float box, rounded outward so that it holds the double
+ * position (computed once per index, not at every level of the tree). */
+static void build(lmb_ic_records *s, const float (*point)[6], uint32_t node, uint32_t lo, uint32_t hi)
 {
     float *b = s->box[node];
     b[0] = b[1] = b[2] = FLT_MAX;
     b[3] = b[4] = b[5] = -FLT_MAX;
     for (uint32_t k = lo; k < hi; k++) {
-        const lmb_ic_record *r = &s->rec[s->order[k]];
+        const float *q = point[s->order[k]];
         for (int a = 0; a < 3; a++) {
-            /* rounded outward so that the float box holds the double positions */
-            float lo_f = nextafterf((float)r->p[a], -FLT_MAX), hi_f = nextafterf((float)r->p[a], FLT_MAX);
-            b[a] = lo_f < b[a] ? lo_f : b[a];
-            b[3 + a] = hi_f > b[3 + a] ? hi_f : b[3 + a];
+            b[a] = q[a] < b[a] ? q[a] : b[a];
+            b[3 + a] = q[3 + a] > b[3 + a] ? q[3 + a] : b[3 + a];
         }
     }
     if (hi - lo <= LEAF)
@@ -112,8 +112,8 @@ static void build(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32_t hi)
             axis = a;
     uint32_t mid = lo + (hi - lo) / 2;
     select_kth(s, axis, s->order, lo, hi, mid);
-    build(s, 2 * node, lo, mid);
-    build(s, 2 * node + 1, mid, hi);
+    build(s, point, 2 * node, lo, mid);
+    build(s, point, 2 * node + 1, mid, hi);
 }
 
 /* Every node's largest reach below it (positions, hence the tree, unchanged). */
@@ -151,10 +151,19 @@ lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory indexing %u records", s->count);
     for (uint32_t k = 0; k < s->count; k++)
         s->order[k] = k;
+    float (*point)[6] = malloc(((size_t)s->count + 1) * sizeof *point);
+    if (!point)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory indexing %u records", s->count);
+    for (uint32_t k = 0; k < s->count; k++)
+        for (int a = 0; a < 3; a++) {
+            point[k][a] = nextafterf((float)s->rec[k].p[a], -FLT_MAX);
+            point[k][3 + a] = nextafterf((float)s->rec[k].p[a], FLT_MAX);
+        }
     if (s->count) {
-        build(s, 1, 0, s->count);
+        build(s, (const float (*)[6])point, 1, 0, s->count);
         refresh_reach(s, 1, 0, s->count);
     }
+    free(point);
     return LMB_OK;
 }
 
@@ -374,22 +383,21 @@ static void fit_visit(void *user, uint32_t k)
  * line give the gradient along it only. A gradient that would change E by more than E over
  * the reach is scaled down to that (noise, not light: irradiance does not go negative).
  */
-lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb_error *err)
+void lmb_ic_records_fit_range(const lmb_ic_records *s, uint32_t first, uint32_t last, uint32_t threads,
+                              double (*g)[3][3])
 {
-    double (*g)[3][3] = malloc(((size_t)s->count + 1) * sizeof *g);
-    if (!g)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u gradients", s->count);
     int nt = threads ? (int)threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(nt) schedule(dynamic, 256)
-    for (uint32_t i = 0; i < s->count; i++) {
+    for (uint32_t i = first; i < last; i++) {
         const lmb_ic_record *r = &s->rec[i];
+        double (*gi)[3] = g[i - first];
         fit_ctx c;
         memset(&c, 0, sizeof c);
         c.s = s;
         c.self = r;
         lmb_frame(r->n, c.t, c.b);
         walk(s, r->p, 2 * r->r, fit_visit, &c);
-        memset(g[i], 0, sizeof g[i]);
+        memset(gi, 0, sizeof g[0]);
         double ridge = 1e-3 * (c.a[0] + c.a[2]) + 1e-30;
         double a0 = c.a[0] + ridge, a1 = c.a[1], a2 = c.a[2] + ridge, det = a0 * a2 - a1 * a1;
         if (c.used < 2 || !(det > 0))
@@ -399,9 +407,17 @@ lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb
             double gv = (a0 * c.rhs[ch][1] - a1 * c.rhs[ch][0]) / det;
             double mag = sqrt(gu * gu + gv * gv) * r->r, scale = mag > r->e[ch] ? r->e[ch] / mag : 1;
             for (int k = 0; k < 3; k++)
-                g[i][ch][k] = scale * (gu * c.t[k] + gv * c.b[k]);
+                gi[ch][k] = scale * (gu * c.t[k] + gv * c.b[k]);
         }
     }
+}
+
+lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb_error *err)
+{
+    double (*g)[3][3] = malloc(((size_t)s->count + 1) * sizeof *g);
+    if (!g)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u gradients", s->count);
+    lmb_ic_records_fit_range(s, 0, s->count, threads, g);
     for (uint32_t i = 0; i < s->count; i++)
         memcpy(s->rec[i].grad_t, g[i], sizeof g[i]);
     free(g);

@@ -87,4 +87,9 @@ lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *
  * README "Irradiance cache": why not Ward and Heckbert's stratified formula). Reads the index. */
 lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb_error *err);
 
+/* The gradients of records [first, last) only, into g[i - first] (the records unchanged): the
+ * farm's step of the fit (irradiance_cache/ic_pass.c). */
+void lmb_ic_records_fit_range(const lmb_ic_records *s, uint32_t first, uint32_t last, uint32_t threads,
+                              double (*g)[3][3]);
+
 #endif

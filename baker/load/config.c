@@ -139,7 +139,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->ic_min_spacing = 4;
     cfg->ic_max_spacing = 32;
     cfg->ic_ray_scale = 4;
-    cfg->farm_min_step_rays = 20000000; /* ~1.5 s of one core: less than a shard's start on a real level */
+    cfg->farm_min_step_rays = 1000000; /* ~0.1 s of one core: a step costs a process start per shard */
     cfg->ic_records = LMB_IC_RECORDS_SHARED; /* README "Irradiance cache": as accurate, 1.0-1.4x faster */
     cfg->seed = 1;
     cfg->threads = 0;
