@@ -1,5 +1,6 @@
 /* A gather pass through the irradiance cache: placement, gradients, interpolation (ic_pass.h). */
 #include "ic_pass.h"
+#include "ic_pass_internal.h"
 
 #include "farm/steps.h"
 #include "gather/guide.h"
@@ -16,58 +17,10 @@
 /* Rounds of placement at most; see lmb_ic_gather_pass. */
 #define LMB_IC_ROUNDS 4
 
-/* A listed texel of some atlas. */
-typedef struct texel_at {
-    uint32_t atlas, index;
-} texel_at;
-
-typedef struct pass_ctx {
-    const lmb_gather_job *job;    /* with the record's rays */
-    const lmb_ic_options *opt;
-    uint32_t atlas_count;
-    const lmb_texels *const *t;
-    uint8_t **is_record;          /* per atlas, per listed texel */
-    lmb_ic_records records;
-    int threads;
-    uint64_t valid_total, levels, level;
-    uint64_t reported;            /* progress never goes back (the last level may run several rounds) */
-    char stage[96];
-    uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
-    uint32_t regather_group;      /* the group being gathered again (step names) */
-    /* guided gathering (gather/guide.h): per record, the mixture it gathered by or learned in
-     * this pass; has_mix[k] is set once record k's whole group is gathered, so a record is
-     * guided only by records of earlier groups (deterministic at any thread count) */
-    int guided;
-    uint32_t lobes;
-    lmb_mixture *mix;
-    uint8_t *has_mix;
-    uint32_t mix_cap;
-} pass_ctx;
 
 
-/* Room for the mixtures of n records (new ones not yet had). */
-static int reserve_mix(pass_ctx *c, uint32_t n)
-{
-    if (!c->guided || n <= c->mix_cap)
-        return 1;
-    uint32_t cap = c->mix_cap ? c->mix_cap : 1024;
-    while (cap < n)
-        cap = cap > UINT32_MAX / 2 ? n : cap * 2;
-    lmb_mixture *m = realloc(c->mix, (size_t)cap * sizeof *m);
-    if (m)
-        c->mix = m;
-    uint8_t *h = realloc(c->has_mix, cap);
-    if (h) {
-        memset(h + c->mix_cap, 0, cap - c->mix_cap);
-        c->has_mix = h;
-    }
-    if (!m || !h)
-        return 0;
-    c->mix_cap = cap;
-    return 1;
-}
 
-static void texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
+void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
 {
     lmb_shading_point sp;
     const lmb_texels *t = c->t[x.atlas];
@@ -76,7 +29,7 @@ static void texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
     memcpy(n, sp.n, 3 * sizeof *n);
 }
 
-static void report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total)
+void lmb_ic_report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total)
 {
     const lmb_gather_job *job = c->job;
     if (!job->progress)
@@ -118,249 +71,6 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, texel_at
     return LMB_OK;
 }
 
-/* Record from a gather at texel x: reach clamps from the texel's size, the rotation gradient
- * bounded like the translation one (at most E over the largest normal difference served). */
-static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_result *g, lmb_ic_record *r)
-{
-    memset(r, 0, sizeof *r);
-    memcpy(r->p, g->p, sizeof r->p);
-    memcpy(r->n, g->n, sizeof r->n);
-    memcpy(r->e, g->e, sizeof r->e);
-    double size = c->t[x.atlas]->texel_size[x.index];
-    r->r_min = c->opt->min_spacing * size;
-    r->r_max = c->opt->max_spacing * size;
-    r->harmonic = g->harmonic;
-    r->r = lmb_ic_reach(&c->records, r);
-    double turn = sqrt(2.0) * c->records.normal_limit; /* |n_i x n| at the largest difference */
-    for (int ch = 0; ch < 3; ch++) {
-        double mag = sqrt(lmb_dot3(g->rot[ch], g->rot[ch])) * turn;
-        double scale = mag > r->e[ch] ? r->e[ch] / mag : 1;
-        for (int k = 0; k < 3; k++)
-            r->grad_r[ch][k] = scale * g->rot[ch][k];
-    }
-    r->atlas = x.atlas;
-    r->texel = x.index;
-}
-
-/* A record's bytes in a step (farm/steps.h): its doubles p .. r (31, contiguous), atlas, texel. */
-#define RECORD_DOUBLES 31
-_Static_assert(offsetof(lmb_ic_record, r) - offsetof(lmb_ic_record, p) == (RECORD_DOUBLES - 1) * sizeof(double),
-               "lmb_ic_record: p .. r are contiguous doubles");
-
-static lmb_status put_record(lmb_buf *out, const lmb_ic_record *r, lmb_error *err)
-{
-    lmb_status st = lmb_buf_append(out, r->p, RECORD_DOUBLES * sizeof(double), err);
-    if (st == LMB_OK)
-        st = lmb_buf_append(out, &r->atlas, 4, err);
-    if (st == LMB_OK)
-        st = lmb_buf_append(out, &r->texel, 4, err);
-    return st;
-}
-
-static int take_record(lmb_buf *in, lmb_ic_record *r)
-{
-    memset(r, 0, sizeof *r);
-    return lmb_buf_take(in, r->p, RECORD_DOUBLES * sizeof(double)) && lmb_buf_take(in, &r->atlas, 4) &&
-           lmb_buf_take(in, &r->texel, 4);
-}
-
-/* A mixture's bytes: count, diffuse, then per lobe its 14 doubles and `aimed` (unused lobes
- * are not written: a part's bytes do not depend on memory left over). */
-static lmb_status put_mixture(lmb_buf *out, const lmb_mixture *m, lmb_error *err)
-{
-    lmb_status st = lmb_buf_append(out, &m->count, 4, err);
-    if (st == LMB_OK)
-        st = lmb_buf_append(out, &m->diffuse, 8, err);
-    for (uint32_t k = 0; k < m->count && k < LMB_MIXTURE_MAX_LOBES && st == LMB_OK; k++) {
-        double v[14];
-        memcpy(v, m->lobe[k].axis, 24);
-        v[3] = m->lobe[k].a;
-        v[4] = m->weight[k];
-        memcpy(v + 5, m->tangent[k], 24);
-        memcpy(v + 8, m->bitangent[k], 24);
-        memcpy(v + 11, m->target[k], 24);
-        int32_t aimed = m->aimed[k];
-        st = lmb_buf_append(out, v, sizeof v, err);
-        if (st == LMB_OK)
-            st = lmb_buf_append(out, &aimed, 4, err);
-    }
-    return st;
-}
-
-static int take_mixture(lmb_buf *in, lmb_mixture *m)
-{
-    memset(m, 0, sizeof *m);
-    if (!lmb_buf_take(in, &m->count, 4) || !lmb_buf_take(in, &m->diffuse, 8) || m->count > LMB_MIXTURE_MAX_LOBES)
-        return 0;
-    for (uint32_t k = 0; k < m->count; k++) {
-        double v[14];
-        int32_t aimed;
-        if (!lmb_buf_take(in, v, sizeof v) || !lmb_buf_take(in, &aimed, 4))
-            return 0;
-        memcpy(m->lobe[k].axis, v, 24);
-        m->lobe[k].a = v[3];
-        m->weight[k] = v[4];
-        memcpy(m->tangent[k], v + 5, 24);
-        memcpy(m->bitangent[k], v + 8, 24);
-        memcpy(m->target[k], v + 11, 24);
-        m->aimed[k] = aimed;
-    }
-    return 1;
-}
-
-/* A gather_records call as a step: its items are the texels at[]. */
-typedef struct records_step {
-    pass_ctx *c;
-    const texel_at *at;
-    const uint32_t *slots;
-    int candidates;              /* at[] are a level's candidates: each is first tested for coverage
-                                    by the records so far, and gathered only when uncovered */
-    uint64_t done_before, total; /* progress */
-} records_step;
-
-/* Gathers at items [first, last) in parallel blocks: per item its record (and, guided, the
- * mixture it gathered by or learned). Reads earlier groups' records and mixtures only. */
-static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
-                                       uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
-{
-    const records_step *rs = user;
-    pass_ctx *c = rs->c;
-    const uint64_t block = 64;
-    int failed = 0;
-    lmb_status st = LMB_OK;
-    lmb_ic_record *rec = malloc(block * sizeof *rec);
-    lmb_mixture *mix = c->guided ? malloc(block * sizeof *mix) : NULL;
-    uint8_t covered[64] = {0};
-    if (!rec || (c->guided && !mix))
-        failed = 1;
-    for (uint64_t start = first; start < last && !failed && st == LMB_OK; start += block) {
-        uint64_t end = start + block < last ? start + block : last, rays = 0, texels = 0, adapted = 0;
-#pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
-        {
-            lmb_rt_thread_init();
-            lmb_estimator_scratch scratch = {0};
-            lmb_gather_stats gs = {0, 0, 0, 0};
-#pragma omp for schedule(dynamic, 1)
-            for (uint64_t k = start; k < end; k++) {
-                lmb_mixture guide;
-                const lmb_mixture *by = NULL;
-                const texel_at x = rs->at[k];
-                if (rs->candidates) {
-                    double p[3], nn[3];
-                    texel_point(c, x, p, nn);
-                    covered[k - start] = lmb_ic_interpolate(&c->records, p, nn, NULL) >= LMB_IC_COVERED;
-                    if (covered[k - start])
-                        continue;
-                }
-                if (c->guided) {
-                    double p[3], n[3];
-                    texel_point(c, x, p, n);
-                    int64_t j = lmb_ic_records_nearest(&c->records, p, n, LMB_GUIDE_SAME_SURFACE_COS, c->has_mix);
-                    if (j >= 0) {
-                        lmb_mixture_reaim(&c->mix[j], c->records.rec[j].p, p, &guide);
-                        by = &guide;
-                    }
-                }
-                lmb_gather_point_result g;
-                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, &scratch, &g, &gs) !=
-                    LMB_OK) {
-                    failed = 1;
-                    continue;
-                }
-                if (c->guided)
-                    mix[k - start] = by ? guide : g.learned;
-                make_record(c, x, &g, &rec[k - start]);
-            }
-            lmb_estimator_scratch_free(&scratch);
-            rays += gs.rays;
-            texels += gs.texels;
-            adapted += gs.adapted;
-        }
-        counters[0] += rays;
-        counters[1] += texels;
-        counters[2] += adapted;
-        for (uint64_t k = start; k < end && !failed && st == LMB_OK; k++) {
-            if (rs->candidates) { /* a flag byte: covered (nothing follows) or a record */
-                uint8_t flag = !covered[k - start];
-                st = lmb_buf_append(out, &flag, 1, err);
-                if (!flag || st != LMB_OK)
-                    continue;
-            }
-            st = put_record(out, &rec[k - start], err);
-            if (st == LMB_OK && c->guided)
-                st = put_mixture(out, &mix[k - start], err);
-        }
-        report(c, rs->done_before + end, rs->total);
-    }
-    free(rec);
-    free(mix);
-    if (failed)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for %u gather samples", c->job->stage,
-                             c->job->estimator.rays);
-    return st;
-}
-
-/*
- * Gathers at the m texels at[] (one step of the bake). slots == NULL: new records, appended
- * to rec[] (*made of them; NULL made: every texel makes one); with `candidates`, a texel the
- * records so far cover makes none (level placement: the test runs in the step, beside the
- * gathers). slots != NULL: records placed by an earlier pass (`irradiance_cache.records:
- * shared`), record slots[k], updated with this pass's irradiance and rotation gradient,
- * keeping position and reach. Guided: each gathers by the nearest record of an earlier group
- * on the same surface (its mixture re-aimed), or learns one.
- */
-static lmb_status gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, int candidates,
-                                 lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
-                                 lmb_gather_stats *stats, lmb_error *err)
-{
-    if (!reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for guides");
-    records_step rs = {c, at, slots, candidates, done_before, total};
-    char name[160];
-    snprintf(name, sizeof name, "%s: %s %u", c->stage, slots ? "records gathered again, group" : "records placed, level",
-             slots ? c->regather_group : c->group);
-    lmb_step_desc d = {name, m, NULL, (double)m * c->job->estimator.rays, gather_records_range, &rs};
-    lmb_buf bytes = {0};
-    uint64_t counters[LMB_STEP_COUNTERS];
-    lmb_status st = lmb_steps_run(c->job->steps, &d, &bytes, counters, err);
-    stats->rays += counters[0];
-    stats->texels += counters[1];
-    stats->adapted += counters[2];
-    uint64_t n = 0; /* records made */
-    for (uint64_t k = 0; k < m && st == LMB_OK; k++) {
-        uint8_t flag = 1;
-        if (candidates && !lmb_buf_take(&bytes, &flag, 1))
-            flag = 2;
-        if (!flag)
-            continue;
-        uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)n;
-        lmb_ic_record fresh;
-        lmb_mixture mix;
-        if (flag == 2 || !take_record(&bytes, &fresh) || (c->guided && !take_mixture(&bytes, &mix))) {
-            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step '%s' holds fewer records than %llu", c->job->stage, name,
-                               (unsigned long long)m);
-            break;
-        }
-        if (c->guided)
-            c->mix[slot] = mix;
-        if (slots) {
-            memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
-            memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
-        } else {
-            rec[n] = fresh;
-        }
-        n++;
-    }
-    lmb_buf_free(&bytes);
-    if (made)
-        *made = n;
-    if (st != LMB_OK)
-        return st;
-    for (uint64_t k = 0; c->guided && k < n; k++) /* the group is in: later groups may be guided by it */
-        c->has_mix[slots ? slots[k] : c->records.count + (uint32_t)k] = 1;
-    return LMB_OK;
-}
-
 /* The records of an earlier pass, gathered again with this pass's light, group by group in
  * placement order (guided gathering reads earlier groups' mixtures). */
 static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
@@ -391,7 +101,7 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
             }
         c->regather_group = g;
         if (n)
-            st = gather_records(c, at, n, slots, 0, NULL, NULL, done, m, stats, err);
+            st = lmb_ic_gather_records(c, at, n, slots, 0, NULL, NULL, done, m, stats, err);
         done += n;
     }
     free(at);
@@ -415,7 +125,7 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
                              (unsigned long long)n);
     }
     uint64_t m = 0;
-    st = gather_records(c, cand, n, NULL, 1, fresh, &m, 0, n, stats, err);
+    st = lmb_ic_gather_records(c, cand, n, NULL, 1, fresh, &m, 0, n, stats, err);
     for (uint64_t k = 0; st == LMB_OK && k < m; k++) {
         c->is_record[fresh[k].atlas][fresh[k].texel] = 1;
         fresh[k].group = c->group;
@@ -490,7 +200,7 @@ static lmb_status interpolate_range(void *user, uint64_t first, uint64_t last, l
         for (uint32_t i = i0; i < i1; i++) {
             double e[3] = {0, 0, 0}, p[3], n[3];
             if (t->valid[i]) {
-                texel_point(c, (texel_at){a, i}, p, n);
+                lmb_ic_texel_point(c, (texel_at){a, i}, p, n);
                 lmb_ic_interpolate(&c->records, p, n, e);
             }
             for (int k = 0; k < 3; k++)

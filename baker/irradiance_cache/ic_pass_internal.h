@@ -1,0 +1,61 @@
+/*
+ * What the irradiance-cache pass (ic_pass.c) shares with its record gathers
+ * (ic_record_step.c): the pass's state, and the step that gathers records.
+ */
+#ifndef LMBAKE_IC_PASS_INTERNAL_H
+#define LMBAKE_IC_PASS_INTERNAL_H
+
+#include "farm/steps.h"
+#include "gather/gather.h"
+#include "gather/mixture.h"
+#include "irradiance_cache/ic_pass.h"
+#include "irradiance_cache/records.h"
+
+/* A listed texel of some atlas. */
+typedef struct texel_at {
+    uint32_t atlas, index;
+} texel_at;
+
+typedef struct pass_ctx {
+    const lmb_gather_job *job;    /* with the record's rays */
+    const lmb_ic_options *opt;
+    uint32_t atlas_count;
+    const lmb_texels *const *t;
+    uint8_t **is_record;          /* per atlas, per listed texel */
+    lmb_ic_records records;
+    int threads;
+    uint64_t valid_total, levels, level;
+    uint64_t reported;            /* progress never goes back (the last level may run several rounds) */
+    char stage[96];
+    uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
+    uint32_t regather_group;      /* the group being gathered again (step names) */
+    /* guided gathering (gather/guide.h): per record, the mixture it gathered by or learned in
+     * this pass; has_mix[k] is set once record k's whole group is gathered, so a record is
+     * guided only by records of earlier groups (deterministic at any thread count) */
+    int guided;
+    uint32_t lobes;
+    lmb_mixture *mix;
+    uint8_t *has_mix;
+    uint32_t mix_cap;
+} pass_ctx;
+
+/* The world position and shading normal a texel gathers at. */
+void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3]);
+
+/* Progress: done_in_level of level_total gathers of the current level. */
+void lmb_ic_report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total);
+
+/*
+ * Gathers at the m texels at[] (one step of the bake). slots == NULL: new records, appended
+ * to rec[] (*made of them; NULL made: every texel makes one); with `candidates`, a texel the
+ * records so far cover makes none (level placement: the test runs in the step, beside the
+ * gathers). slots != NULL: records placed by an earlier pass (`irradiance_cache.records:
+ * shared`), record slots[k], updated with this pass's irradiance and rotation gradient,
+ * keeping position and reach. Guided: each gathers by the nearest record of an earlier group
+ * on the same surface (its mixture re-aimed), or learns one.
+ */
+lmb_status lmb_ic_gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, int candidates,
+                                 lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
+                                 lmb_gather_stats *stats, lmb_error *err);
+
+#endif
