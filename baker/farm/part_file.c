@@ -3,6 +3,7 @@
 #include "part_file.h"
 
 #include "load/gltf_adapter.h"
+#include "load/uri.h"
 #include "util/file.h"
 
 #include <errno.h>
@@ -38,6 +39,37 @@ static void hex8(const uint8_t *sha, char out[17])
         snprintf(out + 2 * i, 3, "%02x", sha[i]);
 }
 
+/* The image files the glTF references by relative path (textures change a bake too): each
+ * one's path and contents; one the bake could not read counts by its path alone (the bake
+ * skips it with a warning, and so does every machine that cannot read it). */
+static void hash_image_files(const lmb_scene *scene, struct sha256_ctx *c)
+{
+    char folder[4096], relative[4096], path[8200], resolved[4096];
+    snprintf(folder, sizeof folder, "%s", scene->path);
+    char *slash = strrchr(folder, '/');
+    if (slash)
+        *slash = 0;
+    else
+        snprintf(folder, sizeof folder, ".");
+    const lmb_gltf_view *v = lmb_gltf_get_view(scene->doc);
+    for (uint32_t k = 0; k < v->image_count; k++) {
+        if (lmb_uri_check(v->image_uris[k], relative, sizeof relative) != LMB_URI_INSIDE)
+            continue;
+        snprintf(path, sizeof path, "%s/%s", folder, relative);
+        sha256_update(c, strlen(relative) + 1, (const uint8_t *)relative);
+        char *data = NULL;
+        size_t size = 0;
+        lmb_error ignored;
+        if (lmb_path_inside(folder, path, resolved, sizeof resolved) &&
+            lmb_read_file(resolved, "image", &data, &size, &ignored) == LMB_OK) {
+            uint64_t n = size;
+            sha256_update(c, sizeof n, (const uint8_t *)&n);
+            sha256_update(c, size, (const uint8_t *)data);
+        }
+        free(data);
+    }
+}
+
 lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg, lmb_part_identity *id,
                                   lmb_error *err)
 {
@@ -59,6 +91,7 @@ lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg,
         if (n)
             sha256_update(&c, n, v->buffers[b].data);
     }
+    hash_image_files(scene, &c);
     sha256_digest(&c, 32, id->input);
     lmb_config bare = *cfg;
     bare.threads = 0;

@@ -43,8 +43,9 @@ typedef struct lmb_part_place {
 } lmb_part_place;
 
 /* The identity of a bake of `scene` (loaded from its file) with cfg: lmbake's version, the
- * hashes of the glTF file plus every buffer as loaded, and of the config's text with threads
- * set to 0 (the thread count never changes a result). plan is left zero. */
+ * hash of the glTF file, every buffer as loaded and every image file it references, and of
+ * the config's text with threads set to 0 (the thread count never changes a result). plan is
+ * left zero. */
 lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg, lmb_part_identity *id,
                                   lmb_error *err);
 void lmb_part_identity_free(lmb_part_identity *id);

@@ -3,7 +3,7 @@
 `lmbake bake --plan` writes the same files as `lmbake bake`, byte for byte (here at another
 thread count as well); a plan is refused, exit 2 with no output folder, when it was made with
 another config (the message names the key and both values), from another input, or is damaged
-or truncated (each named).
+or truncated (each named), or when a texture file it references changed after the plan.
 
 usage: check_plan_stage.py LMBAKE WORKDIR SCENE...
 """
@@ -79,6 +79,21 @@ def main():
             if os.path.exists(refused):
                 fail("a refused plan left the output folder %s" % refused)
             print("  refused (exit 2): %s" % want)
+        # a texture the glTF references changed after the plan: another input
+        folder = os.path.dirname(os.path.abspath(scene))
+        images = sorted(n for n in os.listdir(folder) if n.lower().endswith((".png", ".jpg", ".jpeg")))
+        if images:
+            copy = os.path.join(work, name + "-copy")
+            shutil.copytree(folder, copy)
+            copied = os.path.join(copy, os.path.basename(scene))
+            copy_plan = os.path.join(work, name + "-copy.plan")
+            run([lmbake, "plan", copied, "-c", cfg, "-o", copy_plan, "-q"])
+            with open(os.path.join(copy, images[0]), "ab") as f:
+                f.write(b"\0")
+            r = run([lmbake, "bake", copied, "-c", cfg, "--plan", copy_plan, "-o", refused], want=2)
+            if "made from another input" not in r.stderr or os.path.exists(refused):
+                fail("%s: a changed texture (%s) not refused: %s" % (name, images[0], r.stderr[-300:]))
+            print("  refused (exit 2): texture %s changed after the plan: made from another input" % images[0])
     print("ok: %d level(s): bake --plan identical to bake; foreign, damaged and truncated plans refused, named" %
           len(scenes))
 
