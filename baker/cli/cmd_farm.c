@@ -252,8 +252,10 @@ int cmd_farm(int argc, char **argv)
     if (n <= 0)
         return cli_fail(&(lmb_error){LMB_ERR_INTERNAL, "cannot find the lmbake binary (/proc/self/exe)"});
     exe[n] = 0;
-    if (!realpath(a.scene, scene))
-        return cli_fail(&(lmb_error){LMB_ERR_INPUT, "scene not found"});
+    if (!realpath(a.scene, scene)) {
+        lmb_error_set(&err, LMB_ERR_INPUT, "cannot open glTF '%s': %s", a.scene, strerror(errno));
+        return cli_fail(&err);
+    }
     if (a.config && !realpath(a.config, config)) {
         lmb_error_set(&err, LMB_ERR_INPUT, "cannot open config '%s': %s", a.config, strerror(errno));
         return cli_fail(&err);

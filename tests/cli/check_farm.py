@@ -78,7 +78,7 @@ def faults(lmbake, work, scene, cfg):
     run([lmbake, "bake", scene, "-c", cfg, "-o", ref, "-q", "--threads", "2"])
     common = [scene, "-c", cfg, "--farm", farm]
     run([lmbake, "plan"] + common + ["-q"])
-    killed = twice = 0
+    killed = late = twice = 0
     step = 0
     while not os.path.exists(os.path.join(farm, "end")):
         # shard 1 as it should run, timed: the kill of shard 2 comes at half that time
@@ -88,15 +88,22 @@ def faults(lmbake, work, scene, cfg):
         p = subprocess.Popen([lmbake, "step"] + common + ["--step", str(step), "--shard", "2/%d" % SHARDS, "-q",
                               "--threads", "1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(took / 2)
+        left = None
         if p.poll() is None:
             p.send_signal(signal.SIGKILL)
             p.wait()
+            # killed before its part was renamed into place: no part; killed after (while it
+            # exits): a whole part, the same bytes as its rerun writes
             if os.path.exists(part(farm, step, 2)):
-                fail("step %d: shard 2 killed half-way left its part" % step)
-            killed += 1
+                left = open(part(farm, step, 2), "rb").read()
+                late += 1
+            else:
+                killed += 1
         else:
             p.wait()
         run([lmbake, "step"] + common + ["--step", str(step), "--shard", "2/%d" % SHARDS, "-q", "--threads", "1"])
+        if left is not None and open(part(farm, step, 2), "rb").read() != left:
+            fail("step %d: shard 2 killed after writing its part left other bytes than its rerun" % step)
         # shard 3 twice: the same bytes
         run([lmbake, "step"] + common + ["--step", str(step), "--shard", "3/%d" % SHARDS, "-q", "--threads", "2"])
         first = open(part(farm, step, 3), "rb").read()
@@ -119,9 +126,9 @@ def faults(lmbake, work, scene, cfg):
         fail("no shard was still running at half its time: the kill test did not kill")
     run([lmbake, "finish"] + common + ["-o", out, "-q"])
     names = same_files(ref, out, "faults")
-    print("faults: %d steps; %d shards killed half-way (no part left) and rerun; %d shards run twice "
-          "(same bytes); finish before the last merge refused; output = lmbake bake in all %d files" %
-          (steps_of(farm), killed, twice, len(names)))
+    print("faults: %d steps; %d shards killed half-way (no part left) and rerun, %d killed while exiting "
+          "(whole part, = rerun); %d shards run twice (same bytes); finish before the last merge refused; "
+          "output = lmbake bake in all %d files" % (steps_of(farm), killed, late, twice, len(names)))
     return farm
 
 

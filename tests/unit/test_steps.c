@@ -1,0 +1,217 @@
+/*
+ * The farm's step runner (baker/farm/steps.h) on a synthetic step of 1,000 items whose cost
+ * grows with the index (item i costs i + 1): each of 4 shards computes a contiguous range, the
+ * ranges tile [0, 1000), and each range's cost is within one item's cost of a quarter of the
+ * total (cut by cost, not by count: the first shard gets ~500 items, the last ~134); the merged
+ * state reads back (finish mode) as the items in order with the counters summed; a shard run
+ * twice writes the same bytes; a step under min_rays runs in every process and is no farm step;
+ * a merge over a missing part or a part of another config is refused, naming it.
+ * usage: test_steps WORKDIR
+ */
+#define _GNU_SOURCE
+#include "check.h"
+#include "farm/steps.h"
+
+#include <lmbake/lmbake.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define ITEMS 1000
+#define SHARDS 4
+
+typedef struct fake {
+    uint64_t first, last, calls;
+} fake;
+
+/* Item i's bytes: its index (u32); counter 0 counts items, counter 1 sums the indices. */
+static lmb_status compute(void *user, uint64_t first, uint64_t last, lmb_buf *out, uint64_t counters[LMB_STEP_COUNTERS],
+                          lmb_error *err)
+{
+    fake *f = user;
+    f->first = first;
+    f->last = last;
+    f->calls++;
+    for (uint64_t i = first; i < last; i++) {
+        uint32_t v = (uint32_t)i;
+        lmb_status st = lmb_buf_append(out, &v, 4, err);
+        if (st != LMB_OK)
+            return st;
+        counters[0]++;
+        counters[1] += i;
+    }
+    return LMB_OK;
+}
+
+static lmb_part_identity identity(const char *config_text)
+{
+    lmb_part_identity id;
+    memset(&id, 0, sizeof id);
+    snprintf(id.version, sizeof id.version, "%s", LMB_VERSION_STRING);
+    id.config_text = strdup(config_text);
+    lmb_sha256(config_text, strlen(config_text), id.config);
+    return id;
+}
+
+static char *read_all(const char *path, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    *n = (size_t)ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *d = malloc(*n + 1);
+    if (d && fread(d, 1, *n, f) != *n) {
+        free(d);
+        d = NULL;
+    }
+    fclose(f);
+    return d;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: test_steps WORKDIR\n");
+        return 2;
+    }
+    const char *dir = argv[1];
+    lmb_error err;
+    char farm[4096], other[4096], path[4400], path2[4400];
+    snprintf(farm, sizeof farm, "%s/farm", dir);
+    snprintf(other, sizeof other, "%s/other", dir);
+    mkdir(dir, 0777);
+    CHECK_INT(lmb_steps_make_dirs(farm, &err), LMB_OK);
+    CHECK_INT(lmb_steps_make_dirs(other, &err), LMB_OK);
+    double cost[ITEMS], total = 0;
+    for (int i = 0; i < ITEMS; i++) {
+        cost[i] = i + 1;
+        total += cost[i];
+    }
+    lmb_part_identity id = identity("samples.gather: 64\n"), id_other = identity("samples.gather: 128\n");
+    lmb_step_desc small = {"small", 10, NULL, 10.0, compute, NULL};
+    uint64_t next = 0;
+    for (int k = 0; k < SHARDS; k++) {
+        lmb_steps *s;
+        CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, farm, &id, 0, (uint32_t)k, SHARDS, 100.0, NULL, &s, &err), LMB_OK);
+        fake f = {0, 0, 0}, fs = {0, 0, 0};
+        lmb_buf out = {0};
+        uint64_t counters[LMB_STEP_COUNTERS];
+        /* under min_rays: computed here, whole, and not counted as a step */
+        small.user = &fs;
+        CHECK_INT(lmb_steps_run(s, &small, &out, counters, &err), LMB_OK);
+        CHECK_INT(fs.calls, 1);
+        CHECK_INT(fs.last - fs.first, 10);
+        CHECK_INT(lmb_steps_count(s), 0);
+        lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
+        CHECK_INT(lmb_steps_run(s, &d, &out, counters, &err), LMB_STEP_STOPPED);
+        CHECK_INT(f.first, next);
+        double sum = 0;
+        for (uint64_t i = f.first; i < f.last; i++)
+            sum += cost[i];
+        printf("shard %d: items %llu-%llu (%llu), cost %.0f of %.0f (quarter %.0f)\n", k + 1,
+               (unsigned long long)f.first, (unsigned long long)f.last, (unsigned long long)(f.last - f.first), sum,
+               total, total / SHARDS);
+        CHECK(fabs(sum - total / SHARDS) <= ITEMS + 1);
+        next = f.last;
+        lmb_buf_free(&out);
+        lmb_steps_free(s);
+    }
+    CHECK_INT(next, ITEMS);
+
+    /* shard 2 again: the same bytes */
+    snprintf(path, sizeof path, "%s/parts/0000.2-of-4.part", farm);
+    size_t n1 = 0, n2 = 0;
+    char *first = read_all(path, &n1);
+    {
+        lmb_steps *s;
+        CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, farm, &id, 0, 1, SHARDS, 100.0, NULL, &s, &err), LMB_OK);
+        fake f = {0, 0, 0};
+        lmb_buf out = {0};
+        uint64_t counters[LMB_STEP_COUNTERS];
+        lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
+        CHECK_INT(lmb_steps_run(s, &d, &out, counters, &err), LMB_STEP_STOPPED);
+        lmb_buf_free(&out);
+        lmb_steps_free(s);
+    }
+    char *second = read_all(path, &n2);
+    CHECK(first && second && n1 == n2 && memcmp(first, second, n1) == 0);
+    free(first);
+    free(second);
+
+    /* a part of another config in the farm: refused, naming the part and the key */
+    {
+        lmb_steps *s;
+        CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, other, &id_other, 0, 2, SHARDS, 100.0, NULL, &s, &err), LMB_OK);
+        fake f = {0, 0, 0};
+        lmb_buf out = {0};
+        uint64_t counters[LMB_STEP_COUNTERS];
+        lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
+        CHECK_INT(lmb_steps_run(s, &d, &out, counters, &err), LMB_STEP_STOPPED);
+        lmb_buf_free(&out);
+        lmb_steps_free(s);
+        snprintf(path, sizeof path, "%s/parts/0000.3-of-4.part", farm);
+        snprintf(path2, sizeof path2, "%s/parts/0000.3-of-4.part", other);
+        size_t n = 0;
+        char *mine = read_all(path, &n), *theirs = read_all(path2, &n2);
+        FILE *f3 = fopen(path, "wb");
+        fwrite(theirs, 1, n2, f3);
+        fclose(f3);
+        lmb_merge_report r;
+        CHECK_INT(lmb_steps_merge(farm, &id, 0, SHARDS, &r, &err), LMB_ERR_INPUT);
+        printf("refused: %s\n", err.message);
+        CHECK(strstr(err.message, "0000.3-of-4.part") && strstr(err.message, "samples.gather"));
+        f3 = fopen(path, "wb"); /* back */
+        fwrite(mine, 1, n, f3);
+        fclose(f3);
+        free(mine);
+        free(theirs);
+    }
+
+    /* a missing part: the shard to rerun named */
+    snprintf(path, sizeof path, "%s/parts/0000.4-of-4.part", farm);
+    snprintf(path2, sizeof path2, "%s/parts/saved", farm);
+    CHECK(rename(path, path2) == 0);
+    lmb_merge_report r;
+    CHECK_INT(lmb_steps_merge(farm, &id, 0, SHARDS, &r, &err), LMB_ERR_INPUT);
+    printf("refused: %s\n", err.message);
+    CHECK(strstr(err.message, "--shard 4/4") != NULL);
+    CHECK(rename(path2, path) == 0);
+
+    /* the merge, read back in finish mode: the items in order, counters summed */
+    CHECK_INT(lmb_steps_merge(farm, &id, 0, SHARDS, &r, &err), LMB_OK);
+    CHECK_INT(r.items, ITEMS);
+    CHECK(!r.end);
+    {
+        lmb_steps *s;
+        CHECK_INT(lmb_steps_create(LMB_STEPS_FINISH, farm, &id, 0, 0, 1, 100.0, NULL, &s, &err), LMB_OK);
+        fake f = {0, 0, 0};
+        lmb_buf out = {0};
+        uint64_t counters[LMB_STEP_COUNTERS];
+        lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
+        CHECK_INT(lmb_steps_run(s, &d, &out, counters, &err), LMB_OK);
+        CHECK_INT(f.calls, 0); /* read, not computed */
+        CHECK_INT(out.size, 4 * ITEMS);
+        int in_order = 1;
+        for (uint32_t i = 0; i < ITEMS && out.size == 4 * ITEMS; i++) {
+            uint32_t v;
+            memcpy(&v, out.data + 4 * i, 4);
+            in_order &= v == i;
+        }
+        CHECK(in_order);
+        CHECK_INT(counters[0], ITEMS);
+        CHECK_INT(counters[1], ITEMS * (ITEMS - 1) / 2);
+        /* the next step is not merged: refused, named */
+        lmb_step_desc d2 = {"next", 5, NULL, 1e9, compute, &f};
+        CHECK_INT(lmb_steps_run(s, &d2, &out, counters, &err), LMB_ERR_INPUT);
+        CHECK(strstr(err.message, "has not been merged") != NULL);
+        lmb_buf_free(&out);
+        lmb_steps_free(s);
+    }
+    lmb_part_identity_free(&id);
+    lmb_part_identity_free(&id_other);
+    printf("%s\n", check_failed_count ? "FAILED" : "ok");
+    return check_failed_count != 0;
+}
