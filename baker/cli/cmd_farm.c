@@ -10,7 +10,9 @@
  *             a job array (--array=1-N, --dependency=afterok:<previous merge>) and a merge job
  *             (afterok:<array>). The number of steps is known only as the bake runs (bounces:
  *             auto, irradiance-cache rounds), so each merge job submits the next step's array
- *             and merge, or the finish job after the last step.
+ *             and merge, or the finish job after the last step. A failed shard cancels the
+ *             jobs after it; submitting the script again resumes (merged steps and finished
+ *             parts are kept; the jobs for them exit at once).
  * Every path in the scripts is absolute: on a farm DIR must be a folder every node sees at the
  * same path, and so must SCENE, CONFIG and the lmbake binary.
  */
@@ -180,7 +182,8 @@ static const char parallel_body[] =
     "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" \"${QUIET[@]}\"\n"
     "stamp plan\n"
     "step=0\n"
-    "while [ ! -f \"$FARM/end\" ]; do\n"
+    "while :; do  # steps 0, 1, ... up to the one whose merge found the end (DIR/end: its number)\n"
+    "  [ -f \"$FARM/end\" ] && [ \"$step\" -ge \"$(cat \"$FARM/end\")\" ] && break\n"
     "  if [ ! -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$step\")\" ]; then\n"
     "    todo=()  # shards whose part is missing (a rerun after a failure runs only those)\n"
     "    for k in $(seq 1 \"$SHARDS\"); do\n"
@@ -220,12 +223,16 @@ static const char slurm_body[] =
     "    echo \"submitted: plan job ${plan%%;*}, step 0 array $array (each merge job submits the next step)\";;\n"
     "  plan)\n"
     "    [ -f \"$FARM/plan.lmbp\" ] || exec \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" -q;;\n"
-    "  shard)\n"
+    "  shard)  # a merged step or a finished part is kept: resubmitting resumes\n"
+    "    [ -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$2\")\" ] && exit 0\n"
+    "    [ -f \"$(printf '%s/parts/%04d.%d-of-%d.part' \"$FARM\" \"$2\" \"$SLURM_ARRAY_TASK_ID\" \"$SHARDS\")\" ] && exit 0\n"
     "    exec \"$LMBAKE\" step \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --step \"$2\" \\\n"
     "      --shard \"$SLURM_ARRAY_TASK_ID/$SHARDS\" -q;;\n"
     "  merge)\n"
-    "    \"$LMBAKE\" merge \"$SCENE\" \"${CONFIG[@]}\" --farm \"$FARM\" --step \"$2\" --shards \"$SHARDS\" -q\n"
-    "    if [ -f \"$FARM/end\" ]; then\n"
+    "    [ -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$2\")\" ] ||\n"
+    "      \"$LMBAKE\" merge \"$SCENE\" \"${CONFIG[@]}\" --farm \"$FARM\" --step \"$2\" --shards \"$SHARDS\" -q ||\n"
+    "      { touch \"$FARM/failed\"; exit 1; }\n"
+    "    if [ -f \"$FARM/end\" ] && [ $(($2 + 1)) -ge \"$(cat \"$FARM/end\")\" ]; then\n"
     "      \"${SBATCH[@]}\" --job-name=lmbake-finish --dependency=\"afterok:$SLURM_JOB_ID\" --cpus-per-task=\"$CPUS\" \\\n"
     "        --output=\"$FARM/logs/finish.out\" \"$SELF\" finish >/dev/null\n"
     "    else\n"
@@ -281,7 +288,8 @@ int cmd_farm(int argc, char **argv)
             LMB_VERSION_STRING, a.shards);
     script_head(f, &a, exe, scene, a.config ? config : NULL, farm, out);
     if (slurm) {
-        fprintf(f, "CPUS=%llu\nSBATCH=(sbatch --parsable", a.threads ? a.threads : 1);
+        /* --kill-on-invalid-dep: a failed shard cancels the jobs that wait on it (none hang) */
+    fprintf(f, "CPUS=%llu\nSBATCH=(sbatch --parsable --kill-on-invalid-dep=yes", a.threads ? a.threads : 1);
         if (a.partition) {
             fprintf(f, " --partition=");
             shq(f, a.partition);

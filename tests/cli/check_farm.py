@@ -71,6 +71,22 @@ def identity(lmbake, work, scene, name, cfg):
     names = same_files(ref, out, name)
     print("%s: farm parallel, %d shards x %d steps (%.1f s) = lmbake bake in all %d files, byte for byte: %s" %
           (name, SHARDS, steps_of(farm), time.time() - t0, len(names), " ".join(names)))
+    if steps_of(farm) > 1:
+        # resume: step 1's state and one of its parts lost, the output gone; the script run
+        # again runs that one shard, merges, finishes: the same files
+        os.remove(os.path.join(farm, "steps", "0001.state"))
+        os.remove(part(farm, 1, 2))
+        shutil.rmtree(out)
+        run(["bash", os.path.join(farm, "parallel.sh")])
+        with open(os.path.join(farm, "logs", "step-1.joblog")) as f:
+            lines = f.read().strip().splitlines()
+        last_header = max(i for i, l in enumerate(lines) if l.startswith("Seq"))
+        rerun = lines[last_header + 1:]  # the jobs of the latest run of step 1
+        if len(rerun) != 1 or "--shard 2/4" not in rerun[0]:
+            fail("%s: the resumed script ran %s, not shard 2/4 of step 1 alone" % (name, rerun))
+        same_files(ref, out, name + " resumed")
+        print("%s: parallel.sh run again after losing step 1's state and part 2: reran that shard alone, "
+              "output identical" % name)
 
 
 def faults(lmbake, work, scene, cfg):
