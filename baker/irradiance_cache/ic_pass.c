@@ -109,15 +109,88 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
     return st;
 }
 
-/* Gathers at the uncovered candidates of one level and appends them as records. */
-static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t *placed, lmb_gather_stats *stats,
-                              lmb_error *err)
+/*
+ * A later round's candidates at one level: keeps, in order, those the records leave uncovered
+ * now. Records are only added and reaches only shrink (neighbour clamping lowers harmonic
+ * distances, and a record's weight falls with its reach), so a candidate found covered when
+ * the level was last tested is covered still unless a record that weighed at it then has
+ * shrunk since. Only candidates where some shrunk record had a positive weight with its reach
+ * of then (those records, as they were, form a small set of their own) are tested again: a
+ * few thousand of a million on level-single-10, so the test runs here, in every process of a
+ * farm, and the level's step holds only the gathers.
+ */
+static lmb_status uncovered_again(pass_ctx *c, uint32_t slot, texel_at *cand, uint64_t *n, lmb_error *err)
+{
+    const double *then = c->tested_reach[slot];
+    lmb_ic_records shrunk;
+    lmb_ic_records_init(&shrunk, c->records.error);
+    lmb_status st = LMB_OK;
+    for (uint32_t i = 0; i < c->tested_count[slot] && st == LMB_OK; i++)
+        if (c->records.rec[i].r < then[i]) {
+            lmb_ic_record as_then = c->records.rec[i];
+            as_then.r = then[i];
+            st = lmb_ic_records_append(&shrunk, &as_then, 1, err);
+        }
+    uint8_t *keep = NULL;
+    if (st == LMB_OK && shrunk.count) {
+        st = lmb_ic_records_index(&shrunk, err);
+        keep = malloc(*n + 1);
+        if (st == LMB_OK && !keep)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu candidates",
+                               (unsigned long long)*n);
+    }
+    if (st == LMB_OK && keep) {
+        const uint64_t count = *n;
+#pragma omp parallel for num_threads(c->threads) schedule(dynamic, 4096)
+        for (uint64_t k = 0; k < count; k++) {
+            double p[3], nn[3];
+            lmb_ic_texel_point(c, cand[k], p, nn);
+            keep[k] = lmb_ic_interpolate(&shrunk, p, nn, NULL) > 0 &&
+                      lmb_ic_interpolate(&c->records, p, nn, NULL) < LMB_IC_COVERED;
+        }
+    }
+    uint64_t m = 0;
+    for (uint64_t k = 0; st == LMB_OK && keep && k < *n; k++)
+        if (keep[k])
+            cand[m++] = cand[k];
+    if (st == LMB_OK)
+        *n = m;
+    free(keep);
+    lmb_ic_records_free(&shrunk);
+    return st;
+}
+
+/* The reaches of the records so far, as level `slot`'s candidates are tested against them. */
+static lmb_status note_tested(pass_ctx *c, uint32_t slot, lmb_error *err)
+{
+    double *r = realloc(c->tested_reach[slot], ((size_t)c->records.count + 1) * sizeof *r);
+    if (!r)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records",
+                             c->records.count);
+    for (uint32_t i = 0; i < c->records.count; i++)
+        r[i] = c->records.rec[i].r;
+    c->tested_reach[slot] = r;
+    c->tested_count[slot] = c->records.count;
+    return LMB_OK;
+}
+
+/* Gathers at the uncovered candidates of one level (slot: its place from the coarsest) and
+ * appends them as records. The first round tests coverage inside the step (a million
+ * lookups, worth sharing out); later rounds before it (uncovered_again). */
+static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint32_t round, int clamp,
+                              uint64_t *placed, lmb_gather_stats *stats, lmb_error *err)
 {
     texel_at *cand = NULL;
     uint64_t n = 0;
     lmb_status st = level_candidates(c, spacing, &cand, &n, err);
-    if (st != LMB_OK)
+    if (st == LMB_OK && round > 0)
+        st = uncovered_again(c, slot, cand, &n, err);
+    if (st == LMB_OK)
+        st = note_tested(c, slot, err);
+    if (st != LMB_OK) {
+        free(cand);
         return st;
+    }
     lmb_ic_record *fresh = malloc((size_t)(n + 1) * sizeof *fresh);
     if (!fresh) {
         free(cand);
@@ -125,7 +198,7 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
                              (unsigned long long)n);
     }
     uint64_t m = 0;
-    st = lmb_ic_gather_records(c, cand, n, NULL, 1, fresh, &m, 0, n, stats, err);
+    st = lmb_ic_gather_records(c, cand, n, NULL, round == 0, fresh, &m, 0, n, stats, err);
     for (uint64_t k = 0; st == LMB_OK && k < m; k++) {
         c->is_record[fresh[k].atlas][fresh[k].texel] = 1;
         fresh[k].group = c->group;
@@ -143,7 +216,6 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, int clamp, uint64_t
     return st;
 }
 
-/* Every valid texel := the interpolation at its gather point (invalid: 0). */
 /* The translation-gradient fit as a step: items are records, 9 doubles each. */
 static lmb_status fit_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
                             uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
@@ -295,6 +367,10 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
         top *= 2;
     for (uint32_t s = top; s >= 1; s /= 2)
         c.levels++;
+    c.tested_reach = calloc(c.levels + 1, sizeof *c.tested_reach);
+    c.tested_count = calloc(c.levels + 1, sizeof *c.tested_count);
+    if (st == LMB_OK && (!c.tested_reach || !c.tested_count))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
     if (st == LMB_OK)
         st = lmb_ic_records_index(&c.records, err);
     if (st == LMB_OK && reuse)
@@ -302,13 +378,15 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a
      * level can shrink reaches and uncover texels found covered before, and such a patch is
      * refilled coarse to fine too (a round of spacing 1 alone would fill it texel by texel).
-     * The last allowed round does not clamp, so no valid texel is left uncovered. */
+     * The last allowed round does not clamp, so no valid texel is left uncovered. A later
+     * round tests again only the candidates near records that shrank (uncovered_again). */
     for (uint32_t round = 0; round < LMB_IC_ROUNDS && st == LMB_OK && !reuse; round++) {
         int last_round = round + 1 == LMB_IC_ROUNDS;
         uint64_t placed_in_round = 0;
-        for (uint32_t s = top; s >= 1 && st == LMB_OK; s /= 2, c.level += round == 0) {
+        uint32_t slot = 0;
+        for (uint32_t s = top; s >= 1 && st == LMB_OK; s /= 2, slot++, c.level += round == 0) {
             uint64_t placed = 0;
-            st = place_level(&c, s, !last_round, &placed, stats, err);
+            st = place_level(&c, s, slot, round, !last_round, &placed, stats, err);
             placed_in_round += placed;
         }
         if (!placed_in_round)
@@ -336,6 +414,10 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     free(c.is_record);
     free(c.mix);
     free(c.has_mix);
+    for (uint32_t l = 0; c.tested_reach && l < c.levels; l++)
+        free(c.tested_reach[l]);
+    free(c.tested_reach);
+    free(c.tested_count);
     if (shared && st == LMB_OK) { /* handed to the next pass */
         lmb_ic_records_free(shared);
         *shared = c.records;

@@ -10,7 +10,8 @@
  * record set does not depend on the thread count or on any split of the work. The level
  * sequence repeats (at most 4 rounds) while neighbour clamping uncovers texels; the last
  * round does not clamp, and its spacing-1 level leaves no valid texel uncovered (each is at
- * worst its own record).
+ * worst its own record). A later round tests again only candidates where a record that
+ * weighed there at the level's last test has shrunk since (weights only fall with a reach).
  * A record's reach is r = clamp(error x R, min_spacing, max_spacing texels), R the harmonic
  * mean distance of its gather rays (Ward 1988), neighbour-clamped after every level.
  * Then translation gradients are fitted from neighbouring records (records.h), and every

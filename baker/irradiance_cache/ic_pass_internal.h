@@ -37,6 +37,10 @@ typedef struct pass_ctx {
     lmb_mixture *mix;
     uint8_t *has_mix;
     uint32_t mix_cap;
+    /* placement rounds after the first (ic_pass.c, uncovered_again): per level, the reach of
+     * each record when the level's candidates were last tested, and how many records there were */
+    double **tested_reach;
+    uint32_t *tested_count;
 } pass_ctx;
 
 /* The world position and shading normal a texel gathers at. */
