@@ -8,7 +8,10 @@ Per farm run, from DIR/logs/times.tsv (the driver's stamps) and GNU parallel's j
   plan, shards (sum over steps of each step's wall time), merge (sum), finish: seconds;
   overhead = (plan + merge + finish) / wall;
   slowest/mean = sum over steps of the slowest shard's time / sum of the mean shard time
-  (time-weighted: what the steps' imbalance costs), and the worst single step's ratio.
+  (time-weighted: what the steps' imbalance costs), and the worst single step's ratio;
+  critical path = plan + sum over steps of the slowest shard + merge + finish: the wall time
+  if every shard had a machine of its own. It is derived from this run's shard times (shards
+  of 2 and 4 ran on 1 thread each, two at a time), not measured on N machines.
 Ratios (farm wall / bake wall) are taken pair by pair within a round, then their median.
 
 usage: bench_farm.py LMBAKE LEVEL WORKDIR CSV PNG [ROUNDS] [CONFIG]
@@ -89,7 +92,8 @@ def main():
         wall = run([lmbake, "bake", level] + cfg + ["-o", ref, "-q", "--threads", "2"])
         bake_wall = wall
         rows.append(dict(round=rnd, mode="bake", shards=0, wall=wall, plan="", shards_s="", merge="", finish="",
-                         overhead="", slowest_over_mean="", worst_step="", steps="", vs_bake=1.0, identical=""))
+                         overhead="", slowest_over_mean="", worst_step="", steps="", vs_bake=1.0, identical="",
+                         critical_path=""))
         print("round %d: bake %.1f s" % (rnd, wall), flush=True)
         for shards in (1, 2, 4):
             farm, out = os.path.join(work, "farm-%d" % shards), os.path.join(work, "out-%d" % shards)
@@ -106,11 +110,13 @@ def main():
                              merge=st["merge"], finish=st["finish"],
                              overhead=(st["plan"] + st["merge"] + st["finish"]) / wall,
                              slowest_over_mean=slow / mean if mean else 1.0, worst_step=worst, steps=steps,
-                             vs_bake=wall / bake_wall, identical=same))
+                             vs_bake=wall / bake_wall, identical=same,
+                             critical_path=st["plan"] + slow + st["merge"] + st["finish"]))
             print("round %d: %d shard(s) %.1f s (%.2fx the bake), %d steps, plan %.1f + shards %.1f + merge %.1f + "
-                  "finish %.1f s, overhead %.1f%%, slowest/mean %.2f (worst step %.2f), identical: %s" %
+                  "finish %.1f s, overhead %.1f%%, slowest/mean %.2f (worst step %.2f), critical path %.1f s, identical: %s" %
                   (rnd, shards, wall, wall / bake_wall, steps, st["plan"], st["shards"], st["merge"], st["finish"],
-                   100 * rows[-1]["overhead"], rows[-1]["slowest_over_mean"], worst, same), flush=True)
+                   100 * rows[-1]["overhead"], rows[-1]["slowest_over_mean"], worst, rows[-1]["critical_path"], same),
+                  flush=True)
             if not same:
                 sys.exit("bench_farm: the %d-shard output differs from lmbake bake" % shards)
     with open(csv_path, "w", newline="") as f:
@@ -127,8 +133,9 @@ def main():
             print("  bake: %.1f s" % med("wall"))
         else:
             print("  %d shard(s): %.1f s, %.2fx the bake (pair by pair), overhead (plan+merge+finish) %.1f%%, "
-                  "slowest/mean %.2f" % (shards, med("wall"), med("vs_bake"), 100 * med("overhead"),
-                                         med("slowest_over_mean")))
+                  "slowest/mean %.2f, critical path %.1f s" % (shards, med("wall"), med("vs_bake"),
+                                                              100 * med("overhead"), med("slowest_over_mean"),
+                                                              med("critical_path")))
     try:
         import matplotlib
         matplotlib.use("Agg")

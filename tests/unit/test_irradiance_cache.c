@@ -8,13 +8,19 @@
  *   - gradients fitted from neighbours recover a linear field's slope (within 1%), and the
  *     interpolation then reproduces the field between records (within 1%);
  *   - neighbour clamping: a record's harmonic distance ends at most a neighbour's plus the
- *     distance between them.
+ *     distance between them;
+ *   - the two facts that let later placement rounds skip candidates (ic_pass.c,
+ *     uncovered_again): on random record sets, clamping never grows a reach, and a record's
+ *     weight at any point never grows when its reach shrinks, so a weight sum falls only
+ *     where a reach shrank.
  */
 #include "check.h"
 
 #include "irradiance_cache/records.h"
 
+#include <math.h>
 #include <stdlib.h>
+#include <stdint.h>
 
 static lmb_ic_record rec(double x, double y, double z, double nx, double ny, double nz, double e, double reach)
 {
@@ -142,11 +148,88 @@ static void test_neighbour_clamp(void)
     lmb_ic_records_free(&s);
 }
 
+/* A deterministic generator for the random sets below (xorshift64*). */
+static double uniform(uint64_t *state)
+{
+    *state ^= *state >> 12;
+    *state ^= *state << 25;
+    *state ^= *state >> 27;
+    return (double)((*state * 2685821657736338717ull) >> 11) / 9007199254740992.0;
+}
+
+static void random_unit(uint64_t *state, double n[3])
+{
+    double len = 0;
+    do {
+        for (int k = 0; k < 3; k++)
+            n[k] = 2 * uniform(state) - 1;
+        len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    } while (len < 0.1 || len > 1);
+    for (int k = 0; k < 3; k++)
+        n[k] /= len;
+}
+
+static void test_reach_only_shrinks(void)
+{
+    uint64_t state = 0x9e3779b97f4a7c15ull;
+    lmb_error err;
+    int weights_checked = 0, shrunk = 0, fell = 0;
+    for (int set = 0; set < 20; set++) {
+        lmb_ic_records s;
+        lmb_ic_records_init(&s, 0.3);
+        for (int i = 0; i < 200; i++) {
+            double p[3] = {uniform(&state), uniform(&state), 0.2 * uniform(&state)}, n[3];
+            random_unit(&state, n);
+            n[2] = fabs(n[2]) + 1; /* mostly up: neighbours that see each other */
+            double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            lmb_ic_record r = rec(p[0], p[1], p[2], n[0] / len, n[1] / len, n[2] / len, 1, 0);
+            r.harmonic = 0.01 + 0.5 * uniform(&state);
+            r.r_min = 0.005;
+            r.r_max = 0.2;
+            r.r = lmb_ic_reach(&s, &r);
+            CHECK(lmb_ic_records_append(&s, &r, 1, &err) == LMB_OK);
+        }
+        CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+        double before[200];
+        for (int i = 0; i < 200; i++)
+            before[i] = s.rec[i].r;
+        CHECK(lmb_ic_records_clamp(&s, 1, &err) == LMB_OK);
+        for (int i = 0; i < 200; i++) {
+            CHECK(s.rec[i].r <= before[i]);
+            shrunk += s.rec[i].r < before[i];
+        }
+        /* a record's weight at points around it, with its reach of before and of now */
+        for (int i = 0; i < 200; i++)
+            for (int k = 0; k < 10; k++) {
+                double p[3], n[3], len = 0;
+                random_unit(&state, n);
+                for (int a = 0; a < 3; a++) { /* within the old reach, normal near the record's */
+                    p[a] = s.rec[i].p[a] + before[i] * (uniform(&state) - 0.5);
+                    n[a] = s.rec[i].n[a] + 0.3 * n[a];
+                    len += n[a] * n[a];
+                }
+                for (int a = 0; a < 3; a++)
+                    n[a] /= sqrt(len);
+                lmb_ic_record then = s.rec[i];
+                then.r = before[i];
+                double w_then = lmb_ic_weight(&s, &then, p, n), w_now = lmb_ic_weight(&s, &s.rec[i], p, n);
+                CHECK(w_now <= w_then);
+                weights_checked += w_then > 0;
+                fell += w_now < w_then;
+            }
+        lmb_ic_records_free(&s);
+    }
+    CHECK(shrunk > 100);           /* the sets did exercise clamping */
+    CHECK(weights_checked > 1000); /* and weights that were not 0 */
+    CHECK(fell > 100);             /* some of which the shrinking lowered */
+}
+
 int main(void)
 {
     test_constant_plane();
     test_corner_and_facing_away();
     test_gradients();
     test_neighbour_clamp();
+    test_reach_only_shrinks();
     return check_failed_count != 0;
 }
