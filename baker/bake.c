@@ -192,7 +192,7 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
     return LMB_OK;
 }
 
-/* The post stage on the final lightmaps (README "What artists see"): fireflies spread to their
+/* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
  * neighbours, then seams stitched. */
 static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
                                lmb_cache *cache, lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)

@@ -193,10 +193,10 @@ static lmb_status texel_step(const pass_env *env, const char *name, uint32_t dir
     return st;
 }
 
-/* One gather pass over every atlas: result = direct + gather(cache), then (store) the cache :=
- * result; without store the cache keeps the previous pass (bounces: auto reads it). The
- * gather runs at every texel, or at irradiance-cache records (irradiance_cache.error > 0). */
-static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int store, lmb_error *err)
+/* One gather pass over every atlas: result = gather(cache) (+ direct with add_direct), then
+ * (store) the cache := result. The gather runs at every texel, or at irradiance-cache records
+ * (irradiance_cache.error > 0). */
+static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add_direct, int store, lmb_error *err)
 {
     lmb_gather_job *job = env->job;
     atlas_work *w = env->w;
@@ -209,7 +209,7 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int sto
         st = cached_gather(env, gs, err);
     else
         st = texel_step(env, job->stage, 0, offsetof(atlas_work, result), gs, err);
-    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
+    for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++)
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++)
             w[a].result[k] += w[a].direct[k];
     if (st == LMB_OK && store)
@@ -244,99 +244,122 @@ static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3
 }
 
 /*
- * bounces: auto (README "Bounces"). Pass b sets the cache to E_b = E_direct + gather(E_{b-1});
- * what it added, D_b = mean(E_b - E_{b-1}), shrinks by the scene's bounce ratio r = D_b / D_{b-1}
- * (the mean albedo seen, weighted by where light goes; per channel). The bounces no pass
- * computes form a geometric tail: after pass b the final gather adds bounce b + 1 and the
- * rest is D_b (r^2 + r^3 + ...). Passes go on until the tail the cache is missing,
- * T = D_b r / (1 - r), is below bounces_auto.tail of the total, with two ratios in a row
- * agreeing (the tail is an extrapolation: it needs a settled ratio), or a pass adds under 0.1%
- * of the light (the passes' noise level), or bounces_auto.max.
- * Then the tail is added to the cache texel by texel, T_x = (E_b - E_{b-1})_x r / (1 - r),
- * so the final gather reads converged light and adds what the passes left out: a closed
- * room of albedo rho gets pi Le / (1 - rho), not the series cut after b + 1 terms.
- * Why extrapolate rather than run until the tail is negligible: at rho = 0.8 a 1% tail takes
- * ~20 passes; the ratio settles after 3-4, and the extrapolation is exact for a furnace and
- * within the ratio's error times the tail elsewhere.
+ * The bounce passes before the final gather (docs/lighting.md "Bounces"). Each pass gathers
+ * the light the previous pass added, not all the light so far:
+ *   D_0 = E_direct,  D_b = K D_{b-1},  E_b = D_0 + D_1 + ... + D_b,
+ * with K one cosine gather (per texel or through the irradiance cache). The sum is the same
+ * Neumann series as gathering E_{b-1} again (E_b = E_direct + K E_{b-1}), but each pass's noise
+ * is now proportional to what that pass adds: gathering E_{b-1} again re-gathers the direct
+ * light's hot spots in every pass, and their noise (a few % of the light with a point light
+ * near a ceiling) swamped the later passes' small increments and the ratio that bounces: auto
+ * reads from them.
+ *
+ * bounces: k runs k - 1 passes. bounces: auto runs passes until what they add settles into
+ * a geometric series: the ratio r = D_b / D_{b-1} (per channel: the mean albedo seen, weighted
+ * by where light goes) agrees with the previous pass's, and the tail the passes leave out,
+ * T = D_b r / (1 - r) beyond E_b, is below bounces_auto.tail of the total; or a pass adds under
+ * 0.1% of the light; or bounces_auto.max. The tail is then added texel by texel,
+ * T_x = D_b,x r / (1 - r), so the final gather reads converged light: a closed room of albedo
+ * rho gets pi Le / (1 - rho), not the series cut after b + 1 terms. (At rho = 0.8 a 1% tail
+ * takes ~20 passes; the ratio settles after 3-4 and the extrapolation is exact for a furnace.)
+ * On return w[].result holds E_b (+ tail) and so does the cache.
  */
-static lmb_status auto_bounces(const pass_env *env, uint32_t *passes, lmb_error *err)
+static lmb_status bounce_passes(const pass_env *env, uint32_t *passes, lmb_error *err)
 {
     const lmb_config *cfg = env->cfg;
     lmb_gather_job *job = env->job;
     atlas_work *w = env->w;
     lmb_cache *cache = env->cache;
     lmb_bake_stats *stats = env->stats;
-    uint32_t n = cache->atlas_count, max_passes = cfg->bounces_max - 1;
-    double before[3], after[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
-    lmb_status st = LMB_OK;
-    mean_rgb(w, n, offsetof(atlas_work, direct), before);
-    stats->bounce_energy[0] = lmb_luminance(before);
+    uint32_t n = cache->atlas_count;
+    int automatic = cfg->bounces == LMB_AUTO;
+    uint32_t max_passes = automatic ? cfg->bounces_max - 1 : cfg->bounces - 1;
+    double direct[3], total[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
+    float **sum = calloc((size_t)n + 1, sizeof *sum);
+    lmb_status st = sum ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+        sum[a] = malloc((3 * (size_t)w[a].t.count + 1) * sizeof **sum);
+        if (!sum[a])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+        else
+            memcpy(sum[a], w[a].direct, 3 * (size_t)w[a].t.count * sizeof **sum);
+    }
+    mean_rgb(w, n, offsetof(atlas_work, direct), direct);
+    memcpy(total, direct, sizeof total);
+    stats->bounce_energy[0] = lmb_luminance(direct);
     char stage[64];
-    int converged = 0;
     uint32_t done = 0;
-    for (uint32_t b = 1; b <= max_passes && !converged && st == LMB_OK; b++) {
+    double tail_factor[3] = {0, 0, 0};
+    for (uint32_t b = 1; b <= max_passes && st == LMB_OK; b++) {
         lmb_gather_stats gs = {0, 0, 0, 0};
         lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
         job->estimator = e;
         job->pass = b;
-        snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
+        if (automatic)
+            snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
+        else
+            snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
         job->stage = stage;
-        st = gather_pass(env, &gs, 0, err); /* the cache still holds pass b - 1 */
+        st = gather_pass(env, &gs, 0, 0, err); /* result := D_b, gathered from D_{b-1} in the cache */
         if (st != LMB_OK)
             break;
-        mean_rgb(w, n, offsetof(atlas_work, result), after);
+        done = b;
+        mean_rgb(w, n, offsetof(atlas_work, result), added);
+        for (uint32_t a = 0; a < n; a++)
+            for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++)
+                sum[a][k] += w[a].result[k];
         for (int c = 0; c < 3; c++) {
-            added[c] = after[c] - before[c];
+            total[c] += added[c];
             ratio[c] = last[c] > 0 ? added[c] / last[c] : 0;
             ratio[c] = ratio[c] < 0 ? 0 : ratio[c] > 0.98 ? 0.98 : ratio[c];
+            last[c] = added[c];
         }
         if (b < LMB_MAX_REPORTED_BOUNCES)
             stats->bounce_energy[b] = lmb_luminance(added);
-        double r = lmb_luminance(ratio), total = lmb_luminance(after), tail[3];
-        for (int c = 0; c < 3; c++)
-            tail[c] = added[c] * ratio[c] / (1 - ratio[c]);
-        double tail_share = total + lmb_luminance(tail) > 0 ? lmb_luminance(tail) / (total + lmb_luminance(tail)) : 0;
-        int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
-        /* a pass that adds under 0.1% of the light is at the passes' noise level: stop there */
-        int small = lmb_luminance(added) <= 1e-3 * total;
-        converged = small || (settled && tail_share < cfg->bounces_tail);
-        stats->bounce_stop = small ? LMB_BOUNCES_SMALL_PASS : converged ? LMB_BOUNCES_TAIL : LMB_BOUNCES_MAX;
-        stats->tail_share = b >= 2 ? tail_share : 0;
-        stats->bounce_ratio = b >= 2 ? r : 0;
-        prev_ratio = b >= 2 ? r : -1;
-        done = b;
-        for (int c = 0; c < 3; c++) {
-            last[c] = added[c];
-            before[c] = after[c];
+        int last_pass = b == max_passes;
+        if (automatic) {
+            double r = lmb_luminance(ratio), tail[3];
+            for (int c = 0; c < 3; c++)
+                tail[c] = added[c] * ratio[c] / (1 - ratio[c]);
+            double all = lmb_luminance(total) + lmb_luminance(tail);
+            double tail_share = all > 0 ? lmb_luminance(tail) / all : 0;
+            int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
+            /* a pass that adds under 0.1% of the light leaves a tail below the passes' noise */
+            int small = lmb_luminance(added) <= 1e-3 * lmb_luminance(total);
+            int converged = small || (settled && tail_share < cfg->bounces_tail);
+            stats->bounce_stop = small ? LMB_BOUNCES_SMALL_PASS : converged ? LMB_BOUNCES_TAIL : LMB_BOUNCES_MAX;
+            stats->tail_share = b >= 2 ? tail_share : 0;
+            stats->bounce_ratio = b >= 2 ? r : 0;
+            prev_ratio = b >= 2 ? r : -1;
+            last_pass |= converged;
+            if (last_pass && b >= 2 && lmb_luminance(added) > 0)
+                for (int c = 0; c < 3; c++)
+                    tail_factor[c] = ratio[c] / (1 - ratio[c]);
+            else if (last_pass)
+                stats->tail_share = 0; /* nothing left to extrapolate */
+            stats->tail_added = tail_factor[0] > 0 || tail_factor[1] > 0 || tail_factor[2] > 0;
         }
-        int last_pass = converged || b == max_passes;
-        if (last_pass && lmb_luminance(added) > 0 && b >= 2) {
-            /* the geometric tail, texel by texel, from E_b - E_{b-1} (E_{b-1} is what the cache
-             * holds at valid texels; invalid ones are stored as 0 whatever they hold) */
-            for (uint32_t a = 0; a < n; a++) {
-                const float *prev = cache->irradiance[a];
-                for (uint32_t i = 0; i < w[a].t.count; i++)
-                    for (int c = 0; c < 3; c++) {
-                        size_t k = 3 * (size_t)i + (size_t)c;
-                        double f = ratio[c] / (1 - ratio[c]);
-                        double v = w[a].result[k] + (w[a].result[k] - prev[3 * (size_t)w[a].t.texel[i] + c]) * f;
-                        w[a].result[k] = (float)(v > 0 ? v : 0);
-                    }
-            }
-            stats->tail_added = 1;
-        } else if (last_pass) {
-            stats->tail_share = 0; /* nothing left to extrapolate */
-        }
-        st = store_pass(w, cache, err);
         if (last_pass)
             break;
+        st = store_pass(w, cache, err); /* the cache := D_b, what the next pass gathers */
     }
+    /* result := E_b + the tail D_b r / (1 - r); the cache := result */
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++)
+        for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
+            double v = sum[a][k] + (done ? w[a].result[k] * tail_factor[k % 3] : 0);
+            w[a].result[k] = (float)(v > 0 ? v : 0);
+        }
+    if (st == LMB_OK)
+        st = store_pass(w, cache, err);
+    for (uint32_t a = 0; sum && a < n; a++)
+        free(sum[a]);
+    free(sum);
     *passes = done;
     return st;
 }
 
 /*
- * Directional lightmaps (output.directional; README "Directional lightmaps"): per texel the
+ * Directional lightmaps (output.directional; docs/artists.md): per texel the
  * mean direction the light arrives from, weighted by irradiance,
  *   D = (v_direct + v_indirect) / lum(E),   v = integral lum(L(w)) w cos dw,
  * v_direct from the lights stage (exact per light), v_indirect from samples.directional cosine
@@ -443,20 +466,8 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     stats->no_light = dark;
     /* bounce passes: classic gathering with few rays, a fixed number or until converged */
     uint32_t passes = 0;
-    if (st == LMB_OK && !dark && !cfg->reference && cfg->bounces == LMB_AUTO)
-        st = auto_bounces(&env, &passes, err);
-    char stage[64];
-    for (uint32_t b = 1; !dark && cfg->bounces != LMB_AUTO && b < cfg->bounces && !cfg->reference && st == LMB_OK;
-         b++) {
-        lmb_gather_stats gs = {0, 0, 0, 0};
-        lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
-        job.estimator = e;
-        job.pass = b;
-        snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
-        job.stage = stage;
-        st = gather_pass(&env, &gs, 1, err);
-        passes = b;
-    }
+    if (st == LMB_OK && !dark && !cfg->reference && (cfg->bounces == LMB_AUTO || cfg->bounces > 1))
+        st = bounce_passes(&env, &passes, err);
     uint32_t bounces = dark ? 0 : cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
     stats->bounces = bounces;
     /* the final gather, or the reference */
@@ -480,7 +491,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         double t0 = lmb_seconds();
         env.points = records;
         if (st == LMB_OK)
-            st = gather_pass(&env, &gs, 1, err);
+            st = gather_pass(&env, &gs, 1, 1, err);
         env.points = NULL;
         stats->gather_records = gs.records;
         stats->gather_seconds = lmb_seconds() - t0;

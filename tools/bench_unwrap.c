@@ -2,7 +2,7 @@
  * Unwrap benchmark (not a test: it measures time). For each reference mesh (Cornell box,
  * 128x80 UV sphere, 125x80 torus, and a 100k-triangle bumpy sphere): unwrap, pack into
  * one ~1024x1024 atlas with padding 2 at the highest density that fits, and print one CSV
- * row with the README's metrics and the charting/packing times, next to xatlas's figures
+ * row with the metrics of docs/unwrap.md and the charting/packing times, next to xatlas's figures
  * measured on this kind of machine (../shared/NOTES.md).
  * usage: bench_unwrap [SIZE] > unwrap.csv
  */

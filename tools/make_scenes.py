@@ -5,6 +5,8 @@ usage: make_scenes.py OUTDIR
 
   cornell-point.gltf  the demo: a 1 m Cornell box (5 walls, 2 blocks), a 10 cd point light
                       just under the ceiling (the AMIS paper's Figure 1 set-up)
+  cornell-closed.gltf the same box closed (six walls of albedo 0.8, red and green sides), the
+                      point light 5 cm under the ceiling: the defaults' accuracy scene
   point-plane.gltf    10 x 10 plane, point light of I = 100 cd at h = 2 above (0, 0)
   sun-box.gltf        10 x 10 plane, closed 1 m cube on it, directional light of 1000 lux
   disk.gltf           plane, emissive disk (64 segments, R = 0.5, L = 10 nits) facing down at h = 1
@@ -19,7 +21,8 @@ usage: make_scenes.py OUTDIR
   furnace.gltf        closed 2 m box, every face albedo 0.5 and emitting 1 nit (the furnace test;
                       also the benchmark's "light from everywhere" scene)
   furnace-*.gltf      the same box with other materials (FURNACE_MATERIALS: spec-gloss, a
-                      metallicRoughness texture's blue channel, a mirrored base colour texture);
+                      metallicRoughness texture's blue channel, a mirrored base colour texture,
+                      a base colour texture too large to read whole);
                       each states the albedo rho it must bounce with
   two-spots.gltf      the Cornell room without blocks, two point lights 3 cm from the left and
                       right walls: two bright spots in opposite directions (benchmark)
@@ -199,7 +202,9 @@ FURNACE_MATERIALS = {
     "metal-blue128": 0.5 * (1 - 128 / 255.0),
     "metal-blue255": 0.0,
     "basecolor-mirror": srgb_to_linear(188),
+    "basecolor-large": 0.5,
 }
+LARGE_TEXTURE_WIDTH = 9000  # over lmbake's 4096 a side: read reduced 3x, averaging in linear light
 
 # 20 point lights 2 m above the plane (x, z, candela): more than lmbake evaluates exactly
 MANY_LIGHTS = [(-4 + 2 * (k % 5), -3 + 2 * (k // 5), 10.0 + 7.0 * k) for k in range(20)]
@@ -245,6 +250,28 @@ def cornell(out):
     s.mesh("short_block", box(0.55, 0, 0.15, 0.85, 0.3, 0.45, bottom=False), white)
     s.light("ceiling_point", "point", 10.0, translation=(0.5, 0.97, 0.5))
     s.write(os.path.join(out, "cornell-point.gltf"))
+
+
+def cornell_closed(out):
+    """The defaults' accuracy scene: a closed 1 m Cornell box (six inward walls, albedo 0.8 but for
+    a red and a green side wall), two blocks, a 10 cd point light 5 cm under the ceiling. Closed
+    with bright walls, light bounces many times (the series converges at a ratio near 0.75), so
+    it is where a cut-off or extrapolated bounce tail shows."""
+    s = Scene()
+    white = s.material("white", (0.8, 0.8, 0.8))
+    red = s.material("red", (0.8, 0.1, 0.1))
+    green = s.material("green", (0.1, 0.8, 0.1))
+    c = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)]
+    s.mesh("floor", quad(c[0], c[3], c[2], c[1]), white)
+    s.mesh("ceiling", quad(c[4], c[5], c[6], c[7]), white)
+    s.mesh("back", quad(c[0], c[1], c[5], c[4]), white)
+    s.mesh("front", quad(c[3], c[7], c[6], c[2]), white)
+    s.mesh("left", quad(c[0], c[4], c[7], c[3]), red)
+    s.mesh("right", quad(c[1], c[2], c[6], c[5]), green)
+    s.mesh("tall_block", box(0.13, 0, 0.37, 0.43, 0.6, 0.67, bottom=False), white)
+    s.mesh("short_block", box(0.55, 0, 0.15, 0.85, 0.3, 0.45, bottom=False), white)
+    s.light("ceiling_point", "point", 10.0, translation=(0.5, 0.95, 0.5))
+    s.write(os.path.join(out, "cornell-closed.gltf"))
 
 
 def analytic(out):
@@ -347,6 +374,13 @@ def furnace_variant(out, name):
         pbr["baseColorTexture"] = {"index": tex, "extensions": {"KHR_texture_transform": {
             "offset": [-0.75, 0.0], "scale": [0.1, 0.1]}}}
         s.require("KHR_texture_transform")
+    elif name == "basecolor-large":
+        # 9000 x 2 sRGB columns alternating 255 and 0 (linear 1 and 0): albedo 0.5 on average.
+        # Read reduced 3x, each pixel averages 3 columns; averaged before sRGB decoding, the
+        # mean would be 0.246 instead
+        row = [(255, 255, 255) if x % 2 == 0 else (0, 0, 0) for x in range(LARGE_TEXTURE_WIDTH)]
+        pbr["baseColorFactor"] = [1.0, 1.0, 1.0, 1.0]
+        pbr["baseColorTexture"] = {"index": s.texture_pixels([row, row])}
     s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), mat, uv=True)
     s.write(os.path.join(out, "furnace-%s.gltf" % name))
 
@@ -531,6 +565,7 @@ if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     cornell(out)
+    cornell_closed(out)
     analytic(out)
     indirect(out)
     artists(out)

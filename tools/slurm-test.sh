@@ -6,7 +6,7 @@
 # `lmbake bake` byte for byte. Then stops the daemons. Not part of .ci/run (it starts system
 # daemons and takes a few minutes); run it as root on a machine without a Slurm of its own.
 #   usage: tools/slurm-test.sh [SHARDS] [SCENE] [CONFIG]      (default: 4, bevy's Cornell box, a small config)
-# README "The farm" says how to start such a Slurm by hand.
+# docs/farm.md says how to start such a Slurm by hand.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)

@@ -1,6 +1,6 @@
 /*
  * `lmbake preview OUT.gltf [--port N]`: serves a baked level to a browser on 127.0.0.1 (the
- * three.js page of tools/preview; README "Preview"). The server is node's: this command
+ * three.js page of tools/preview; docs/preview.md). The server is node's: this command
  * checks its arguments and hands over to tools/preview/serve.mjs.
  */
 #include "cli_common.h"

@@ -26,7 +26,7 @@ static const char help[] =
     "  -q, --quiet         no progress or warnings\n"
     "  -h, --help          this help\n"
     "\n"
-    "Metrics (README, \"UV layout metrics\"): coverage = texel centres inside a triangle /\n"
+    "Metrics (docs/unwrap.md): coverage = texel centres inside a triangle /\n"
     "atlas area; L2 stretch (Sander 2001, 1 = ideal); density = UV/3D area per triangle over\n"
     "the mean, area-weighted percentiles; overlapping texels = centres covered twice.\n";
 

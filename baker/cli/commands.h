@@ -1,5 +1,5 @@
 /* The lmbake subcommands; each takes its own argv (argv[0] is the subcommand name) and
- * returns the process exit code (README: "Exit codes"). */
+ * returns the process exit code (docs/cli.md). */
 #ifndef LMBAKE_COMMANDS_H
 #define LMBAKE_COMMANDS_H
 

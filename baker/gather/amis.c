@@ -234,7 +234,7 @@ lmb_status lmb_amis_unbiased(const lmb_estimator_options *opt, const lmb_lobe *c
 /* Guided gathering: every sample from the fixed pdf q = d p_cos + (1 - d) G, G learned at a
  * neighbour before this point's samples, so E = 1/N sum f / q is unbiased. (A texel's own
  * adaptation on top, G refined by EM over its first samples, lowered the noise by 6-8% and cost
- * 12-25% more time: README, "Guided gathering".) */
+ * 12-25% more time: docs/lighting.md.) */
 void lmb_amis_guided(const lmb_estimator_options *opt, const lmb_lobe *cosine, const double ng[3], lmb_rng rng,
                    lmb_radiance_fn radiance, void *user, lmb_estimate *out)
 {

@@ -84,7 +84,7 @@ int64_t lmb_ic_records_nearest(const lmb_ic_records *s, const double p[3], const
 lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *err);
 
 /* Translation gradients by a weighted least-squares fit over each record's neighbours (see
- * README "Irradiance cache": why not Ward and Heckbert's stratified formula). Reads the index. */
+ * docs/irradiance-cache.md: why not Ward and Heckbert's stratified formula). Reads the index. */
 lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb_error *err);
 
 /* The gradients of records [first, last) only, into g[i - first] (the records unchanged): the

@@ -126,21 +126,21 @@ void lmb_config_default(lmb_config *cfg)
     cfg->direct_samples = 16;
     cfg->gather_rays = 256;
     cfg->bounce_rays = 64;
-    cfg->bounce_rays_high = 16; /* README "Defaults for real levels": no measurable loss, 15% faster */
+    cfg->bounce_rays_high = 16; /* docs/defaults.md: no measurable loss, 15% faster */
     cfg->amis_iterations = 4;
     cfg->bounces = LMB_AUTO;
     cfg->bounces_max = 32;
-    cfg->bounces_tail = 0.2;
+    cfg->bounces_tail = 0.05;
     cfg->gather_method = LMB_GATHER_AMIS_DEFENSIVE;
     cfg->defensive_fraction = 0.1;
     cfg->guide_stride = 8;
     cfg->guide_lobes = 2;
     cfg->ic_error = 0.3;
     cfg->ic_min_spacing = 4;
-    cfg->ic_max_spacing = 32;
+    cfg->ic_max_spacing = 8;
     cfg->ic_ray_scale = 4;
     cfg->farm_min_step_rays = 1000000; /* ~0.1 s of one core: a step costs a process start per shard */
-    cfg->ic_records = LMB_IC_RECORDS_SHARED; /* README "Irradiance cache": as accurate, 1.0-1.4x faster */
+    cfg->ic_records = LMB_IC_RECORDS_SHARED; /* docs/irradiance-cache.md: as accurate, 1.0-1.4x faster */
     cfg->seed = 1;
     cfg->threads = 0;
     cfg->output_formats = LMB_OUTPUT_EXR | LMB_OUTPUT_HDR | LMB_OUTPUT_PNG;
@@ -149,17 +149,17 @@ void lmb_config_default(lmb_config *cfg)
     strcpy(cfg->extras_key, "lightmap");
     cfg->light_intensity_scale = 1.0;
     cfg->emissive_scale = 1.0;
-    cfg->emission_sides = LMB_EMIT_FRONT; /* README "Which side of a face counts" */
+    cfg->emission_sides = LMB_EMIT_FRONT; /* docs/artists.md */
     cfg->seam_stitch = 1;
     cfg->firefly_spread = 1;
-    cfg->directional = 1; /* README "Directional lightmaps": +5% time on level-single-10 */
+    cfg->directional = 1; /* docs/artists.md: +5% time on level-single-10 */
     cfg->directional_rays = 32;
 }
 
 uint64_t lmb_config_atlas_texels(const lmb_config *cfg)
 {
     /* one 1024^2 atlas (or one max_size atlas if smaller) at 0.6, the share of an atlas the
-     * packer fills with chart texels on real levels (README "Texel density") */
+     * packer fills with chart texels on real levels (docs/defaults.md) */
     double side = cfg->max_atlas_size < 1024 ? cfg->max_atlas_size : 1024;
     return cfg->atlas_texels ? cfg->atlas_texels : (uint64_t)(0.6 * side * side);
 }

@@ -159,7 +159,7 @@ lmb_status lmb_cfg_set_u64(parse_ctx *c, const key_spec *k, const yaml_node_t *n
     return LMB_OK;
 }
 
-/* ---- "auto" or a number: auto leaves the choice to the baker (README: "Defaults") ---- */
+/* ---- "auto" or a number: auto leaves the choice to the baker (docs/defaults.md) ---- */
 
 static int is_auto(const yaml_node_t *n)
 {

@@ -34,6 +34,9 @@ struct lmb_gltf_doc {
     lmb_gltf_view view;
     /* writer: (original material, lightmap texture) -> lightmapped material copy */
     std::map<std::pair<int, int>, int> lightmap_materials;
+    /* writer: meshes a node used before it got its lightmapped copy (gltf_prune.cpp drops the
+     * ones no node uses any more) */
+    std::vector<int> replaced_meshes;
 };
 
 #endif

@@ -36,13 +36,103 @@ static const char *mem_name(const char *mime)
     return "embedded.png";
 }
 
-/* Sizes before memory (issue 15): an image whose header declares more pixels than this is
+/* Sizes before memory: an image whose header declares more pixels than this is
  * refused before decoding (8192 x 8192: 0.8 GB as float RGB, 1 GB while decoding). */
 #define LMB_MAX_TEXTURE_PIXELS ((uint64_t)1 << 26)
 
-/* Decodes name (a file, or bytes) after checking its declared size; *fatal: it was too large. */
+/* Textures are read at most this many pixels a side: the baker samples a texture where gather
+ * rays hit (bounce albedo) and where emitters are sampled, at the scale of lightmap texels, far
+ * coarser than a texture's pixels; a larger image is read reduced by a whole factor. */
+#define LMB_TEXTURE_MAX_SIDE 4096u
+
+/* sRGB decoding memo: decoded 8-bit images hold at most 256 distinct values, and each value's
+ * conversion is kept in the slot of its nearest 8-bit code and reused when the same float comes
+ * again (the same function of the same input: results are unchanged), so a 64-Mpixel texture
+ * costs 256 powf, not 200 million (a 1.6 KB JPEG declaring 63488 x 767 took 12 s under the
+ * sanitizers before it). */
+typedef struct srgb_memo {
+    float in[256], out[256];
+} srgb_memo;
+
+static void srgb_memo_init(srgb_memo *m)
+{
+    for (int k = 0; k < 256; k++)
+        m->in[k] = -1.0f; /* no decoded value is negative */
+}
+
+/* values as stored -> the texture's space (colour: linear from sRGB; data: unchanged) */
+static void to_space(float *px, size_t count, lmb_tex_space space, srgb_memo *m)
+{
+    if (space != LMB_TEX_COLOUR)
+        return;
+    for (size_t i = 0; i < count; i++) {
+        float v = px[i];
+        int k = v >= 0.0f && v <= 1.0f ? (int)(v * 255.0f + 0.5f) : -1;
+        if (k >= 0 && m->in[k] == v) {
+            px[i] = m->out[k];
+            continue;
+        }
+        px[i] = srgb_to_linear(v);
+        if (k >= 0) {
+            m->in[k] = v;
+            m->out[k] = px[i];
+        }
+    }
+}
+
+/* Reads an image of w x h reduced by `factor`: each pixel of the result is the mean, in the
+ * texture's space (after sRGB decoding), of the up to factor x factor pixels it covers. Reads a
+ * band of `factor` rows at a time, so memory follows the result, not the image. */
+static lmb_status read_reduced(const char *name, const uint8_t *bytes, size_t size, uint32_t factor,
+                               lmb_tex_space space, uint32_t *w, uint32_t *h, float **rgb, lmb_error *err)
+{
+    lmb_image_rows *r = NULL;
+    uint32_t iw, ih;
+    lmb_status st = lmb_image_rows_open(name, bytes, size, &r, &iw, &ih, err);
+    if (st != LMB_OK)
+        return st;
+    uint32_t ow = (iw + factor - 1) / factor, oh = (ih + factor - 1) / factor;
+    float *band = malloc(3 * (size_t)iw * factor * sizeof *band + 1);
+    float *out = calloc(3 * (size_t)ow * oh + 1, sizeof *out);
+    if (!band || !out)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for a %ux%u reduced image", name, ow, oh);
+    srgb_memo memo;
+    srgb_memo_init(&memo);
+    for (uint32_t oy = 0; oy < oh && st == LMB_OK; oy++) {
+        uint32_t y0 = oy * factor, y1 = y0 + factor < ih ? y0 + factor : ih;
+        st = lmb_image_rows_read(r, y0, y1, band, err);
+        if (st != LMB_OK)
+            break;
+        to_space(band, 3 * (size_t)iw * (y1 - y0), space, &memo);
+        float *row = out + 3 * (size_t)ow * oy;
+        for (uint32_t y = 0; y < y1 - y0; y++)
+            for (uint32_t x = 0; x < iw; x++)
+                for (int c = 0; c < 3; c++)
+                    row[3 * (size_t)(x / factor) + (size_t)c] += band[3 * ((size_t)y * iw + x) + (size_t)c];
+        for (uint32_t ox = 0; ox < ow; ox++) {
+            uint32_t cols = (ox + 1) * factor < iw ? factor : iw - ox * factor;
+            float inv = 1.0f / (float)(cols * (y1 - y0));
+            for (int c = 0; c < 3; c++)
+                row[3 * (size_t)ox + (size_t)c] *= inv;
+        }
+    }
+    lmb_image_rows_close(r);
+    free(band);
+    if (st != LMB_OK) {
+        free(out);
+        return st;
+    }
+    *w = ow;
+    *h = oh;
+    *rgb = out;
+    return LMB_OK;
+}
+
+/* Decodes name (a file, or bytes) into the texture's space after checking its declared size
+ * (*fatal: it was too large); an image over LMB_TEXTURE_MAX_SIDE a side is read reduced. */
 static lmb_status decode_checked(const lmb_scene *s, int32_t src, const char *name, const uint8_t *bytes, size_t size,
-                                 uint32_t *w, uint32_t *h, float **rgb, int *fatal, lmb_error *err)
+                                 lmb_tex_space space, uint32_t *w, uint32_t *h, float **rgb, int *fatal,
+                                 const lmb_log *log, lmb_error *err)
 {
     lmb_status st = lmb_image_size(name, bytes, size, w, h, err);
     if (st != LMB_OK)
@@ -53,19 +143,35 @@ static lmb_status decode_checked(const lmb_scene *s, int32_t src, const char *na
                              "8192); refused before decoding", s->path, src, *w, *h,
                              (unsigned long long)LMB_MAX_TEXTURE_PIXELS);
     }
-    return lmb_image_read_rgb(name, bytes, size, w, h, rgb, err);
+    uint32_t side = *w > *h ? *w : *h;
+    uint32_t factor = (side + LMB_TEXTURE_MAX_SIDE - 1) / LMB_TEXTURE_MAX_SIDE;
+    if (factor > 1) {
+        uint32_t iw = *w, ih = *h;
+        st = read_reduced(name, bytes, size, factor, space, w, h, rgb, err);
+        if (st == LMB_OK)
+            lmb_info(log, "%s: image %d is %ux%u: read reduced %ux to %ux%u (lmbake reads textures at most %u a side)",
+                     s->path, src, iw, ih, factor, *w, *h, LMB_TEXTURE_MAX_SIDE);
+        return st;
+    }
+    st = lmb_image_read_rgb(name, bytes, size, w, h, rgb, err);
+    if (st == LMB_OK) {
+        srgb_memo memo;
+        srgb_memo_init(&memo);
+        to_space(*rgb, 3 * (size_t)*w * *h, space, &memo);
+    }
+    return st;
 }
 
-/* Reads texture tex's image as stored (8-bit values come back in [0, 1], still encoded). */
-static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, uint32_t *w, uint32_t *h,
-                              float **rgb, int *fatal, lmb_error *err)
+/* Reads texture tex's image in `space` (colour: linear). */
+static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, lmb_tex_space space,
+                              uint32_t *w, uint32_t *h, float **rgb, int *fatal, const lmb_log *log, lmb_error *err)
 {
     int32_t src = v->textures[tex].source;
     if (src < 0 || (uint32_t)src >= v->image_count)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: texture %u has no usable image", s->path, tex);
     const lmb_gltf_image *img = &v->images[src];
     if (img->bytes)
-        return decode_checked(s, src, mem_name(img->mime), img->bytes, img->size, w, h, rgb, fatal, err);
+        return decode_checked(s, src, mem_name(img->mime), img->bytes, img->size, space, w, h, rgb, fatal, log, err);
     /* files only from the input's folder and below (issue 15; load/uri.h) */
     char folder[4096], rel[4096], path[8300], real[4096];
     const char *slash = strrchr(s->path, '/');
@@ -78,7 +184,7 @@ static lmb_status read_pixels(const lmb_scene *s, const lmb_gltf_view *v, uint32
     if (!lmb_path_inside(folder, path, real, sizeof real))
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: image %d: '%s' is not a file inside the input's folder", s->path,
                              src, img->uri);
-    return decode_checked(s, src, real, NULL, 0, w, h, rgb, fatal, err);
+    return decode_checked(s, src, real, NULL, 0, space, w, h, rgb, fatal, log, err);
 }
 
 static int wrap_mode(int32_t gl, const char *axis, const lmb_scene *s, uint32_t tex, const lmb_log *log)
@@ -97,32 +203,11 @@ static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t 
         return LMB_OK;
     float *px = NULL;
     uint32_t w, h;
-    lmb_status st = read_pixels(s, v, tex, &w, &h, &px, fatal, err);
+    lmb_status st = read_pixels(s, v, tex, space, &w, &h, &px, fatal, log, err);
     if (st != LMB_OK)
         return st;
     size_t n = (size_t)w * h;
     if (space == LMB_TEX_COLOUR) {
-        /* Decoded 8-bit images hold at most 256 distinct values: each value's conversion is
-         * kept in the slot of its nearest 8-bit code and reused when the same float comes again
-         * (the same function of the same input: results are unchanged), so a 64-Mpixel texture
-         * costs 256 powf, not 200 million (issue 15: a 1.6 KB JPEG declaring 63488 x 767 took
-         * 12 s under the sanitizers). */
-        float seen_in[256], seen_out[256];
-        for (int k = 0; k < 256; k++)
-            seen_in[k] = -1.0f; /* no decoded value is negative */
-        for (size_t i = 0; i < 3 * n; i++) {
-            float v = px[i];
-            int k = v >= 0.0f && v <= 1.0f ? (int)(v * 255.0f + 0.5f) : -1;
-            if (k >= 0 && seen_in[k] == v) {
-                px[i] = seen_out[k];
-                continue;
-            }
-            px[i] = srgb_to_linear(v);
-            if (k >= 0) {
-                seen_in[k] = v;
-                seen_out[k] = px[i];
-            }
-        }
         for (int c = 0; c < 3; c++) {
             double sum = 0;
             for (size_t i = 0; i < n; i++)

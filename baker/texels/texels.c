@@ -32,7 +32,7 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
 {
     uint32_t n = dst->count + band->count;
     /* exact growth: large blocks are mmap'd and realloc moves them with mremap, not a copy,
-     * and no slack is left behind (memory per texel, README "Memory") */
+     * and no slack is left behind (memory per texel, docs/defaults.md) */
     uint32_t *texel = realloc(dst->texel, ((size_t)n + 1) * sizeof *texel);
     if (texel) dst->texel = texel;
     uint8_t *points_in = realloc(dst->points_in, (size_t)n + 1);

@@ -1,5 +1,5 @@
 /*
- * UV layout quality metrics (definitions in metrics.h and the README).
+ * UV layout quality metrics (definitions in metrics.h and docs/unwrap.md).
  * Rasterization snaps UVs to 1/256 texel and evaluates edge functions in 64-bit integers,
  * so the top-left rule is exact: a texel centre on an edge shared by two triangles is
  * counted once, and overlap counts only real overlaps.

@@ -1,5 +1,5 @@
 /*
- * Quality of a lightmap UV layout, with the definitions the README states:
+ * Quality of a lightmap UV layout, with the definitions docs/unwrap.md states:
  *   coverage  = texels whose centre lies inside some triangle / (width x height)
  *   overlap   = texel centres covered by two or more triangles
  *   L2 stretch = Sander et al. 2001, area-weighted, normalized so 1.0 is ideal

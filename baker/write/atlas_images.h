@@ -15,7 +15,7 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
                                   const float *rgb, const uint8_t *valid, uint32_t width, uint32_t height,
                                   lmb_error *err);
 
-/* The directional atlas (output.directional; README "Directional lightmaps"): d holds the
+/* The directional atlas (output.directional; docs/artists.md): d holds the
  * light's mean direction D per texel (3 floats, world space, |D| <= 1).
  * <stem>-lightmap-N-dir.exr holds D as floats, <stem>-lightmap-N-dir.png (the glTF references
  * it) (D + 1) / 2 in 8 bits, linear. */

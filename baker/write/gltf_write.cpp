@@ -9,6 +9,7 @@
 #include "gltf_write.h"
 
 #include "../load/gltf_doc.hpp"
+#include "gltf_prune.hpp"
 
 #include <cstring>
 #include <map>
@@ -266,6 +267,7 @@ extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, c
             mesh.primitives[p.gltf_primitive] = q;
         }
         m.meshes.push_back(mesh);
+        doc->replaced_meshes.push_back(m.nodes[node].mesh);
         m.nodes[node].mesh = (int)m.meshes.size() - 1;
         return LMB_OK;
     } catch (const std::exception &e) {
@@ -307,6 +309,7 @@ lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_na
             else if (m.buffers[i].uri.empty() || m.buffers[i].uri.rfind("data:", 0) == 0)
                 m.buffers[i].uri = stem + "-input" + std::to_string(i) + ".bin";
         }
+        lmb_gltf_prune_replaced(doc);
         m.asset.generator = "lmbake " LMB_VERSION_STRING;
         tinygltf::TinyGLTF g;
         g.SetImageWriter(keep_image, nullptr);

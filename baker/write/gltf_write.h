@@ -36,8 +36,8 @@ int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char *png_uri, l
 
 /* Gives node `node` a copy of its mesh with the primitives in prims replaced (others kept)
  * and lightmapped materials using `texture`; with direction_texture >= 0 the materials name
- * it in extras.lightmap_directional {index, texCoord: 1, encoding, decode} (README
- * "Directional lightmaps"; the material's other extras are kept). */
+ * it in extras.lightmap_directional {index, texCoord: 1, encoding, decode} (docs/artists.md;
+ * the material's other extras are kept). */
 lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count,
                                   int32_t texture, int32_t direction_texture, lmb_error *err);
 

@@ -133,3 +133,58 @@ extern "C" lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes,
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", name, e.what());
     }
 }
+
+struct lmb_image_rows {
+    OIIO::Filesystem::IOMemReader mem;
+    std::unique_ptr<OIIO::ImageInput> in;
+    std::vector<float> band;
+    std::string name;
+    lmb_image_rows(const uint8_t *bytes, size_t size) : mem(bytes, bytes ? size : 0) {}
+};
+
+extern "C" lmb_status lmb_image_rows_open(const char *name, const uint8_t *bytes, size_t size, lmb_image_rows **out,
+                                          uint32_t *w, uint32_t *h, lmb_error *err)
+{
+    *out = nullptr;
+    try {
+        std::unique_ptr<lmb_image_rows> r(new lmb_image_rows(bytes, size));
+        r->name = name;
+        r->in = OIIO::ImageInput::open(name, nullptr, bytes ? &r->mem : nullptr);
+        if (!r->in)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot read image: %s", name, OIIO::geterror().c_str());
+        const OIIO::ImageSpec &spec = r->in->spec();
+        if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: unusable image size %dx%d", name, spec.width, spec.height);
+        *w = (uint32_t)spec.width;
+        *h = (uint32_t)spec.height;
+        *out = r.release();
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot read image: %s", name, e.what());
+    }
+}
+
+extern "C" lmb_status lmb_image_rows_read(lmb_image_rows *r, uint32_t y0, uint32_t y1, float *rgb, lmb_error *err)
+{
+    try {
+        const OIIO::ImageSpec &spec = r->in->spec();
+        int ch = spec.nchannels;
+        size_t w = (size_t)spec.width, rows = y1 - y0;
+        r->band.resize(w * rows * (size_t)ch);
+        if (!r->in->read_scanlines(0, 0, spec.y + (int)y0, spec.y + (int)y1, 0, 0, ch, OIIO::TypeDesc::FLOAT,
+                                   r->band.data()))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot decode rows %u..%u: %s", r->name.c_str(), y0, y1 - 1,
+                                 r->in->geterror().c_str());
+        for (size_t i = 0; i < w * rows; i++)
+            for (int c = 0; c < 3; c++)
+                rgb[3 * i + c] = r->band[i * ch + (ch >= 3 ? c : 0)];
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", r->name.c_str(), e.what());
+    }
+}
+
+extern "C" void lmb_image_rows_close(lmb_image_rows *r)
+{
+    delete r;
+}

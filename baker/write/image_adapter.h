@@ -22,16 +22,31 @@ lmb_status lmb_image_write_u8(const char *path, uint32_t width, uint32_t height,
 lmb_status lmb_image_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                                const float *pixels, lmb_error *err);
 
-/* Reads an image as RGB floats (grey is replicated, alpha dropped), rows top to bottom,
- * values as stored: 8-bit formats come back sRGB-encoded in [0, 1]. From the file `name`,
- * or from memory when bytes != NULL (then `name` only picks the format by its extension).
- * The caller frees *rgb. */
 /* The size of an image from its header alone (nothing decoded): name is a file, or with bytes
  * the format hint of an in-memory image. */
 lmb_status lmb_image_size(const char *name, const uint8_t *bytes, size_t size, uint32_t *w, uint32_t *h, lmb_error *err);
 
+/* Reads an image as RGB floats (grey is replicated, alpha dropped), rows top to bottom,
+ * values as stored: 8-bit formats come back sRGB-encoded in [0, 1]. From the file `name`,
+ * or from memory when bytes != NULL (then `name` only picks the format by its extension).
+ * The caller frees *rgb. */
 lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t size, uint32_t *width, uint32_t *height,
                               float **rgb, lmb_error *err);
+
+/* A reader that decodes an image a band of rows at a time, so a large texture can be reduced
+ * while it is read without holding it whole (load/textures.c). Opened from a file or from
+ * memory as lmb_image_read_rgb; bytes, if given, must outlive the reader. */
+typedef struct lmb_image_rows lmb_image_rows;
+
+lmb_status lmb_image_rows_open(const char *name, const uint8_t *bytes, size_t size, lmb_image_rows **out,
+                               uint32_t *width, uint32_t *height, lmb_error *err);
+
+/* Rows y0 .. y1 - 1 (top to bottom) as RGB floats into rgb (3 x width x (y1 - y0) values),
+ * with the same conventions as lmb_image_read_rgb. */
+lmb_status lmb_image_rows_read(lmb_image_rows *r, uint32_t y0, uint32_t y1, float *rgb, lmb_error *err);
+
+/* Closes the reader (NULL is fine). */
+void lmb_image_rows_close(lmb_image_rows *r);
 
 #ifdef __cplusplus
 }

@@ -104,6 +104,41 @@ static void sibling_prefix(const char *name, char *out, size_t size)
     snprintf(out, size, ".%.*s.lmbake-staging-", STAGING_NAME_CHARS, name);
 }
 
+/* Creates dir and any missing parents, as mkdir -p, counting them in *made; names the part
+ * that cannot be made. */
+static lmb_status make_folders(const char *dir, int *made, lmb_error *err)
+{
+    *made = 0;
+    char path[4096];
+    size_t len = strlen(dir);
+    if (len >= sizeof path)
+        return lmb_error_set(err, LMB_ERR_INPUT, "output folder '%.64s...' has too long a path", dir);
+    memcpy(path, dir, len + 1);
+    while (len > 1 && path[len - 1] == '/')
+        path[--len] = '\0';
+    for (size_t i = 1; i <= len; i++) {
+        if (path[i] != '/' && path[i] != '\0')
+            continue;
+        char keep = path[i];
+        path[i] = '\0';
+        struct stat sb;
+        if (stat(path, &sb) == 0) {
+            if (!S_ISDIR(sb.st_mode)) {
+                lmb_status st = lmb_error_set(err, LMB_ERR_INPUT, "cannot create output folder '%s': '%s' exists and "
+                                              "is not a folder", dir, path);
+                return st;
+            }
+        } else if (mkdir(path, 0777) == 0) {
+            (*made)++;
+        } else if (errno != EEXIST) {
+            return lmb_error_set(err, LMB_ERR_INPUT, "cannot create output folder '%s': cannot create '%s': %s", dir,
+                                 path, strerror(errno));
+        }
+        path[i] = keep;
+    }
+    return LMB_OK;
+}
+
 lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, const lmb_log *log,
                                lmb_error *err)
 {
@@ -119,10 +154,12 @@ lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *
     if (stat(dir, &sb) == 0) {
         if (!S_ISDIR(sb.st_mode))
             return lmb_error_set(err, LMB_ERR_INPUT, "output '%s' exists and is not a folder", dir);
-    } else if (mkdir(dir, 0777) != 0) {
-        return lmb_error_set(err, LMB_ERR_INPUT, "cannot create output folder '%s': %s", dir, strerror(errno));
     } else {
-        od->created_dir = 1;
+        lmb_status st = make_folders(dir, &od->created_dir, err);
+        if (st != LMB_OK) {
+            lmb_output_dir_abort(od);
+            return st;
+        }
     }
     char in_dir[4096], real_in[PATH_MAX];
     dirname_of(input_path, in_dir, sizeof in_dir);
@@ -311,6 +348,21 @@ void lmb_output_dir_abort(lmb_output_dir *od)
     if (od->staging[0])
         remove_tree(od->staging);
     od->staging[0] = '\0';
-    if (od->created_dir)
-        rmdir(od->dir);
+    /* the folders the bake made, dir and then its parents, as long as they are empty */
+    char path[sizeof od->dir];
+    snprintf(path, sizeof path, "%s", od->dir);
+    for (int removed = 0; removed < od->created_dir;) {
+        size_t len = strlen(path);
+        while (len > 1 && path[len - 1] == '/')
+            path[--len] = '\0';
+        if (rmdir(path) == 0)
+            removed++;
+        else if (errno != ENOENT) /* not empty, or not ours to remove */
+            break;
+        char *slash = strrchr(path, '/');
+        if (!slash || slash == path)
+            break;
+        *slash = '\0';
+    }
+    od->created_dir = 0;
 }

@@ -28,7 +28,7 @@ typedef struct lmb_output_dir {
     char real[4096];    /* its real path (the folder the swap replaces) */
     char staging[4600]; /* where the bake writes: the sibling staging folder (or one inside dir) */
     char stem[256];     /* input file name without extension */
-    int created_dir;    /* the bake created dir */
+    int created_dir;    /* folders the bake created: dir and the missing parents above it */
     int inside;         /* fallback: staging is inside dir, commit moves files one by one */
     const lmb_log *log; /* for the fallbacks' warnings */
 } lmb_output_dir;

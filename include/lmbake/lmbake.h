@@ -23,7 +23,7 @@ extern "C" {
 
 /* ---- status and errors ---------------------------------------------------- */
 
-/* Values double as the CLI's exit codes (README: "Exit codes"). */
+/* Values double as the CLI's exit codes (docs/cli.md). */
 typedef enum lmb_status {
     LMB_OK = 0,
     LMB_ERR_USAGE = 1,    /* bad command line */
@@ -195,7 +195,7 @@ typedef enum lmb_ic_records_mode {
     LMB_IC_RECORDS_SHARED = 1    /* the first pass places them, later passes gather again at them */
 } lmb_ic_records_mode;
 
-/* Which sides of an emissive face emit (README "Which side of a face counts"). */
+/* Which sides of an emissive face emit (docs/artists.md). */
 typedef enum lmb_emission_sides {
     LMB_EMIT_FRONT = 0,    /* the front only, whatever the material says (as Unity's default GI) */
     LMB_EMIT_MATERIAL = 1  /* both sides where the material is doubleSided (as Cycles renders glTF) */
@@ -269,7 +269,7 @@ typedef struct lmb_config {
     int seam_stitch;               /* least-squares seam stitching after the gather */
 } lmb_config;
 
-/* Fills cfg with the documented defaults (README: "Bake config"). */
+/* Fills cfg with the documented defaults (docs/config.md). */
 void lmb_config_default(lmb_config *cfg);
 
 /* The auto density's texel budget: cfg->atlas_texels, or when 0 the texels of one 1024^2

@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """What artists see (issue 14): no bright rim around a light fixture flush under a ceiling,
-sealed double-sided rooms stay dark, under both emission policies (README "Which side of a
-face counts").
+sealed double-sided rooms stay dark, under both emission policies (docs/artists.md).
 
 usage: check_artists.py LMBAKE WORKDIR CASE
   rim-front            a one-sided emitter quad 1 mm under the ceiling, turned 20 degrees so its

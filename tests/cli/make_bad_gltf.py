@@ -120,7 +120,7 @@ def cases():
     # not JSON at all
     yield "not-json", "{ this is not json"
 
-    # required extensions (README "What load accepts"): ones that change only what a diffuse
+    # required extensions (docs/input.md): ones that change only what a diffuse
     # bake ignores load with a warning naming them; geometry compression stays an error
     d = copy.deepcopy(ok)
     d["materials"] = [{"name": "Velvet", "pbrMetallicRoughness": {"metallicFactor": 0},

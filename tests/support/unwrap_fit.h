@@ -1,7 +1,7 @@
 /*
  * Shared by the unwrap quality test and the unwrap benchmark: unwrap a generated mesh and
  * pack it into one atlas of about size x size texels at the highest texel density that
- * fits (found by bisection), then measure the result with the README's metrics.
+ * fits (found by bisection), then measure the result with the metrics of docs/unwrap.md.
  */
 #ifndef LMBAKE_TESTS_UNWRAP_FIT_H
 #define LMBAKE_TESTS_UNWRAP_FIT_H

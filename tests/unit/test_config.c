@@ -44,7 +44,7 @@ static void test_defaults(void)
     CHECK_INT(c.amis_iterations, 4);
     CHECK(c.bounces == LMB_AUTO);
     CHECK_INT(c.bounces_max, 32);
-    CHECK_NEAR(c.bounces_tail, 0.2, 0);
+    CHECK_NEAR(c.bounces_tail, 0.05, 0);
     CHECK_INT(c.gather_method, LMB_GATHER_AMIS_DEFENSIVE);
     CHECK_NEAR(c.defensive_fraction, 0.1, 0);
     CHECK(c.seed == 1);
@@ -139,12 +139,12 @@ static void test_partial_and_edges(void)
     CHECK(c.bounces == LMB_AUTO);
     CHECK(c.atlas_texels == 0);
     CHECK_INT(parse("texel_density: 12\nbounces: 3\natlas: {texels: 2000000, max_size: 2048}\n"
-                    "bounces_auto: {max: 8, tail: 0.05}\n", &c, &err), LMB_OK);
+                    "bounces_auto: {max: 8, tail: 0.1}\n", &c, &err), LMB_OK);
     CHECK_NEAR(c.texel_density, 12, 0);
     CHECK_INT(c.bounces, 3);
     CHECK(c.atlas_texels == 2000000 && lmb_config_atlas_texels(&c) == 2000000);
     CHECK_INT(c.bounces_max, 8);
-    CHECK_NEAR(c.bounces_tail, 0.05, 0);
+    CHECK_NEAR(c.bounces_tail, 0.1, 0);
     CHECK_INT(parse("atlas: {max_size: 2048}\n", &c, &err), LMB_OK);
     CHECK(lmb_config_atlas_texels(&c) == 629145);
     CHECK_INT(parse("atlas: {max_size: 512}\n", &c, &err), LMB_OK);

@@ -1,7 +1,7 @@
 /*
  * Unwrap + pack quality on issue 3's reference meshes, each packed into one atlas of about
  * 1024 x 1024 (padding 2) at a fixed density (the one tools/bench_unwrap.c found), measured
- * with the README's metrics: zero overlapping texels, L2 stretch <= 1.01, and coverage at
+ * with the metrics of docs/unwrap.md: zero overlapping texels, L2 stretch <= 1.01, and coverage at
  * least xatlas's: Cornell box 0.894, sphere 0.662, torus 0.553.
  */
 #include "check.h"

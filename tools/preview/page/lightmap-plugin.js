@@ -98,7 +98,7 @@ class LightmapPlugin {
   }
 }
 
-// Directional lightmaps (lmbake's output.directional; README "Directional lightmaps"): a
+// Directional lightmaps (lmbake's output.directional; docs/artists.md): a
 // material's extras.lightmap_directional names a PNG holding (D + 1) / 2, D the light's mean
 // direction (world space). The lit view then shades with the material's normal map:
 //   E(n') = E max(0, 1 + 1.5 D.n') / (1 + 1.5 D.n)

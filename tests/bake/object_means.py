@@ -1,0 +1,107 @@
+"""Per-object means of a bake's lightmap: which valid texel belongs to which lightmapped node,
+and the mean irradiance over each node's texels. Shared by the defaults' accuracy check
+(check_defaults.py) and the tool that makes its stored reference (tools/make_reference.py).
+
+A texel belongs to the node whose lightmap-UV triangle covers its centre or, for the
+conservatively rasterized edge texels, lies within 0.75 texel of it; texels are valid where the
+bake's mask (output.formats: mask) says 255. Two bakes with the same layout (same scene, same
+density) get the same texel sets, so their per-object means compare texel set by texel set.
+"""
+import json
+import os
+import struct
+
+import numpy as np
+import OpenImageIO as oiio
+
+
+def _accessor(doc, bins, index):
+    a = doc["accessors"][index]
+    v = doc["bufferViews"][a["bufferView"]]
+    comps = {"SCALAR": 1, "VEC2": 2, "VEC3": 3}[a["type"]]
+    fmt = {5126: "f", 5125: "I", 5123: "H", 5121: "B"}[a["componentType"]]
+    size = struct.calcsize(fmt)
+    stride = v.get("byteStride", size * comps)
+    start = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+    data = bins[v["buffer"]]
+    return np.array([struct.unpack_from("<%d%s" % (comps, fmt), data, start + i * stride) for i in range(a["count"])])
+
+
+def _image(path):
+    buf = oiio.ImageBuf(path)
+    px = buf.get_pixels(oiio.FLOAT)
+    if px is None or px.size == 0:
+        raise RuntimeError("cannot read %s: %s" % (path, buf.geterror()))
+    return px.astype(np.float64)
+
+
+def _cover(uv, w, h, reach=0.75):
+    """Texels (boolean h x w) whose centre lies in the UV triangle or within reach texels of it."""
+    p = uv * np.array([w, h])
+    x0, y0 = np.maximum(np.floor(p.min(axis=0) - 1).astype(int), 0)
+    x1, y1 = np.minimum(np.ceil(p.max(axis=0) + 1).astype(int), [w - 1, h - 1])
+    mask = np.zeros((h, w), bool)
+    if x1 < x0 or y1 < y0:
+        return mask
+    ys, xs = np.mgrid[y0:y1 + 1, x0:x1 + 1]
+    c = np.stack([xs + 0.5, ys + 0.5], axis=-1)
+    dist = np.full(xs.shape, np.inf)
+    inside = np.ones(xs.shape, bool)
+    area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])
+    for k in range(3):
+        a, b = p[k], p[(k + 1) % 3]
+        e = b - a
+        cross = e[0] * (c[..., 1] - a[1]) - e[1] * (c[..., 0] - a[0])
+        inside &= cross * np.sign(area) >= 0
+        l2 = e @ e
+        t = np.clip(((c - a) @ e) / l2, 0, 1) if l2 > 0 else np.zeros(xs.shape)
+        q = a + t[..., None] * e
+        dist = np.minimum(dist, np.linalg.norm(c - q, axis=-1))
+    mask[y0:y1 + 1, x0:x1 + 1] = inside | (dist <= reach)
+    return mask
+
+
+def object_means(out):
+    """{node name: (mean rgb over its valid texels, texel count)} for the bake in folder out,
+    plus its "all" entry (every valid texel of every node). Needs output.formats exr and mask."""
+    name = [f for f in os.listdir(out) if f.endswith(".gltf")][0]
+    doc = json.load(open(os.path.join(out, name)))
+    bins = [open(os.path.join(out, b["uri"]), "rb").read() for b in doc["buffers"]]
+    atlases = {}
+    owner = {}  # atlas -> (h x w) node index + 1, 0 for none
+    nodes = []
+    for node in doc["nodes"]:
+        if "mesh" not in node:
+            continue
+        for prim in doc["meshes"][node["mesh"]]["primitives"]:
+            if "TEXCOORD_1" not in prim["attributes"]:
+                continue
+            tex = doc["materials"][prim["material"]]["extensions"]["MOZ_lightmap"]["index"]
+            if tex not in atlases:
+                png = doc["images"][doc["textures"][tex]["source"]]["uri"]
+                exr = _image(os.path.join(out, png[:-4] + ".exr"))[..., :3]
+                mask = _image(os.path.join(out, png[:-4] + "-mask.png"))[..., 0]
+                atlases[tex] = (exr, mask > 0.99)
+                owner[tex] = np.zeros(mask.shape, int)
+            if node["name"] not in nodes:
+                nodes.append(node["name"])
+            label = nodes.index(node["name"]) + 1
+            exr, valid = atlases[tex]
+            h, w = valid.shape
+            uv = _accessor(doc, bins, prim["attributes"]["TEXCOORD_1"])
+            idx = _accessor(doc, bins, prim["indices"]).reshape(-1)
+            for k in range(0, len(idx), 3):
+                cover = _cover(uv[idx[k:k + 3]], w, h) & valid & (owner[tex] == 0)
+                owner[tex][cover] = label
+    sums = {n: [np.zeros(3), 0] for n in nodes + ["all"]}
+    for tex, (exr, valid) in atlases.items():
+        for label, n in enumerate(nodes, 1):
+            sel = owner[tex] == label
+            for key in (n, "all"):
+                sums[key][0] += exr[sel].sum(axis=0)
+                sums[key][1] += int(sel.sum())
+    return {n: (s / max(c, 1), c) for n, (s, c) in sums.items()}
+
+
+def luminance(rgb):
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
