@@ -9,7 +9,7 @@
 # seed and regression input is run once, alone, and the slowest is printed (and written to
 # build-fuzz/seed-times.csv). A crash, leak, timeout (> TIMEOUT s per input, below) or
 # out-of-memory (> 2 GiB) leaves its input in
-# build-fuzz/artifacts/<target>/ and fails the run: copy it to tests/fuzz/regressions/<target>/,
+# build-fuzz/artifacts/<target>/ and fails the run: copy it to tests/fuzz/regressions/<target>/ (regressions-large/ if it is legal but takes over 1 s here),
 # where ctest replays it in every test build, then fix the bug.
 # Prints executions, coverage (edges, features) and corpus size per target, and writes
 # build-fuzz/fuzz-summary.csv.
@@ -27,10 +27,10 @@ LMB_BUILD_TARGETS="${targets[*]/#/fuzz_}" CC=clang-14 CXX=clang++-14 \
   tools/setup.sh build-fuzz -DLMB_FUZZ=ON -DBUILD_TESTING=OFF
 
 out=build-fuzz
-# Per-input limit. The slowest seed takes 0.0X s alone in the fuzz build on this machine
-# (2 cores; measured by the replay below, see build-fuzz/seed-times.csv), so 60 s is over 100x
-# its time: a busy machine (all targets fuzz at once, a build or a bake beside them) cannot
-# reach it, a real hang does.
+# Per-input limit. Measured by the replay below on this machine (2 cores, fuzz build): the
+# slowest of the 84 seed and regression inputs takes 0.18 s alone (gltf
+# truncated-png-data-uri.gltf); 60 s is over 300x that, so a busy machine (every target fuzzing
+# at once, a build or a bake beside them) cannot reach it, while a real hang does.
 TIMEOUT=60
 seed_files() { # the seeds of one target, as in tests/fuzz/CMakeLists.txt
   case $1 in
@@ -45,8 +45,10 @@ for t in "${targets[@]}"; do
   rm -rf "$out/seeds/$t" "$out/artifacts/$t" "$out/logs/$t.log"
   mkdir -p "$out/seeds/$t" "$out/corpus/$t" "$out/artifacts/$t" "$out/logs"
   n=0
-  while IFS= read -r f; do cp "$f" "$out/seeds/$t/$n-$(basename "$f")"; n=$((n + 1)); done < <(seed_files "$t")
-  cp tests/fuzz/regressions/"$t"/* "$out/seeds/$t/" 2>/dev/null || true
+  # cut to max_len, as libFuzzer cuts every corpus input it loads: the seeds are what the timed
+  # run starts from (ctest replays the whole files: fuzz_regressions_<target>)
+  while IFS= read -r f; do head -c "$(max_len "$t")" "$f" >"$out/seeds/$t/$n-$(basename "$f")"; n=$((n + 1)); done < <(seed_files "$t")
+  for f in tests/fuzz/regressions/"$t"/*; do [ -f "$f" ] && head -c "$(max_len "$t")" "$f" >"$out/seeds/$t/$(basename "$f")"; done
   if [ "$t" = plan ]; then # the scene's own layout, written by the target
     LMB_FUZZ_PLAN_SEED="$out/seeds/plan/cornell-layout" ASAN_OPTIONS=detect_leaks=0 "$out/tests/fuzz/fuzz_plan" -runs=0 >/dev/null 2>&1
   fi

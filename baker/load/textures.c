@@ -80,9 +80,30 @@ static void to_space(float *px, size_t count, lmb_tex_space space, srgb_memo *m)
     }
 }
 
+/* Adds a band of rows (values already in the texture's space) into one row of the reduced
+ * image: each reduced pixel gets the sum of the up to factor columns it covers. */
+static void add_band_f32(const float *band, uint32_t iw, uint32_t rows, uint32_t factor, float *row)
+{
+    for (uint32_t y = 0; y < rows; y++)
+        for (uint32_t x = 0; x < iw; x++)
+            for (int c = 0; c < 3; c++)
+                row[3 * (size_t)(x / factor) + (size_t)c] += band[3 * ((size_t)y * iw + x) + (size_t)c];
+}
+
+/* The same for 8-bit values, through a table of what each code is in the texture's space. */
+static void add_band_u8(const uint8_t *band, uint32_t iw, uint32_t rows, uint32_t factor, const float table[256],
+                        float *row)
+{
+    for (uint32_t y = 0; y < rows; y++)
+        for (uint32_t x = 0; x < iw; x++)
+            for (int c = 0; c < 3; c++)
+                row[3 * (size_t)(x / factor) + (size_t)c] += table[band[3 * ((size_t)y * iw + x) + (size_t)c]];
+}
+
 /* Reads an image of w x h reduced by `factor`: each pixel of the result is the mean, in the
  * texture's space (after sRGB decoding), of the up to factor x factor pixels it covers. Reads a
- * band of `factor` rows at a time, so memory follows the result, not the image. */
+ * band of `factor` rows at a time, so memory follows the result, not the image; 8-bit images
+ * are read as stored and decoded through a table. */
 static lmb_status read_reduced(const char *name, const uint8_t *bytes, size_t size, uint32_t factor,
                                lmb_tex_space space, uint32_t *w, uint32_t *h, float **rgb, lmb_error *err)
 {
@@ -91,25 +112,35 @@ static lmb_status read_reduced(const char *name, const uint8_t *bytes, size_t si
     lmb_status st = lmb_image_rows_open(name, bytes, size, &r, &iw, &ih, err);
     if (st != LMB_OK)
         return st;
+    int u8 = lmb_image_rows_is_u8(r);
     uint32_t ow = (iw + factor - 1) / factor, oh = (ih + factor - 1) / factor;
-    float *band = malloc(3 * (size_t)iw * factor * sizeof *band + 1);
+    size_t band_values = 3 * (size_t)iw * factor;
+    void *band = malloc(band_values * (u8 ? 1 : sizeof(float)) + 1);
     float *out = calloc(3 * (size_t)ow * oh + 1, sizeof *out);
     if (!band || !out)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for a %ux%u reduced image", name, ow, oh);
     srgb_memo memo;
     srgb_memo_init(&memo);
+    float table[256];
+    for (int k = 0; k < 256; k++) {
+        table[k] = (float)k / 255.0f;
+        to_space(&table[k], 1, space, &memo);
+    }
     for (uint32_t oy = 0; oy < oh && st == LMB_OK; oy++) {
         uint32_t y0 = oy * factor, y1 = y0 + factor < ih ? y0 + factor : ih;
-        st = lmb_image_rows_read(r, y0, y1, band, err);
-        if (st != LMB_OK)
-            break;
-        to_space(band, 3 * (size_t)iw * (y1 - y0), space, &memo);
         float *row = out + 3 * (size_t)ow * oy;
-        for (uint32_t y = 0; y < y1 - y0; y++)
-            for (uint32_t x = 0; x < iw; x++)
-                for (int c = 0; c < 3; c++)
-                    row[3 * (size_t)(x / factor) + (size_t)c] += band[3 * ((size_t)y * iw + x) + (size_t)c];
-        for (uint32_t ox = 0; ox < ow; ox++) {
+        if (u8) {
+            st = lmb_image_rows_read_u8(r, y0, y1, band, err);
+            if (st == LMB_OK)
+                add_band_u8(band, iw, y1 - y0, factor, table, row);
+        } else {
+            st = lmb_image_rows_read(r, y0, y1, band, err);
+            if (st == LMB_OK) {
+                to_space(band, 3 * (size_t)iw * (y1 - y0), space, &memo);
+                add_band_f32(band, iw, y1 - y0, factor, row);
+            }
+        }
+        for (uint32_t ox = 0; ox < ow && st == LMB_OK; ox++) {
             uint32_t cols = (ox + 1) * factor < iw ? factor : iw - ox * factor;
             float inv = 1.0f / (float)(cols * (y1 - y0));
             for (int c = 0; c < 3; c++)

@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include <cmath>
@@ -138,6 +139,7 @@ struct lmb_image_rows {
     OIIO::Filesystem::IOMemReader mem;
     std::unique_ptr<OIIO::ImageInput> in;
     std::vector<float> band;
+    std::vector<uint8_t> band_u8;
     std::string name;
     lmb_image_rows(const uint8_t *bytes, size_t size) : mem(bytes, bytes ? size : 0) {}
 };
@@ -178,6 +180,35 @@ extern "C" lmb_status lmb_image_rows_read(lmb_image_rows *r, uint32_t y0, uint32
         for (size_t i = 0; i < w * rows; i++)
             for (int c = 0; c < 3; c++)
                 rgb[3 * i + c] = r->band[i * ch + (ch >= 3 ? c : 0)];
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", r->name.c_str(), e.what());
+    }
+}
+
+extern "C" int lmb_image_rows_is_u8(const lmb_image_rows *r)
+{
+    return r->in->spec().format == OIIO::TypeDesc::UINT8;
+}
+
+extern "C" lmb_status lmb_image_rows_read_u8(lmb_image_rows *r, uint32_t y0, uint32_t y1, uint8_t *rgb, lmb_error *err)
+{
+    try {
+        const OIIO::ImageSpec &spec = r->in->spec();
+        int ch = spec.nchannels;
+        size_t w = (size_t)spec.width, rows = y1 - y0;
+        r->band_u8.resize(w * rows * (size_t)ch);
+        if (!r->in->read_scanlines(0, 0, spec.y + (int)y0, spec.y + (int)y1, 0, 0, ch, OIIO::TypeDesc::UINT8,
+                                   r->band_u8.data()))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot decode rows %u..%u: %s", r->name.c_str(), y0, y1 - 1,
+                                 r->in->geterror().c_str());
+        if (ch == 3) {
+            std::memcpy(rgb, r->band_u8.data(), w * rows * 3);
+            return LMB_OK;
+        }
+        for (size_t i = 0; i < w * rows; i++)
+            for (int c = 0; c < 3; c++)
+                rgb[3 * i + c] = r->band_u8[i * ch + (ch >= 3 ? c : 0)];
         return LMB_OK;
     } catch (const std::exception &e) {
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", r->name.c_str(), e.what());

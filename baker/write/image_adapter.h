@@ -45,6 +45,13 @@ lmb_status lmb_image_rows_open(const char *name, const uint8_t *bytes, size_t si
  * with the same conventions as lmb_image_read_rgb. */
 lmb_status lmb_image_rows_read(lmb_image_rows *r, uint32_t y0, uint32_t y1, float *rgb, lmb_error *err);
 
+/* 1 if the image stores 8-bit values: then lmb_image_rows_read_u8 reads them as stored. */
+int lmb_image_rows_is_u8(const lmb_image_rows *r);
+
+/* Rows y0 .. y1 - 1 as 8-bit RGB (3 x width x (y1 - y0) bytes), values as stored (sRGB-encoded
+ * for colour images). Only for images lmb_image_rows_is_u8 says are 8-bit. */
+lmb_status lmb_image_rows_read_u8(lmb_image_rows *r, uint32_t y0, uint32_t y1, uint8_t *rgb, lmb_error *err);
+
 /* Closes the reader (NULL is fine). */
 void lmb_image_rows_close(lmb_image_rows *r);
 
