@@ -277,15 +277,18 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_rt rt;
     lmb_emitters *em = NULL;
     lmb_direct *direct = NULL;
+    lmb_sky *sky = NULL;
     lmb_textures tx;
     lmb_cache cache;
     lmb_ic_points records = {NULL, 0};
+    memset(&l, 0, sizeof l);
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
-    if (plan_path) /* the plan stage's layout (farm/plan.h), checked against this scene and config */
+    st = lmb_sky_create(cfg, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
+    if (st == LMB_OK && plan_path) /* the plan stage's layout (farm/plan.h), checked against this scene and config */
         st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
-    else
+    else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
@@ -294,7 +297,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK)
         st = lmb_emitters_build(s, cfg, &tx, &em, err);
     if (st == LMB_OK)
-        st = lmb_direct_create(s, cfg, &rt, em, &direct, err);
+        st = lmb_direct_create(s, cfg, &rt, em, sky, &direct, err);
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
@@ -304,8 +307,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
                               (double)cfg->farm_min_step_rays, log, &steps, err);
     double tl = lmb_seconds();
     if (st == LMB_OK && !shard && !lmb_direct_any_light(direct))
-        lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material): the lightmaps "
-                 "are black", s->path);
+        lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material, no sky): the "
+                 "lightmaps are black", s->path);
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
     if (shard) { /* the shard's part is written (stopped), or the bake ended before its step */
@@ -347,6 +350,7 @@ done:
     lmb_cache_free(&cache);
     free(records.xyzr);
     lmb_direct_free(direct);
+    lmb_sky_free(sky);
     lmb_emitters_free(em);
     lmb_textures_free(&tx);
     lmb_rt_free(&rt);

@@ -10,6 +10,11 @@ usage: make_scenes.py OUTDIR
   point-plane.gltf    10 x 10 plane, point light of I = 100 cd at h = 2 above (0, 0)
   sun-box.gltf        10 x 10 plane, closed 1 m cube on it, directional light of 1000 lux
   disk.gltf           plane, emissive disk (64 segments, R = 0.5, L = 10 nits) facing down at h = 1
+  sky-plane.gltf      10 x 10 plane and no light: lit by the config's sky (sky.* keys)
+  sky-well.gltf       a disk (R = 0.5) at the bottom of a black open cylinder 1 deep: lit by
+                      the sky through the opening only
+  sun-plate.gltf      4 x 4 ground, a sun straight down, a plate 1.5 above the x < 0 half: the
+                      shadow edge's penumbra (lights.sun_angle)
   many-lights.gltf    10 x 10 plane under 20 point lights (sampled by power, not looped)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
   disk-transform.gltf the same disk with a 2 x 1 emissive texture (black | white, NEAREST,
@@ -339,6 +344,42 @@ def analytic(out):
     s.write(os.path.join(out, "box-floor.gltf"))
 
 
+PLATE_HEIGHT = 1.5  # sun-plate.gltf
+WELL = (0.5, 1.0)  # sky-well.gltf: radius and depth of the well; its opening subtends atan(R / H)
+
+
+def sky(out):
+    """Scenes lit by the sky alone (no punctual light): the tests set sky.* in their config."""
+    s = Scene()
+    s.mesh("plane", plane(10), s.material("grey", (0.5, 0.5, 0.5)))
+    s.write(os.path.join(out, "sky-plane.gltf"))
+
+    # a disk at the bottom of a black, open cylinder: a point at the centre sees the sky through
+    # the opening only, E = pi L sin^2(alpha), alpha = atan(R / H)
+    s = Scene()
+    r, h, n = WELL[0], WELL[1], 96
+    ring = [(r * math.cos(2 * math.pi * k / n), r * math.sin(2 * math.pi * k / n)) for k in range(n)]
+    floor = [((0, 0, 0), (ring[(k + 1) % n][0], 0, ring[(k + 1) % n][1]), (ring[k][0], 0, ring[k][1]))
+             for k in range(n)]  # faces +y
+    wall = []
+    for k in range(n):
+        a, b = ring[k], ring[(k + 1) % n]
+        wall += quad((a[0], 0, a[1]), (b[0], 0, b[1]), (b[0], h, b[1]), (a[0], h, a[1]))  # faces inward
+    s.mesh("floor", floor, s.material("grey", (0.5, 0.5, 0.5)))
+    s.mesh("wall", wall, s.material("black", (0.0, 0.0, 0.0)))
+    s.write(os.path.join(out, "sky-well.gltf"))
+
+    # a sun straight down and a thin plate at PLATE_HEIGHT over the ground's x < 0 half: the
+    # penumbra along x = 0 is PLATE_HEIGHT x tan(lights.sun_angle) wide
+    s = Scene()
+    grey = s.material("grey", (0.5, 0.5, 0.5))
+    s.mesh("ground", plane(4), grey)
+    y = PLATE_HEIGHT
+    s.mesh("plate", quad((-3, y, -3), (-3, y, 3), (0, y, 3), (0, y, -3)), grey)  # faces -y
+    s.light("sun", "directional", 1000.0, rotation=[-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)])  # -Z -> -Y
+    s.write(os.path.join(out, "sun-plate.gltf"))
+
+
 def furnace_variant(out, name):
     """The furnace box (Le = 1 nit) with material `name` of FURNACE_MATERIALS; TEXCOORD_0 = (x, z)."""
     s = Scene()
@@ -567,5 +608,6 @@ if __name__ == "__main__":
     cornell(out)
     cornell_closed(out)
     analytic(out)
+    sky(out)
     indirect(out)
     artists(out)

@@ -4,7 +4,11 @@
  *                W = clamp(1 - (d/range)^4, 0, 1)^2 when a range is given, as the spec suggests)
  *   spot:        the same times clamp((cos(a) - cos_o) / (cos_i - cos_o), 0, 1)^2 (the spec's
  *                smooth cone; a = angle to the spot axis)
- *   directional: E = E_sun c cos(theta)                     (intensity in lux)
+ *   directional: E = E_sun c cos(theta)                     (intensity in lux; with lights.sun_angle
+ *                a disc of that angular diameter: directions uniform in its cone, each
+ *                E_sun c cos(theta) / mean cos over the cone, so E_sun is the illuminance at
+ *                normal incidence)
+ *   sky:         sky.c (map and cosine samples, multiple importance sampling)
  *   area:        E = sum over samples of L_e cos(theta_x) cos(theta_y) / d^2 / p_A(y) / N,
  *                triangles chosen in proportion to power (area x luminance), points uniform
  *                on the triangle: p_A(y) = P_tri / A_tri (area sampling; one-sided emitters
@@ -187,6 +191,7 @@ struct lmb_direct {
     const lmb_config *cfg;
     const lmb_rt *rt;
     const lmb_emitters *emitters;
+    const lmb_sky *sky;
     light_set lights;
     uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
 };
@@ -198,7 +203,8 @@ const lmb_config *lmb_direct_config(const lmb_direct *d)
 
 int lmb_direct_any_light(const lmb_direct *d)
 {
-    return (d->scene->light_count > 0 && d->cfg->light_intensity_scale > 0) || lmb_emitters_count(d->emitters) > 0;
+    return (d->scene->light_count > 0 && d->cfg->light_intensity_scale > 0) || lmb_emitters_count(d->emitters) > 0 ||
+           d->sky != NULL;
 }
 
 typedef struct point_ctx {
@@ -259,6 +265,34 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     for (int k = 0; k < 3; k++)
         rgb[k] = weight * scale * l->intensity * l->color[k] * cosang * w;
     add_light(c, d, rgb, e);
+}
+
+/* A directional light as a disc of angular diameter lights.sun_angle: c->samples directions
+ * uniform in its cone (solid angle), each with a shadow ray. */
+static void sun_disc(point_ctx *c, const lmb_light *l, lmb_rng *rng, double e[3])
+{
+    double half = 0.5 * c->d->cfg->sun_angle * LMB_PI / 180.0, cos_max = cos(half), axis[3], t[3], b[3];
+    for (int k = 0; k < 3; k++)
+        axis[k] = -l->direction[k];
+    lmb_frame(axis, t, b);
+    uint32_t n = c->samples;
+    double scale = c->d->cfg->light_intensity_scale * l->intensity / (0.5 * (1 + cos_max)) / n;
+    for (uint32_t s = 0; s < n; s++) {
+        double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng);
+        double ct = 1 - u1 * (1 - cos_max), st = sqrt(fmax(0.0, 1 - ct * ct)), phi = 2 * LMB_PI * u2, d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = ct * axis[k] + st * (cos(phi) * t[k] + sin(phi) * b[k]);
+        double cosang = lmb_dot3(c->n, d);
+        if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
+            continue;
+        c->rays++;
+        if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, 1e300))
+            continue;
+        double rgb[3];
+        for (int k = 0; k < 3; k++)
+            rgb[k] = scale * l->color[k] * cosang;
+        add_light(c, d, rgb, e);
+    }
 }
 
 /* Point and spot lights: all of them when few, else power-proportional samples. */
@@ -419,11 +453,19 @@ uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_
     point_init(&c, d, sp);
     c.samples = samples ? samples : d->cfg->direct_samples;
     e[0] = e[1] = e[2] = 0;
-    for (uint32_t l = 0; l < d->lights.directional_count; l++)
-        punctual(&c, &d->scene->lights[d->lights.directional[l]], 1.0, e);
+    for (uint32_t l = 0; l < d->lights.directional_count; l++) {
+        const lmb_light *sun = &d->scene->lights[d->lights.directional[l]];
+        if (d->cfg->sun_angle > 0)
+            sun_disc(&c, sun, rng, e);
+        else
+            punctual(&c, sun, 1.0, e);
+    }
     local_lights(&c, rng, e);
     if (lmb_emitters_count(d->emitters))
         area_lights(&c, rng, e);
+    if (d->sky)
+        c.rays += lmb_sky_irradiance(d->sky, d->rt, c.o, c.n, c.ng, c.eps, samples ? samples : d->cfg->sky_samples, rng,
+                                     e, c.dir);
     if (dir)
         memcpy(dir, c.dir, sizeof c.dir);
     return (uint32_t)c.rays;
@@ -486,7 +528,7 @@ static void light_set_free(light_set *ls)
 }
 
 lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, const lmb_rt *rt,
-                             const lmb_emitters *emitters, lmb_direct **out, lmb_error *err)
+                             const lmb_emitters *emitters, const lmb_sky *sky, lmb_direct **out, lmb_error *err)
 {
     lmb_direct *d = calloc(1, sizeof *d);
     if (!d || !light_set_build(scene, &d->lights)) {
@@ -499,6 +541,7 @@ lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, cons
     d->cfg = cfg;
     d->rt = rt;
     d->emitters = emitters;
+    d->sky = sky;
     d->emitter_of = calloc((size_t)rt->geom_count + 1, sizeof *d->emitter_of);
     lmb_status st = d->emitter_of ? LMB_OK : LMB_ERR_INTERNAL;
     /* emitters come grouped by (instance, primitive); geometries in the same order */

@@ -9,6 +9,7 @@
 #ifndef LMBAKE_DIRECT_H
 #define LMBAKE_DIRECT_H
 
+#include "lights/sky.h"
 #include "raytrace/rt_scene.h"
 #include "load/textures.h"
 #include "texels/texels.h"
@@ -25,14 +26,14 @@ uint32_t lmb_emitters_count(const lmb_emitters *e);
 
 typedef struct lmb_direct lmb_direct; /* opaque: a scene's lights ready to evaluate at any point */
 
-/* The lights of scene (punctual from scene->lights, area from emitters), for any number of
- * threads at once. Borrows everything it is given; free with lmb_direct_free. */
+/* The lights of scene (punctual from scene->lights, area from emitters, the sky if not NULL),
+ * for any number of threads at once. Borrows everything it is given; free with lmb_direct_free. */
 lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, const lmb_rt *rt,
-                             const lmb_emitters *emitters, lmb_direct **out, lmb_error *err);
+                             const lmb_emitters *emitters, const lmb_sky *sky, lmb_direct **out, lmb_error *err);
 void lmb_direct_free(lmb_direct *d);
 
 /* 0 when nothing in the scene emits light (no punctual light that the config keeps, no
- * emissive triangle): every lightmap is exactly 0 and no gather needs to run. */
+ * emissive triangle, no sky): every lightmap is exactly 0 and no gather needs to run. */
 int lmb_direct_any_light(const lmb_direct *d);
 
 /* A point on a surface: position, shading and geometric normals (unit, front side) and the
@@ -43,8 +44,10 @@ typedef struct lmb_shading_point {
 } lmb_shading_point;
 
 /* Direct irradiance at sp (lux, RGB) from every light with shadow rays; rng drives area-light
- * and many-light sampling, `samples` of each (0: samples.direct; a caller that averages many
- * evaluations, as gather rays and reference paths do, passes 1). Returns the rays traced.
+ * and many-light sampling, `samples` of each (0: samples.direct, and sky.samples for the sky; a
+ * caller that averages many evaluations, as gather rays and reference paths do, passes 1). A
+ * directional light with lights.sun_angle > 0 is a disc sampled `samples` times. Returns the
+ * rays traced.
  * dir (may be NULL): the sum over contributions of their luminance times their direction
  * (unit, toward the light): the direct part of the texel's light direction (lmb_direction). */
 uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3],

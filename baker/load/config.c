@@ -39,6 +39,9 @@ static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node
 #define ENUM(p, off, nm) {.path = p, .set = lmb_cfg_set_enum, .offset = off, .names = nm}
 #define FLAGS(p, off, nm) {.path = p, .set = lmb_cfg_set_flags, .offset = off, .names = nm, .max_items = LMB_MAX_PATTERNS}
 #define STRING(p, off) {.path = p, .set = lmb_cfg_set_string, .offset = off}
+#define RGB(p, off, lo, hi, op) {.path = p, .set = lmb_cfg_set_rgb, .offset = off, .flo = lo, .fhi = hi, .open = op}
+#define DIRECTION(p, off) {.path = p, .set = lmb_cfg_set_direction, .offset = off}
+#define PATH(p, off) {.path = p, .set = lmb_cfg_set_path, .offset = off}
 #define LIST(p, fn, off, cnt) {.path = p, .set = fn, .offset = off, .count_offset = cnt, .max_items = LMB_MAX_PATTERNS}
 
 /* Index = lmb_gather_method value; bit i = 1 << i = LMB_OUTPUT_* */
@@ -46,6 +49,7 @@ static const char *const gather_methods[] = {"cosine", "amis", "amis_defensive",
 static const char *const amis_weights[] = {"unbiased", "balance", NULL};
 static const char *const ic_records_modes[] = {"per_pass", "shared", NULL};
 static const char *const emission_sides[] = {"front", "material", NULL};
+static const char *const sky_samplings[] = {"mis", "cosine", NULL};
 static const char *const output_formats[] = {"exr", "hdr", "png", "mask", NULL};
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
 _Static_assert(LMB_EMIT_FRONT == 0 && LMB_EMIT_MATERIAL == 1, "emission_sides");
@@ -91,6 +95,15 @@ static const key_spec config_keys[] = {
     FLOAT("lights.intensity_scale", OFF(light_intensity_scale), 0, 1e9, 0),
     FLOAT("lights.emissive_scale", OFF(emissive_scale), 0, 1e9, 0),
     ENUM("lights.emission_sides", OFF(emission_sides), emission_sides),
+    FLOAT("lights.sun_angle", OFF(sun_angle), 0, 30, 0),
+    FLOAT("sky.intensity", OFF(sky_intensity), 0, 1e9, 0),
+    RGB("sky.color", OFF(sky_color), 0, 1e9, 0),
+    RGB("sky.ground_color", OFF(sky_ground), 0, 1e9, OPEN_NONE),
+    PATH("sky.image", OFF(sky_image)),
+    FLOAT("sky.rotation", OFF(sky_rotation), -360, 360, 0),
+    DIRECTION("sky.up", OFF(sky_up)),
+    U32("sky.samples", OFF(sky_samples), 1, 65536),
+    ENUM("sky.sampling", OFF(sky_cosine_only), sky_samplings),
     BOOL("seams.stitch", OFF(seam_stitch)),
     BOOL("fireflies.spread", OFF(firefly_spread)),
 };
@@ -138,6 +151,12 @@ void lmb_config_default(lmb_config *cfg)
     cfg->ic_error = 0.3;
     cfg->ic_min_spacing = 4;
     cfg->ic_max_spacing = 8;
+    cfg->sun_angle = 0.53; /* the real sun's angular diameter */
+    cfg->sky_intensity = 0;
+    cfg->sky_color[0] = cfg->sky_color[1] = cfg->sky_color[2] = 1;
+    cfg->sky_ground[0] = cfg->sky_ground[1] = cfg->sky_ground[2] = -1; /* none */
+    cfg->sky_up[1] = 1;
+    cfg->sky_samples = 64;
     cfg->ic_ray_scale = 4;
     cfg->farm_min_step_rays = 1000000; /* ~0.1 s of one core: a step costs a process start per shard */
     cfg->ic_records = LMB_IC_RECORDS_SHARED; /* docs/irradiance-cache.md: as accurate, 1.0-1.4x faster */
@@ -416,5 +435,6 @@ lmb_status lmb_config_load(const char *path, lmb_config *cfg, lmb_error *err)
         return st;
     st = lmb_config_parse(path, buf, n, cfg, err);
     free(buf);
+    snprintf(cfg->config_path, sizeof cfg->config_path, "%s", path);
     return st;
 }

@@ -28,7 +28,8 @@ typedef struct key_spec key_spec;
 /* Reads node n into the struct at base (at k->offset), or fails naming k->path. */
 typedef lmb_status (*setter_fn)(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 
-enum { OPEN_LO = 1, OPEN_HI = 2 }; /* float ranges: '>' lo and '<' hi instead of >=, <= */
+enum { OPEN_LO = 1, OPEN_HI = 2, OPEN_NONE = 4 }; /* float ranges: '>' lo and '<' hi instead of >=, <=;
+                                                    OPEN_NONE: an RGB key may be "none" */
 
 struct key_spec {
     const char *path; /* dotted, as in the file */
@@ -76,6 +77,12 @@ lmb_status lmb_cfg_set_enum(parse_ctx *c, const key_spec *k, const yaml_node_t *
 lmb_status lmb_cfg_set_flags(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 lmb_status lmb_cfg_set_string(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 lmb_status lmb_cfg_set_globs(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+/* [r, g, b], each in the key's float range; with OPEN_NONE also "none" (stored as -1, -1, -1) */
+lmb_status lmb_cfg_set_rgb(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+/* [x, y, z], finite, not all 0 (stored as given: users normalize) */
+lmb_status lmb_cfg_set_direction(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+/* a relative path of at most LMB_PATTERN_LEN - 1 characters, or "" for none */
+lmb_status lmb_cfg_set_path(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 
 /* Lists: each entry through fn (a null is an empty list, a lone value a list of one). */
 typedef lmb_status (*lmb_cfg_item_fn)(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base,

@@ -282,6 +282,56 @@ lmb_status lmb_cfg_set_string(parse_ctx *c, const key_spec *k, const yaml_node_t
     return copy_string(c, k, n, base + k->offset);
 }
 
+lmb_status lmb_cfg_set_path(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    const char *s = lmb_cfg_scalar(n);
+    if (s && !*s) {
+        base[k->offset] = '\0';
+        return LMB_OK;
+    }
+    return copy_string(c, k, n, base + k->offset);
+}
+
+/* Three numbers of a YAML sequence into v; 0 if n is not one. */
+static int read_three(parse_ctx *c, const yaml_node_t *n, double v[3])
+{
+    if (n->type != YAML_SEQUENCE_NODE || n->data.sequence.items.top - n->data.sequence.items.start != 3)
+        return 0;
+    for (int i = 0; i < 3; i++) {
+        const char *s = lmb_cfg_scalar(lmb_cfg_node(c, n->data.sequence.items.start[i]));
+        if (!s || !parse_float(s, &v[i]))
+            return 0;
+    }
+    return 1;
+}
+
+lmb_status lmb_cfg_set_rgb(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    double v[3];
+    const char *s = lmb_cfg_scalar(n);
+    if ((k->open & OPEN_NONE) && s && !strcmp(s, "none")) {
+        v[0] = v[1] = v[2] = -1;
+    } else if (!read_three(c, n, v) || !float_in_range(k, v[0]) || !float_in_range(k, v[1]) ||
+               !float_in_range(k, v[2])) {
+        char want[128];
+        snprintf(want, sizeof want, "[r, g, b] with each number >= %.15g and <= %.15g%s", k->flo, k->fhi,
+                 (k->open & OPEN_NONE) ? ", or none" : "");
+        return lmb_cfg_bad_value(c, k, n, want);
+    }
+    memcpy(base + k->offset, v, sizeof v);
+    return LMB_OK;
+}
+
+lmb_status lmb_cfg_set_direction(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    double v[3];
+    if (!read_three(c, n, v) || !(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 1e-12) ||
+        !isfinite(v[0] + v[1] + v[2]))
+        return lmb_cfg_bad_value(c, k, n, "[x, y, z], finite and not all 0");
+    memcpy(base + k->offset, v, sizeof v);
+    return LMB_OK;
+}
+
 /* ---- lists ------------------------------------------------------------------ */
 
 

@@ -94,8 +94,26 @@ static void put_value(text_out *o, const key_spec *k, const char *base)
                 first = 0;
             }
         put(o, "]");
-    } else if (k->set == lmb_cfg_set_string) {
+    } else if (k->set == lmb_cfg_set_string || k->set == lmb_cfg_set_path) {
         put_quoted(o, at);
+    } else if (k->set == lmb_cfg_set_rgb || k->set == lmb_cfg_set_direction) {
+        double v[3];
+        memcpy(v, at, sizeof v);
+        if (k->set == lmb_cfg_set_rgb && (k->open & OPEN_NONE) && v[0] < 0) {
+            put(o, "none");
+        } else {
+            put(o, "[");
+            for (int i = 0; i < 3; i++) {
+                char text[40];
+                for (int digits = 15; digits <= 17; digits++) {
+                    snprintf(text, sizeof text, "%.*g", digits, v[i]);
+                    if (strtod(text, NULL) == v[i])
+                        break;
+                }
+                put(o, "%s%s", i ? ", " : "", text);
+            }
+            put(o, "]");
+        }
     } else if (k->set == lmb_cfg_set_globs) {
         uint32_t count;
         memcpy(&count, base + k->count_offset, sizeof count);

@@ -267,6 +267,18 @@ typedef struct lmb_config {
     int firefly_spread;            /* fireflies.spread: outlier texels' excess moved to their neighbours */
     /* seams */
     int seam_stitch;               /* least-squares seam stitching after the gather */
+    /* sky (lights/sky.h): light from every direction a ray leaves the level by */
+    double sky_intensity;          /* radiance multiplier, nits; 0 = no sky */
+    double sky_color[3];           /* linear RGB, times sky_intensity (and the image) */
+    double sky_ground[3];          /* radiance below the horizon, times sky_intensity; [0] < 0: none (the sky or image's own) */
+    char sky_image[LMB_PATTERN_LEN]; /* equirectangular HDR/EXR, relative to the config's folder; "" = none */
+    double sky_rotation;           /* degrees about sky_up */
+    double sky_up[3];              /* the sky's up axis (unit; +Y, glTF's up) */
+    uint32_t sky_samples;          /* sky rays per gather point, split between the map's and the cosine distribution */
+    int sky_cosine_only;           /* sky.sampling: cosine: no map samples (the benchmark's comparison) */
+    double sun_angle;              /* degrees: a directional light is a disc of this angular diameter; 0 = a point */
+    char config_path[4096];        /* the config file it was loaded from (lmb_config_load), "" for none: sky.image is
+                                      read from its folder; not a key */
 } lmb_config;
 
 /* Fills cfg with the documented defaults (docs/config.md). */

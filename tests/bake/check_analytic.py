@@ -35,7 +35,8 @@ DIRECT = {"disk-transform": 1024}
 # cases that bake another case's scene with more config: sun-bright is sun-box at 100,000 lux,
 # irradiance past half float's 65504 (the EXR must hold it, not Inf)
 SCENE = {"sun-bright": "sun-box"}
-EXTRA = {"sun-bright": "lights: {intensity_scale: 100}\n"}
+# the sun here is the hard one of the formula (lights.sun_angle 0); sun-penumbra checks the disc
+EXTRA = {"sun-box": "lights: {sun_angle: 0}\n", "sun-bright": "lights: {intensity_scale: 100, sun_angle: 0}\n"}
 
 
 def bake(lmbake, work, case):

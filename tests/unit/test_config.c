@@ -341,6 +341,8 @@ static void test_example(const char *path)
     CHECK_INT(lmb_config_load(path, &c, &err), LMB_OK);
     if (err.message[0])
         fprintf(stderr, "%s\n", err.message);
+    CHECK(strcmp(c.config_path, path) == 0);
+    memset(c.config_path, 0, sizeof c.config_path); /* where it was read from (sky.image is read beside it), not a key */
     CHECK(same_as_defaults(&c));
 }
 
