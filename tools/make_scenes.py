@@ -13,6 +13,7 @@ usage: make_scenes.py OUTDIR
   sky-plane.gltf      10 x 10 plane and no light: lit by the config's sky (sky.* keys)
   sky-well.gltf       a disk (R = 0.5) at the bottom of a black open cylinder 1 deep: lit by
                       the sky through the opening only
+  sky-bare-wall.gltf  the open plane and a wall on it with no material (materials.default)
   sun-plate.gltf      4 x 4 ground, a sun straight down, a plate 1.5 above the x < 0 half: the
                       shadow edge's penumbra (lights.sun_angle)
   many-lights.gltf    10 x 10 plane under 20 point lights (sampled by power, not looped)
@@ -141,7 +142,9 @@ class Scene:
                 pos.append(tuple(float(x) for x in p))
                 nrm.append(tuple(n))
         prim = {"attributes": {"POSITION": self._accessor(pos, 3), "NORMAL": self._accessor(nrm, 3)},
-                "indices": self._accessor(idx, 1, True), "material": material}
+                "indices": self._accessor(idx, 1, True)}
+        if material is not None:  # None: no material, glTF's default
+            prim["material"] = material
         if uv:
             uv_sets = [lambda p: (p[0], p[2])]
         for k, f in enumerate(uv_sets or []):
@@ -368,6 +371,12 @@ def sky(out):
     s.mesh("floor", floor, s.material("grey", (0.5, 0.5, 0.5)))
     s.mesh("wall", wall, s.material("black", (0.0, 0.0, 0.0)))
     s.write(os.path.join(out, "sky-well.gltf"))
+
+    # the open plane beside a wall 2 high and 0.1 thick with no material (glTF's default material: metal)
+    s = Scene()
+    s.mesh("plane", plane(10), s.material("grey", (0.5, 0.5, 0.5)))
+    s.mesh("wall", box(-0.05, 0, -5, 0.05, 2, 5, bottom=False), None)
+    s.write(os.path.join(out, "sky-bare-wall.gltf"))
 
     # a sun straight down and a thin plate at PLATE_HEIGHT over the ground's x < 0 half: the
     # penumbra along x = 0 is PLATE_HEIGHT x tan(lights.sun_angle) wide

@@ -84,8 +84,9 @@ lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels 
 /* Diffuse albedo / pi of primitive pr's material at barycentrics (b1, b2) of triangle f. */
 static void albedo_at(const lmb_cache *c, const lmb_primitive *pr, uint32_t f, double b1, double b2, double out[3])
 {
-    if (pr->material < 0) { /* glTF default material: white, fully metallic, so no diffuse */
-        out[0] = out[1] = out[2] = 0;
+    if (pr->material < 0) { /* glTF default material: fully metallic, no diffuse, unless materials.default.albedo */
+        for (int j = 0; j < 3; j++)
+            out[j] = c->scene->default_albedo[j] * LMB_INV_PI;
         return;
     }
     lmb_material_albedo(c->textures, &c->scene->materials[pr->material], pr, f, b1, b2, out);

@@ -27,6 +27,8 @@
 #include <yaml.h>
 
 static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_material_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static const schema material_override_schema;
 
 #define OFF(f) offsetof(lmb_config, f)
 #define FLOAT(p, off, lo, hi, op) {.path = p, .set = lmb_cfg_set_float, .offset = off, .flo = lo, .fhi = hi, .open = op}
@@ -102,6 +104,10 @@ static const key_spec config_keys[] = {
     PATH("sky.image", OFF(sky_image)),
     FLOAT("sky.rotation", OFF(sky_rotation), -360, 360, 0),
     DIRECTION("sky.up", OFF(sky_up)),
+    RGB("materials.default.albedo", OFF(default_albedo), 0, 1, OPEN_NONE),
+    {.path = "materials.override", .set = set_material_overrides, .offset = OFF(material_overrides),
+     .count_offset = OFF(material_override_count), .max_items = LMB_MAX_PATTERNS, .items = &material_override_schema,
+     .item_size = sizeof(lmb_material_override)},
     U32("sky.samples", OFF(sky_samples), 1, 65536),
     ENUM("sky.sampling", OFF(sky_cosine_only), sky_samplings),
     BOOL("seams.stitch", OFF(seam_stitch)),
@@ -113,6 +119,15 @@ static const key_spec override_keys[] = {
     STRING("density_overrides.match", offsetof(lmb_density_override, pattern)),
     FLOAT("density_overrides.texel_density", offsetof(lmb_density_override, texel_density), 0, 100000, OPEN_LO),
 };
+
+/* One materials.override entry, filled into an lmb_material_override. */
+static const key_spec material_override_keys[] = {
+    STRING("materials.override.match", offsetof(lmb_material_override, pattern)),
+    RGB("materials.override.albedo", offsetof(lmb_material_override, albedo), 0, 1, OPEN_NONE),
+    RGB("materials.override.emissive", offsetof(lmb_material_override, emissive), 0, 1e9, OPEN_NONE),
+};
+static const schema material_override_schema = {material_override_keys,
+                                                sizeof material_override_keys / sizeof *material_override_keys};
 
 static const schema config_schema = {config_keys, sizeof config_keys / sizeof *config_keys};
 static const schema override_schema = {override_keys, sizeof override_keys / sizeof *override_keys};
@@ -157,6 +172,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->sky_ground[0] = cfg->sky_ground[1] = cfg->sky_ground[2] = -1; /* none */
     cfg->sky_up[1] = 1;
     cfg->sky_samples = 64;
+    cfg->default_albedo[0] = cfg->default_albedo[1] = cfg->default_albedo[2] = -1; /* none: glTF's metal */
     cfg->ic_ray_scale = 4;
     cfg->farm_min_step_rays = 1000000; /* ~0.1 s of one core: a step costs a process start per shard */
     cfg->ic_records = LMB_IC_RECORDS_SHARED; /* docs/irradiance-cache.md: as accurate, 1.0-1.4x faster */
@@ -199,6 +215,28 @@ static lmb_status override_item(parse_ctx *c, const key_spec *k, const yaml_node
     if (st == LMB_OK && (!o->pattern[0] || !(o->texel_density > 0)))
         return lmb_cfg_key_error(c, item, k->path, "each entry needs both match and texel_density");
     return st;
+}
+
+static lmb_status material_override_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base,
+                                         uint32_t index)
+{
+    lmb_material_override *o = (lmb_material_override *)(void *)(base + k->offset) + index;
+    memset(o, 0, sizeof *o);
+    o->albedo[0] = o->albedo[1] = o->albedo[2] = -1; /* keep the file's */
+    o->emissive[0] = o->emissive[1] = o->emissive[2] = -1;
+    if (item->type != YAML_MAPPING_NODE)
+        return lmb_cfg_bad_value(c, k, item, "a mapping {match: GLOB, albedo: [r, g, b], emissive: [r, g, b]}");
+    lmb_status st = walk_mapping(c, &material_override_schema, item, k->path, (char *)o);
+    if (st == LMB_OK && (!o->pattern[0] || (o->albedo[0] < 0 && o->emissive[0] < 0)))
+        return lmb_cfg_key_error(c, item, k->path, "each entry needs match and at least one of albedo and emissive");
+    return st;
+}
+
+static lmb_status set_material_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    uint32_t count = 0;
+    lmb_status st = lmb_cfg_each_item(c, k, n, base, material_override_item, &count);
+    return lmb_cfg_set_count(k, base, count, st);
 }
 
 static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)

@@ -41,12 +41,15 @@ struct key_spec {
     const char *const *names; /* enums and flag lists: NULL-terminated; index = value or bit */
     size_t count_offset;     /* lists: the uint32_t entry count */
     uint32_t max_items;      /* lists: most entries */
+    const struct schema *items; /* lists of mappings: each entry's keys (NULL: density_overrides) */
+    size_t item_size;        /* lists of mappings: each entry's struct size */
 };
 
-typedef struct schema {
+typedef struct schema schema;
+struct schema {
     const key_spec *keys;
     size_t count;
-} schema;
+};
 
 /* The schema tables (config.c), for the writer (config_write.c). */
 const schema *lmb_cfg_schema(void);

@@ -123,16 +123,17 @@ static void put_value(text_out *o, const key_spec *k, const char *base)
             put_quoted(o, at + (size_t)i * LMB_PATTERN_LEN);
         }
         put(o, "]");
-    } else { /* density_overrides: a list of {match, texel_density} */
-        const schema *ov = lmb_cfg_override_schema();
+    } else { /* lists of mappings: density_overrides ({match, texel_density}), materials.override */
+        const schema *ov = k->items ? k->items : lmb_cfg_override_schema();
+        size_t item_size = k->items ? k->item_size : sizeof(lmb_density_override);
         uint32_t count;
         memcpy(&count, base + k->count_offset, sizeof count);
         put(o, "[");
         for (uint32_t i = 0; i < count; i++) {
-            const char *item = at + (size_t)i * sizeof(lmb_density_override);
+            const char *item = at + (size_t)i * item_size;
             put(o, "%s{", i ? ", " : "");
             for (size_t f = 0; f < ov->count; f++) {
-                put(o, "%s%s: ", f ? ", " : "", strchr(ov->keys[f].path, '.') + 1);
+                put(o, "%s%s: ", f ? ", " : "", strrchr(ov->keys[f].path, '.') + 1);
                 put_value(o, &ov->keys[f], item);
             }
             put(o, "}");

@@ -24,6 +24,10 @@ lmb_status lmb_load_nodes(const lmb_accessor_ctx *ctx, lmb_scene *scene, const l
 /* Fills scene->materials from the glTF's materials (materials.c). */
 lmb_status lmb_load_materials(const char *path, const lmb_gltf_view *v, lmb_scene *scene, lmb_error *err);
 
+/* materials.default and materials.override applied to the loaded scene (material_config.c);
+ * LMB_ERR_INTERNAL only when out of memory. */
+lmb_status lmb_apply_material_config(lmb_scene *s, const lmb_config *cfg, const lmb_log *log);
+
 /* "name" or "<kind> N" when the glTF object has no name; buf must hold 160 bytes. */
 const char *lmb_object_label(char *buf, const char *kind, uint32_t index, const char *name);
 

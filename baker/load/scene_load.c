@@ -124,6 +124,8 @@ lmb_status lmb_scene_load(const char *path, const lmb_config *cfg, lmb_scene **o
             st = load_meshes(&ctx, s, log, err);
         if (st == LMB_OK)
             st = lmb_load_nodes(&ctx, s, log, err);
+        if (st == LMB_OK && lmb_apply_material_config(s, cfg, log) != LMB_OK)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
     }
     if (st != LMB_OK) {
         lmb_scene_free(s);

@@ -174,6 +174,8 @@ typedef struct lmb_scene {
     uint32_t light_count;
     uint32_t node_count;
     uint32_t gpu_instanced_nodes; /* nodes expanded from EXT_mesh_gpu_instancing */
+    double default_albedo[3];     /* diffuse albedo of primitives with no material (materials.default.albedo; glTF's
+                                     default material is fully metallic: 0) */
     lmb_gltf_doc *doc;            /* owned */
 } lmb_scene;
 
@@ -214,6 +216,14 @@ typedef struct lmb_density_override {
     char pattern[LMB_PATTERN_LEN]; /* glob over node and mesh names */
     double texel_density;
 } lmb_density_override;
+
+/* materials.override entry: the materials whose name matches get this diffuse albedo and/or
+ * emission (a component < 0: keep the file's) */
+typedef struct lmb_material_override {
+    char pattern[LMB_PATTERN_LEN]; /* glob over material names */
+    double albedo[3];              /* linear RGB, [0] < 0: keep */
+    double emissive[3];            /* nits, linear RGB, [0] < 0: keep */
+} lmb_material_override;
 
 typedef struct lmb_config {
     /* unwrap / pack */
@@ -277,6 +287,10 @@ typedef struct lmb_config {
     uint32_t sky_samples;          /* sky rays per gather point, split between the map's and the cosine distribution */
     int sky_cosine_only;           /* sky.sampling: cosine: no map samples (the benchmark's comparison) */
     double sun_angle;              /* degrees: a directional light is a disc of this angular diameter; 0 = a point */
+    /* materials the file did not set, or set wrongly for a bake */
+    double default_albedo[3];      /* materials.default.albedo: primitives with no material; [0] < 0: none (glTF's metal) */
+    lmb_material_override material_overrides[LMB_MAX_PATTERNS];
+    uint32_t material_override_count;
     char config_path[4096];        /* the config file it was loaded from (lmb_config_load), "" for none: sky.image is
                                       read from its folder; not a key */
 } lmb_config;

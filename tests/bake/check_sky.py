@@ -24,6 +24,9 @@ usage: check_sky.py LMBAKE WORKDIR CASE
             across it and scaled by the disc's profile, is 1.5 x tan(8 deg) wide within 10%; the
             texels across the edge follow the disc's profile: off by 0.02 of the sun's irradiance
             on average, 99% within 0.1 (64 shadow rays per point).
+  materials materials.override in the furnace (albedo 0.8, 2 nits, two bounces: E = 2 pi (1 +
+            0.8 + 0.64) within 1%); a wall with no material beside a plane under a sky: a warning,
+            and with materials.default.albedo 0.7 the plane beside it gains over 5%.
   bad-image a sky.image that is missing, outside the config's folder, absolute, not an image or
             not 2:1: exit 2 naming the key, nothing written; with NaN, Inf and negative texels: a
             warning naming how many were replaced by 0.
@@ -51,8 +54,11 @@ def bake(lmbake, work, scene, name, config, density=8, direct=16):
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
                    stdout=subprocess.DEVNULL)
     cfg = os.path.join(work, name + ".yaml")  # the map files are written beside it
+    base = BASE % (density, direct)
+    if "bounces:" in config:  # the case's own
+        base = base.replace("bounces: 0\n", "")
     with open(cfg, "w") as f:
-        f.write(BASE % (density, direct) + config)
+        f.write(base + config)
     out = os.path.join(work, "out-" + name)
     p = subprocess.run([lmbake, "bake", os.path.join(scenes, scene + ".gltf"), "-c", cfg, "-o", out, "-q"],
                        capture_output=True, text=True)
@@ -264,11 +270,54 @@ def bad_image(lmbake, work):
     return ok
 
 
+def materials(lmbake, work):
+    """materials.override and materials.default against what they must give."""
+    ok = True
+    # the furnace (albedo 0.5, 1 nit) overridden to albedo 0.8 and 2 nits, two bounces (default rays):
+    # E = pi x 2 x (1 + 0.8 + 0.64)
+    cfg = ("bounces: 2\n"
+           "materials: {override: [{match: \"furn*\", albedo: [0.8, 0.8, 0.8], emissive: [2, 2, 2]}]}\n")
+    charts, images = bake(lmbake, work, "furnace", "override", cfg, direct=64)
+    v = np.array([float(x[1][0]) for x in ca.texels(charts, images)])
+    want = math.pi * 2 * (1 + 0.8 + 0.64)
+    good = abs(v.mean() / want - 1) <= 0.01
+    ok &= good
+    print("materials.override: furnace at albedo 0.8 and 2 nits: mean E %.4f = %.4f x pi Le (1 + rho + rho^2) "
+          "(bound 1 +- 1%%)  %s" % (v.mean(), v.mean() / want, "ok" if good else "FAIL"))
+    # a wall with no material beside the open plane: without materials.default the bake warns and
+    # the wall reflects nothing (the plane beside it gets the sky it sees, < pi L); with albedo
+    # 0.7 the wall bounces sky light onto it
+    near = {}
+    for label, extra in (("none", ""), ("0.7", "materials: {default: {albedo: [0.7, 0.7, 0.7]}}\n")):
+        scenes = os.path.join(work, "scenes")
+        cfg_path = os.path.join(work, "bare-%s.yaml" % label)
+        with open(cfg_path, "w") as f:
+            f.write((BASE % (8, 16)).replace("bounces: 0", "bounces: 2") + "sky: {intensity: 1000}\n" + extra)
+        out = os.path.join(work, "out-bare-" + label)
+        p = subprocess.run([lmbake, "bake", os.path.join(scenes, "sky-bare-wall.gltf"), "-c", cfg_path, "-o", out],
+                           capture_output=True, text=True)
+        if p.returncode != 0:
+            sys.exit("bake bare-%s failed (%d): %s" % (label, p.returncode, p.stderr))
+        charts, images = ca.load_output(out)
+        vals = [float(x[1][0]) for x in ca.texels(charts, images) if x[0] == "plane" and
+                all(0.1 < p[0] < 1.0 and abs(p[2]) < 4 for p in x[2])]
+        near[label] = (np.mean(vals), p.stdout + p.stderr)
+    warned = "have no material, so they get glTF's default material" in near["none"][1]
+    told = "bounce light with albedo [0.7, 0.7, 0.7] (materials.default.albedo)" in near["0.7"][1]
+    gain = near["0.7"][0] / near["none"][0]
+    good = warned and told and near["none"][0] < math.pi * 1000 and gain > 1.05
+    ok &= good
+    print("materials.default: the plane within 1 of a bare wall under a 1000-nit sky: %.1f lux without (< pi L = "
+          "%.1f; warned: %s), %.1f with albedo 0.7 (x %.3f, bound > 1.05; said: %s)  %s"
+          % (near["none"][0], math.pi * 1000, warned, near["0.7"][0], gain, told, "ok" if good else "FAIL"))
+    return ok
+
+
 def main():
     lmbake, work, case = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
     checks = {"plane": plane, "well": well, "sealed": sealed, "patch": patch, "sun-map": sun_map,
-              "penumbra": penumbra, "bad-image": bad_image}
+              "penumbra": penumbra, "bad-image": bad_image, "materials": materials}
     sys.exit(0 if checks[case](lmbake, work) else 1)
 
 
