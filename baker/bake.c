@@ -285,7 +285,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
-    st = lmb_sky_create(cfg, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
+    st = lmb_sky_create(cfg, s, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
     if (st == LMB_OK && plan_path) /* the plan stage's layout (farm/plan.h), checked against this scene and config */
         st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
     else if (st == LMB_OK)

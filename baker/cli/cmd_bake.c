@@ -40,6 +40,8 @@ static const char help[] =
     "texels, whatever the level's units; the density chosen is printed) and bounces auto\n"
     "(bounce passes until the light converges, then its geometric tail; the log says what each\n"
     "pass added). Set either to a number in the config to fix it.\n"
+    "Outdoor levels: sky.intensity (nits) or sky.image (an HDR map) gives them a sky, and\n"
+    "materials.default.albedo an albedo where the file has no material (docs/sky.md).\n"
     "\n"
     "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
 

@@ -17,6 +17,7 @@
 #include "sky.h"
 
 #include "gather/lobe.h"
+#include "load/gltf_adapter.h"
 #include "load/uri.h"
 #include "util/frame.h"
 #include "util/lmb_math.h"
@@ -217,11 +218,97 @@ static void sky_frame(const lmb_config *cfg, lmb_sky *s)
     lmb_cross3(s->up, s->south, s->east);
 }
 
-lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_log *log, lmb_sky **out, lmb_error *err)
+/* Real spherical harmonics up to l = 2 at unit direction (x, y, z), in the order (0,0) (1,-1)
+ * (1,0) (1,1) (2,-2) (2,-1) (2,0) (2,1) (2,2) (Sloan, "Stupid Spherical Harmonics Tricks", with
+ * glTF's own axes). */
+static void sh9(double x, double y, double z, double out[9])
+{
+    out[0] = 0.282095;
+    out[1] = 0.488603 * y;
+    out[2] = 0.488603 * z;
+    out[3] = 0.488603 * x;
+    out[4] = 1.092548 * x * y;
+    out[5] = 1.092548 * y * z;
+    out[6] = 0.315392 * (3 * z * z - 1);
+    out[7] = 1.092548 * x * z;
+    out[8] = 0.546274 * (x * x - y * y);
+}
+
+/* v rotated by the inverse of unit quaternion q (x, y, z, w). */
+static void rotate_inverse(const float q[4], const double v[3], double out[3])
+{
+    double x = -q[0], y = -q[1], z = -q[2], w = q[3];
+    double t[3] = {2 * (y * v[2] - z * v[1]), 2 * (z * v[0] - x * v[2]), 2 * (x * v[1] - y * v[0])};
+    out[0] = v[0] + w * t[0] + (y * t[2] - z * t[1]);
+    out[1] = v[1] + w * t[1] + (z * t[0] - x * t[2]);
+    out[2] = v[2] + w * t[2] + (x * t[1] - y * t[0]);
+}
+
+/*
+ * EXT_lights_image_based's irradiance as a sky: its coefficients are the irradiance
+ * E(n) = sum E_lm Y_lm(n); radiance is L_lm = E_lm / A_l with the cosine lobe's A_0 = pi,
+ * A_1 = 2 pi / 3, A_2 = pi / 4 (Ramamoorthi and Hanrahan 2001, eq. 8), evaluated at each pixel
+ * of a 64 x 32 map (after the light's rotation, times its intensity) and clamped at 0 (nine
+ * coefficients can ring below zero).
+ */
+static lmb_status sky_from_ibl(const lmb_gltf_ibl *ibl, lmb_sky *s, lmb_error *err)
+{
+    static const double band[9] = {LMB_PI, 2 * LMB_PI / 3, 2 * LMB_PI / 3, 2 * LMB_PI / 3, LMB_PI / 4,
+                                   LMB_PI / 4, LMB_PI / 4, LMB_PI / 4, LMB_PI / 4};
+    s->w = 64;
+    s->h = 32;
+    s->radiance = malloc(3 * (size_t)s->w * s->h * sizeof *s->radiance);
+    if (!s->radiance)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "sky: out of memory");
+    for (uint32_t j = 0; j < s->h; j++)
+        for (uint32_t i = 0; i < s->w; i++) {
+            double theta = LMB_PI * (j + 0.5) / s->h, phi = 2 * LMB_PI * ((i + 0.5) / s->w - 0.5);
+            double world[3] = {sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi)}, d[3], y[9];
+            rotate_inverse(ibl->rotation, world, d);
+            sh9(d[0], d[1], d[2], y);
+            for (int c = 0; c < 3; c++) {
+                double l = 0;
+                for (int k = 0; k < 9; k++)
+                    l += ibl->sh[k][c] / band[k] * y[k];
+                s->radiance[3 * ((size_t)j * s->w + i) + (size_t)c] = (float)(l > 0 ? l * ibl->intensity : 0);
+            }
+        }
+    s->has_map = 1;
+    return LMB_OK;
+}
+
+lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
+                          lmb_error *err)
 {
     *out = NULL;
+    const lmb_gltf_ibl *ibl = scene && scene->doc ? &lmb_gltf_get_view(scene->doc)->ibl : NULL;
+    if (!(cfg->sky_intensity > 0) && ibl && ibl->present) {
+        if (!ibl->usable)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: EXT_lights_image_based: %s", scene->path, ibl->problem);
+        lmb_sky *s = calloc(1, sizeof *s);
+        if (!s)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "sky: out of memory");
+        s->east[0] = s->up[1] = s->south[2] = 1; /* the file's own axes */
+        lmb_status st = sky_from_ibl(ibl, s, err);
+        if (st == LMB_OK)
+            st = build_tables(s, err);
+        if (st != LMB_OK || !(s->row_cdf[s->h] > 0)) {
+            lmb_sky_free(s);
+            if (st == LMB_OK)
+                lmb_warn(log, "%s: EXT_lights_image_based light '%s' is black: no sky light", scene->path, ibl->name);
+            return st;
+        }
+        lmb_info(log, "sky: the file's EXT_lights_image_based light '%s': its irradiance (9 spherical-harmonic "
+                 "coefficients) as a 64x32 radiance map x intensity %g; its specular images are not read", ibl->name,
+                 ibl->intensity);
+        *out = s;
+        return LMB_OK;
+    }
     if (!(cfg->sky_intensity > 0))
         return LMB_OK;
+    if (ibl && ibl->present)
+        lmb_info(log, "sky: from the config (sky.intensity %g); the file's EXT_lights_image_based light '%s' is not "
+                 "used", cfg->sky_intensity, ibl->name);
     lmb_sky *s = calloc(1, sizeof *s);
     if (!s)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "sky: out of memory");

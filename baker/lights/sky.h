@@ -19,10 +19,13 @@
 
 typedef struct lmb_sky lmb_sky; /* opaque, read-only once made: any number of threads at once */
 
-/* The sky cfg describes, or *out = NULL when there is none (sky.intensity 0). The image is
- * read from the folder of cfg->config_path under the input rules (relative, inside that folder); non-finite
- * or negative texels are replaced by 0 with a warning naming how many. */
-lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_log *log, lmb_sky **out, lmb_error *err);
+/* The sky cfg describes; when it sets none (sky.intensity 0), the scene's EXT_lights_image_based
+ * light if it has one (its irradiance spherical harmonics as a radiance map); else *out = NULL.
+ * The log says which. sky.image is read from the folder of cfg->config_path under the input
+ * rules (relative, inside that folder); non-finite or negative texels are replaced by 0 with a
+ * warning naming how many. */
+lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
+                          lmb_error *err);
 void lmb_sky_free(lmb_sky *s);
 
 /* Radiance (nits, RGB) of the sky seen looking along world direction w (unit). */

@@ -3,8 +3,9 @@
  * changes specular reflection, layers on top of the base (sheen, clear coat), refraction,
  * animation or metadata changes nothing the bake reads, and a file requiring it is baked with
  * a warning naming the file and the extension. One that changes geometry (Draco, meshopt),
- * the diffuse colour in a way lmbake does not model (KHR_materials_diffuse_transmission) or the
- * light (EXT_lights_image_based) is not listed: requiring it is an error.
+ * the diffuse colour in a way lmbake does not model (KHR_materials_diffuse_transmission) is not
+ * listed: requiring it is an error. EXT_lights_image_based is the sky when the config sets none
+ * (lights/sky.c: its irradiance spherical harmonics; its specular cube maps are not read).
  * Choices worth knowing:
  *   - KHR_materials_unlit: an unlit surface shows its base colour whatever the light, so it
  *     reflects none in the bake (albedo 0: no invented bounce off a backdrop or sky dome); it
@@ -19,6 +20,7 @@
 
 static const lmb_extension_info table[] = {
     {"KHR_lights_punctual", LMB_EXT_SUPPORTED, NULL},
+    {"EXT_lights_image_based", LMB_EXT_SUPPORTED, NULL},
     {"KHR_materials_emissive_strength", LMB_EXT_SUPPORTED, NULL},
     {"EXT_mesh_gpu_instancing", LMB_EXT_SUPPORTED, NULL},
     {"KHR_mesh_quantization", LMB_EXT_SUPPORTED, NULL},

@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <new>
@@ -317,11 +318,63 @@ void fill_lights(lmb_gltf_doc &d)
     }
 }
 
+/* The scene's EXT_lights_image_based light into d.view.ibl (present, and usable or why not). */
+void fill_ibl(lmb_gltf_doc &d, const tinygltf::Scene &scene)
+{
+    lmb_gltf_ibl &ibl = d.view.ibl;
+    const tinygltf::Value *ref = extension(scene.extensions, "EXT_lights_image_based");
+    if (!ref)
+        return;
+    ibl.present = 1;
+    ibl.index = int_member(ref, "light", -1);
+    ibl.intensity = 1.0f;
+    ibl.rotation[3] = 1.0f;
+    std::snprintf(ibl.name, sizeof ibl.name, "light %d", ibl.index);
+    const tinygltf::Value *root = extension(d.model.extensions, "EXT_lights_image_based");
+    const tinygltf::Value *lights = root ? member(*root, "lights") : nullptr;
+    if (!lights || !lights->IsArray() || ibl.index < 0 || (size_t)ibl.index >= lights->ArrayLen()) {
+        std::snprintf(ibl.problem, sizeof ibl.problem, "the scene names light %d, which the extension's lights do not "
+                      "hold", ibl.index);
+        return;
+    }
+    const tinygltf::Value &l = lights->Get(ibl.index);
+    const tinygltf::Value *name = member(l, "name");
+    if (name && name->IsString())
+        std::snprintf(ibl.name, sizeof ibl.name, "%s", name->Get<std::string>().c_str());
+    const tinygltf::Value *intensity = member(l, "intensity");
+    if (intensity && intensity->IsNumber())
+        ibl.intensity = (float)intensity->GetNumberAsDouble();
+    const tinygltf::Value *rot = member(l, "rotation");
+    if (rot && rot->IsArray() && rot->ArrayLen() == 4)
+        for (int k = 0; k < 4; k++)
+            if (rot->Get(k).IsNumber())
+                ibl.rotation[k] = (float)rot->Get(k).GetNumberAsDouble();
+    const tinygltf::Value *sh = member(l, "irradianceCoefficients");
+    int ok = sh && sh->IsArray() && sh->ArrayLen() == 9;
+    for (int i = 0; ok && i < 9; i++) {
+        const tinygltf::Value &row = sh->Get(i);
+        ok = row.IsArray() && row.ArrayLen() == 3;
+        for (int c = 0; ok && c < 3; c++) {
+            ok = row.Get(c).IsNumber() && std::isfinite(row.Get(c).GetNumberAsDouble());
+            if (ok)
+                ibl.sh[i][c] = (float)row.Get(c).GetNumberAsDouble();
+        }
+    }
+    if (!ok || !std::isfinite(ibl.intensity) || ibl.intensity < 0) {
+        std::snprintf(ibl.problem, sizeof ibl.problem, "light %d: irradianceCoefficients must be 9 x 3 finite numbers "
+                      "and intensity a number >= 0", ibl.index);
+        return;
+    }
+    ibl.usable = 1;
+}
+
 void fill_scene(lmb_gltf_doc &d)
 {
     const auto &m = d.model;
     int s = m.defaultScene >= 0 ? m.defaultScene : (m.scenes.empty() ? -1 : 0);
     d.view.has_scene = s >= 0 && s < (int)m.scenes.size();
+    if (d.view.has_scene)
+        fill_ibl(d, m.scenes[(size_t)s]);
     if (d.view.has_scene) {
         d.scene_roots.assign(m.scenes[(size_t)s].nodes.begin(), m.scenes[(size_t)s].nodes.end());
         return;

@@ -115,6 +115,19 @@ typedef struct lmb_gltf_image {
 } lmb_gltf_image;
 
 /* Everything lmbake reads, as plain arrays. All pointers are owned by the doc. */
+/* The scene's EXT_lights_image_based light, if it names one (its irradiance as spherical
+ * harmonics; the specular cube maps are not read). */
+typedef struct lmb_gltf_ibl {
+    int present;          /* the baked scene names a light of the extension */
+    int32_t index;        /* which one */
+    char name[128];       /* its name, or "light N" */
+    float intensity;      /* default 1 */
+    float rotation[4];    /* quaternion x, y, z, w; default identity */
+    float sh[9][3];       /* irradianceCoefficients, bands l = 0..2 in the order (0,0) (1,-1) (1,0) (1,1) (2,-2) .. (2,2) */
+    int usable;           /* 0: the index or irradianceCoefficients is malformed (problem says why) */
+    char problem[160];
+} lmb_gltf_ibl;
+
 typedef struct lmb_gltf_view {
     const lmb_gltf_buffer *buffers;             uint32_t buffer_count;
     const lmb_gltf_buffer_view *buffer_views;   uint32_t buffer_view_count;
@@ -132,6 +145,7 @@ typedef struct lmb_gltf_view {
     const char *const *image_uris;              uint32_t image_count; /* "" when in a buffer view */
     const lmb_gltf_image *images;               /* image_count of them */
     const lmb_gltf_texture *textures;           uint32_t texture_count;
+    lmb_gltf_ibl ibl;
 } lmb_gltf_view;
 
 /* Parses path (.gltf or .glb by content). `extras_key` names the node extras bool read

@@ -27,6 +27,9 @@ usage: check_sky.py LMBAKE WORKDIR CASE
   materials materials.override in the furnace (albedo 0.8, 2 nits, two bounces: E = 2 pi (1 +
             0.8 + 0.64) within 1%); a wall with no material beside a plane under a sky: a warning,
             and with materials.default.albedo 0.7 the plane beside it gains over 5%.
+  ibl       the file's EXT_lights_image_based irradiance coefficients for L = 500 (1 + y): the open
+            plane gets 500 x 5 pi / 3 within 1% (3% per texel); a config sky wins over it, and the
+            log names the source; 8 rows of coefficients are refused (exit 2).
   bad-image a sky.image that is missing, outside the config's folder, absolute, not an image or
             not 2:1: exit 2 naming the key, nothing written; with NaN, Inf and negative texels: a
             warning naming how many were replaced by 0.
@@ -313,11 +316,75 @@ def materials(lmbake, work):
     return ok
 
 
+def ibl(lmbake, work):
+    """The file's EXT_lights_image_based irradiance as the sky: L(w) = L0 (1 + w.y), whose
+    irradiance coefficients are E_00 = pi L0 sqrt(4 pi) and E_1,-1 = (2 pi / 3) L0 0.488603 (4 pi / 3);
+    an upward plane gets E = L0 (pi + 2 pi / 3). A config sky wins over it (the log says so); a
+    malformed light is refused naming the extension."""
+    import json as jsonlib
+    L0 = 500.0
+    scenes = os.path.join(work, "scenes")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
+                   stdout=subprocess.DEVNULL)
+    doc = jsonlib.load(open(os.path.join(scenes, "sky-plane.gltf")))
+    sh = [[0.0] * 3 for _ in range(9)]
+    for c in range(3):
+        sh[0][c] = math.pi * L0 * math.sqrt(4 * math.pi)
+        sh[1][c] = 2 * math.pi / 3 * L0 * 0.488603 * 4 * math.pi / 3
+    doc["extensionsUsed"] = doc.get("extensionsUsed", []) + ["EXT_lights_image_based"]
+    doc["extensions"] = {"EXT_lights_image_based": {"lights": [{"name": "dome", "intensity": 1.0,
+                                                                "irradianceCoefficients": sh,
+                                                                "specularImageSize": 1, "specularImages": []}]}}
+    doc["scenes"][0]["extensions"] = {"EXT_lights_image_based": {"light": 0}}
+    path = os.path.join(scenes, "sky-ibl.gltf")
+    with open(path, "w") as f:
+        jsonlib.dump(doc, f)
+    ok = True
+    runs = {}
+    for label, config in (("file", ""), ("config", "sky: {intensity: 1000}\n")):
+        cfg = os.path.join(work, "ibl-%s.yaml" % label)
+        with open(cfg, "w") as f:
+            f.write(BASE % (8, 16) + config)
+        out = os.path.join(work, "out-ibl-" + label)
+        p = subprocess.run([lmbake, "bake", path, "-c", cfg, "-o", out], capture_output=True, text=True)
+        if p.returncode != 0:
+            sys.exit("bake ibl-%s failed: %s" % (label, p.stderr))
+        charts, images = ca.load_output(out)
+        runs[label] = (np.array([float(x[1][0]) for x in ca.texels(charts, images)]), p.stdout + p.stderr)
+    want = L0 * (math.pi + 2 * math.pi / 3)
+    r = runs["file"][0] / want
+    said = "sky: the file's EXT_lights_image_based light 'dome'" in runs["file"][1]
+    good = said and r.size > 1000 and abs(r.mean() - 1) <= 0.01 and np.max(np.abs(r - 1)) <= 0.03
+    ok &= good
+    print("ibl: L = %g (1 + y) from the file's irradiance coefficients: E / (5 pi L0 / 3) mean %.4f, from %.4f to %.4f "
+          "(bounds 1%% and 3%%); log names the source: %s  %s" % (L0, r.mean(), r.min(), r.max(), said,
+                                                                 "ok" if good else "FAIL"))
+    c = runs["config"][0] / (math.pi * 1000)
+    said = "sky: from the config (sky.intensity 1000); the file's EXT_lights_image_based light 'dome' is not used" \
+        in runs["config"][1]
+    good = said and abs(c.mean() - 1) <= 0.003
+    ok &= good
+    print("ibl: a config sky of 1000 nits wins: E / (pi L) %.5f; the log says so: %s  %s"
+          % (c.mean(), said, "ok" if good else "FAIL"))
+    doc["extensions"]["EXT_lights_image_based"]["lights"][0]["irradianceCoefficients"] = sh[:8]
+    bad = os.path.join(scenes, "sky-ibl-bad.gltf")
+    with open(bad, "w") as f:
+        jsonlib.dump(doc, f)
+    out = os.path.join(work, "out-ibl-bad")
+    p = subprocess.run([lmbake, "bake", bad, "-o", out], capture_output=True, text=True)
+    good = p.returncode == 2 and "EXT_lights_image_based: light 0: irradianceCoefficients must be 9 x 3" in p.stderr \
+        and not os.path.exists(out)
+    ok &= good
+    print("ibl: 8 rows of coefficients: exit %d, %s  %s" % (p.returncode, p.stderr.strip().splitlines()[-1][:120],
+                                                           "ok" if good else "FAIL"))
+    return ok
+
+
 def main():
     lmbake, work, case = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
     checks = {"plane": plane, "well": well, "sealed": sealed, "patch": patch, "sun-map": sun_map,
-              "penumbra": penumbra, "bad-image": bad_image, "materials": materials}
+              "penumbra": penumbra, "bad-image": bad_image, "materials": materials, "ibl": ibl}
     sys.exit(0 if checks[case](lmbake, work) else 1)
 
 

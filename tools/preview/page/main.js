@@ -1,6 +1,6 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
 // the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
-// (mode, ev, tonemap, view|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
+// (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
 // directional lightmaps) and the page exposes hooks for
 // tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen.
 import * as THREE from 'three';
@@ -10,6 +10,7 @@ import { lightmapPlugin, applyDirectionalLightmaps } from './lightmap-plugin.js'
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
+import { startView } from './start-view.js';
 import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
 
 const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
@@ -21,7 +22,7 @@ const FOV = 45; // degrees, vertical
 const q = new URLSearchParams(location.search);
 const state = {
   mode: q.get('mode') || 'lit', ev: q.get('ev') ?? 'auto', tonemap: q.get('tonemap') || 'agx',
-  view: q.get('view') || 'front', cam: q.get('cam'), atlas: Number(q.get('atlas') ?? 0),
+  view: q.get('view') || 'start', cam: q.get('cam'), atlas: Number(q.get('atlas') ?? 0),
   layer: q.get('layer') || 'lightmap', zoom: q.get('zoom') ? Number(q.get('zoom')) : null,
   at: q.get('at') ? q.get('at').split(',').map(Number) : null, ui: q.get('ui') !== '0',
   directional: q.get('directional') !== '0', // directional lightmaps in the lit view, when the bake has them
@@ -128,7 +129,13 @@ if (state.cam) {
   if (c.length !== 6 || c.some((v) => !Number.isFinite(v))) throw new Error(`cam wants px,py,pz,tx,ty,tz`);
   camera.position.set(c[0], c[1], c[2]); controls.target.set(c[3], c[4], c[5]); camera.lookAt(controls.target);
 } else if (state.view === 'front') frontView();
-else throw new Error(`unknown view '${state.view}' (front, or cam=px,py,pz,tx,ty,tz)`);
+else if (state.view === 'start') {
+  const start = startView(gltf, root, box);
+  if (start) {
+    camera.position.copy(start.position); controls.target.copy(start.target); camera.lookAt(start.target);
+  } else frontView();
+  info.startView = start ? start.from : 'front';
+} else throw new Error(`unknown view '${state.view}' (start, front, or cam=px,py,pz,tx,ty,tz)`);
 controls.update();
 
 // Applying the state
