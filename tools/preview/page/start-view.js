@@ -4,8 +4,9 @@
 //  2. a point inside the level: the bounding box's centre dropped onto the floor below it, at eye
 //     height (1.7 units, glTF's metres, or a third of the room's height if that is less),
 //     looking along the horizontal direction, of 16, whose ray runs longest before it meets a
-//     wall; used only when at least 13 of the 16 meet one (the point is enclosed: inside a
-//     level, not in front of an object or an open box);
+//     wall; used only when at least 13 of the 16 meet one (the point is enclosed) and their
+//     median distance is at least 1 unit (a space a person stands in, in glTF's metres): inside
+//     a level, not among the blocks of an open box or in front of an object;
 //  3. null: the caller uses the front view.
 import * as THREE from 'three';
 
@@ -35,14 +36,19 @@ export function startView(gltf, root, box) {
   const ceilingY = Number.isFinite(up) ? centre.y + up : box.max.y;
   const eye = new THREE.Vector3(centre.x, floorY + Math.min(1.7, (ceilingY - floorY) / 3), centre.z);
   let best = null, bestDistance = -1, enclosed = 0;
+  const distances = [];
   for (let k = 0; k < 16; k++) {
     const a = (2 * Math.PI * k) / 16;
     const dir = new THREE.Vector3(Math.sin(a), 0, -Math.cos(a));
     const d = first(eye, dir);
+    distances.push(d);
     if (!Number.isFinite(d)) continue;
     enclosed++;
     if (d > bestDistance) { bestDistance = d; best = dir; }
   }
-  if (enclosed < 13 || !best) return null;
+  startView.last = { eye: eye.toArray(), distances };
+  const walls = distances.filter(Number.isFinite).sort((x, y) => x - y);
+  const median = walls.length ? walls[walls.length >> 1] : 0;
+  if (enclosed < 13 || median < 1 || !best) return null;
   return { position: eye, target: eye.clone().addScaledVector(best, Math.max(bestDistance * 0.5, 1e-3)), from: 'inside' };
 }
