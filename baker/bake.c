@@ -55,6 +55,8 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir,
     if (!tex)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
     lmb_status st = LMB_OK;
+    if (s->default_albedo_given)
+        lmb_gltf_set_default_albedo(s->doc, s->default_albedo);
     for (uint32_t a = 0; a < l->atlas_count && st == LMB_OK; a++) {
         char png[512], hdr[512], dpng[512];
         snprintf(png, sizeof png, "%s-lightmap-%u.png", stem, a);

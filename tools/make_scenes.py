@@ -243,43 +243,36 @@ def box(x0, y0, z0, x1, y1, z1, inward=False, bottom=True):
     return tris
 
 
-def cornell(out):
+def cornell_box(out, name, colours, light_y, closed):
+    """A 1 m Cornell box (white, red left and green right walls, two blocks) with a 10 cd point
+    light at height light_y; closed adds the front wall."""
     s = Scene()
-    white = s.material("white", (0.73, 0.73, 0.73))
-    red = s.material("red", (0.65, 0.05, 0.05))
-    green = s.material("green", (0.12, 0.45, 0.15))
+    white, red, green = (s.material(n, c) for n, c in zip(("white", "red", "green"), colours))
     c = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)]
     s.mesh("floor", quad(c[0], c[3], c[2], c[1]), white)
     s.mesh("ceiling", quad(c[4], c[5], c[6], c[7]), white)
     s.mesh("back", quad(c[0], c[1], c[5], c[4]), white)
+    if closed:
+        s.mesh("front", quad(c[3], c[7], c[6], c[2]), white)
     s.mesh("left", quad(c[0], c[4], c[7], c[3]), red)
     s.mesh("right", quad(c[1], c[2], c[6], c[5]), green)
     s.mesh("tall_block", box(0.13, 0, 0.37, 0.43, 0.6, 0.67, bottom=False), white)
     s.mesh("short_block", box(0.55, 0, 0.15, 0.85, 0.3, 0.45, bottom=False), white)
-    s.light("ceiling_point", "point", 10.0, translation=(0.5, 0.97, 0.5))
-    s.write(os.path.join(out, "cornell-point.gltf"))
+    s.light("ceiling_point", "point", 10.0, translation=(0.5, light_y, 0.5))
+    s.write(os.path.join(out, name))
+
+
+def cornell(out):
+    """The demo: open at the front, the light 3 cm under the ceiling."""
+    cornell_box(out, "cornell-point.gltf", ((0.73, 0.73, 0.73), (0.65, 0.05, 0.05), (0.12, 0.45, 0.15)), 0.97, False)
 
 
 def cornell_closed(out):
-    """The defaults' accuracy scene: a closed 1 m Cornell box (six inward walls, albedo 0.8 but for
-    a red and a green side wall), two blocks, a 10 cd point light 5 cm under the ceiling. Closed
-    with bright walls, light bounces many times (the series converges at a ratio near 0.75), so
-    it is where a cut-off or extrapolated bounce tail shows."""
-    s = Scene()
-    white = s.material("white", (0.8, 0.8, 0.8))
-    red = s.material("red", (0.8, 0.1, 0.1))
-    green = s.material("green", (0.1, 0.8, 0.1))
-    c = [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1), (0, 1, 0), (1, 1, 0), (1, 1, 1), (0, 1, 1)]
-    s.mesh("floor", quad(c[0], c[3], c[2], c[1]), white)
-    s.mesh("ceiling", quad(c[4], c[5], c[6], c[7]), white)
-    s.mesh("back", quad(c[0], c[1], c[5], c[4]), white)
-    s.mesh("front", quad(c[3], c[7], c[6], c[2]), white)
-    s.mesh("left", quad(c[0], c[4], c[7], c[3]), red)
-    s.mesh("right", quad(c[1], c[2], c[6], c[5]), green)
-    s.mesh("tall_block", box(0.13, 0, 0.37, 0.43, 0.6, 0.67, bottom=False), white)
-    s.mesh("short_block", box(0.55, 0, 0.15, 0.85, 0.3, 0.45, bottom=False), white)
-    s.light("ceiling_point", "point", 10.0, translation=(0.5, 0.95, 0.5))
-    s.write(os.path.join(out, "cornell-closed.gltf"))
+    """The defaults' accuracy scene: the box closed, walls of albedo 0.8 but for a red and a green
+    one, the light 5 cm under the ceiling. Closed with bright walls, light bounces many times (the
+    series converges at a ratio near 0.7), so it is where a cut-off or extrapolated bounce tail
+    shows."""
+    cornell_box(out, "cornell-closed.gltf", ((0.8, 0.8, 0.8), (0.8, 0.1, 0.1), (0.1, 0.8, 0.1)), 0.95, True)
 
 
 def analytic(out):

@@ -37,6 +37,9 @@ struct lmb_gltf_doc {
     /* writer: meshes a node used before it got its lightmapped copy (gltf_prune.cpp drops the
      * ones no node uses any more) */
     std::vector<int> replaced_meshes;
+    /* writer: materials.default.albedo for primitives with no material, if given */
+    bool has_default_albedo = false;
+    double default_albedo[3] = {0, 0, 0};
 };
 
 #endif

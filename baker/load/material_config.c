@@ -16,6 +16,7 @@ lmb_status lmb_apply_material_config(lmb_scene *s, const lmb_config *cfg, const 
     int have_default = cfg && cfg->default_albedo[0] >= 0;
     for (int k = 0; k < 3; k++)
         s->default_albedo[k] = have_default ? cfg->default_albedo[k] : 0.0;
+    s->default_albedo_given = have_default;
     /* primitives drawn with glTF's default material */
     uint32_t drawn = 0, bare = 0;
     for (uint32_t i = 0; i < s->instance_count; i++) {

@@ -103,7 +103,7 @@ int gather_accessor(writer &w, int index, const uint32_t *source, uint32_t count
     return (int)w.m.accessors.size() - 1;
 }
 
-int lightmapped_material(tinygltf::Model &m, int material, int texture, int direction_texture,
+int lightmapped_material(const lmb_gltf_doc &doc, tinygltf::Model &m, int material, int texture, int direction_texture,
                          std::map<std::pair<int, int>, int> &cache)
 {
     auto key = std::make_pair(material, texture);
@@ -113,6 +113,11 @@ int lightmapped_material(tinygltf::Model &m, int material, int texture, int dire
     tinygltf::Material mat = material >= 0 ? m.materials[(size_t)material] : tinygltf::Material();
     if (material < 0)
         mat.name = "default";
+    if (material < 0 && doc.has_default_albedo) { /* as the bake saw it: materials.default.albedo */
+        mat.pbrMetallicRoughness.baseColorFactor = {doc.default_albedo[0], doc.default_albedo[1], doc.default_albedo[2],
+                                                    1.0};
+        mat.pbrMetallicRoughness.metallicFactor = 0.0;
+    }
     mat.name += " (lightmap)";
     Value::Object ext;
     ext["index"] = Value(texture);
@@ -263,7 +268,7 @@ extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, c
         for (uint32_t k = 0; k < count; k++) {
             const lmb_gltf_prim_out &p = prims[k];
             tinygltf::Primitive q = rebuild(w, mesh.primitives[p.gltf_primitive], p);
-            q.material = lightmapped_material(m, q.material, texture, direction_texture, doc->lightmap_materials);
+            q.material = lightmapped_material(*doc, m, q.material, texture, direction_texture, doc->lightmap_materials);
             mesh.primitives[p.gltf_primitive] = q;
         }
         m.meshes.push_back(mesh);
@@ -273,6 +278,13 @@ extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, c
     } catch (const std::exception &e) {
         return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: node %u: %s", node, e.what());
     }
+}
+
+extern "C" void lmb_gltf_set_default_albedo(lmb_gltf_doc *doc, const double albedo[3])
+{
+    doc->has_default_albedo = true;
+    for (int k = 0; k < 3; k++)
+        doc->default_albedo[k] = albedo[k];
 }
 
 extern "C" lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, uint32_t count, lmb_error *err)

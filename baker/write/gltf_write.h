@@ -46,6 +46,10 @@ lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gl
  * the asset's other extras are kept. */
 lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, uint32_t count, lmb_error *err);
 
+/* Lightmapped primitives with no material get a material of this diffuse albedo (metallic 0:
+ * materials.default.albedo, so the level looks as it was baked) instead of glTF's default. */
+void lmb_gltf_set_default_albedo(lmb_gltf_doc *doc, const double albedo[3]);
+
 /* Writes the document as path (.gltf) with its new data in `bin_name` beside it. Buffers of
  * the input are written beside it too; images keep their URIs (the caller copies files). */
 lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err);

@@ -166,24 +166,35 @@ extern "C" lmb_status lmb_image_rows_open(const char *name, const uint8_t *bytes
     }
 }
 
-extern "C" lmb_status lmb_image_rows_read(lmb_image_rows *r, uint32_t y0, uint32_t y1, float *rgb, lmb_error *err)
+namespace {
+
+/* Rows y0 .. y1 - 1 as T (float or uint8_t) into band, then as RGB into rgb. */
+template <typename T>
+lmb_status read_rows(lmb_image_rows *r, std::vector<T> &band, OIIO::TypeDesc type, uint32_t y0, uint32_t y1, T *rgb,
+                     lmb_error *err)
 {
     try {
         const OIIO::ImageSpec &spec = r->in->spec();
         int ch = spec.nchannels;
         size_t w = (size_t)spec.width, rows = y1 - y0;
-        r->band.resize(w * rows * (size_t)ch);
-        if (!r->in->read_scanlines(0, 0, spec.y + (int)y0, spec.y + (int)y1, 0, 0, ch, OIIO::TypeDesc::FLOAT,
-                                   r->band.data()))
+        band.resize(w * rows * (size_t)ch);
+        if (!r->in->read_scanlines(0, 0, spec.y + (int)y0, spec.y + (int)y1, 0, 0, ch, type, band.data()))
             return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot decode rows %u..%u: %s", r->name.c_str(), y0, y1 - 1,
                                  r->in->geterror().c_str());
         for (size_t i = 0; i < w * rows; i++)
             for (int c = 0; c < 3; c++)
-                rgb[3 * i + c] = r->band[i * ch + (ch >= 3 ? c : 0)];
+                rgb[3 * i + c] = band[i * ch + (ch >= 3 ? c : 0)];
         return LMB_OK;
     } catch (const std::exception &e) {
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", r->name.c_str(), e.what());
     }
+}
+
+} // namespace
+
+extern "C" lmb_status lmb_image_rows_read(lmb_image_rows *r, uint32_t y0, uint32_t y1, float *rgb, lmb_error *err)
+{
+    return read_rows(r, r->band, OIIO::TypeDesc::FLOAT, y0, y1, rgb, err);
 }
 
 extern "C" int lmb_image_rows_is_u8(const lmb_image_rows *r)
@@ -193,26 +204,7 @@ extern "C" int lmb_image_rows_is_u8(const lmb_image_rows *r)
 
 extern "C" lmb_status lmb_image_rows_read_u8(lmb_image_rows *r, uint32_t y0, uint32_t y1, uint8_t *rgb, lmb_error *err)
 {
-    try {
-        const OIIO::ImageSpec &spec = r->in->spec();
-        int ch = spec.nchannels;
-        size_t w = (size_t)spec.width, rows = y1 - y0;
-        r->band_u8.resize(w * rows * (size_t)ch);
-        if (!r->in->read_scanlines(0, 0, spec.y + (int)y0, spec.y + (int)y1, 0, 0, ch, OIIO::TypeDesc::UINT8,
-                                   r->band_u8.data()))
-            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot decode rows %u..%u: %s", r->name.c_str(), y0, y1 - 1,
-                                 r->in->geterror().c_str());
-        if (ch == 3) {
-            std::memcpy(rgb, r->band_u8.data(), w * rows * 3);
-            return LMB_OK;
-        }
-        for (size_t i = 0; i < w * rows; i++)
-            for (int c = 0; c < 3; c++)
-                rgb[3 * i + c] = r->band_u8[i * ch + (ch >= 3 ? c : 0)];
-        return LMB_OK;
-    } catch (const std::exception &e) {
-        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", r->name.c_str(), e.what());
-    }
+    return read_rows(r, r->band_u8, OIIO::TypeDesc::UINT8, y0, y1, rgb, err);
 }
 
 extern "C" void lmb_image_rows_close(lmb_image_rows *r)

@@ -176,6 +176,7 @@ typedef struct lmb_scene {
     uint32_t gpu_instanced_nodes; /* nodes expanded from EXT_mesh_gpu_instancing */
     double default_albedo[3];     /* diffuse albedo of primitives with no material (materials.default.albedo; glTF's
                                      default material is fully metallic: 0) */
+    int default_albedo_given;     /* materials.default.albedo was set: the output's material for them says so */
     lmb_gltf_doc *doc;            /* owned */
 } lmb_scene;
 

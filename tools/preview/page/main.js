@@ -135,7 +135,7 @@ else if (state.view === 'start') {
     camera.position.copy(start.position); controls.target.copy(start.target); camera.lookAt(start.target);
   } else frontView();
   info.startView = start ? start.from : 'front';
-  info.startProbe = startView.last || null; // the eye and its 16 horizontal distances (Infinity: open)
+  info.startProbe = startView.last || null; // the candidates: eye, blocked, walls met of 16, median distance
 } else throw new Error(`unknown view '${state.view}' (start, front, or cam=px,py,pz,tx,ty,tz)`);
 controls.update();
 
