@@ -23,6 +23,7 @@ usage: make_scenes.py OUTDIR
                       texCoord override to TEXCOORD_1 = (x, z)) lights the part of the disk where
                       x + 0.433 z >= -0.1 (DISK_TRANSFORM)
   sealed-room.gltf    closed 2 m room (inward faces), point light outside it
+  sealed-room-camera.gltf  the same with a glTF camera at (0.3, 1.2, 0.4) looking along -z
   box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
   furnace.gltf        closed 2 m box, every face albedo 0.5 and emitting 1 nit (the furnace test;
                       also the benchmark's "light from everywhere" scene)
@@ -331,6 +332,11 @@ def analytic(out):
     s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), s.material("grey", (0.5, 0.5, 0.5)))
     s.light("outside", "point", 1000.0, translation=(3, 1, 0))
     s.write(os.path.join(out, "sealed-room.gltf"))
+    # the same room with a glTF camera in it (the preview's start view takes it)
+    s.doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}]
+    s.doc["nodes"].append({"name": "view", "camera": 0, "translation": [0.3, 1.2, 0.4]})
+    s.doc["scenes"][0]["nodes"].append(len(s.doc["nodes"]) - 1)
+    s.write(os.path.join(out, "sealed-room-camera.gltf"))
 
     s = Scene()
     grey = s.material("grey", (0.5, 0.5, 0.5))

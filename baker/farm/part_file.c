@@ -70,6 +70,28 @@ static void hash_image_files(const lmb_scene *scene, struct sha256_ctx *c)
     }
 }
 
+/* The config's sky.image (read beside the config): its name and contents, as the glTF's images. */
+static void hash_sky_image(const lmb_config *cfg, struct sha256_ctx *c)
+{
+    if (!cfg->sky_image[0])
+        return;
+    char folder[4096], path[8300], resolved[4096];
+    const char *slash = strrchr(cfg->config_path, '/');
+    snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - cfg->config_path) : 1, slash ? cfg->config_path : ".");
+    snprintf(path, sizeof path, "%s/%s", folder, cfg->sky_image);
+    sha256_update(c, strlen(cfg->sky_image) + 1, (const uint8_t *)cfg->sky_image);
+    char *data = NULL;
+    size_t size = 0;
+    lmb_error ignored;
+    if (lmb_path_inside(folder, path, resolved, sizeof resolved) &&
+        lmb_read_file(resolved, "sky image", &data, &size, &ignored) == LMB_OK) {
+        uint64_t n = size;
+        sha256_update(c, sizeof n, (const uint8_t *)&n);
+        sha256_update(c, size, (const uint8_t *)data);
+    }
+    free(data);
+}
+
 lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg, lmb_part_identity *id,
                                   lmb_error *err)
 {
@@ -92,6 +114,7 @@ lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg,
             sha256_update(&c, n, v->buffers[b].data);
     }
     hash_image_files(scene, &c);
+    hash_sky_image(cfg, &c);
     sha256_digest(&c, 32, id->input);
     lmb_config bare = *cfg;
     bare.threads = 0;

@@ -27,7 +27,6 @@ EXPECTED_FAILURES = {
     "mesh-invalid-sparse-indices.gltf": "sparse index out of range",
     "mesh-invalid.gltf": "buffer without uri",
     "mesh-no-indices-no-vertices-no-buffer-uri.gltf": "buffer without uri",
-    "required-extensions-unsupported.gltf": "requires unsupported extensions",
     "scene-invalid-cycle.gltf": "node graph cycle",
     "scene-invalid-multiple-parents.gltf": "node with two parents",
     "version-unsupported.gltf": "asset.version 3.0",

@@ -132,6 +132,10 @@ def cases():
     d = copy.deepcopy(d)
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "EXT_meshopt_compression"]
     yield "required-sheen-meshopt", d
+    # a required extension that changes the diffuse colour in a way lmbake does not model: refused
+    d = copy.deepcopy(ok)
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_diffuse_transmission"]
+    yield "required-diffuse-transmission", d
 
     # KHR_texture_basisu required: the base colour texture has only a KTX2 image (error), or
     # also a PNG fallback `source` (loads with a warning). The KTX2 bytes are never decoded.

@@ -3,12 +3,13 @@
 //   an open Cornell box (cornell-point): not enclosed, so the front view (lmbInfo.startView 'front');
 //   a closed 2 m room (sealed-room, the box -1..1 x 0..2 x -1..1): 'inside', the camera inside
 //   the room at eye height a third of the way up (2/3), looking horizontally.
-//   usage: node tests/preview/preview_start.mjs OPEN_GLTF CLOSED_GLTF
+//   the same room with a glTF camera at (0.3, 1.2, 0.4): 'camera', from there along -z.
+//   usage: node tests/preview/preview_start.mjs OPEN_GLTF CLOSED_GLTF CAMERA_GLTF
 import { startServer } from '../../tools/preview/server.mjs';
 import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
 
-const [open, closed] = process.argv.slice(2);
-if (!closed) { console.error('usage: node tests/preview/preview_start.mjs OPEN_GLTF CLOSED_GLTF'); process.exit(1); }
+const [open, closed, withCamera] = process.argv.slice(2);
+if (!withCamera) { console.error('usage: node tests/preview/preview_start.mjs OPEN_GLTF CLOSED_GLTF CAMERA_GLTF'); process.exit(1); }
 const browser = await launchBrowser();
 let ok = true;
 async function start(gltf) {
@@ -31,5 +32,11 @@ const inside = Math.abs(px) < 1 && Math.abs(pz) < 1 && Math.abs(py - 2 / 3) < 1e
 const good2 = b.from === 'inside' && inside;
 ok &&= good2;
 console.log(`closed room: start view '${b.from}', camera (${b.cam.position.map((x) => x.toFixed(3))}) looking at (${b.cam.target.map((x) => x.toFixed(3))}) (want inside at eye height 0.667, level)  ${good2 ? 'ok' : 'FAIL'}`);
+const c = await start(withCamera);
+const [cx, cy, cz] = c.cam.position, [ux, uy, uz] = c.cam.target;
+const good3 = c.from === 'camera' && Math.hypot(cx - 0.3, cy - 1.2, cz - 0.4) < 1e-4 &&
+  Math.abs(ux - 0.3) < 1e-4 && Math.abs(uy - 1.2) < 1e-4 && uz < cz;
+ok &&= good3;
+console.log(`room with a camera: start view '${c.from}', camera (${c.cam.position.map((x) => x.toFixed(3))}) looking at (${c.cam.target.map((x) => x.toFixed(3))}) (want the file's camera at 0.3,1.2,0.4 along -z)  ${good3 ? 'ok' : 'FAIL'}`);
 await browser.close();
 process.exit(ok ? 0 : 1);

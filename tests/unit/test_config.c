@@ -238,7 +238,7 @@ static void test_value_errors(void)
     expect_error("atlas:\n  keep_uv1: maybe\n", "level.yaml:2: ",
                  "key 'atlas.keep_uv1': expected true or false, got 'maybe'");
     expect_error("output:\n  formats:\n    - exr\n    - tiff\n", "level.yaml:4: ",
-                 "key 'output.formats': expected one of exr, hdr, png, mask, got 'tiff'");
+                 "key 'output.formats': expected one of exr, hdr, png, mask, ktx2, got 'tiff'");
     expect_error("output:\n  formats: []\n", "level.yaml:2: ", "key 'output.formats': expected at least one of exr");
     expect_error("lightmap:\n  extras_key: \"\"\n", "level.yaml:2: ",
                  "key 'lightmap.extras_key': expected a non-empty string");
@@ -425,6 +425,44 @@ static void test_glob(void)
     CHECK(lmb_glob_match("*a*a*a*a*a*a*a*a*a*a*a*a*", many_a));
 }
 
+/* The sky, sun and materials keys: values, and the usual named errors for unknown keys and bad values. */
+static void test_outdoor_keys(void)
+{
+    lmb_config c;
+    lmb_error err;
+    CHECK_INT(parse("sky:\n  intensity: 2000\n  color: [0.5, 0.6, 1]\n  ground_color: [0.2, 0.2, 0.1]\n"
+                    "  image: maps/sky.exr\n  rotation: -90\n  up: [0, 0, 1]\n  samples: 32\n  sampling: cosine\n"
+                    "lights: {sun_angle: 2}\n"
+                    "materials:\n  default: {albedo: [0.7, 0.6, 0.5]}\n"
+                    "  override: [{match: \"Wood*\", albedo: [0.4, 0.3, 0.2]}, {match: Lamp, emissive: [5, 4, 3]}]\n",
+                    &c, &err), LMB_OK);
+    CHECK_NEAR(c.sky_intensity, 2000, 0);
+    CHECK_NEAR(c.sky_color[1], 0.6, 0);
+    CHECK_NEAR(c.sky_ground[2], 0.1, 0);
+    CHECK(strcmp(c.sky_image, "maps/sky.exr") == 0);
+    CHECK_NEAR(c.sky_rotation, -90, 0);
+    CHECK_NEAR(c.sky_up[2], 1, 0);
+    CHECK_INT(c.sky_samples, 32);
+    CHECK_INT(c.sky_cosine_only, 1);
+    CHECK_NEAR(c.sun_angle, 2, 0);
+    CHECK_NEAR(c.default_albedo[0], 0.7, 0);
+    CHECK_INT(c.material_override_count, 2);
+    CHECK(strcmp(c.material_overrides[0].pattern, "Wood*") == 0);
+    CHECK_NEAR(c.material_overrides[0].albedo[2], 0.2, 0);
+    CHECK(c.material_overrides[0].emissive[0] < 0); /* not given: keep the file's */
+    CHECK(c.material_overrides[1].albedo[0] < 0);
+    CHECK_NEAR(c.material_overrides[1].emissive[0], 5, 0);
+    expect_error("sky:\n  colour: [1, 1, 1]\n", "level.yaml:2: ", "unknown key 'sky.colour'");
+    expect_error("materials:\n  defaults: {albedo: [1, 1, 1]}\n", "level.yaml:2: ", "unknown key 'materials.defaults'");
+    expect_error("lights:\n  sun_size: 1\n", "level.yaml:2: ", "unknown key 'lights.sun_size'");
+    expect_error("sky: {color: [1, 1]}\n", "level.yaml:1: ", "key 'sky.color': expected [r, g, b]");
+    expect_error("sky: {up: [0, 0, 0]}\n", "level.yaml:1: ", "key 'sky.up': expected [x, y, z], finite and not all 0");
+    expect_error("materials: {default: {albedo: [2, 0, 0]}}\n", "level.yaml:1: ", "key 'materials.default.albedo'");
+    expect_error("materials: {override: [{match: Wood}]}\n", "level.yaml:1: ",
+                 "each entry needs match and at least one of albedo and emissive");
+    expect_error("lights: {sun_angle: 45}\n", "level.yaml:1: ", "key 'lights.sun_angle': expected a number >= 0 and <= 30");
+}
+
 int main(int argc, char **argv)
 {
     test_defaults();
@@ -444,5 +482,6 @@ int main(int argc, char **argv)
     }
     test_glob();
     test_write();
+    test_outdoor_keys();
     return check_failures();
 }
