@@ -17,6 +17,7 @@ packages=(
   libtinygltf-dev                   # glTF 2.0 reading and writing
   libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
   nettle-dev                        # SHA-256 of the staged bake's plan and part files
+  libzstd-dev                       # Zstandard supercompression of KTX2 lightmaps
   libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
   libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
   libopenmesh-dev                   # the unwrapper's half-edge mesh (OpenMesh, behind baker/unwrap/halfedge_adapter.cpp)
@@ -48,8 +49,8 @@ if ((${#missing[@]})); then
   rm -f "$log"
 fi
 
-# npm pieces (package.json): the Khronos glTF validator for the tests
-if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ]; then
+# npm pieces (package.json): the Khronos glTF validator and ktx-parse (an independent KTX2 reader) for the tests
+if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ]; then
   echo "setup: installing npm packages (package.json)"
   npm install --no-audit --no-fund --silent >/dev/null 2>&1 || { echo "setup: npm install failed"; exit 1; }
 fi

@@ -52,10 +52,13 @@ static const char *const amis_weights[] = {"unbiased", "balance", NULL};
 static const char *const ic_records_modes[] = {"per_pass", "shared", NULL};
 static const char *const emission_sides[] = {"front", "material", NULL};
 static const char *const sky_samplings[] = {"mis", "cosine", NULL};
-static const char *const output_formats[] = {"exr", "hdr", "png", "mask", NULL};
+static const char *const output_formats[] = {"exr", "hdr", "png", "mask", "ktx2", NULL};
+static const char *const ktx2_formats[] = {"e5b9g9r9", "b10g11r11", "rgba16f", NULL};
+static const char *const ktx2_supercompressions[] = {"none", "zstd", NULL};
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
 _Static_assert(LMB_EMIT_FRONT == 0 && LMB_EMIT_MATERIAL == 1, "emission_sides");
-_Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4 && LMB_OUTPUT_MASK == 8,
+_Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4 && LMB_OUTPUT_MASK == 8 &&
+                   LMB_OUTPUT_KTX2 == 16,
                "output_formats");
 
 static const key_spec config_keys[] = {
@@ -91,6 +94,8 @@ static const key_spec config_keys[] = {
     U32("threads", OFF(threads), 0, 1024),
     FLAGS("output.formats", OFF(output_formats), output_formats),
     BOOL("output.directional", OFF(directional)),
+    ENUM("output.ktx2_format", OFF(ktx2_format), ktx2_formats),
+    ENUM("output.ktx2_supercompression", OFF(ktx2_zstd), ktx2_supercompressions),
     LIST("lightmap.include", lmb_cfg_set_globs, OFF(include), OFF(include_count)),
     LIST("lightmap.exclude", lmb_cfg_set_globs, OFF(exclude), OFF(exclude_count)),
     STRING("lightmap.extras_key", OFF(extras_key)),
@@ -172,6 +177,8 @@ void lmb_config_default(lmb_config *cfg)
     cfg->sky_ground[0] = cfg->sky_ground[1] = cfg->sky_ground[2] = -1; /* none */
     cfg->sky_up[1] = 1;
     cfg->sky_samples = 64;
+    cfg->ktx2_format = 0; /* e5b9g9r9 */
+    cfg->ktx2_zstd = 1;
     cfg->default_albedo[0] = cfg->default_albedo[1] = cfg->default_albedo[2] = -1; /* none: glTF's metal */
     cfg->ic_ray_scale = 4;
     cfg->farm_min_step_rays = 1000000; /* ~0.1 s of one core: a step costs a process start per shard */

@@ -5,6 +5,7 @@
 #include "atlas_images.h"
 
 #include "image_adapter.h"
+#include "ktx2.h"
 #include "post/dilate.h"
 
 #include <math.h>
@@ -66,6 +67,11 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
         snprintf(path, sizeof path, "%s/%s-lightmap-%u.png", dir, stem, a);
         st = lmb_image_write_u8(path, w, h, 3, png, err);
         free(png);
+    }
+    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_KTX2)) {
+        snprintf(path, sizeof path, "%s/%s-lightmap-%u.ktx2", dir, stem, a);
+        st = lmb_ktx2_write(path, w, h, rgb, (lmb_ktx2_format)cfg->ktx2_format, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0,
+                            err);
     }
     if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_MASK)) {
         uint8_t *mask = malloc((size_t)w * h + 1);

@@ -2,7 +2,8 @@
  * Writing one atlas's lightmap: <stem>-lightmap-N.exr (linear irradiance, half float or 32-bit
  * when beyond half's range), .hdr (the glTF references it), .png (tonemapped preview: the
  * 95th percentile of valid texels' luminance at 0.8, Reinhard, sRGB) and, with output.formats
- * mask, -mask.png (255 valid, 128 inside geometry, 0 padding); with output.directional,
+ * mask, -mask.png (255 valid, 128 inside geometry, 0 padding); with ktx2, .ktx2 (write/ktx2.h,
+ * output.ktx2_format and output.ktx2_supercompression); with output.directional,
  * -dir.exr and -dir.png.
  */
 #ifndef LMBAKE_ATLAS_IMAGES_H

@@ -205,7 +205,7 @@ typedef enum lmb_emission_sides {
 } lmb_emission_sides;
 
 /* MASK: <stem>-lightmap-N-mask.png, per texel 255 = lit (valid), 128 = inside geometry, 0 = padding */
-enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8 };
+enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8, LMB_OUTPUT_KTX2 = 16 };
 
 /* A u32 key set to "auto" (bounces). */
 #define LMB_AUTO UINT32_MAX
@@ -275,6 +275,8 @@ typedef struct lmb_config {
     lmb_emission_sides emission_sides; /* front only, or as the material's doubleSided */
     uint32_t directional_rays;     /* samples.directional: cosine rays per texel for the indirect light's direction */
     int directional;               /* output.directional: directional lightmaps (lmb_direction.h) */
+    int ktx2_format;               /* output.ktx2_format: lmb_ktx2_format (write/ktx2.h) */
+    int ktx2_zstd;                 /* output.ktx2_supercompression: 1 zstd, 0 none */
     int firefly_spread;            /* fireflies.spread: outlier texels' excess moved to their neighbours */
     /* seams */
     int seam_stitch;               /* least-squares seam stitching after the gather */
