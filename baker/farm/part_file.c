@@ -39,57 +39,52 @@ static void hex8(const uint8_t *sha, char out[17])
         snprintf(out + 2 * i, 3, "%02x", sha[i]);
 }
 
-/* The image files the glTF references by relative path (textures change a bake too): each
- * one's path and contents; one the bake could not read counts by its path alone (the bake
- * skips it with a warning, and so does every machine that cannot read it). */
-static void hash_image_files(const lmb_scene *scene, struct sha256_ctx *c)
+/* A file by its path relative to folder: the path, then its size and contents; one that
+ * cannot be read counts by its path alone (the bake skips it with a warning, and so does every
+ * machine that cannot read it). */
+static void hash_file(const char *folder, const char *relative, struct sha256_ctx *c)
 {
-    char folder[4096], relative[4096], path[8200], resolved[4096];
-    snprintf(folder, sizeof folder, "%s", scene->path);
-    char *slash = strrchr(folder, '/');
-    if (slash)
-        *slash = 0;
-    else
-        snprintf(folder, sizeof folder, ".");
-    const lmb_gltf_view *v = lmb_gltf_get_view(scene->doc);
-    for (uint32_t k = 0; k < v->image_count; k++) {
-        if (lmb_uri_check(v->image_uris[k], relative, sizeof relative) != LMB_URI_INSIDE)
-            continue;
-        snprintf(path, sizeof path, "%s/%s", folder, relative);
-        sha256_update(c, strlen(relative) + 1, (const uint8_t *)relative);
-        char *data = NULL;
-        size_t size = 0;
-        lmb_error ignored;
-        if (lmb_path_inside(folder, path, resolved, sizeof resolved) &&
-            lmb_read_file(resolved, "image", &data, &size, &ignored) == LMB_OK) {
-            uint64_t n = size;
-            sha256_update(c, sizeof n, (const uint8_t *)&n);
-            sha256_update(c, size, (const uint8_t *)data);
-        }
-        free(data);
-    }
-}
-
-/* The config's sky.image (read beside the config): its name and contents, as the glTF's images. */
-static void hash_sky_image(const lmb_config *cfg, struct sha256_ctx *c)
-{
-    if (!cfg->sky_image[0])
-        return;
-    char folder[4096], path[8300], resolved[4096];
-    const char *slash = strrchr(cfg->config_path, '/');
-    snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - cfg->config_path) : 1, slash ? cfg->config_path : ".");
-    snprintf(path, sizeof path, "%s/%s", folder, cfg->sky_image);
-    sha256_update(c, strlen(cfg->sky_image) + 1, (const uint8_t *)cfg->sky_image);
+    char path[8300], resolved[4096];
+    snprintf(path, sizeof path, "%s/%s", folder, relative);
+    sha256_update(c, strlen(relative) + 1, (const uint8_t *)relative);
     char *data = NULL;
     size_t size = 0;
     lmb_error ignored;
     if (lmb_path_inside(folder, path, resolved, sizeof resolved) &&
-        lmb_read_file(resolved, "sky image", &data, &size, &ignored) == LMB_OK) {
+        lmb_read_file(resolved, "input", &data, &size, &ignored) == LMB_OK) {
         uint64_t n = size;
         sha256_update(c, sizeof n, (const uint8_t *)&n);
         sha256_update(c, size, (const uint8_t *)data);
     }
     free(data);
+}
+
+/* The folder of a file path ("." for a bare name). */
+static void folder_of(const char *file, char *out, size_t size)
+{
+    const char *slash = strrchr(file, '/');
+    snprintf(out, size, "%.*s", slash ? (int)(slash - file) : 1, slash ? file : ".");
+}
+
+/* The image files the glTF references by relative path (textures change a bake too). */
+static void hash_image_files(const lmb_scene *scene, struct sha256_ctx *c)
+{
+    char folder[4096], relative[4096];
+    folder_of(scene->path, folder, sizeof folder);
+    const lmb_gltf_view *v = lmb_gltf_get_view(scene->doc);
+    for (uint32_t k = 0; k < v->image_count; k++)
+        if (lmb_uri_check(v->image_uris[k], relative, sizeof relative) == LMB_URI_INSIDE)
+            hash_file(folder, relative, c);
+}
+
+/* The config's sky.image, read beside the config. */
+static void hash_sky_image(const lmb_config *cfg, struct sha256_ctx *c)
+{
+    char folder[4096];
+    if (!cfg->sky_image[0])
+        return;
+    folder_of(cfg->config_path, folder, sizeof folder);
+    hash_file(folder, cfg->sky_image, c);
 }
 
 lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg, lmb_part_identity *id,
