@@ -22,6 +22,7 @@
 #include "seams/seams.h"
 #include "texels/texels.h"
 #include "write/gltf_write.h"
+#include "write/ktx2.h"
 #include "write/atlas_images.h"
 #include "write/output_dir.h"
 #include "write/records_file.h"
@@ -48,8 +49,9 @@ static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
     }
 }
 
-static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir, const char *stem,
-                             const lmb_ic_points *records, int directional, lmb_error *err)
+static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
+                             const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
+                             int directional, lmb_error *err)
 {
     int32_t *tex = malloc(((size_t)l->atlas_count + 1) * 2 * sizeof *tex), *dir_tex = tex + l->atlas_count + 1;
     if (!tex)
@@ -58,11 +60,29 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir,
     if (s->default_albedo_given)
         lmb_gltf_set_default_albedo(s->doc, s->default_albedo);
     for (uint32_t a = 0; a < l->atlas_count && st == LMB_OK; a++) {
-        char png[512], hdr[512], dpng[512];
+        char png[512], hdr[512], exr[512], ktx2[512], rgbm[512], dpng[512], dexr[512], dktx2[512];
         snprintf(png, sizeof png, "%s-lightmap-%u.png", stem, a);
         snprintf(hdr, sizeof hdr, "%s-lightmap-%u.hdr", stem, a);
+        snprintf(exr, sizeof exr, "%s-lightmap-%u.exr", stem, a);
+        snprintf(ktx2, sizeof ktx2, "%s-lightmap-%u.ktx2", stem, a);
+        snprintf(rgbm, sizeof rgbm, "%s-lightmap-%u-rgbm.png", stem, a);
         snprintf(dpng, sizeof dpng, "%s-lightmap-%u-dir.png", stem, a);
-        tex[a] = lmb_gltf_add_lightmap_texture(s->doc, png, hdr, err);
+        snprintf(dexr, sizeof dexr, "%s-lightmap-%u-dir.exr", stem, a);
+        snprintf(dktx2, sizeof dktx2, "%s-lightmap-%u-dir.ktx2", stem, a);
+        unsigned f = cfg->output_formats;
+        lmb_gltf_lightmap_files files = {
+            .atlas = a, .width = l->width[a], .height = l->height[a],
+            .radiance = cfg->output_scale == LMB_SCALE_RADIANCE,
+            .png = png, .hdr = hdr,
+            .exr = f & LMB_OUTPUT_EXR ? exr : NULL,
+            .ktx2 = f & LMB_OUTPUT_KTX2 ? ktx2 : NULL,
+            .rgbm = f & LMB_OUTPUT_RGBM ? rgbm : NULL,
+            .rgbm_range = outputs[a].rgbm_range,
+            .ktx2_vkformat = lmb_ktx2_vkformat((lmb_ktx2_format)cfg->ktx2_format),
+            .direction_png = directional ? dpng : NULL,
+            .direction_exr = directional ? dexr : NULL,
+            .direction_ktx2 = directional && (f & LMB_OUTPUT_KTX2) ? dktx2 : NULL};
+        tex[a] = lmb_gltf_add_lightmap_texture(s->doc, &files, err);
         dir_tex[a] = directional && tex[a] >= 0 ? lmb_gltf_add_direction_texture(s->doc, dpng, err) : -1;
         if (tex[a] < 0 || (directional && dir_tex[a] < 0))
             st = LMB_ERR_INTERNAL;
@@ -76,7 +96,7 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_layout *l, const char *dir,
         st = instance_primitives(s, l, i, &prims, &n, &owned, &owned_n, err);
         if (st == LMB_OK)
             st = lmb_gltf_lightmap_node(s->doc, s->instances[i].node, prims, n, tex[l->instances[i].atlas],
-                                        dir_tex[l->instances[i].atlas], err);
+                                        dir_tex[l->instances[i].atlas], l->instances[i].scale_offset, err);
         for (uint32_t k = 0; k < owned_n; k++)
             free(owned[k]);
         free(owned);
@@ -175,8 +195,13 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
                 memcpy(nrm + 3 * (size_t)lo, pr->normals + 3 * (size_t)v, 3 * sizeof(float));
             if (uv0)
                 memcpy(uv0 + 2 * (size_t)lo, pr->uv0 + 2 * (size_t)v, 2 * sizeof(float));
-            uv1[2 * (size_t)lo] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3)] / w);
-            uv1[2 * (size_t)lo + 1] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h);
+            if (lm->kept_uv1) { /* its own TEXCOORD_1, untouched: the node's rectangle places it */
+                uv1[2 * (size_t)lo] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3)];
+                uv1[2 * (size_t)lo + 1] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3) + 1];
+            } else {
+                uv1[2 * (size_t)lo] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3)] / w);
+                uv1[2 * (size_t)lo + 1] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h);
+            }
         }
         nv = distinct;
         lmb_gltf_prim_out *o = &(*out)[(*count)++];
@@ -326,11 +351,21 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     run->steps = lmb_steps_count(steps);
     if (st == LMB_OK)
         st = post_process(s, cfg, &l, &rt, &cache, stats, log, err);
-    for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
+    lmb_atlas_output *outputs = calloc((size_t)l.atlas_count + 1, sizeof *outputs);
+    if (st == LMB_OK && !outputs)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "output: out of memory");
+    uint64_t clamped = 0;
+    for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
-                                    l.height[a], err);
+                                    l.height[a], &outputs[a], err);
+        clamped += outputs[a].rgbm_clamped;
+        if (st == LMB_OK && outputs[a].rgbm_clamped)
+            lmb_warn(log, "atlas %u: %llu texels brighter than RGBM's range %g were clamped (output.rgbm_range; auto "
+                     "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
+    }
+    stats->rgbm_clamped = clamped;
     for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)
-        st = lmb_write_direction_images(od.staging, od.stem, a, cache.direction[a], l.width[a], l.height[a], err);
+        st = lmb_write_direction_images(cfg, od.staging, od.stem, a, cache.direction[a], l.width[a], l.height[a], err);
     stats->light_seconds = lmb_seconds() - tl;
     stats->atlases = l.atlas_count;
     stats->texel_density = l.density.scene_density;
@@ -338,8 +373,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     stats->density_capped = l.density.capped;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
-        st = write_gltf(s, &l, od.staging, od.stem, &records, cache.direction != NULL, err);
+        st = write_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL, err);
     }
+    free(outputs);
     if (st == LMB_OK)
         st = lmb_output_dir_commit(&od, err);
     else

@@ -52,13 +52,15 @@ static const char *const amis_weights[] = {"unbiased", "balance", NULL};
 static const char *const ic_records_modes[] = {"per_pass", "shared", NULL};
 static const char *const emission_sides[] = {"front", "material", NULL};
 static const char *const sky_samplings[] = {"mis", "cosine", NULL};
-static const char *const output_formats[] = {"exr", "hdr", "png", "mask", "ktx2", NULL};
+static const char *const output_formats[] = {"exr", "hdr", "png", "mask", "ktx2", "rgbm", NULL};
+static const char *const output_scales[] = {"irradiance", "radiance", NULL};
 static const char *const ktx2_formats[] = {"e5b9g9r9", "b10g11r11", "rgba16f", NULL};
 static const char *const ktx2_supercompressions[] = {"none", "zstd", NULL};
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
+_Static_assert(LMB_SCALE_IRRADIANCE == 0 && LMB_SCALE_RADIANCE == 1, "output_scales");
 _Static_assert(LMB_EMIT_FRONT == 0 && LMB_EMIT_MATERIAL == 1, "emission_sides");
 _Static_assert(LMB_OUTPUT_EXR == 1 && LMB_OUTPUT_HDR == 2 && LMB_OUTPUT_PNG == 4 && LMB_OUTPUT_MASK == 8 &&
-                   LMB_OUTPUT_KTX2 == 16,
+                   LMB_OUTPUT_KTX2 == 16 && LMB_OUTPUT_RGBM == 32,
                "output_formats");
 
 static const key_spec config_keys[] = {
@@ -96,6 +98,8 @@ static const key_spec config_keys[] = {
     BOOL("output.directional", OFF(directional)),
     ENUM("output.ktx2_format", OFF(ktx2_format), ktx2_formats),
     ENUM("output.ktx2_supercompression", OFF(ktx2_zstd), ktx2_supercompressions),
+    ENUM("output.scale", OFF(output_scale), output_scales),
+    FLOAT_AUTO("output.rgbm_range", OFF(rgbm_range), 0, 1e9, OPEN_LO),
     LIST("lightmap.include", lmb_cfg_set_globs, OFF(include), OFF(include_count)),
     LIST("lightmap.exclude", lmb_cfg_set_globs, OFF(exclude), OFF(exclude_count)),
     STRING("lightmap.extras_key", OFF(extras_key)),

@@ -33,7 +33,7 @@ struct lmb_gltf_doc {
     std::vector<lmb_gltf_texture> textures;
     lmb_gltf_view view;
     /* writer: (original material, lightmap texture) -> lightmapped material copy */
-    std::map<std::pair<int, int>, int> lightmap_materials;
+    std::map<std::string, int> lightmap_materials; /* (material, texture, rectangle) -> lightmapped copy */
     /* writer: meshes a node used before it got its lightmapped copy (gltf_prune.cpp drops the
      * ones no node uses any more) */
     std::vector<int> replaced_meshes;

@@ -1,8 +1,11 @@
 /*
  * atlas.keep_uv1: a mesh that already has TEXCOORD_1 on every primitive keeps it. Its UVs
- * ([0,1], glTF's top-left origin) become one chart; each instance gets an atlas of its own,
- * sized so the texel density matches the config (S = density x sqrt(world area / UV area)),
- * and the layout is checked: overlapping texels are reported, not fixed.
+ * ([0,1], glTF's top-left origin) become one chart; each instance gets a square of S x S
+ * texels, S chosen so the texel density matches the config (S = density x sqrt(world area /
+ * UV area)), and the squares share atlases, placed on shelves without rotation, so an engine
+ * maps the untouched TEXCOORD_1 with one scale and offset per instance (bevy's uv_rect,
+ * Unity's lightmapScaleOffset). The layout is checked: overlapping texels are reported, not
+ * fixed.
  */
 #include "keep_uv1.h"
 
@@ -67,4 +70,66 @@ uint32_t lmb_uv1_atlas_size(double world_area, const lmb_charts *c, double densi
     double s = uv_area > 0 ? density * sqrt(world_area / uv_area) : 16;
     s = ceil(s / 4) * 4;
     return s < 16 ? 16 : s > max_size ? max_size : (uint32_t)s;
+}
+
+lmb_status lmb_place_squares(const uint32_t *side, uint32_t n, uint32_t padding, uint32_t max_size, uint32_t *atlas_of,
+                             uint32_t *x, uint32_t *y, uint32_t *atlas_count, uint32_t **width, uint32_t **height,
+                             lmb_error *err)
+{
+    uint32_t *order = malloc(((size_t)n + 1) * sizeof *order);
+    *width = malloc(((size_t)n + 1) * sizeof **width);
+    *height = malloc(((size_t)n + 1) * sizeof **height);
+    *atlas_count = 0;
+    if (!order || !*width || !*height) {
+        free(order);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "keep_uv1: out of memory");
+    }
+    double area = 0;
+    uint32_t largest = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        order[k] = k;
+        area += ((double)side[k] + padding) * ((double)side[k] + padding);
+        largest = side[k] > largest ? side[k] : largest;
+    }
+    /* largest first, ties in instance order (insertion sort: stable, n is the kept instances) */
+    for (uint32_t k = 1; k < n; k++)
+        for (uint32_t j = k; j > 0 && side[order[j - 1]] < side[order[j]]; j--) {
+            uint32_t t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+    /* shelves across a roughly square atlas */
+    double w = ceil(sqrt(area) / 4) * 4;
+    uint32_t W = w > max_size ? max_size : w < largest ? largest : (uint32_t)w;
+    uint32_t cx = 0, cy = 0, shelf = 0, used_w = 0, a = 0;
+    for (uint32_t j = 0; j < n; j++) {
+        uint32_t k = order[j], s = side[k];
+        if (cx > 0 && cx + s > W) { /* next shelf */
+            cy += shelf + padding;
+            cx = shelf = 0;
+        }
+        if (cy > 0 && cy + s > max_size) { /* next atlas */
+            (*width)[a] = used_w;
+            (*height)[a] = cy - padding;
+            a++;
+            cx = cy = shelf = used_w = 0;
+        }
+        atlas_of[k] = a;
+        x[k] = cx;
+        y[k] = cy;
+        cx += s + padding;
+        shelf = s > shelf ? s : shelf;
+        used_w = cx - padding > used_w ? cx - padding : used_w;
+    }
+    if (n) {
+        (*width)[a] = used_w;
+        (*height)[a] = cy + shelf;
+        *atlas_count = a + 1;
+    }
+    for (uint32_t k = 0; k < *atlas_count; k++) { /* multiples of 4, as packed atlases */
+        (*width)[k] = ((*width)[k] + 3) / 4 * 4;
+        (*height)[k] = ((*height)[k] + 3) / 4 * 4;
+    }
+    free(order);
+    return LMB_OK;
 }

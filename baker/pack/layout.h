@@ -4,6 +4,9 @@
  * units (so a scaled instance gets more texels), and pack them into atlases. Every
  * instance gets its own texels and lands whole in one atlas (one lightmap texture per
  * instance, as glTF materials need); the writer gives each instance its own TEXCOORD_1.
+ * Meshes that keep their own TEXCOORD_1 (atlas.keep_uv1) are placed whole, as squares of
+ * shared atlases (keep_uv1.c), and keep their UVs: a scale/offset rectangle per instance maps
+ * them into the atlas, as engines' per-instance lightmap rectangles do.
  */
 #ifndef LMBAKE_LAYOUT_H
 #define LMBAKE_LAYOUT_H
@@ -43,6 +46,9 @@ typedef struct lmb_layout_instance {
     uint32_t atlas;
     double texel_density; /* texels per world unit used for it */
     double *uv1;          /* 6 per mesh triangle, atlas texel coordinates; 0 for skipped triangles */
+    double scale_offset[4]; /* (sx, sy, ox, oy): the output TEXCOORD_1 uv lands at uv * s + o in the atlas ([0,1]):
+                               (1, 1, 0, 0) for unwrapped meshes (their TEXCOORD_1 is written in atlas space), the
+                               instance's rectangle for a mesh that kept its own TEXCOORD_1 */
     size_t uv1_count;     /* doubles in uv1 */
 } lmb_layout_instance;
 

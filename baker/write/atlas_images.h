@@ -3,24 +3,31 @@
  * when beyond half's range), .hdr (the glTF references it), .png (tonemapped preview: the
  * 95th percentile of valid texels' luminance at 0.8, Reinhard, sRGB) and, with output.formats
  * mask, -mask.png (255 valid, 128 inside geometry, 0 padding); with ktx2, .ktx2 (write/ktx2.h,
- * output.ktx2_format and output.ktx2_supercompression); with output.directional,
- * -dir.exr and -dir.png.
+ * output.ktx2_format and output.ktx2_supercompression); with rgbm, -rgbm.png (write/rgbm.h);
+ * with output.directional, -dir.exr and -dir.png (and -dir.ktx2 in half floats with ktx2).
+ * Lightmap files hold output.scale's quantity: E (lux) or E / pi.
  */
 #ifndef LMBAKE_ATLAS_IMAGES_H
 #define LMBAKE_ATLAS_IMAGES_H
 
 #include <lmbake/lmbake.h>
 
-/* rgb: 3 floats per atlas texel; valid: LMB_TEXEL_* per texel. Files go into dir. */
+/* What writing an atlas decided, for the glTF and the log. */
+typedef struct lmb_atlas_output {
+    double rgbm_range;     /* rgbm: the range written */
+    uint64_t rgbm_clamped; /* rgbm: valid texels above it, clamped */
+} lmb_atlas_output;
+
+/* irradiance: 3 floats per atlas texel (E, lux); valid: LMB_TEXEL_* per texel. Files go into dir. */
 lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
-                                  const float *rgb, const uint8_t *valid, uint32_t width, uint32_t height,
-                                  lmb_error *err);
+                                  const float *irradiance, const uint8_t *valid, uint32_t width, uint32_t height,
+                                  lmb_atlas_output *info, lmb_error *err);
 
 /* The directional atlas (output.directional; docs/artists.md): d holds the
  * light's mean direction D per texel (3 floats, world space, |D| <= 1).
  * <stem>-lightmap-N-dir.exr holds D as floats, <stem>-lightmap-N-dir.png (the glTF references
  * it) (D + 1) / 2 in 8 bits, linear. */
-lmb_status lmb_write_direction_images(const char *dir, const char *stem, uint32_t atlas, const float *d, uint32_t width,
-                                      uint32_t height, lmb_error *err);
+lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
+                                      const float *d, uint32_t width, uint32_t height, lmb_error *err);
 
 #endif

@@ -10,7 +10,9 @@
 
 #include "../load/gltf_doc.hpp"
 #include "gltf_prune.hpp"
+#include "rgbm.h"
 
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <utility>
@@ -103,10 +105,27 @@ int gather_accessor(writer &w, int index, const uint32_t *source, uint32_t count
     return (int)w.m.accessors.size() - 1;
 }
 
-int lightmapped_material(const lmb_gltf_doc &doc, tinygltf::Model &m, int material, int texture, int direction_texture,
-                         std::map<std::pair<int, int>, int> &cache)
+bool identity_rect(const double so[4])
 {
-    auto key = std::make_pair(material, texture);
+    return so[0] == 1 && so[1] == 1 && so[2] == 0 && so[3] == 0;
+}
+
+/* The texture's extras.lightmap (lmb_gltf_add_lightmap_texture), or an empty object. */
+Value::Object texture_lightmap_extras(const tinygltf::Model &m, int texture)
+{
+    if (texture < 0 || (size_t)texture >= m.textures.size())
+        return Value::Object();
+    const Value &x = m.textures[(size_t)texture].extras;
+    if (!x.IsObject() || !x.Has("lightmap") || !x.Get("lightmap").IsObject())
+        return Value::Object();
+    return x.Get("lightmap").Get<Value::Object>();
+}
+
+int lightmapped_material(const lmb_gltf_doc &doc, tinygltf::Model &m, int material, int texture, int direction_texture,
+                         const double so[4], std::map<std::string, int> &cache)
+{
+    char key[256];
+    std::snprintf(key, sizeof key, "%d %d %.17g %.17g %.17g %.17g", material, texture, so[0], so[1], so[2], so[3]);
     auto it = cache.find(key);
     if (it != cache.end())
         return it->second;
@@ -119,10 +138,20 @@ int lightmapped_material(const lmb_gltf_doc &doc, tinygltf::Model &m, int materi
         mat.pbrMetallicRoughness.metallicFactor = 0.0;
     }
     mat.name += " (lightmap)";
+    Value::Object lm = texture_lightmap_extras(m, texture);
+    bool radiance = lm.count("scale") && lm["scale"].IsString() && lm["scale"].Get<std::string>() == "radiance";
     Value::Object ext;
     ext["index"] = Value(texture);
     ext["texCoord"] = Value(1);
-    ext["intensity"] = Value(1.0);
+    ext["intensity"] = Value(radiance ? 3.14159265358979323846 : 1.0); /* texel x intensity = E */
+    if (!identity_rect(so)) {
+        Value::Object tt;
+        tt["scale"] = Value(Value::Array{Value(so[0]), Value(so[1])});
+        tt["offset"] = Value(Value::Array{Value(so[2]), Value(so[3])});
+        Value::Object exts;
+        exts["KHR_texture_transform"] = Value(tt);
+        ext["extensions"] = Value(exts);
+    }
     mat.extensions["MOZ_lightmap"] = Value(ext);
     if (direction_texture >= 0) {
         Value::Object extras = mat.extras.IsObject() ? mat.extras.Get<Value::Object>() : Value::Object();
@@ -211,14 +240,14 @@ bool keep_image(const std::string *, const std::string *, const tinygltf::Image 
 
 } // namespace
 
-extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *png_uri, const char *hdr_uri, lmb_error *err)
+extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gltf_lightmap_files *f, lmb_error *err)
 {
     try {
         tinygltf::Model &m = doc->model;
         tinygltf::Image png, hdr;
-        png.uri = png_uri;
+        png.uri = f->png;
         png.mimeType = "image/png";
-        hdr.uri = hdr_uri;
+        hdr.uri = f->hdr;
         m.images.push_back(png);
         m.images.push_back(hdr);
         tinygltf::Texture t;
@@ -226,6 +255,33 @@ extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *
         Value::Object rgbe;
         rgbe["source"] = Value((int)m.images.size() - 1);
         t.extensions["MOZ_texture_rgbe"] = Value(rgbe);
+        Value::Object files, lm;
+        const std::pair<const char *, const char *> named[] = {
+            {"exr", f->exr}, {"hdr", f->hdr}, {"png", f->png}, {"ktx2", f->ktx2}, {"rgbm", f->rgbm},
+            {"directionPng", f->direction_png}, {"directionExr", f->direction_exr}, {"directionKtx2", f->direction_ktx2}};
+        for (const auto &n : named)
+            if (n.second)
+                files[n.first] = Value(std::string(n.second));
+        lm["atlas"] = Value((int)f->atlas);
+        lm["width"] = Value((int)f->width);
+        lm["height"] = Value((int)f->height);
+        lm["scale"] = Value(std::string(f->radiance ? "radiance" : "irradiance"));
+        lm["unit"] = Value(std::string(f->radiance ? "nits (E / pi)" : "lux (E)"));
+        lm["files"] = Value(files);
+        if (f->rgbm) {
+            Value::Object r;
+            r["range"] = Value(f->rgbm_range);
+            r["decode"] = Value(std::string(LMB_RGBM_DECODE));
+            lm["rgbm"] = Value(r);
+        }
+        if (f->ktx2) {
+            Value::Object k;
+            k["vkFormat"] = Value((int)f->ktx2_vkformat);
+            lm["ktx2"] = Value(k);
+        }
+        Value::Object extras;
+        extras["lightmap"] = Value(lm);
+        t.extras = Value(extras);
         m.textures.push_back(t);
         use_extension(m, "MOZ_lightmap");
         use_extension(m, "MOZ_texture_rgbe");
@@ -255,7 +311,8 @@ extern "C" int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char 
 }
 
 extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
-                                             uint32_t count, int32_t texture, int32_t direction_texture, lmb_error *err)
+                                             uint32_t count, int32_t texture, int32_t direction_texture,
+                                             const double scale_offset[4], lmb_error *err)
 {
     try {
         tinygltf::Model &m = doc->model;
@@ -268,9 +325,22 @@ extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, c
         for (uint32_t k = 0; k < count; k++) {
             const lmb_gltf_prim_out &p = prims[k];
             tinygltf::Primitive q = rebuild(w, mesh.primitives[p.gltf_primitive], p);
-            q.material = lightmapped_material(*doc, m, q.material, texture, direction_texture, doc->lightmap_materials);
+            q.material = lightmapped_material(*doc, m, q.material, texture, direction_texture, scale_offset,
+                                              doc->lightmap_materials);
             mesh.primitives[p.gltf_primitive] = q;
         }
+        if (!identity_rect(scale_offset))
+            use_extension(m, "KHR_texture_transform");
+        Value::Object tex = texture_lightmap_extras(m, texture), lm;
+        lm["atlas"] = tex.count("atlas") ? tex["atlas"] : Value(0);
+        lm["texCoord"] = Value(1);
+        lm["scaleOffset"] = Value(Value::Array{Value(scale_offset[0]), Value(scale_offset[1]), Value(scale_offset[2]),
+                                               Value(scale_offset[3])});
+        lm["scale"] = tex.count("scale") ? tex["scale"] : Value(std::string("irradiance"));
+        lm["files"] = tex.count("files") ? tex["files"] : Value(Value::Object());
+        Value::Object extras = n.extras.IsObject() ? n.extras.Get<Value::Object>() : Value::Object();
+        extras["lightmap"] = Value(lm);
+        n.extras = Value(extras);
         m.meshes.push_back(mesh);
         doc->replaced_meshes.push_back(m.nodes[node].mesh);
         m.nodes[node].mesh = (int)m.meshes.size() - 1;

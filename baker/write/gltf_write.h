@@ -4,7 +4,10 @@
  * TEXCOORD_1 (vertices split where charts meet) and materials that reference the atlas
  * through MOZ_lightmap {index, texCoord: 1, intensity}; the texture's source is a PNG and
  * its MOZ_texture_rgbe source the Radiance .hdr (the convention three.js-based viewers
- * such as Mozilla Hubs read). Everything else in the file is kept as it was.
+ * such as Mozilla Hubs read). intensity is pi when the files hold E / pi (output.scale
+ * radiance), so texel x intensity is irradiance either way. Every file of an atlas is named
+ * in its texture's extras.lightmap and every lightmapped node's (docs/output.md). Everything
+ * else in the file is kept as it was.
  */
 #ifndef LMBAKE_GLTF_WRITE_H
 #define LMBAKE_GLTF_WRITE_H
@@ -27,9 +30,22 @@ typedef struct lmb_gltf_prim_out {
     const uint32_t *indices; /* 3 per triangle, into the new vertices */
 } lmb_gltf_prim_out;
 
-/* Adds a texture for one atlas (png_uri: the texture's source; hdr_uri: MOZ_texture_rgbe).
- * Returns its index, or -1 on failure. */
-int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const char *png_uri, const char *hdr_uri, lmb_error *err);
+/* One atlas's lightmap files (URIs relative to the glTF; NULL: not written) and what they hold. */
+typedef struct lmb_gltf_lightmap_files {
+    uint32_t atlas, width, height;
+    int radiance;             /* output.scale radiance: texels hold E / pi (else E, lux) */
+    const char *png, *hdr;    /* always: the texture's source and its MOZ_texture_rgbe source */
+    const char *exr, *ktx2, *rgbm;
+    double rgbm_range;        /* rgbm: its range (write/rgbm.h) */
+    uint32_t ktx2_vkformat;   /* ktx2: its vkFormat */
+    const char *direction_png, *direction_exr, *direction_ktx2; /* output.directional */
+} lmb_gltf_lightmap_files;
+
+/* Adds the texture of one atlas: source files->png, MOZ_texture_rgbe files->hdr, and
+ * extras.lightmap {atlas, width, height, scale, files {format: uri}, rgbm {range, decode},
+ * ktx2 {vkFormat}}, so an engine script finds every file without guessing names. Returns its
+ * index, or -1 on failure. */
+int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gltf_lightmap_files *files, lmb_error *err);
 
 /* Adds a texture for one atlas's directions (png_uri: the -dir.png). Returns its index, or -1. */
 int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char *png_uri, lmb_error *err);
@@ -37,9 +53,14 @@ int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char *png_uri, l
 /* Gives node `node` a copy of its mesh with the primitives in prims replaced (others kept)
  * and lightmapped materials using `texture`; with direction_texture >= 0 the materials name
  * it in extras.lightmap_directional {index, texCoord: 1, encoding, decode} (docs/artists.md;
- * the material's other extras are kept). */
+ * the material's other extras are kept). scale_offset (sx, sy, ox, oy) places the node's
+ * TEXCOORD_1 in the atlas: uv_atlas = uv * (sx, sy) + (ox, oy); not (1, 1, 0, 0) (a mesh that
+ * kept its own TEXCOORD_1 as a rectangle of a shared atlas) its materials' MOZ_lightmap carry
+ * it as KHR_texture_transform. The node gets extras.lightmap {atlas, texCoord, scaleOffset,
+ * scale, files} (its other extras are kept; a boolean extras.lightmap flag is replaced). */
 lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count,
-                                  int32_t texture, int32_t direction_texture, lmb_error *err);
+                                  int32_t texture, int32_t direction_texture, const double scale_offset[4],
+                                  lmb_error *err);
 
 /* Names the irradiance cache's records file in asset.extras.lmbake.irradianceCacheRecords:
  * {"uri": uri, "count": count, "layout": "float32le x y z reach"} (write/records_file.h);

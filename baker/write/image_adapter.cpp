@@ -52,6 +52,9 @@ lmb_status write_image(const char *path, uint32_t w, uint32_t h, uint32_t ch, OI
     OIIO::ImageSpec spec((int)w, (int)h, (int)ch, stored);
     if (ends_with(target, ".exr"))
         spec.attribute("compression", "zip");
+    /* 4 channels are data (RGBM), not colour with associated alpha: stored as given */
+    if (ch == 4)
+        spec.attribute("oiio:UnassociatedAlpha", 1);
     /* no time stamp: the same bake must give byte-identical files */
     spec.attribute("DateTime", "");
     if (!out->open(tmp, spec) || !out->write_image(type, pixels) || !out->close()) {

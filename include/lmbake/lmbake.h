@@ -205,7 +205,22 @@ typedef enum lmb_emission_sides {
 } lmb_emission_sides;
 
 /* MASK: <stem>-lightmap-N-mask.png, per texel 255 = lit (valid), 128 = inside geometry, 0 = padding */
-enum { LMB_OUTPUT_EXR = 1, LMB_OUTPUT_HDR = 2, LMB_OUTPUT_PNG = 4, LMB_OUTPUT_MASK = 8, LMB_OUTPUT_KTX2 = 16 };
+/* KTX2: <stem>-lightmap-N.ktx2 (write/ktx2.h); RGBM: <stem>-lightmap-N-rgbm.png (write/rgbm.h) */
+enum {
+    LMB_OUTPUT_EXR = 1,
+    LMB_OUTPUT_HDR = 2,
+    LMB_OUTPUT_PNG = 4,
+    LMB_OUTPUT_MASK = 8,
+    LMB_OUTPUT_KTX2 = 16,
+    LMB_OUTPUT_RGBM = 32
+};
+
+/* output.scale: what a lightmap texel holds. three.js multiplies a lightmap by albedo / pi
+ * (it wants E); bevy's and Unity's shaders multiply by albedo alone (they want E / pi). */
+typedef enum lmb_output_scale {
+    LMB_SCALE_IRRADIANCE = 0, /* E, lux */
+    LMB_SCALE_RADIANCE = 1    /* E / pi: the exitant radiance of a white diffuse surface, nits */
+} lmb_output_scale;
 
 /* A u32 key set to "auto" (bounces). */
 #define LMB_AUTO UINT32_MAX
@@ -277,6 +292,9 @@ typedef struct lmb_config {
     int directional;               /* output.directional: directional lightmaps (lmb_direction.h) */
     int ktx2_format;               /* output.ktx2_format: lmb_ktx2_format (write/ktx2.h) */
     int ktx2_zstd;                 /* output.ktx2_supercompression: 1 zstd, 0 none */
+    lmb_output_scale output_scale; /* output.scale: E or E / pi in every lightmap file */
+    double rgbm_range;             /* output.rgbm_range: the largest value RGBM holds; 0 = auto (each atlas's
+                                      largest valid texel, rounded up to a power of two) */
     int firefly_spread;            /* fireflies.spread: outlier texels' excess moved to their neighbours */
     /* seams */
     int seam_stitch;               /* least-squares seam stitching after the gather */
@@ -386,6 +404,7 @@ typedef struct lmb_bake_stats {
     double firefly_moved;   /* the light that moved, as a share of all light */
     uint64_t seam_edges;    /* seam edges stitched */
     double seam_jump_before, seam_jump_after; /* largest relative luminance jump across them */
+    uint64_t rgbm_clamped;  /* output rgbm: valid texels above the range, clamped */
     char gltf_path[8600];   /* the output glTF */
 } lmb_bake_stats;
 

@@ -61,6 +61,13 @@ def _cover(uv, w, h, reach=0.75):
     return mask
 
 
+def lightmap_uv(node, uv):
+    """TEXCOORD_1 placed in its atlas by the node's extras.lightmap.scaleOffset (sx, sy, ox, oy):
+    (1, 1, 0, 0) for unwrapped meshes, a rectangle for meshes that kept their own TEXCOORD_1."""
+    so = node.get("extras", {}).get("lightmap", {}).get("scaleOffset", [1, 1, 0, 0])
+    return uv * np.array(so[:2]) + np.array(so[2:])
+
+
 def object_means(out):
     """{node name: (mean rgb over its valid texels, texel count)} for the bake in folder out,
     plus its "all" entry (every valid texel of every node). Needs output.formats exr and mask."""
@@ -88,7 +95,7 @@ def object_means(out):
             label = nodes.index(node["name"]) + 1
             exr, valid = atlases[tex]
             h, w = valid.shape
-            uv = _accessor(doc, bins, prim["attributes"]["TEXCOORD_1"])
+            uv = lightmap_uv(node, _accessor(doc, bins, prim["attributes"]["TEXCOORD_1"]))
             idx = _accessor(doc, bins, prim["indices"]).reshape(-1)
             for k in range(0, len(idx), 3):
                 cover = _cover(uv[idx[k:k + 3]], w, h) & valid & (owner[tex] == 0)

@@ -238,7 +238,16 @@ static void test_value_errors(void)
     expect_error("atlas:\n  keep_uv1: maybe\n", "level.yaml:2: ",
                  "key 'atlas.keep_uv1': expected true or false, got 'maybe'");
     expect_error("output:\n  formats:\n    - exr\n    - tiff\n", "level.yaml:4: ",
-                 "key 'output.formats': expected one of exr, hdr, png, mask, ktx2, got 'tiff'");
+                 "key 'output.formats': expected one of exr, hdr, png, mask, ktx2, rgbm, got 'tiff'");
+    expect_error("output:\n  ktx2_format: bc6h\n", "level.yaml:2: ",
+                 "key 'output.ktx2_format': expected one of e5b9g9r9, b10g11r11, rgba16f, got 'bc6h'");
+    expect_error("output:\n  ktx2_supercompression: lz4\n", "level.yaml:2: ",
+                 "key 'output.ktx2_supercompression': expected one of none, zstd, got 'lz4'");
+    expect_error("output:\n  scale: lux\n", "level.yaml:2: ",
+                 "key 'output.scale': expected one of irradiance, radiance, got 'lux'");
+    expect_error("output:\n  rgbm_range: 0\n", "level.yaml:2: ",
+                 "key 'output.rgbm_range': expected auto or a number > 0");
+    expect_error("output: {rgbm_range: -8}\n", "level.yaml:1: ", "key 'output.rgbm_range'");
     expect_error("output:\n  formats: []\n", "level.yaml:2: ", "key 'output.formats': expected at least one of exr");
     expect_error("lightmap:\n  extras_key: \"\"\n", "level.yaml:2: ",
                  "key 'lightmap.extras_key': expected a non-empty string");
@@ -425,6 +434,23 @@ static void test_glob(void)
     CHECK(lmb_glob_match("*a*a*a*a*a*a*a*a*a*a*a*a*", many_a));
 }
 
+/* The engine-output keys: formats, KTX2 format, scale, RGBM range. */
+static void test_output_keys(void)
+{
+    lmb_config c;
+    lmb_error err;
+    CHECK_INT(parse("output:\n  formats: [exr, ktx2, rgbm]\n  ktx2_format: b10g11r11\n  ktx2_supercompression: none\n"
+                    "  scale: radiance\n  rgbm_range: 6\n", &c, &err), LMB_OK);
+    CHECK_INT(c.output_formats, LMB_OUTPUT_EXR | LMB_OUTPUT_KTX2 | LMB_OUTPUT_RGBM);
+    CHECK_INT(c.ktx2_format, 1);
+    CHECK_INT(c.ktx2_zstd, 0);
+    CHECK_INT(c.output_scale, LMB_SCALE_RADIANCE);
+    CHECK_NEAR(c.rgbm_range, 6, 0);
+    CHECK_INT(parse("output: {rgbm_range: auto}\n", &c, &err), LMB_OK);
+    CHECK_NEAR(c.rgbm_range, 0, 0);
+    CHECK_INT(c.output_scale, LMB_SCALE_IRRADIANCE); /* the default */
+}
+
 /* The sky, sun and materials keys: values, and the usual named errors for unknown keys and bad values. */
 static void test_outdoor_keys(void)
 {
@@ -483,5 +509,6 @@ int main(int argc, char **argv)
     test_glob();
     test_write();
     test_outdoor_keys();
+    test_output_keys();
     return check_failures();
 }
