@@ -51,7 +51,7 @@ static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
 
 static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                              const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
-                             int directional, lmb_error *err)
+                             int directional, int shadowmask, lmb_error *err)
 {
     int32_t *tex = malloc(((size_t)l->atlas_count + 1) * 2 * sizeof *tex), *dir_tex = tex + l->atlas_count + 1;
     if (!tex)
@@ -60,7 +60,7 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
     if (s->default_albedo_given)
         lmb_gltf_set_default_albedo(s->doc, s->default_albedo);
     for (uint32_t a = 0; a < l->atlas_count && st == LMB_OK; a++) {
-        char png[512], hdr[512], exr[512], ktx2[512], rgbm[512], dpng[512], dexr[512], dktx2[512];
+        char png[512], hdr[512], exr[512], ktx2[512], rgbm[512], dpng[512], dexr[512], dktx2[512], mask[512];
         snprintf(png, sizeof png, "%s-lightmap-%u.png", stem, a);
         snprintf(hdr, sizeof hdr, "%s-lightmap-%u.hdr", stem, a);
         snprintf(exr, sizeof exr, "%s-lightmap-%u.exr", stem, a);
@@ -69,6 +69,7 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
         snprintf(dpng, sizeof dpng, "%s-lightmap-%u-dir.png", stem, a);
         snprintf(dexr, sizeof dexr, "%s-lightmap-%u-dir.exr", stem, a);
         snprintf(dktx2, sizeof dktx2, "%s-lightmap-%u-dir.ktx2", stem, a);
+        snprintf(mask, sizeof mask, "%s-lightmap-%u-shadowmask.png", stem, a);
         unsigned f = cfg->output_formats;
         lmb_gltf_lightmap_files files = {
             .atlas = a, .width = l->width[a], .height = l->height[a],
@@ -81,7 +82,8 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
             .ktx2_vkformat = lmb_ktx2_vkformat((lmb_ktx2_format)cfg->ktx2_format),
             .direction_png = directional ? dpng : NULL,
             .direction_exr = directional ? dexr : NULL,
-            .direction_ktx2 = directional && (f & LMB_OUTPUT_KTX2) ? dktx2 : NULL};
+            .direction_ktx2 = directional && (f & LMB_OUTPUT_KTX2) ? dktx2 : NULL,
+            .shadowmask = shadowmask ? mask : NULL};
         tex[a] = lmb_gltf_add_lightmap_texture(s->doc, &files, err);
         dir_tex[a] = directional && tex[a] >= 0 ? lmb_gltf_add_direction_texture(s->doc, dpng, err) : -1;
         if (tex[a] < 0 || (directional && dir_tex[a] < 0))
@@ -102,6 +104,8 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
         free(owned);
         free(prims);
     }
+    if (st == LMB_OK)
+        st = lmb_gltf_set_light_modes(s->doc, s->lights, s->light_count, err);
     char path[8600], bin[512], rec[512];
     lmb_records_file_name(stem, rec, sizeof rec);
     if (st == LMB_OK && records->count) /* the file itself, before the glTF that names it */
@@ -292,6 +296,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     run->ended = 0;
     double t0 = lmb_seconds();
     memset(stats, 0, sizeof *stats);
+    lmb_scene_set_light_modes(s, cfg, shard ? NULL : log); /* mixed lighting: which lights the bake holds */
     lmb_output_dir od;
     memset(&od, 0, sizeof od);
     lmb_status st = writes ? lmb_output_dir_open(&od, outdir, s->path, log, err) : LMB_OK;
@@ -364,6 +369,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
                      "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
     }
     stats->rgbm_clamped = clamped;
+    for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
+        st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
     for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)
         st = lmb_write_direction_images(cfg, od.staging, od.stem, a, cache.direction[a], l.width[a], l.height[a], err);
     stats->light_seconds = lmb_seconds() - tl;
@@ -373,7 +380,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     stats->density_capped = l.density.capped;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
-        st = write_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL, err);
+        st = write_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
+                        cache.shadowmask != NULL, err);
     }
     free(outputs);
     if (st == LMB_OK)

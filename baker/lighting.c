@@ -21,6 +21,8 @@ typedef struct atlas_work {
     float *result;   /* 3 per listed texel: the pass being computed */
     float *direct_dir; /* output.directional: 3 per listed texel, direct light's direction sum */
     float *indirect_dir; /* output.directional: 3 per listed texel, the indirect part, then the direction */
+    float *deferred; /* mixed lighting: 3 per listed texel, the `indirect` lights' part of direct; else NULL */
+    float *shadowmask; /* output.shadowmask: 4 per listed texel; else NULL */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -31,6 +33,8 @@ static void work_free(atlas_work *w, uint32_t n)
         free(w[a].result);
         free(w[a].direct_dir);
         free(w[a].indirect_dir);
+        free(w[a].deferred);
+        free(w[a].shadowmask);
     }
     free(w);
 }
@@ -209,9 +213,12 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
         st = cached_gather(env, gs, err);
     else
         st = texel_step(env, job->stage, 0, offsetof(atlas_work, result), gs, err);
+    /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */
     for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++)
-        for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++)
-            w[a].result[k] += w[a].direct[k];
+        for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
+            float v = w[a].result[k] + w[a].direct[k] - (w[a].deferred ? w[a].deferred[k] : 0.0f);
+            w[a].result[k] = v > 0 ? v : 0.0f;
+        }
     if (st == LMB_OK && store)
         st = store_pass(w, cache, err);
     stats->rays += gs->rays;
@@ -425,6 +432,8 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         w[a].t = da.t;
         w[a].direct = da.direct;
         w[a].direct_dir = da.direction;
+        w[a].deferred = da.deferred;
+        w[a].shadowmask = da.shadowmask;
         if (st == LMB_OK)
             st = lmb_rim_limit(&w[a].t, w[a].direct, &rim, err);
         if (st != LMB_OK)
@@ -498,6 +507,16 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         stats->gather_rays = gs.rays;
         stats->amis_adapted = gs.adapted;
     }
+    /* no gather ran: the lightmap is the direct light without the `indirect` lights' */
+    for (uint32_t a = 0; a < n && st == LMB_OK && bounces == 0 && w[a].deferred; a++) {
+        for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
+            float v = w[a].direct[k] - w[a].deferred[k];
+            w[a].direct[k] = v > 0 ? v : 0.0f;
+        }
+        st = lmb_cache_store(cache, a, &w[a].t, w[a].direct, err);
+    }
+    for (uint32_t a = 0; a < n && st == LMB_OK && w[a].shadowmask; a++)
+        st = lmb_cache_store_shadowmask(cache, a, &w[a].t, w[a].shadowmask, err);
     if (st == LMB_OK && cfg->directional)
         st = light_directions(&env, err);
     lmb_ic_records_free(&shared);

@@ -17,10 +17,13 @@ void lmb_cache_free(lmb_cache *c)
             free(c->state[a]);
         if (c->direction)
             free(c->direction[a]);
+        if (c->shadowmask)
+            free(c->shadowmask[a]);
     }
     free(c->irradiance);
     free(c->state);
     free(c->direction);
+    free(c->shadowmask);
     memset(c, 0, sizeof *c);
 }
 
@@ -77,6 +80,35 @@ lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels 
     lmb_status s = c->direction && c->direction[a] && st
                        ? scatter(c->direction[a], st, c->layout->width[a], c->layout->height[a], t, d, err)
                        : lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u's directions", a);
+    free(st);
+    return s;
+}
+
+/* Dilation works on 3 channels: the 4 visibilities go through it as (0, 1, 2) and (3, -, -). */
+lmb_status lmb_cache_store_shadowmask(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *v, lmb_error *err)
+{
+    uint32_t w = c->layout->width[a], h = c->layout->height[a];
+    size_t n = (size_t)w * h;
+    if (!c->shadowmask)
+        c->shadowmask = calloc((size_t)c->atlas_count + 1, sizeof *c->shadowmask);
+    if (c->shadowmask && !c->shadowmask[a])
+        c->shadowmask[a] = malloc((4 * n + 1) * sizeof **c->shadowmask);
+    float *img = malloc((3 * n + 1) * sizeof *img), *part = malloc((3 * (size_t)t->count + 1) * sizeof *part);
+    uint8_t *st = malloc(n + 1);
+    lmb_status s = c->shadowmask && c->shadowmask[a] && img && part && st
+                       ? LMB_OK
+                       : lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u's shadowmask", a);
+    for (int half = 0; half < 2 && s == LMB_OK; half++) {
+        for (uint32_t i = 0; i < t->count; i++)
+            for (int k = 0; k < 3; k++)
+                part[3 * (size_t)i + k] = half == 0 ? v[4 * (size_t)i + k] : k == 0 ? v[4 * (size_t)i + 3] : 0.0f;
+        s = scatter(img, st, w, h, t, part, err);
+        for (size_t p = 0; p < n && s == LMB_OK; p++)
+            for (int k = 0; k < (half ? 1 : 3); k++)
+                c->shadowmask[a][4 * p + (half ? 3 : k)] = img[3 * p + k];
+    }
+    free(img);
+    free(part);
     free(st);
     return s;
 }

@@ -34,6 +34,8 @@ typedef struct lmb_cache {
     uint8_t **state;    /* owned: per atlas width x height LMB_TEXEL_* */
     float **direction;  /* owned, NULL until lmb_cache_store_direction: per atlas width x height x 3,
                            the light's mean direction (directional lightmaps), dilated */
+    float **shadowmask; /* owned, NULL until lmb_cache_store_shadowmask: per atlas width x height x 4,
+                           the shadowmask lights' visibility (output.shadowmask), dilated */
 } lmb_cache;
 
 typedef enum lmb_hit_kind {
@@ -52,6 +54,9 @@ lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const 
 
 /* Atlas a's direction image := d (3 floats per listed texel of t), dilated as the irradiance. */
 lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *d, lmb_error *err);
+
+/* Atlas a's shadowmask image := v (4 floats per listed texel of t), dilated as the irradiance. */
+lmb_status lmb_cache_store_shadowmask(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *v, lmb_error *err);
 
 /* At a ray hit: albedo / pi (RGB) and, for LMB_HIT_CACHED, the irradiance E (RGB). */
 lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double albedo_over_pi[3], double e[3]);

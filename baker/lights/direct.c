@@ -19,6 +19,7 @@
  * a texel with no usable point is invalid and filled later by dilation.
  */
 #include "direct.h"
+#include "direct_internal.h"
 
 #include "../util/frame.h"
 #include "../util/lmb_math.h"
@@ -35,167 +36,6 @@
  * cost does not grow with the light count. Directional lights are always evaluated. */
 #define EXACT_LOCAL_LIGHTS 8
 
-typedef struct light_set {
-    uint32_t *local, local_count;       /* point and spot lights */
-    uint32_t *directional, directional_count;
-    double *cdf;                        /* local_count + 1, by power */
-} light_set;
-
-typedef struct emitter {
-    double p[9];   /* world corners */
-    double n[3];   /* unit front normal */
-    double area;
-    float le[3];   /* radiance, nits (times the texture when there is one) */
-    int two_sided;
-    const lmb_texture *tex; /* emissive texture or NULL */
-    double uv[6];  /* its texture coordinates at the corners (KHR_texture_transform applied) */
-    uint32_t instance, primitive, triangle; /* where it is in the scene (primitive: lmb_scene index) */
-} emitter;
-
-struct lmb_emitters {
-    emitter *e;
-    double *cdf; /* count + 1 */
-    uint32_t count;
-};
-
-uint32_t lmb_emitters_count(const lmb_emitters *e)
-{
-    return e ? e->count : 0;
-}
-
-void lmb_emitters_free(lmb_emitters *e)
-{
-    if (!e)
-        return;
-    free(e->e);
-    free(e->cdf);
-    free(e);
-}
-
-static lmb_status add_emitter(lmb_emitters *es, uint32_t *cap, const emitter *x, lmb_error *err)
-{
-    if (es->count == *cap) {
-        uint32_t c = *cap ? 2 * *cap : 64;
-        emitter *n = realloc(es->e, (size_t)c * sizeof *n);
-        if (!n)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "emitters: out of memory");
-        es->e = n;
-        *cap = c;
-    }
-    es->e[es->count++] = *x;
-    return LMB_OK;
-}
-
-static void world_point(const double m[16], const float *p, double *out)
-{
-    for (int r = 0; r < 3; r++)
-        out[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
-}
-
-/* The emissive texture of material `mat` on primitive pr, and its corner UVs for face f with
- * the slot's KHR_texture_transform applied (an affine map commutes with barycentric interpolation). */
-static const lmb_texture *emitter_texture(const lmb_textures *tx, const lmb_material *mat, const lmb_primitive *pr,
-                                          uint32_t f, double uv[6])
-{
-    const lmb_texture *t = lmb_textures_get(tx, &mat->emissive_texture, LMB_TEX_COLOUR);
-    const float *set = mat->emissive_texture.texcoord == 1 ? pr->uv1 : mat->emissive_texture.texcoord == 0 ? pr->uv0 : NULL;
-    if (!t || !set)
-        return NULL;
-    for (int k = 0; k < 3; k++) {
-        lmb_texture_ref_apply(&mat->emissive_texture, set[2 * pr->indices[3 * f + k]],
-                              set[2 * pr->indices[3 * f + k] + 1], &uv[2 * k], &uv[2 * k + 1]);
-    }
-    return t;
-}
-
-lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const lmb_textures *tx, lmb_emitters **out,
-                              lmb_error *err)
-{
-    lmb_emitters *es = calloc(1, sizeof *es);
-    uint32_t cap = 0;
-    lmb_status st = es ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "emitters: out of memory");
-    for (uint32_t i = 0; st == LMB_OK && i < s->instance_count; i++) {
-        const lmb_instance *in = &s->instances[i];
-        const lmb_mesh *m = &s->meshes[in->mesh];
-        for (uint32_t p = 0; st == LMB_OK && p < m->primitive_count; p++) {
-            const lmb_primitive *pr = &s->primitives[m->first_primitive + p];
-            if (pr->material < 0 || !lmb_material_is_emissive(&s->materials[pr->material]))
-                continue;
-            const lmb_material *mat = &s->materials[pr->material];
-            for (uint32_t f = 0; st == LMB_OK && f < pr->triangle_count; f++) {
-                if (pr->degenerate[f])
-                    continue;
-                emitter x;
-                for (int k = 0; k < 3; k++)
-                    world_point(in->world, pr->positions + 3 * pr->indices[3 * f + k], x.p + 3 * k);
-                double e1[3] = {x.p[3] - x.p[0], x.p[4] - x.p[1], x.p[5] - x.p[2]};
-                double e2[3] = {x.p[6] - x.p[0], x.p[7] - x.p[1], x.p[8] - x.p[2]};
-                double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-                double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-                if (!(len > 0))
-                    continue;
-                for (int k = 0; k < 3; k++)
-                    x.n[k] = (in->flips_winding ? -c[k] : c[k]) / len;
-                x.area = 0.5 * len;
-                for (int k = 0; k < 3; k++)
-                    x.le[k] = (float)(mat->emissive[k] * cfg->emissive_scale);
-                x.two_sided = cfg->emission_sides == LMB_EMIT_MATERIAL && mat->double_sided;
-                x.tex = emitter_texture(tx, mat, pr, f, x.uv);
-                x.instance = i;
-                x.primitive = m->first_primitive + p;
-                x.triangle = f;
-                st = add_emitter(es, &cap, &x, err);
-            }
-        }
-    }
-    if (st == LMB_OK) {
-        es->cdf = malloc(((size_t)es->count + 1) * sizeof *es->cdf);
-        if (!es->cdf)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "emitters: out of memory");
-    }
-    if (st != LMB_OK) {
-        lmb_emitters_free(es);
-        return st;
-    }
-    double acc = 0;
-    es->cdf[0] = 0;
-    for (uint32_t k = 0; k < es->count; k++) {
-        const emitter *x = &es->e[k];
-        const double *m = x->tex ? x->tex->mean : NULL;
-        double lum = 0.2126 * x->le[0] * (m ? m[0] : 1) + 0.7152 * x->le[1] * (m ? m[1] : 1) +
-                     0.0722 * x->le[2] * (m ? m[2] : 1);
-        acc += x->area * (lum > 0 ? lum : 1e-12) * (x->two_sided ? 2 : 1);
-        es->cdf[k + 1] = acc;
-    }
-    *out = es;
-    return LMB_OK;
-}
-
-static uint32_t pick(const lmb_emitters *es, double u, double *prob)
-{
-    double target = u * es->cdf[es->count];
-    uint32_t lo = 0, hi = es->count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (es->cdf[mid + 1] <= target)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    *prob = (es->cdf[lo + 1] - es->cdf[lo]) / es->cdf[es->count];
-    return lo;
-}
-
-struct lmb_direct {
-    const lmb_scene *scene;
-    const lmb_config *cfg;
-    const lmb_rt *rt;
-    const lmb_emitters *emitters;
-    const lmb_sky *sky;
-    light_set lights;
-    uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
-};
-
 const lmb_config *lmb_direct_config(const lmb_direct *d)
 {
     return d->cfg;
@@ -203,27 +43,32 @@ const lmb_config *lmb_direct_config(const lmb_direct *d)
 
 int lmb_direct_any_light(const lmb_direct *d)
 {
-    return (d->scene->light_count > 0 && d->cfg->light_intensity_scale > 0) || lmb_emitters_count(d->emitters) > 0 ||
-           d->sky != NULL;
+    return (d->lights.local_count + d->lights.directional_count > 0 && d->cfg->light_intensity_scale > 0) ||
+           lmb_emitters_count(d->emitters) > 0 || d->sky != NULL;
 }
 
-typedef struct point_ctx {
-    const lmb_direct *d;
-    double o[3];    /* offset origin */
-    double p[3], n[3], ng[3];
-    double eps;
-    uint32_t samples; /* area-light and many-light samples */
-    uint64_t rays;
-    double dir[3];    /* sum of each contribution's luminance times its direction (unit, toward the light) */
-} point_ctx;
+int lmb_direct_has_deferred(const lmb_direct *d)
+{
+    return d->lights.indirect_count > 0;
+}
 
-/* Adds one light's contribution rgb, arriving from unit direction d, to e (and to c->dir). */
-static void add_light(point_ctx *c, const double d[3], const double rgb[3], double e[3])
+uint32_t lmb_direct_shadowmask_channels(const lmb_direct *d)
+{
+    return d->lights.mask_channels;
+}
+
+/* Adds one light's contribution rgb, arriving from unit direction d, to e (and to c->dir); an
+ * `indirect` light's also to c->deferred. */
+static void add_light(point_ctx *c, const lmb_light *l, const double d[3], const double rgb[3], double e[3])
 {
     double lum = lmb_luminance(rgb);
+    int deferred = l && l->mode == LMB_LIGHT_INDIRECT;
     for (int k = 0; k < 3; k++) {
         e[k] += rgb[k];
-        c->dir[k] += lum * d[k];
+        if (deferred)
+            c->deferred[k] += rgb[k];
+        else
+            c->dir[k] += lum * d[k];
     }
 }
 
@@ -264,24 +109,30 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     double rgb[3];
     for (int k = 0; k < 3; k++)
         rgb[k] = weight * scale * l->intensity * l->color[k] * cosang * w;
-    add_light(c, d, rgb, e);
+    add_light(c, l, d, rgb, e);
+}
+
+void lmb_sun_disc_direction(const lmb_config *cfg, const lmb_light *l, double u1, double u2, double d[3])
+{
+    double half = 0.5 * cfg->sun_angle * LMB_PI / 180.0, cos_max = cos(half), axis[3], t[3], b[3];
+    for (int k = 0; k < 3; k++)
+        axis[k] = -l->direction[k];
+    lmb_frame(axis, t, b);
+    double ct = 1 - u1 * (1 - cos_max), st = sqrt(fmax(0.0, 1 - ct * ct)), phi = 2 * LMB_PI * u2;
+    for (int k = 0; k < 3; k++)
+        d[k] = ct * axis[k] + st * (cos(phi) * t[k] + sin(phi) * b[k]);
 }
 
 /* A directional light as a disc of angular diameter lights.sun_angle: c->samples directions
  * uniform in its cone (solid angle), each with a shadow ray. */
 static void sun_disc(point_ctx *c, const lmb_light *l, lmb_rng *rng, double e[3])
 {
-    double half = 0.5 * c->d->cfg->sun_angle * LMB_PI / 180.0, cos_max = cos(half), axis[3], t[3], b[3];
-    for (int k = 0; k < 3; k++)
-        axis[k] = -l->direction[k];
-    lmb_frame(axis, t, b);
+    double cos_max = cos(0.5 * c->d->cfg->sun_angle * LMB_PI / 180.0);
     uint32_t n = c->samples;
     double scale = c->d->cfg->light_intensity_scale * l->intensity / (0.5 * (1 + cos_max)) / n;
     for (uint32_t s = 0; s < n; s++) {
-        double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng);
-        double ct = 1 - u1 * (1 - cos_max), st = sqrt(fmax(0.0, 1 - ct * ct)), phi = 2 * LMB_PI * u2, d[3];
-        for (int k = 0; k < 3; k++)
-            d[k] = ct * axis[k] + st * (cos(phi) * t[k] + sin(phi) * b[k]);
+        double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), d[3];
+        lmb_sun_disc_direction(c->d->cfg, l, u1, u2, d);
         double cosang = lmb_dot3(c->n, d);
         if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
             continue;
@@ -291,7 +142,7 @@ static void sun_disc(point_ctx *c, const lmb_light *l, lmb_rng *rng, double e[3]
         double rgb[3];
         for (int k = 0; k < 3; k++)
             rgb[k] = scale * l->color[k] * cosang;
-        add_light(c, d, rgb, e);
+        add_light(c, l, d, rgb, e);
     }
 }
 
@@ -356,7 +207,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
     for (uint32_t s = 0; s < n; s++) {
         /* light sample */
         double prob, u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), u3 = lmb_rng_next(rng);
-        const emitter *x = &es->e[pick(es, u1, &prob)];
+        const emitter *x = &es->e[lmb_emitter_pick(es, u1, &prob)];
         double su = sqrt(u2), b1 = su * (1 - u3), b2 = su * u3, y[3], d[3], le[3], cy;
         for (int k = 0; k < 3; k++) {
             y[k] = (1 - b1 - b2) * x->p[k] + b1 * x->p[3 + k] + b2 * x->p[6 + k];
@@ -374,7 +225,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
                     double g = cx * pl / (pl * pl + pb * pb) / n, rgb[3]; /* (cx / pl) x power weight */
                     for (int k = 0; k < 3; k++)
                         rgb[k] = le[k] * g;
-                    add_light(c, d, rgb, e);
+                    add_light(c, NULL, d, rgb, e);
                 }
             }
         }
@@ -402,7 +253,7 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
         double g = cz * pb / (pl * pl + pb * pb) / n, rgb[3]; /* (cz / pb) x power weight */
         for (int k = 0; k < 3; k++)
             rgb[k] = le[k] * g;
-        add_light(c, w, rgb, e);
+        add_light(c, NULL, w, rgb, e);
     }
 }
 
@@ -433,7 +284,7 @@ static int back_face_hits(point_ctx *c, lmb_rng *rng)
     return back;
 }
 
-static void point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp)
+void lmb_point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp)
 {
     memset(c, 0, sizeof *c);
     c->d = d;
@@ -449,8 +300,14 @@ static void point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_poin
 uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3],
                        double dir[3])
 {
+    return lmb_direct_at_split(d, sp, samples, rng, e, dir, NULL);
+}
+
+uint32_t lmb_direct_at_split(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng,
+                             double e[3], double dir[3], double deferred[3])
+{
     point_ctx c;
-    point_init(&c, d, sp);
+    lmb_point_init(&c, d, sp);
     c.samples = samples ? samples : d->cfg->direct_samples;
     e[0] = e[1] = e[2] = 0;
     for (uint32_t l = 0; l < d->lights.directional_count; l++) {
@@ -468,6 +325,8 @@ uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_
                                      e, c.dir);
     if (dir)
         memcpy(dir, c.dir, sizeof c.dir);
+    if (deferred)
+        memcpy(deferred, c.deferred, sizeof c.deferred);
     return (uint32_t)c.rays;
 }
 
@@ -475,7 +334,7 @@ int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, 
                               int *sees_back)
 {
     point_ctx c;
-    point_init(&c, d, sp);
+    lmb_point_init(&c, d, sp);
     int back = back_face_hits(&c, rng);
     *rays += (uint32_t)c.rays;
     *sees_back = back > 0;
@@ -505,8 +364,18 @@ static int light_set_build(const lmb_scene *s, light_set *ls)
     if (!ls->local || !ls->directional || !ls->cdf)
         return 0;
     ls->cdf[0] = 0;
+    for (int k = 0; k < LMB_SHADOWMASK_CHANNELS; k++)
+        ls->mask_light[k] = -1;
     for (uint32_t i = 0; i < s->light_count; i++) {
         const lmb_light *l = &s->lights[i];
+        if (l->mode == LMB_LIGHT_REALTIME) /* not in the bake */
+            continue;
+        ls->indirect_count += l->mode == LMB_LIGHT_INDIRECT;
+        if (l->shadowmask_channel >= 0 && l->shadowmask_channel < LMB_SHADOWMASK_CHANNELS) {
+            ls->mask_light[l->shadowmask_channel] = (int)i;
+            ls->mask_channels = (uint32_t)l->shadowmask_channel + 1 > ls->mask_channels ? (uint32_t)l->shadowmask_channel + 1
+                                                                                        : ls->mask_channels;
+        }
         if (l->type == LMB_LIGHT_DIRECTIONAL) {
             ls->directional[ls->directional_count++] = i;
             continue;

@@ -53,6 +53,21 @@ typedef struct lmb_shading_point {
 uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng, double e[3],
                        double dir[3]);
 
+/* lmb_direct_at, and deferred (may be NULL) := the part of e from `indirect` lights (mixed
+ * lighting: their direct light is not in the lightmap, their bounced light is). */
+uint32_t lmb_direct_at_split(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng,
+                             double e[3], double dir[3], double deferred[3]);
+
+/* 1 when some light is `indirect` (lmb_direct_at_split's deferred part can be non-zero). */
+int lmb_direct_has_deferred(const lmb_direct *d);
+
+/* output.shadowmask: the channels in use (0: none), and per channel the visibility in [0, 1]
+ * of its light from sp (samples.direct rays over a sun's disc, one ray to a point or spot;
+ * 0 facing away). Returns the rays traced. */
+uint32_t lmb_direct_shadowmask_channels(const lmb_direct *d);
+uint32_t lmb_shadowmask_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng,
+                           double vis[LMB_SHADOWMASK_CHANNELS]);
+
 /* 1 when sp lies inside geometry (most of its hemisphere rays hit back faces); adds to *rays;
  * *sees_back: any of them hit a back face (sp is near geometry's inside: in a gap, at a contact). */
 int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays,
@@ -71,6 +86,8 @@ typedef struct lmb_direct_job {
     void *progress_user;
     float *direction;    /* NULL, or 3 floats per listed texel: lmb_direct_at's dir, averaged over the
                             texel's points as the irradiance is (directional lightmaps) */
+    float *deferred;     /* NULL, or 3 floats per listed texel: the `indirect` lights' part of the irradiance */
+    float *shadowmask;   /* NULL, or 4 floats per listed texel: lmb_shadowmask_at averaged over the points */
 } lmb_direct_job;
 
 /* Fills irradiance (3 floats per listed texel of t), t->valid and t->gather_at. Counts rays. */

@@ -27,8 +27,10 @@ static void band_progress(void *user, const char *stage, uint64_t done, uint64_t
 }
 
 /* A band's bytes: u32 count; per texel u32 texel, f32 size, lmb_point_ref, u8 valid, u8 partly;
- * then 3 f32 direct light per texel, and 3 f32 direction sum per texel when directional. */
-static lmb_status put_band(const lmb_texels *t, const float *e, const float *dir, lmb_buf *out, lmb_error *err)
+ * then 3 f32 direct light per texel, 3 f32 direction sum per texel when directional, 3 f32
+ * deferred light (mixed lighting) and 4 f32 shadowmask visibilities when those are on. */
+static lmb_status put_band(const lmb_texels *t, const float *e, const float *dir, const float *deferred,
+                           const float *mask, lmb_buf *out, lmb_error *err)
 {
     lmb_status st = lmb_buf_append(out, &t->count, 4, err);
     for (uint32_t i = 0; i < t->count && st == LMB_OK; i++) {
@@ -45,6 +47,10 @@ static lmb_status put_band(const lmb_texels *t, const float *e, const float *dir
         st = lmb_buf_append(out, e, 3 * sizeof *e * t->count, err);
     if (st == LMB_OK && dir)
         st = lmb_buf_append(out, dir, 3 * sizeof *dir * t->count, err);
+    if (st == LMB_OK && deferred)
+        st = lmb_buf_append(out, deferred, 3 * sizeof *deferred * t->count, err);
+    if (st == LMB_OK && mask)
+        st = lmb_buf_append(out, mask, LMB_SHADOWMASK_CHANNELS * sizeof *mask * t->count, err);
     return st;
 }
 
@@ -61,25 +67,40 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
             break;
         float *e = calloc(3 * (size_t)band.count + 1, sizeof *e);
         float *dir = c->cfg->directional ? calloc(3 * (size_t)band.count + 1, sizeof *dir) : NULL;
-        if (!e || (c->cfg->directional && !dir))
+        int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
+        float *deferred = has_deferred ? calloc(3 * (size_t)band.count + 1, sizeof *deferred) : NULL;
+        float *mask = has_mask ? calloc(LMB_SHADOWMASK_CHANNELS * (size_t)band.count + 1, sizeof *mask) : NULL;
+        if (!e || (c->cfg->directional && !dir) || (has_deferred && !deferred) || (has_mask && !mask))
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
         c->row0 = y0;
         c->band_rows = y1 - y0;
-        lmb_direct_job job = {c->direct, c->atlas, c->progress ? band_progress : NULL, c, dir};
+        lmb_direct_job job = {c->direct, c->atlas, c->progress ? band_progress : NULL, c, dir, deferred, mask};
         if (st == LMB_OK)
             st = lmb_direct_compute(&job, &band, e, &counters[0], err);
         if (st == LMB_OK)
-            st = put_band(&band, e, dir, out, err);
+            st = put_band(&band, e, dir, deferred, mask, out, err);
         free(e);
         free(dir);
+        free(deferred);
+        free(mask);
         lmb_texels_free(&band);
     }
     return st;
 }
 
 /* Appends the next band of `in` to out (exact growth, as lmb_texels_append). */
+/* Grows *arr to hold `total` texels of `per` floats; 0 when out of memory. */
+static int grow_floats(float **arr, size_t total, size_t per)
+{
+    float *p = realloc(*arr, (per * total + 1) * sizeof *p);
+    if (p)
+        *arr = p;
+    return p != NULL;
+}
+
 static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out, const band_ctx *c, lmb_error *err)
 {
+    int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
     uint32_t n;
     if (!lmb_buf_take(in, &n, 4) || (uint64_t)n * 26 > in->size - in->read)
         return lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
@@ -117,9 +138,16 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
         band.valid[i] = flags[0];
         band.partly_covered[i] = flags[1];
     }
+    if (st == LMB_OK && ((has_deferred && !grow_floats(&out->deferred, total, 3)) ||
+                         (has_mask && !grow_floats(&out->shadowmask, total, LMB_SHADOWMASK_CHANNELS))))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
     if (st == LMB_OK && (!lmb_buf_take(in, out->direct + 3 * (size_t)out->t.count, 3 * sizeof(float) * n) ||
                          (directional && !lmb_buf_take(in, out->direction + 3 * (size_t)out->t.count,
-                                                       3 * sizeof(float) * n))))
+                                                       3 * sizeof(float) * n)) ||
+                         (has_deferred && !lmb_buf_take(in, out->deferred + 3 * (size_t)out->t.count,
+                                                        3 * sizeof(float) * n)) ||
+                         (has_mask && !lmb_buf_take(in, out->shadowmask + LMB_SHADOWMASK_CHANNELS * (size_t)out->t.count,
+                                                    LMB_SHADOWMASK_CHANNELS * sizeof(float) * n))))
         st = lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
     if (st == LMB_OK)
         st = lmb_texels_append(&out->t, &band, err);
@@ -165,6 +193,10 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     }
     if (st == LMB_OK && !out->direct)
         out->direct = calloc(1, sizeof *out->direct);
+    if (st == LMB_OK && lmb_direct_has_deferred(direct) && !out->deferred)
+        out->deferred = calloc(1, sizeof *out->deferred);
+    if (st == LMB_OK && lmb_direct_shadowmask_channels(direct) && !out->shadowmask)
+        out->shadowmask = calloc(1, sizeof *out->shadowmask);
     if (st == LMB_OK && cfg->directional && !out->direction)
         out->direction = calloc(1, sizeof *out->direction);
     if (st == LMB_OK && (!out->direct || (cfg->directional && !out->direction)))

@@ -16,6 +16,9 @@ typedef struct lmb_direct_atlas {
     lmb_texels t;        /* the atlas's listed texels, one gather point each */
     float *direct;       /* 3 per listed texel */
     float *direction;    /* output.directional: 3 per listed texel, direct light's direction sum; else NULL */
+    float *deferred;     /* `indirect` lights (lmb_direct_has_deferred): 3 per listed texel, their part of
+                            direct; else NULL */
+    float *shadowmask;   /* output.shadowmask with channels in use: 4 per listed texel, visibilities; else NULL */
 } lmb_direct_atlas;
 
 /* *out := atlas a's texels and direct light (owned: free its arrays and lmb_texels_free). */

@@ -29,6 +29,8 @@
 static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 static lmb_status set_material_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 static const schema material_override_schema;
+static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static const schema light_mode_schema;
 
 #define OFF(f) offsetof(lmb_config, f)
 #define FLOAT(p, off, lo, hi, op) {.path = p, .set = lmb_cfg_set_float, .offset = off, .flo = lo, .fhi = hi, .open = op}
@@ -56,6 +58,8 @@ static const char *const output_formats[] = {"exr", "hdr", "png", "mask", "ktx2"
 static const char *const output_scales[] = {"irradiance", "radiance", NULL};
 static const char *const ktx2_formats[] = {"e5b9g9r9", "b10g11r11", "rgba16f", NULL};
 static const char *const ktx2_supercompressions[] = {"none", "zstd", NULL};
+static const char *const light_mode_names[] = {"baked", "indirect", "realtime", NULL};
+_Static_assert(LMB_LIGHT_BAKED == 0 && LMB_LIGHT_INDIRECT == 1 && LMB_LIGHT_REALTIME == 2, "light_mode_names");
 _Static_assert(LMB_GATHER_COSINE == 0 && LMB_GATHER_AMIS == 1 && LMB_GATHER_AMIS_DEFENSIVE == 2, "gather_methods");
 _Static_assert(LMB_SCALE_IRRADIANCE == 0 && LMB_SCALE_RADIANCE == 1, "output_scales");
 _Static_assert(LMB_EMIT_FRONT == 0 && LMB_EMIT_MATERIAL == 1, "emission_sides");
@@ -107,6 +111,9 @@ static const key_spec config_keys[] = {
     FLOAT("lights.emissive_scale", OFF(emissive_scale), 0, 1e9, 0),
     ENUM("lights.emission_sides", OFF(emission_sides), emission_sides),
     FLOAT("lights.sun_angle", OFF(sun_angle), 0, 30, 0),
+    {.path = "lights.modes", .set = set_light_modes, .offset = OFF(light_modes), .count_offset = OFF(light_mode_count),
+     .max_items = LMB_MAX_PATTERNS, .items = &light_mode_schema, .item_size = sizeof(lmb_light_mode_rule)},
+    BOOL("output.shadowmask", OFF(shadowmask)),
     FLOAT("sky.intensity", OFF(sky_intensity), 0, 1e9, 0),
     RGB("sky.color", OFF(sky_color), 0, 1e9, 0),
     RGB("sky.ground_color", OFF(sky_ground), 0, 1e9, OPEN_NONE),
@@ -135,6 +142,13 @@ static const key_spec material_override_keys[] = {
     RGB("materials.override.albedo", offsetof(lmb_material_override, albedo), 0, 1, OPEN_NONE),
     RGB("materials.override.emissive", offsetof(lmb_material_override, emissive), 0, 1e9, OPEN_NONE),
 };
+/* One lights.modes entry, filled into an lmb_light_mode_rule. */
+static const key_spec light_mode_keys[] = {
+    STRING("lights.modes.match", offsetof(lmb_light_mode_rule, pattern)),
+    ENUM("lights.modes.mode", offsetof(lmb_light_mode_rule, mode), light_mode_names),
+};
+static const schema light_mode_schema = {light_mode_keys, sizeof light_mode_keys / sizeof *light_mode_keys};
+
 static const schema material_override_schema = {material_override_keys,
                                                 sizeof material_override_keys / sizeof *material_override_keys};
 
@@ -247,6 +261,27 @@ static lmb_status set_material_overrides(parse_ctx *c, const key_spec *k, const 
 {
     uint32_t count = 0;
     lmb_status st = lmb_cfg_each_item(c, k, n, base, material_override_item, &count);
+    return lmb_cfg_set_count(k, base, count, st);
+}
+
+/* {match: GLOB, mode: baked | indirect | realtime}, both required */
+static lmb_status light_mode_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
+{
+    lmb_light_mode_rule *o = (lmb_light_mode_rule *)(void *)(base + k->offset) + index;
+    memset(o, 0, sizeof *o);
+    o->mode = -1;
+    if (item->type != YAML_MAPPING_NODE)
+        return lmb_cfg_bad_value(c, k, item, "a mapping {match: GLOB, mode: baked | indirect | realtime}");
+    lmb_status st = walk_mapping(c, &light_mode_schema, item, k->path, (char *)o);
+    if (st == LMB_OK && (!o->pattern[0] || o->mode < 0))
+        return lmb_cfg_key_error(c, item, k->path, "each entry needs both match and mode");
+    return st;
+}
+
+static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    uint32_t count = 0;
+    lmb_status st = lmb_cfg_each_item(c, k, n, base, light_mode_item, &count);
     return lmb_cfg_set_count(k, base, count, st);
 }
 

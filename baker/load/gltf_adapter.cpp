@@ -176,6 +176,15 @@ void fill_meshes(lmb_gltf_doc &d)
     }
 }
 
+/* extras.lightmap_mode as written: "" when absent, "?" when not a string (the loader names it). */
+const char *mode_string(const tinygltf::Value &extras)
+{
+    const tinygltf::Value *v = extras.IsObject() ? member(extras, "lightmap_mode") : nullptr;
+    if (!v)
+        return "";
+    return v->IsString() ? v->Get<std::string>().c_str() : "?";
+}
+
 void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
 {
     c.name = n.name.c_str();
@@ -199,6 +208,7 @@ void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
         else if (flag && flag->IsNumber())
             c.extras_lightmap = flag->GetNumberAsDouble() != 0.0;
     }
+    c.lightmap_mode = mode_string(n.extras);
     const tinygltf::Value *gpu = extension(n.extensions, "EXT_mesh_gpu_instancing");
     const tinygltf::Value *attrs = gpu ? member(*gpu, "attributes") : nullptr;
     c.has_gpu_instancing = attrs != nullptr;
@@ -314,6 +324,7 @@ void fill_lights(lmb_gltf_doc &d)
         c.range = l.range;
         c.inner_cone = l.spot.innerConeAngle;
         c.outer_cone = l.spot.outerConeAngle;
+        c.lightmap_mode = mode_string(l.extras);
         d.lights.push_back(c);
     }
 }

@@ -63,6 +63,7 @@ typedef struct lmb_gltf_node {
     int extras_lightmap; /* -1 absent, 0/1: the bool under the requested extras key */
     int32_t gpu_translation, gpu_rotation, gpu_scale; /* EXT_mesh_gpu_instancing accessors, -1 */
     int has_gpu_instancing;
+    const char *lightmap_mode; /* extras.lightmap_mode as written ("" absent, "?" not a string): the mode of its light */
 } lmb_gltf_node;
 
 /* A glTF textureInfo with its KHR_texture_transform, as written (defaults filled in). */
@@ -105,6 +106,7 @@ typedef struct lmb_gltf_light {
     double color[3];
     double intensity, range;
     double inner_cone, outer_cone;
+    const char *lightmap_mode; /* extras.lightmap_mode as written ("" absent, "?" not a string) */
 } lmb_gltf_light;
 
 typedef struct lmb_gltf_image {

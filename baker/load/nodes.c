@@ -195,13 +195,28 @@ static lmb_status add_light(walk *w, uint32_t node, const double world[16], lmb_
         return lmb_error_set(err, LMB_ERR_INPUT,
                              "%s: %s: spot cone angles inner %g, outer %g must satisfy 0 <= inner < outer <= pi/2",
                              w->ctx->path, label, gl->inner_cone, gl->outer_cone);
+    /* extras.lightmap_mode: the light's own, else its node's */
+    const char *mode = gl->lightmap_mode && *gl->lightmap_mode ? gl->lightmap_mode : n->lightmap_mode;
+    l.mode = LMB_LIGHT_BAKED;
+    l.shadowmask_channel = -1;
+    if (mode && *mode && lmb_light_mode_parse(mode, &l.mode) != 0)
+        return lmb_error_set(err, LMB_ERR_INPUT,
+                             "%s: %s (node %u): extras.lightmap_mode is %s%s%s; expected \"baked\", \"indirect\" or \"realtime\"",
+                             w->ctx->path, label, node, strcmp(mode, "?") ? "'" : "", strcmp(mode, "?") ? mode : "not a string",
+                             strcmp(mode, "?") ? "'" : "");
     void *p = grow(s->lights, &w->light_cap, s->light_count + 1, sizeof *s->lights);
     if (!p)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", w->ctx->path);
     s->lights = p;
     l.name = lmb_strdup(gl->name && *gl->name ? gl->name : label);
-    if (!l.name)
+    char node_label[160];
+    lmb_object_label(node_label, "node", node, n->name);
+    l.node_name = lmb_strdup(n->name && *n->name ? n->name : node_label);
+    if (!l.name || !l.node_name) {
+        free(l.name);
+        free(l.node_name);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", w->ctx->path);
+    }
     l.gltf_light = (uint32_t)n->light;
     l.node = node;
     for (int c = 0; c < 3; c++)

@@ -147,8 +147,10 @@ void lmb_scene_free(lmb_scene *s)
         free(s->instances[i].name);
     for (uint32_t i = 0; i < s->material_count; i++)
         free(s->materials[i].name);
-    for (uint32_t i = 0; i < s->light_count; i++)
+    for (uint32_t i = 0; i < s->light_count; i++) {
         free(s->lights[i].name);
+        free(s->lights[i].node_name);
+    }
     free(s->primitives);
     free(s->meshes);
     free(s->instances);

@@ -151,3 +151,18 @@ lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, co
     }
     return st;
 }
+
+lmb_status lmb_write_shadowmask_image(const char *dir, const char *stem, uint32_t a, const float *v, uint32_t w,
+                                      uint32_t h, lmb_error *err)
+{
+    char path[8600];
+    uint8_t *png = malloc((size_t)w * h * 4 + 1);
+    if (!png)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "shadowmask: out of memory");
+    for (size_t i = 0; i < (size_t)w * h * 4; i++)
+        png[i] = (uint8_t)(v[i] <= 0 ? 0 : v[i] >= 1 ? 255 : lround(v[i] * 255.0));
+    snprintf(path, sizeof path, "%s/%s-lightmap-%u-shadowmask.png", dir, stem, a);
+    lmb_status st = lmb_image_write_u8(path, w, h, 4, png, err);
+    free(png);
+    return st;
+}

@@ -30,4 +30,9 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
 lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
                                       const float *d, uint32_t width, uint32_t height, lmb_error *err);
 
+/* output.shadowmask: <stem>-lightmap-N-shadowmask.png, RGBA8, per channel a light's visibility
+ * (4 floats per texel in [0, 1]), linear. */
+lmb_status lmb_write_shadowmask_image(const char *dir, const char *stem, uint32_t atlas, const float *v, uint32_t width,
+                                      uint32_t height, lmb_error *err);
+
 #endif

@@ -258,7 +258,8 @@ extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gl
         Value::Object files, lm;
         const std::pair<const char *, const char *> named[] = {
             {"exr", f->exr}, {"hdr", f->hdr}, {"png", f->png}, {"ktx2", f->ktx2}, {"rgbm", f->rgbm},
-            {"directionPng", f->direction_png}, {"directionExr", f->direction_exr}, {"directionKtx2", f->direction_ktx2}};
+            {"directionPng", f->direction_png}, {"directionExr", f->direction_exr}, {"directionKtx2", f->direction_ktx2},
+            {"shadowmask", f->shadowmask}};
         for (const auto &n : named)
             if (n.second)
                 files[n.first] = Value(std::string(n.second));
@@ -355,6 +356,59 @@ extern "C" void lmb_gltf_set_default_albedo(lmb_gltf_doc *doc, const double albe
     doc->has_default_albedo = true;
     for (int k = 0; k < 3; k++)
         doc->default_albedo[k] = albedo[k];
+}
+
+extern "C" lmb_status lmb_gltf_set_light_modes(lmb_gltf_doc *doc, const lmb_light *lights, uint32_t count,
+                                               lmb_error *err)
+{
+    try {
+        tinygltf::Model &m = doc->model;
+        bool mixed = false;
+        for (uint32_t i = 0; i < count; i++)
+            mixed |= lights[i].mode != LMB_LIGHT_BAKED;
+        if (!mixed)
+            return LMB_OK;
+        Value::Object channels;
+        for (uint32_t i = 0; i < count; i++) {
+            const lmb_light &l = lights[i];
+            if (l.gltf_light >= m.lights.size())
+                continue;
+            tinygltf::Light &gl = m.lights[l.gltf_light];
+            Value::Object extras = gl.extras.IsObject() ? gl.extras.Get<Value::Object>() : Value::Object();
+            Value::Object lm;
+            lm["mode"] = Value(std::string(lmb_light_mode_name(l.mode)));
+            lm["inLightmap"] = Value(std::string(l.mode == LMB_LIGHT_BAKED      ? "direct and indirect"
+                                                 : l.mode == LMB_LIGHT_INDIRECT ? "indirect only: draw its direct light"
+                                                                                : "nothing: draw it"));
+            if (l.shadowmask_channel >= 0) {
+                std::string ch(1, "RGBA"[l.shadowmask_channel]);
+                lm["shadowmaskChannel"] = Value(ch);
+                channels[ch] = Value(std::string(l.name));
+            }
+            if (!extras.count("lightmap") || !extras["lightmap"].IsObject()) { /* its first node decides */
+                extras["lightmap"] = Value(lm);
+                gl.extras = Value(extras);
+            }
+        }
+        if (!channels.empty())
+            for (auto &t : m.textures) {
+                if (!t.extras.IsObject() || !t.extras.Has("lightmap"))
+                    continue;
+                Value::Object extras = t.extras.Get<Value::Object>();
+                Value::Object lm = extras["lightmap"].Get<Value::Object>();
+                Value::Object sm;
+                sm["lights"] = Value(channels);
+                sm["meaning"] = Value(std::string("per channel the share of the light's shadow rays that reach it, 0..1 "
+                                                  "(8-bit, linear); the engine multiplies the light's real-time direct "
+                                                  "light by it"));
+                lm["shadowmask"] = Value(sm);
+                extras["lightmap"] = Value(lm);
+                t.extras = Value(extras);
+            }
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: cannot name the lights' bake modes: %s", e.what());
+    }
 }
 
 extern "C" lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, uint32_t count, lmb_error *err)

@@ -39,6 +39,7 @@ typedef struct lmb_gltf_lightmap_files {
     double rgbm_range;        /* rgbm: its range (write/rgbm.h) */
     uint32_t ktx2_vkformat;   /* ktx2: its vkFormat */
     const char *direction_png, *direction_exr, *direction_ktx2; /* output.directional */
+    const char *shadowmask;   /* output.shadowmask: the RGBA8 PNG */
 } lmb_gltf_lightmap_files;
 
 /* Adds the texture of one atlas: source files->png, MOZ_texture_rgbe files->hdr, and
@@ -61,6 +62,13 @@ int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char *png_uri, l
 lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count,
                                   int32_t texture, int32_t direction_texture, const double scale_offset[4],
                                   lmb_error *err);
+
+/* Mixed lighting: each KHR_lights_punctual light that lights (its first node's) gets
+ * extras.lightmap {mode, shadowmaskChannel ("R".."A", when it has one)}, so an engine knows
+ * which lights to draw in real time; and with a shadowmask, every lightmap texture's
+ * extras.lightmap.shadowmask names {channel: light name}. Nothing is written when every
+ * light is `baked`. */
+lmb_status lmb_gltf_set_light_modes(lmb_gltf_doc *doc, const lmb_light *lights, uint32_t count, lmb_error *err);
 
 /* Names the irradiance cache's records file in asset.extras.lmbake.irradianceCacheRecords:
  * {"uri": uri, "count": count, "layout": "float32le x y z reach"} (write/records_file.h);

@@ -145,8 +145,22 @@ typedef struct lmb_material {
     int double_sided;
 } lmb_material;
 
+/* How a light is baked (lights.modes, or the light's extras.lightmap_mode): as engines light
+ * levels with some lights real-time (Unity's Baked Indirect and Shadowmask, Godot's per-light
+ * bake mode, bevy's MixedLighting). */
+typedef enum lmb_light_mode {
+    LMB_LIGHT_BAKED = 0,    /* direct and bounced light in the lightmap */
+    LMB_LIGHT_INDIRECT = 1, /* only its bounced light in the lightmap: the engine draws its direct light */
+    LMB_LIGHT_REALTIME = 2  /* not in the bake at all */
+} lmb_light_mode;
+
+#define LMB_SHADOWMASK_CHANNELS 4
+
 typedef struct lmb_light {
     char *name;
+    char *node_name;     /* the node that places it: its name or "node N" */
+    lmb_light_mode mode;
+    int shadowmask_channel; /* output.shadowmask: its visibility's channel (0..3) in the shadowmask, or -1 */
     lmb_light_type type;
     uint32_t gltf_light; /* index into KHR_lights_punctual.lights */
     uint32_t node;       /* node that places it */
@@ -241,6 +255,12 @@ typedef struct lmb_material_override {
     double emissive[3];            /* nits, linear RGB, [0] < 0: keep */
 } lmb_material_override;
 
+/* lights.modes entry: the lights whose name or node name matches get this mode */
+typedef struct lmb_light_mode_rule {
+    char pattern[LMB_PATTERN_LEN];
+    int mode; /* lmb_light_mode; -1 before it is read */
+} lmb_light_mode_rule;
+
 typedef struct lmb_config {
     /* unwrap / pack */
     double texel_density;          /* texels per world unit; 0 = auto: the lightmapped surface fills atlas_texels */
@@ -308,6 +328,9 @@ typedef struct lmb_config {
     uint32_t sky_samples;          /* sky rays per gather point, split between the map's and the cosine distribution */
     int sky_cosine_only;           /* sky.sampling: cosine: no map samples (the benchmark's comparison) */
     double sun_angle;              /* degrees: a directional light is a disc of this angular diameter; 0 = a point */
+    lmb_light_mode_rule light_modes[LMB_MAX_PATTERNS]; /* lights.modes: first match wins, over the file's extras */
+    uint32_t light_mode_count;
+    int shadowmask;                /* output.shadowmask: the visibility of up to 4 `indirect` lights per texel */
     /* materials the file did not set, or set wrongly for a bake */
     double default_albedo[3];      /* materials.default.albedo: primitives with no material; [0] < 0: none (glTF's metal) */
     lmb_material_override material_overrides[LMB_MAX_PATTERNS];
@@ -352,6 +375,18 @@ void lmb_scene_free(lmb_scene *scene);
 
 /* Marks each instance lightmapped or not (with a reason) from the config's include /
  * exclude globs, the node extras flag and the geometry itself. */
+/* "baked", "indirect" or "realtime" -> *mode; -1 for anything else. */
+int lmb_light_mode_parse(const char *name, lmb_light_mode *mode);
+
+/* The name of a mode ("baked", "indirect", "realtime"). */
+const char *lmb_light_mode_name(lmb_light_mode mode);
+
+/* Applies cfg's lights.modes (first matching glob over the light's name and its node's name
+ * wins over the file's extras.lightmap_mode) and, with output.shadowmask, gives the first 4
+ * `indirect` lights their channels (more are listed in a warning and baked instead). Logs
+ * each light's mode when any is not `baked`. */
+void lmb_scene_set_light_modes(lmb_scene *scene, const lmb_config *cfg, const lmb_log *log);
+
 void lmb_scene_select_lightmapped(lmb_scene *scene, const lmb_config *cfg);
 
 /* Counts for reports. Triangle counts include zero-area ones; "in_nodes" counts each node

@@ -50,7 +50,7 @@ const srv = await startServer(gltfPath);
 const browser = await launchBrowser();
 let failedToLoad = false;
 async function view(name, params) {
-  const v = await openPreview(browser, srv.url, params);
+  const v = await openPreview(browser, srv.url, { lightmap: 'hdr', ...params }); // the .hdr, which the checks read, even beside a KTX2
   const file = path.join(shotsDir, `preview-${name}.png`);
   v.png = decodePng(await v.page.screenshot({ path: file }));
   console.log(`shot ${file} (${v.url.replace(srv.url, '/')})`);
@@ -66,7 +66,7 @@ const dist = (a, b) => Math.max(...a.map((v, i) => Math.abs(v - b[i])));
 try {
   // --- 3D views: lit and lightmap-only, front camera, EV -3, tonemap none
   const lit = await view('lit', { mode: 'lit', ev: EV, tonemap: 'none', view: 'front' });
-  const atlasIndex = lit.info.atlases.findIndex((a) => path.basename(a.uri) === hdrName);
+  const atlasIndex = lit.info.atlases.findIndex((a) => path.basename(a.hdr || a.uri) === hdrName);
   check('page knows the atlas', atlasIndex >= 0 && lit.info.atlases[atlasIndex].width === W && lit.info.atlases[atlasIndex].height === H,
     `atlases ${JSON.stringify(lit.info.atlases.map((a) => [a.uri, a.width, a.height]))}, reference ${hdrName} ${W}x${H}`);
   const atlas = lit.info.atlases[atlasIndex].index;

@@ -449,6 +449,25 @@ static void test_output_keys(void)
     CHECK_INT(parse("output: {rgbm_range: auto}\n", &c, &err), LMB_OK);
     CHECK_NEAR(c.rgbm_range, 0, 0);
     CHECK_INT(c.output_scale, LMB_SCALE_IRRADIANCE); /* the default */
+    CHECK_INT(c.shadowmask, 0);
+    CHECK_INT(parse("output: {shadowmask: true}\nlights:\n  modes:\n    - {match: \"Sun*\", mode: indirect}\n"
+                    "    - {match: Lamp, mode: realtime}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.shadowmask, 1);
+    CHECK_INT(c.light_mode_count, 2);
+    CHECK(strcmp(c.light_modes[0].pattern, "Sun*") == 0);
+    CHECK_INT(c.light_modes[0].mode, LMB_LIGHT_INDIRECT);
+    CHECK_INT(c.light_modes[1].mode, LMB_LIGHT_REALTIME);
+    expect_error("lights:\n  modes:\n    - {match: Sun, mode: stationary}\n", "level.yaml:3: ",
+                 "key 'lights.modes.mode': expected one of baked, indirect, realtime, got 'stationary'");
+    expect_error("lights:\n  modes:\n    - {match: Sun}\n", "level.yaml:3: ",
+                 "key 'lights.modes': each entry needs both match and mode");
+    expect_error("lights: {modes: [indirect]}\n", "level.yaml:1: ", "key 'lights.modes': expected a mapping {match: GLOB");
+    expect_error("output: {shadowmask: 4}\n", "level.yaml:1: ", "key 'output.shadowmask': expected true or false");
+    lmb_light_mode m;
+    CHECK_INT(lmb_light_mode_parse("indirect", &m), 0);
+    CHECK_INT(m, LMB_LIGHT_INDIRECT);
+    CHECK_INT(lmb_light_mode_parse("Indirect", &m), -1);
+    CHECK(strcmp(lmb_light_mode_name(LMB_LIGHT_REALTIME), "realtime") == 0);
 }
 
 /* The sky, sun and materials keys: values, and the usual named errors for unknown keys and bad values. */

@@ -1,0 +1,69 @@
+/*
+ * The direct stage's internals, shared by its files (direct.c: lights at a point; emitters.c:
+ * emissive triangles as area lights; shadowmask.c: the visibility of the shadowmask's lights).
+ * Not part of direct.h's API.
+ */
+#ifndef LMBAKE_DIRECT_INTERNAL_H
+#define LMBAKE_DIRECT_INTERNAL_H
+
+#include "direct.h"
+
+typedef struct light_set {
+    uint32_t *local, local_count;       /* point and spot lights */
+    uint32_t *directional, directional_count;
+    double *cdf;                        /* local_count + 1, by power */
+    uint32_t indirect_count;            /* lights in `indirect` mode (their direct light is deferred) */
+    int mask_light[LMB_SHADOWMASK_CHANNELS]; /* output.shadowmask: the light of each channel, -1 */
+    uint32_t mask_channels;
+} light_set;
+
+typedef struct emitter {
+    double p[9];   /* world corners */
+    double n[3];   /* unit front normal */
+    double area;
+    float le[3];   /* radiance, nits (times the texture when there is one) */
+    int two_sided;
+    const lmb_texture *tex; /* emissive texture or NULL */
+    double uv[6];  /* its texture coordinates at the corners (KHR_texture_transform applied) */
+    uint32_t instance, primitive, triangle; /* where it is in the scene (primitive: lmb_scene index) */
+} emitter;
+
+struct lmb_emitters {
+    emitter *e;
+    double *cdf; /* count + 1 */
+    uint32_t count;
+};
+
+struct lmb_direct {
+    const lmb_scene *scene;
+    const lmb_config *cfg;
+    const lmb_rt *rt;
+    const lmb_emitters *emitters;
+    const lmb_sky *sky;
+    light_set lights;
+    uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
+};
+
+
+typedef struct point_ctx {
+    const lmb_direct *d;
+    double o[3];    /* offset origin */
+    double p[3], n[3], ng[3];
+    double eps;
+    uint32_t samples; /* area-light and many-light samples */
+    uint64_t rays;
+    double dir[3];    /* sum of each contribution's luminance times its direction (unit, toward the light) */
+    double deferred[3]; /* the part of e from `indirect` lights (not in the lightmap, not in dir) */
+} point_ctx;
+
+/* Emitter index chosen in proportion to power for u in [0, 1); *prob its probability. */
+uint32_t lmb_emitter_pick(const lmb_emitters *es, double u, double *prob);
+
+/* c := the shading point sp of d, no rays traced yet. */
+void lmb_point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp);
+
+/* Direction (unit, toward the sun) of the sample (u1, u2) of directional light l as a disc of
+ * lights.sun_angle: uniform in its cone of directions. */
+void lmb_sun_disc_direction(const lmb_config *cfg, const lmb_light *l, double u1, double u2, double d[3]);
+
+#endif

@@ -1,0 +1,59 @@
+/* The shadowmask's visibilities (output.shadowmask; see direct.h, lmb_shadowmask_at and
+ * docs/mixed-lighting.md). */
+#include "direct_internal.h"
+
+#include "../util/frame.h"
+#include "../util/lmb_math.h"
+#include "../util/rng.h"
+
+#include <math.h>
+
+/* Visibility of light l from c's point: the share of shadow rays that reach it (a disc's
+ * `samples` directions for a sun with lights.sun_angle, one ray otherwise); 0 where the
+ * surface faces away. */
+static double visibility(point_ctx *c, const lmb_light *l, lmb_rng *rng)
+{
+    double d[3], dist = 1e300;
+    if (l->type == LMB_LIGHT_DIRECTIONAL && c->d->cfg->sun_angle > 0) {
+        uint32_t seen = 0;
+        for (uint32_t s = 0; s < c->samples; s++) {
+            double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng);
+            lmb_sun_disc_direction(c->d->cfg, l, u1, u2, d);
+            if (lmb_dot3(c->n, d) <= 0 || lmb_dot3(c->ng, d) <= 0)
+                continue;
+            c->rays++;
+            seen += !lmb_rt_occluded(c->d->rt, c->o, d, c->eps, 1e300);
+        }
+        return c->samples ? (double)seen / c->samples : 0;
+    }
+    if (l->type == LMB_LIGHT_DIRECTIONAL) {
+        for (int k = 0; k < 3; k++)
+            d[k] = -l->direction[k];
+    } else {
+        for (int k = 0; k < 3; k++)
+            d[k] = l->position[k] - c->p[k];
+        dist = sqrt(lmb_dot3(d, d));
+        if (!(dist > 0))
+            return 0;
+        for (int k = 0; k < 3; k++)
+            d[k] /= dist;
+    }
+    if (lmb_dot3(c->n, d) <= 0 || lmb_dot3(c->ng, d) <= 0)
+        return 0;
+    c->rays++;
+    return lmb_rt_occluded(c->d->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps)
+               ? 0
+               : 1;
+}
+
+uint32_t lmb_shadowmask_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng,
+                           double vis[LMB_SHADOWMASK_CHANNELS])
+{
+    point_ctx c;
+    lmb_point_init(&c, d, sp);
+    c.samples = d->cfg->direct_samples;
+    for (uint32_t k = 0; k < LMB_SHADOWMASK_CHANNELS; k++)
+        vis[k] = k < d->lights.mask_channels ? visibility(&c, &d->scene->lights[d->lights.mask_light[k]], rng) : 0;
+    return (uint32_t)c.rays;
+}
+
