@@ -11,7 +11,7 @@ export const ATLAS_BACKGROUND = 0x141428; // sRGB (20, 20, 40): texels no chart 
 export class AtlasView {
   constructor(atlases, chartMeshes) {
     this.atlases = atlases;
-    this.chartMeshes = chartMeshes; // [{atlas, checkerGeometry}]
+    this.chartMeshes = chartMeshes; // [{atlas, checkerGeometry, scaleOffset (the mesh's rectangle in the atlas)}]
     this.camera = new THREE.OrthographicCamera(0, 1, 0, -1, -10, 10);
     this.scenes = new Map();
     this.atlas = 0; this.layer = 'lightmap'; this.zoom = 1; this.originX = 0; this.originY = 0;
@@ -25,14 +25,15 @@ export class AtlasView {
     scene.background = new THREE.Color(ATLAS_BACKGROUND);
     if (layer === 'checker') {
       const mat = checkerMaterial(a);
-      for (const cm of this.chartMeshes) if (cm.atlas === atlasIndex) scene.add(new THREE.Mesh(atlasLayoutGeometry(cm.checkerGeometry, a), mat));
+      for (const cm of this.chartMeshes) if (cm.atlas === atlasIndex) scene.add(new THREE.Mesh(atlasLayoutGeometry(cm.checkerGeometry, a, cm.scaleOffset), mat));
     } else {
       const g = new THREE.BufferGeometry();
       const w = a.width, h = a.height;
       g.setAttribute('position', new THREE.BufferAttribute(new Float32Array([0, 0, 0, w, 0, 0, w, -h, 0, 0, -h, 0]), 3));
       g.setAttribute('uv1', new THREE.BufferAttribute(new Float32Array([0, 0, 1, 0, 1, 1, 0, 1]), 2));
       g.setIndex([0, 2, 1, 0, 3, 2]);
-      scene.add(new THREE.Mesh(g, invalidMaterial(a, 1, { nearest: true, showInvalid: layer === 'invalid' })));
+      // E/pi: a texel x toLux (pi when the files hold E/pi, extras.lightmap.scale radiance)
+      scene.add(new THREE.Mesh(g, invalidMaterial(a, a.toLux, { nearest: true, showInvalid: layer === 'invalid' })));
     }
     this.scenes.set(k, scene);
     return scene;
@@ -76,7 +77,7 @@ export class AtlasView {
     const a = this.atlases[this.atlas];
     const x = Math.floor((px - this.originX) / this.zoom), y = Math.floor((py - this.originY) / this.zoom);
     if (x < 0 || y < 0 || x >= a.width || y >= a.height) return null;
-    return { atlas: this.atlas, x, y, rgb: Array.from(a.data.subarray(4 * (y * a.width + x), 4 * (y * a.width + x) + 3)) };
+    return { atlas: this.atlas, x, y, rgb: Array.from(a.data.subarray(4 * (y * a.width + x), 4 * (y * a.width + x) + 3), (v) => v * a.toLux) };
   }
 
   // Pixel (float, top-left origin) where the centre of texel (x, y) is drawn.

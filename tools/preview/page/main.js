@@ -1,12 +1,12 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
 // the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
 // (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
-// directional lightmaps) and the page exposes hooks for
-// tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen.
+// directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr) and the page exposes hooks for
+// tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { lightmapPlugin, applyDirectionalLightmaps } from './lightmap-plugin.js';
+import { lightmapPlugin, lightmapScaleOffset, applyDirectionalLightmaps, LIGHTMAP_SOURCES } from './lightmap-plugin.js';
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
@@ -26,6 +26,7 @@ const state = {
   layer: q.get('layer') || 'lightmap', zoom: q.get('zoom') ? Number(q.get('zoom')) : null,
   at: q.get('at') ? q.get('at').split(',').map(Number) : null, ui: q.get('ui') !== '0',
   directional: q.get('directional') !== '0', // directional lightmaps in the lit view, when the bake has them
+  lightmap: q.get('lightmap') || 'ktx2', // the lightmap files read: ktx2 (when the glTF names them, else .hdr) or hdr
 };
 const info = (window.lmbInfo = { error: null });
 window.lmbReady = false;
@@ -43,6 +44,7 @@ addEventListener('unhandledrejection', (e) => fail(e.reason && e.reason.stack ? 
 if (!MODES.includes(state.mode)) throw new Error(`unknown mode '${state.mode}' (one of ${MODES.join(', ')})`);
 if (!(state.tonemap in TONEMAPS)) throw new Error(`unknown tonemap '${state.tonemap}' (one of ${Object.keys(TONEMAPS).join(', ')})`);
 if (state.ev !== 'auto' && !Number.isFinite((state.ev = Number(state.ev)))) throw new Error(`ev must be a number or auto`);
+if (!LIGHTMAP_SOURCES.includes(state.lightmap)) throw new Error(`unknown lightmap '${state.lightmap}' (one of ${LIGHTMAP_SOURCES.join(', ')})`);
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(devicePixelRatio);
@@ -55,7 +57,7 @@ const sceneInfo = await (await fetch('/scene.json')).json();
 document.title = `lmbake preview: ${sceneInfo.name}`;
 $('title').textContent = sceneInfo.name;
 const atlases = [];
-const loader = new GLTFLoader().register(lightmapPlugin(atlases));
+const loader = new GLTFLoader().register(lightmapPlugin(atlases, { source: state.lightmap }));
 const gltf = await loader.loadAsync(sceneInfo.gltf);
 const root = gltf.scene;
 const directionalMaterials = state.directional ? await applyDirectionalLightmaps(gltf) : 0;
@@ -75,11 +77,18 @@ const evAuto = state.ev === 'auto';
 if (evAuto) {
   const v = [];
   for (const a of atlases) if (a) for (let i = 0; i < a.data.length; i += 28) {
-    const l = (0.2126 * a.data[i] + 0.7152 * a.data[i + 1] + 0.0722 * a.data[i + 2]) / Math.PI;
+    const l = (0.2126 * a.data[i] + 0.7152 * a.data[i + 1] + 0.0722 * a.data[i + 2]) * a.toLux / Math.PI;
     if (l > 0) v.push(l);
   }
   v.sort((x, y) => x - y);
   state.ev = v.length ? Math.max(-12, Math.min(12, Math.round(2 * Math.log2(0.18 / v[v.length >> 1])) / 2)) : 0;
+}
+
+// The glTF node index an object belongs to (a multi-primitive mesh's meshes are children of
+// the node's group), or -1
+function gltfNode(o) {
+  for (; o; o = o.parent) { const a = gltf.parser.associations.get(o); if (a && a.nodes !== undefined) return a.nodes; }
+  return -1;
 }
 
 // Each mesh and its materials per mode
@@ -91,21 +100,22 @@ let charts = 0;
 root.traverse((o) => {
   if (!o.isMesh) return;
   const lit = o.material, lm = lit.lightMap;
-  const e = { mesh: o, lit, geometry: o.geometry, atlas: lm && lm.userData.atlas !== undefined ? lm.userData.atlas : -1 };
+  // scaleOffset: the mesh's rectangle in its atlas (uv1 x scale + offset), from the lightMap's offset / repeat
+  const e = { mesh: o, lit, geometry: o.geometry, atlas: lm && lm.userData.atlas !== undefined ? lm.userData.atlas : -1, scaleOffset: lightmapScaleOffset(lm), node: gltfNode(o) };
   if (lm) e.lightmap = cached(`lm:${lm.uuid}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(lightmapMaterial(lm, lit.lightMapIntensity), { side: lit.side }));
   if (e.atlas >= 0 && o.geometry.attributes.uv1) {
-    const a = atlases[e.atlas];
-    e.invalid = cached(`inv:${e.atlas}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity), { side: lit.side }));
-    e.checker = cached(`chk:${e.atlas}:${lit.side}`, () => Object.assign(checkerMaterial(a), { side: lit.side }));
+    const a = atlases[e.atlas], so = e.scaleOffset;
+    e.invalid = cached(`inv:${e.atlas}:${so}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity, { scaleOffset: so }), { side: lit.side }));
+    e.checker = cached(`chk:${e.atlas}:${so}:${lit.side}`, () => Object.assign(checkerMaterial(a, so), { side: lit.side }));
     e.checkerGeometry = checkerGeometry(o.geometry, charts);
     charts += e.checkerGeometry.userData.charts;
   }
   entries.push(e);
 });
-const chartMeshes = entries.filter((e) => e.checkerGeometry).map((e) => ({ atlas: e.atlas, checkerGeometry: e.checkerGeometry }));
+const chartMeshes = entries.filter((e) => e.checkerGeometry).map((e) => ({ atlas: e.atlas, checkerGeometry: e.checkerGeometry, scaleOffset: e.scaleOffset }));
 const atlasView = new AtlasView(atlases, chartMeshes);
-// atlases[i] is undefined for a lightmap without its .hdr (PNG only): no data to show
-if (state.mode === 'atlas' && !atlases[state.atlas]) throw new Error(`atlas ${state.atlas} does not exist or has no MOZ_texture_rgbe .hdr (${atlases.filter(Boolean).length} atlases)`);
+// atlases[i] is undefined for a lightmap without its .hdr or KTX2 (PNG only): no data to show
+if (state.mode === 'atlas' && !atlases[state.atlas]) throw new Error(`atlas ${state.atlas} does not exist or has no .hdr (MOZ_texture_rgbe) or KTX2 file (${atlases.filter(Boolean).length} atlases)`);
 if (!['lightmap', 'invalid', 'checker'].includes(state.layer)) throw new Error(`unknown layer '${state.layer}'`);
 
 // Camera: "front" looks along -Z at the centre of the scene's bounding box, from where the
@@ -171,7 +181,9 @@ function updateInfo() {
     camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
     bounds: { min: box.min.toArray(), max: box.max.toArray() },
     canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
-    atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
+    // uri: the file read (source ktx2 or hdr; format: its texel format); hdr: the .hdr's uri either way
+    atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, source: a.source, format: a.format, hdr: a.hdr, fallback: a.fallback, scale: a.scale, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
+    lightmap: state.lightmap,
     meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
     charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),
     directionalMaterials,
@@ -237,7 +249,7 @@ renderer.domElement.addEventListener('wheel', (e) => {
   updateInfo(); requestRender();
 }, { passive: true });
 
-// Hover: texel coordinates and the stored irradiance (from the .hdr data)
+// Hover: texel coordinates and the stored irradiance (from the .hdr or KTX2 data, x toLux: E in lux)
 const raycaster = new THREE.Raycaster();
 function pick(px, py) {
   const ndc = new THREE.Vector2((px / innerWidth) * 2 - 1, -(py / innerHeight) * 2 + 1);
@@ -246,10 +258,15 @@ function pick(px, py) {
   if (!hit) return null;
   const e = entries.find((x) => x.mesh === hit.object);
   const r = { object: hit.object.name, point: hit.point.toArray(), distance: hit.distance, atlas: e ? e.atlas : -1 };
+  if (e) r.node = e.node;
   if (hit.uv1) {
+    // uv1: the mesh's TEXCOORD_1; lightmapUv: where the atlas is read, uv1 x scale + offset
     r.uv1 = [hit.uv1.x, hit.uv1.y];
+    const so = e ? e.scaleOffset : [1, 1, 0, 0];
+    r.lightmapUv = [hit.uv1.x * so[0] + so[2], hit.uv1.y * so[1] + so[3]];
     const a = atlases[r.atlas];
-    if (a) r.texel = [Math.min(a.width - 1, Math.floor(hit.uv1.x * a.width)), Math.min(a.height - 1, Math.floor(hit.uv1.y * a.height))];
+    const clamp = (t, n) => Math.max(0, Math.min(n - 1, Math.floor(t * n)));
+    if (a) r.texel = [clamp(r.lightmapUv[0], a.width), clamp(r.lightmapUv[1], a.height)];
   }
   return r;
 }
@@ -262,7 +279,7 @@ addEventListener('pointermove', (e) => {
   let t = null;
   if (state.mode === 'atlas') t = atlasView.texelAt(e.offsetX, e.offsetY);
   else { const h = pick(e.offsetX, e.offsetY); if (h && h.texel) t = { atlas: h.atlas, x: h.texel[0], y: h.texel[1], object: h.object }; }
-  if (t && !t.rgb) { const a = atlases[t.atlas], i = 4 * (t.y * a.width + t.x); t.rgb = Array.from(a.data.subarray(i, i + 3)); }
+  if (t && !t.rgb) { const a = atlases[t.atlas], i = 4 * (t.y * a.width + t.x); t.rgb = Array.from(a.data.subarray(i, i + 3), (v) => v * a.toLux); }
   const f = (v) => v.toPrecision(4);
   $('hover').textContent = t ? `atlas ${t.atlas} texel (${t.x}, ${t.y})${t.object ? '  ' + t.object : ''}\nE = ${t.rgb.map(f).join(' ')} lux   E/pi = ${t.rgb.map((v) => f(v / Math.PI)).join(' ')}` : '';
 });
@@ -276,23 +293,26 @@ window.lmbProject = (x, y, z) => {
   const v = new THREE.Vector3(x, y, z).project(camera);
   return { x: (v.x + 1) / 2 * innerWidth, y: (1 - v.y) / 2 * innerHeight, inFront: v.z < 1 };
 };
-// What the centre of pixel (px, py) sees: object, world point, uv1, atlas and texel.
+// What the centre of pixel (px, py) sees: object, glTF node, world point, uv1, lightmapUv (the
+// atlas uv: uv1 through the mesh's lightmap rectangle), atlas and texel.
 window.lmbPick = (px, py) => pick(px + 0.5, py + 0.5);
 // Where the centre of texel (x, y) of an atlas is drawn: in the atlas view, the pixel; in
 // the 3D views, the projection of the surface point with that UV1 (visible: a pick there
-// sees the same atlas within a texel).
+// sees the same atlas within a texel). Triangles are matched in atlas uv (uv1 x scale + offset).
 window.lmbTexelToScreen = (atlasIndex, x, y) => {
   if (state.mode === 'atlas') return { ...atlasView.texelToScreen(x, y), visible: atlasIndex === atlasView.atlas };
   const a = atlases[atlasIndex];
   const p = new THREE.Vector2((x + 0.5) / a.width, (y + 0.5) / a.height);
   for (const e of entries) {
     if (e.atlas !== atlasIndex) continue;
-    const g = e.geometry, uv = g.attributes.uv1, pos = g.attributes.position;
+    const g = e.geometry, uv = g.attributes.uv1, pos = g.attributes.position, [su, sv, ou, ov] = e.scaleOffset;
+    if (!uv) continue;
+    const toAtlas = (v) => v.set(v.x * su + ou, v.y * sv + ov);
     const idx = g.index ? g.index.array : null, n = idx ? idx.length : pos.count;
     const A = new THREE.Vector2(), B = new THREE.Vector2(), C = new THREE.Vector2(), bc = new THREE.Vector3();
     for (let t = 0; t < n; t += 3) {
       const i0 = idx ? idx[t] : t, i1 = idx ? idx[t + 1] : t + 1, i2 = idx ? idx[t + 2] : t + 2;
-      A.fromBufferAttribute(uv, i0); B.fromBufferAttribute(uv, i1); C.fromBufferAttribute(uv, i2);
+      toAtlas(A.fromBufferAttribute(uv, i0)); toAtlas(B.fromBufferAttribute(uv, i1)); toAtlas(C.fromBufferAttribute(uv, i2));
       if (!THREE.Triangle.containsPoint(new THREE.Vector3(p.x, p.y, 0), new THREE.Vector3(A.x, A.y, 0), new THREE.Vector3(B.x, B.y, 0), new THREE.Vector3(C.x, C.y, 0))) continue;
       THREE.Triangle.getBarycoord(new THREE.Vector3(p.x, p.y, 0), new THREE.Vector3(A.x, A.y, 0), new THREE.Vector3(B.x, B.y, 0), new THREE.Vector3(C.x, C.y, 0), bc);
       const w = new THREE.Vector3().fromBufferAttribute(pos, i0).multiplyScalar(bc.x)
@@ -307,6 +327,17 @@ window.lmbTexelToScreen = (atlasIndex, x, y) => {
     }
   }
   return null;
+};
+
+// An atlas's float data as stored in the file read (RGBA float32, row 0 = the top; before
+// toLux) for tests: {width, height, source, uri, base64} (the bytes, little-endian), or null.
+window.lmbAtlasData = (i) => {
+  const a = atlases[i];
+  if (!a) return null;
+  const bytes = new Uint8Array(a.data.buffer, a.data.byteOffset, a.data.byteLength);
+  let bin = '';
+  for (let k = 0; k < bytes.length; k += 0x8000) bin += String.fromCharCode.apply(null, bytes.subarray(k, k + 0x8000));
+  return { width: a.width, height: a.height, source: a.source, uri: a.uri, base64: btoa(bin) };
 };
 
 // Render loop: only when something changed (SwiftShader is slow); ready after the first frame

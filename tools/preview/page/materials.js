@@ -6,12 +6,16 @@
 //   invalid:  the lightmap view, with texels whose stored irradiance is exactly 0 in magenta.
 //   checker:  a texel checkerboard of the UV1 atlas (tinted per chart, darker every other 8x8
 //             block), texel grid lines when zoomed in, chart borders in red-orange.
+// The invalid and checker views read the atlas at uv1 x scale + offset, the mesh's lightmap
+// rectangle (MOZ_lightmap's KHR_texture_transform; lightmap-plugin.js lightmapScaleOffset), as
+// three's lightMap does for the lightmap and lit views.
 import * as THREE from 'three';
 
 export const INVALID_COLOR = new THREE.Color(1, 0, 1);       // magenta, linear = sRGB
 export const BORDER_COLOR = new THREE.Color(1, 0.1, 0.0);    // linear; sRGB (255, 89, 0)
 
 const VERT = /* glsl */`
+uniform vec4 uvScaleOffset; // the lightmap rectangle: atlas uv = uv1 * xy + zw
 varying vec2 vUv1;
 #ifdef CHECKER
 attribute vec3 bary;
@@ -22,7 +26,7 @@ varying vec3 vEdge;
 varying vec3 vTint;
 #endif
 void main() {
-  vUv1 = uv1;
+  vUv1 = uv1 * uvScaleOffset.xy + uvScaleOffset.zw;
 #ifdef CHECKER
   vBary = bary; vEdge = edge; vTint = tint;
 #endif
@@ -81,22 +85,26 @@ export function lightmapMaterial(tex, intensity) {
   return new THREE.MeshBasicMaterial({ color: 0xffffff, lightMap: tex, lightMapIntensity: intensity, side: THREE.FrontSide });
 }
 
-export function invalidMaterial(atlas, intensity, { nearest = false, showInvalid = true } = {}) {
+// scaleOffset: [scaleU, scaleV, offsetU, offsetV], the mesh's lightmap rectangle in the atlas
+export function invalidMaterial(atlas, intensity, { nearest = false, showInvalid = true, scaleOffset = [1, 1, 0, 0] } = {}) {
   return new THREE.ShaderMaterial({
     defines: nearest ? { USE_UV1: '', ATLAS_NEAREST: '' } : { USE_UV1: '' },
     uniforms: {
       lightMap: { value: atlas.texture }, invalidMask: { value: atlas.maskTexture },
       intensity: { value: intensity }, atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) },
-      showInvalid: { value: showInvalid },
+      showInvalid: { value: showInvalid }, uvScaleOffset: { value: new THREE.Vector4(...scaleOffset) },
     },
     vertexShader: VERT, fragmentShader: INVALID_FRAG,
   });
 }
 
-export function checkerMaterial(atlas) {
+export function checkerMaterial(atlas, scaleOffset = [1, 1, 0, 0]) {
   return new THREE.ShaderMaterial({
     defines: { USE_UV1: '', CHECKER: '' },
-    uniforms: { atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) }, borderColor: { value: BORDER_COLOR } },
+    uniforms: {
+      atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) }, borderColor: { value: BORDER_COLOR },
+      uvScaleOffset: { value: new THREE.Vector4(...scaleOffset) },
+    },
     vertexShader: VERT, fragmentShader: CHECKER_FRAG, toneMapped: false, side: THREE.DoubleSide,
   });
 }
@@ -155,16 +163,21 @@ export function checkerGeometry(geom, firstChart = 0) {
   return out;
 }
 
-// The same triangles laid out flat in the atlas: x = u * width, y = -v * height (texel units).
-export function atlasLayoutGeometry(checkerGeom, atlas) {
+// The same triangles laid out flat in the atlas: x = u * width, y = -v * height (texel units),
+// (u, v) = uv1 x scale + offset (the mesh's lightmap rectangle); uv1 becomes (u, v) too, so the
+// checker material draws it with the identity rectangle.
+export function atlasLayoutGeometry(checkerGeom, atlas, [su, sv, ou, ov] = [1, 1, 0, 0]) {
   const g = checkerGeom.clone();
   const uv = g.attributes.uv1;
-  const pos = new Float32Array(uv.count * 3);
+  const pos = new Float32Array(uv.count * 3), auv = new Float32Array(uv.count * 2);
   for (let i = 0; i < uv.count; i++) {
-    pos[3 * i] = uv.getX(i) * atlas.width;
-    pos[3 * i + 1] = -uv.getY(i) * atlas.height;
+    auv[2 * i] = uv.getX(i) * su + ou;
+    auv[2 * i + 1] = uv.getY(i) * sv + ov;
+    pos[3 * i] = auv[2 * i] * atlas.width;
+    pos[3 * i + 1] = -auv[2 * i + 1] * atlas.height;
   }
   g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+  g.setAttribute('uv1', new THREE.BufferAttribute(auv, 2));
   g.deleteAttribute('normal');
   return g;
 }
