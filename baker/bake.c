@@ -49,6 +49,28 @@ static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
     }
 }
 
+/* The rectangles of every EXT_mesh_gpu_instancing copy of `node` (in the extension's order;
+ * copies without a lightmap get 0s), written with the node's lightmapped mesh. */
+static lmb_status instanced_node(const lmb_scene *s, const lmb_layout *l, uint32_t node, const lmb_gltf_prim_out *prims,
+                                 uint32_t n, int32_t texture, int32_t direction_texture, lmb_error *err)
+{
+    uint32_t copies = 0;
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        if (s->instances[i].node == node && s->instances[i].gpu_instance >= 0)
+            copies = (uint32_t)s->instances[i].gpu_instance + 1 > copies ? (uint32_t)s->instances[i].gpu_instance + 1
+                                                                        : copies;
+    float *so = calloc(4 * (size_t)copies + 1, sizeof *so);
+    if (!so)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        if (s->instances[i].node == node && s->instances[i].gpu_instance >= 0 && l->instances[i].lightmapped)
+            for (int k = 0; k < 4; k++)
+                so[4 * (size_t)s->instances[i].gpu_instance + k] = (float)l->instances[i].scale_offset[k];
+    lmb_status st = lmb_gltf_lightmap_instanced_node(s->doc, node, prims, n, texture, direction_texture, so, copies, err);
+    free(so);
+    return st;
+}
+
 static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                              const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
                              int directional, int shadowmask, lmb_error *err)
@@ -89,21 +111,29 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
         if (tex[a] < 0 || (directional && dir_tex[a] < 0))
             st = LMB_ERR_INTERNAL;
     }
+    uint8_t *node_done = calloc((size_t)s->node_count + 1, 1);
+    if (!node_done)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
     for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
-        if (!l->instances[i].lightmapped)
+        const lmb_instance *in = &s->instances[i];
+        if (!l->instances[i].lightmapped || (in->gpu_instance >= 0 && node_done[in->node]))
             continue;
         lmb_gltf_prim_out *prims = NULL;
         uint32_t n = 0, owned_n = 0;
         void **owned = NULL;
         st = instance_primitives(s, l, i, &prims, &n, &owned, &owned_n, err);
-        if (st == LMB_OK)
-            st = lmb_gltf_lightmap_node(s->doc, s->instances[i].node, prims, n, tex[l->instances[i].atlas],
-                                        dir_tex[l->instances[i].atlas], l->instances[i].scale_offset, err);
+        int32_t t = tex[l->instances[i].atlas], d = dir_tex[l->instances[i].atlas];
+        if (st == LMB_OK && in->gpu_instance >= 0) /* every copy of the node: one mesh, a rectangle each */
+            st = instanced_node(s, l, in->node, prims, n, t, d, err);
+        else if (st == LMB_OK)
+            st = lmb_gltf_lightmap_node(s->doc, in->node, prims, n, t, d, l->instances[i].scale_offset, err);
+        node_done[in->node] = 1;
         for (uint32_t k = 0; k < owned_n; k++)
             free(owned[k]);
         free(owned);
         free(prims);
     }
+    free(node_done);
     if (st == LMB_OK)
         st = lmb_gltf_set_light_modes(s->doc, s->lights, s->light_count, err);
     char path[8600], bin[512], rec[512];
@@ -202,6 +232,10 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
             if (lm->kept_uv1) { /* its own TEXCOORD_1, untouched: the node's rectangle places it */
                 uv1[2 * (size_t)lo] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3)];
                 uv1[2 * (size_t)lo + 1] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3) + 1];
+            } else if (s->instances[i].gpu_instance >= 0) { /* the layout its copies share: back through its rectangle */
+                const double *so = li->scale_offset;
+                uv1[2 * (size_t)lo] = (float)((li->uv1[6 * (size_t)f + 2 * (c % 3)] / w - so[2]) / so[0]);
+                uv1[2 * (size_t)lo + 1] = (float)((li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h - so[3]) / so[1]);
             } else {
                 uv1[2 * (size_t)lo] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3)] / w);
                 uv1[2 * (size_t)lo + 1] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h);

@@ -37,6 +37,8 @@ usage: make_scenes.py OUTDIR
                       near the ceiling (contact shadows for the irradiance cache's benchmark)
   grazing.gltf        a 4 m x 1 m x 0.6 m corridor, a point light 3 cm above the floor near one
                       end: the floor sees its spot at grazing angles (benchmark)
+  instanced-boxes.gltf  a ground, 576 boxes through EXT_mesh_gpu_instancing (every other one 1.5 x
+                      larger), a roof over the x < 0 half, a sun: instanced copies' lightmaps
   gap.gltf            two 1 m rooms side by side, a wall between them with a 4 cm slit from floor
                       to ceiling, a point light in the left room: the right room is lit through the
                       slit only (guided gathering's failure case in the benchmark, which lightmaps
@@ -168,6 +170,28 @@ class Scene:
         mesh = [m["name"] for m in self.doc["meshes"]].index(mesh_name)
         self.doc["nodes"].append({"name": name, "mesh": mesh, "translation": list(translation)})
         self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def gpu_instances(self, name, mesh_name, translations, scales=None):
+        """A node drawing mesh_name once per translation through EXT_mesh_gpu_instancing (optional
+        per-copy uniform scales)."""
+        self._use("EXT_mesh_gpu_instancing")
+        mesh = [m["name"] for m in self.doc["meshes"]].index(mesh_name)
+        attrs = {"TRANSLATION": self._instance_accessor([tuple(t) for t in translations], 3)}
+        if scales:
+            attrs["SCALE"] = self._instance_accessor([(k, k, k) for k in scales], 3)
+        self.doc["nodes"].append({"name": name, "mesh": mesh, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attrs}}})
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def _instance_accessor(self, values, comps):
+        flat = [c for v in values for c in v]
+        data = struct.pack("<%df" % len(flat), *flat)
+        while len(self.blob) % 4:
+            self.blob.append(0)
+        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data)})
+        self.blob += data
+        self.doc["accessors"].append({"bufferView": len(self.doc["bufferViews"]) - 1, "componentType": 5126,
+                                      "count": len(values), "type": "VEC%d" % comps})
+        return len(self.doc["accessors"]) - 1
 
     def light(self, name, kind, intensity, color=(1, 1, 1), translation=(0, 0, 0), rotation=None, **spot):
         self._use("KHR_lights_punctual")
@@ -610,6 +634,30 @@ def artists(out):
     s.write(os.path.join(out, "seams.gltf"))
 
 
+INSTANCED_GRID = 24  # instanced-boxes.gltf: a GRID x GRID grid of boxes, 1 apart
+ROOF_HEIGHT = 3.0
+
+
+def instanced(out):
+    """A 30 x 30 ground, a 24 x 24 grid of 0.5 boxes through EXT_mesh_gpu_instancing (576 copies of
+    one mesh: every other one 1.5 x larger), a roof 3 above the x < 0 half, a sun 30 degrees off
+    vertical: the copies under the roof get indirect light only."""
+    s = Scene()
+    grey = s.material("grey", (0.6, 0.6, 0.6))
+    s.mesh("ground", plane(30), grey)
+    s.mesh("box", box(-0.25, 0, -0.25, 0.25, 0.5, 0.25), s.material("box", (0.7, 0.7, 0.7)))
+    s.doc["scenes"][0]["nodes"].pop()  # the mesh is drawn only through the instancing node
+    s.doc["nodes"].pop()
+    n = INSTANCED_GRID
+    ts = [((i - n / 2 + 0.5) * 1.0, 0.0, (j - n / 2 + 0.5) * 1.0) for i in range(n) for j in range(n)]
+    s.gpu_instances("boxes", "box", ts, [1.0 if (k % 2 == 0) else 1.5 for k in range(len(ts))])
+    roof = quad((-15, ROOF_HEIGHT, 15), (0, ROOF_HEIGHT, 15), (0, ROOF_HEIGHT, -15), (-15, ROOF_HEIGHT, -15))
+    roof = [(a, c, b) for a, b, c in roof] + roof  # both sides: shade below, catch the sun above
+    s.mesh("roof", roof, grey)
+    s.light("sun", "directional", 1000.0, rotation=[-0.5, 0.0, 0.0, math.sqrt(0.75)])  # (0, -0.866, -0.5): 30 deg off vertical
+    s.write(os.path.join(out, "instanced-boxes.gltf"))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -619,3 +667,4 @@ if __name__ == "__main__":
     sky(out)
     indirect(out)
     artists(out)
+    instanced(out)

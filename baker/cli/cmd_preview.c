@@ -1,5 +1,5 @@
 /*
- * `lmbake preview OUT.gltf [--port N]`: serves a baked level to a browser on 127.0.0.1 (the
+ * `lmbake preview OUT.gltf [--port N] [--lightmap ktx2|hdr]`: serves a baked level to a browser on 127.0.0.1 (the
  * three.js page of tools/preview; docs/preview.md). The server is node's: this command
  * checks its arguments and hands over to tools/preview/serve.mjs.
  */
@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 static const char help[] =
-    "usage: lmbake preview OUT.gltf [--port N]\n"
+    "usage: lmbake preview OUT.gltf [--port N] [--lightmap ktx2|hdr]\n"
     "\n"
     "Serves a baked level (the .gltf `lmbake bake` wrote) on http://127.0.0.1:PORT/ and prints\n"
     "the address; open it in a browser. Views: lit, lightmap only, UV1 checker with texel grid,\n"
@@ -20,11 +20,14 @@ static const char help[] =
     "and only this machine can connect. Ctrl-C stops it.\n"
     "\n"
     "  --port N     port to listen on (default: a free one)\n"
+    "  --lightmap ktx2|hdr\n"
+    "               which file of each atlas the page reads: its KTX2 when the glTF names one\n"
+    "               (the default), or the Radiance .hdr\n"
     "  -h, --help   this help\n";
 
 int cmd_preview(int argc, char **argv)
 {
-    const char *gltf = NULL, *port = NULL, *v;
+    const char *gltf = NULL, *port = NULL, *source = NULL, *v;
     for (int i = 1; i < argc; i++) {
         int r;
         unsigned long long n;
@@ -35,6 +38,10 @@ int cmd_preview(int argc, char **argv)
             if (r < 0 || !cli_parse_uint(v, 65535, &n))
                 return cli_usage_error("preview", "--port needs a number 0..65535");
             port = v;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--lightmap", NULL, &v)) != 0) {
+            if (r < 0 || (strcmp(v, "ktx2") != 0 && strcmp(v, "hdr") != 0))
+                return cli_usage_error("preview", "--lightmap needs ktx2 or hdr");
+            source = v;
         } else if (argv[i][0] == '-' && argv[i][1]) {
             return cli_usage_error("preview", "unknown option '%s'", argv[i]);
         } else if (gltf) {
@@ -53,10 +60,15 @@ int cmd_preview(int argc, char **argv)
     char script[PATH_MAX + 64];
     if (!node_tool_path("serve.mjs", script, sizeof script))
         return LMB_ERR_INTERNAL;
-    char *args[4] = {(char *)gltf, NULL, NULL, NULL};
+    char *args[6] = {(char *)gltf, NULL, NULL, NULL, NULL, NULL};
+    int n = 1;
     if (port) {
-        args[1] = "--port";
-        args[2] = (char *)port;
+        args[n++] = "--port";
+        args[n++] = (char *)port;
+    }
+    if (source) {
+        args[n++] = "--lightmap";
+        args[n++] = (char *)source;
     }
     return node_tool_exec(script, args);
 }

@@ -3,10 +3,10 @@
  *   1. a node extras flag (cfg->extras_key, e.g. "extras": {"lightmap": false}) forces it;
  *   2. a name matching an `exclude` glob removes it;
  *   3. a name matching an `include` glob keeps it (default "*": everything);
- * and whatever the rules say, an instance without usable triangles, with a singular
- * transform, or that is an EXT_mesh_gpu_instancing copy (all copies share one mesh, so
- * they cannot each carry their own TEXCOORD_1) is skipped, with the reason recorded for
- * `lmbake inspect`.
+ * and whatever the rules say, an instance without usable triangles or with a singular
+ * transform is skipped, with the reason recorded for `lmbake inspect`. EXT_mesh_gpu_instancing
+ * copies are lightmapped like nodes: they share one TEXCOORD_1 layout, each with its own
+ * rectangle of the atlas (pack/rect_instances.c).
  */
 #include <lmbake/lmbake.h>
 
@@ -40,9 +40,6 @@ void lmb_scene_select_lightmapped(lmb_scene *s, const lmb_config *cfg)
                      mesh->triangle_count ? "every triangle has zero area" : "no triangles");
         else if (!lmb_mat4_is_finite(in->world) || fabs(lmb_mat4_det3(in->world)) < 1e-30)
             snprintf(in->skip_reason, sizeof in->skip_reason, "singular transform");
-        else if (in->gpu_instance >= 0)
-            snprintf(in->skip_reason, sizeof in->skip_reason,
-                     "EXT_mesh_gpu_instancing copy (copies share one mesh and cannot hold their own lightmap UVs)");
         else if (in->extras_lightmap == 0)
             snprintf(in->skip_reason, sizeof in->skip_reason, "extras.%.60s is false", cfg->extras_key);
         else if (in->extras_lightmap == 1)

@@ -9,6 +9,7 @@
 #include "layout.h"
 #include "density.h"
 #include "keep_uv1.h"
+#include "rect_instances.h"
 #include "pack.h"
 #include "unwrap/metrics.h"
 #include "../util/mat4.h"
@@ -69,7 +70,7 @@ void lmb_layout_world_triangle(const lmb_scene *s, const lmb_layout *l, uint32_t
 }
 
 /* Scales instance i's charts into uv1 (texel units, chart-local) and returns its texel area. */
-static double scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
+double lmb_layout_scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
 {
     lmb_layout_instance *li = &l->instances[i];
     const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
@@ -211,7 +212,7 @@ static lmb_status pack_level(const lmb_scene *s, const lmb_config *cfg, lmb_layo
                  s->instances[failed].name, s->meshes[s->instances[failed].mesh].name, li->texel_density,
                  cfg->max_atlas_size, cfg->max_atlas_size);
         /* a failed packing wrote nothing back: only this instance's charts change scale */
-        scale_instance(s, l, failed);
+        lmb_layout_scale_instance(s, l, failed);
     }
 }
 
@@ -246,106 +247,6 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
     return LMB_OK;
 }
 
-/* World area of instance i's lightmapped triangles. */
-static double world_area(const lmb_scene *s, const lmb_layout *l, uint32_t i)
-{
-    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
-    double q[9], world = 0;
-    for (uint32_t f = 0; f < c->triangle_count; f++)
-        if (c->chart_of[f] != UINT32_MAX) {
-            lmb_layout_world_triangle(s, l, i, f, q);
-            world += lmb_triangle_area(q);
-        }
-    return world;
-}
-
-/* Instance i's own TEXCOORD_1 checked in its side x side square: overlapping texels and UVs
- * outside [0, 1] (they would read a neighbour's texels) are reported. */
-static lmb_status check_kept_uv1(const lmb_scene *s, const lmb_layout *l, uint32_t i, uint32_t side,
-                                 const lmb_log *log, lmb_error *err)
-{
-    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
-    double *pos = malloc(sizeof(double) * 9 * c->triangle_count + 1);
-    double *uv = malloc(sizeof(double) * 6 * c->triangle_count + 1);
-    if (!pos || !uv) {
-        free(pos);
-        free(uv);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    }
-    uint32_t outside = 0;
-    for (uint32_t f = 0; f < c->triangle_count; f++) {
-        lmb_layout_world_triangle(s, l, i, f, pos + 9 * f);
-        int out = 0;
-        for (int k = 0; k < 6; k++) {
-            double u = c->chart_of[f] == UINT32_MAX ? 0 : c->uv[6 * f + k];
-            out |= u < 0 || u > 1;
-            uv[6 * f + k] = u * side;
-        }
-        outside += out && c->chart_of[f] != UINT32_MAX;
-    }
-    lmb_uv_layout lay = {c->triangle_count, pos, uv, side, side};
-    lmb_uv_metrics m;
-    lmb_status st = lmb_uv_metrics_compute(&lay, &m, err);
-    free(pos);
-    free(uv);
-    if (st == LMB_OK && m.overlapping_texels)
-        lmb_warn(log, "instance '%s': its own TEXCOORD_1 (atlas.keep_uv1) overlaps itself on %llu texels of its %ux%u "
-                 "square: those texels mix light from two places",
-                 s->instances[i].name, (unsigned long long)m.overlapping_texels, side, side);
-    if (st == LMB_OK && outside)
-        lmb_warn(log, "instance '%s': %u triangles of its own TEXCOORD_1 (atlas.keep_uv1) leave [0, 1]: their texels "
-                 "fall outside its square, on padding or a neighbour's texels", s->instances[i].name, outside);
-    return st;
-}
-
-/* The instances of kept-TEXCOORD_1 meshes (list[0..n)): a square each, sized to the texel
- * density, placed in shared atlases; their UVs scaled into it and its rectangle recorded. */
-static lmb_status kept_uv1_atlases(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
-                                   uint32_t n, const lmb_log *log, lmb_error *err)
-{
-    uint32_t *side = malloc(((size_t)n + 1) * 4 * sizeof *side), *atlas_of = side + n, *x = side + 2 * n,
-             *y = side + 3 * n, *w = NULL, *h = NULL, count = 0;
-    if (!side)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    for (uint32_t j = 0; j < n; j++)
-        side[j] = lmb_uv1_atlas_size(world_area(s, l, list[j]), &l->meshes[s->instances[list[j]].mesh].charts,
-                                     l->instances[list[j]].texel_density, cfg->max_atlas_size);
-    lmb_status st = lmb_place_squares(side, n, cfg->padding, cfg->max_atlas_size, atlas_of, x, y, &count, &w, &h, err);
-    uint32_t base = l->atlas_count;
-    if (st == LMB_OK) {
-        uint32_t *nw = realloc(l->width, (base + count + 1) * sizeof *nw);
-        if (nw) l->width = nw;
-        uint32_t *nh = realloc(l->height, (base + count + 1) * sizeof *nh);
-        if (nh) l->height = nh;
-        if (!nw || !nh)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    }
-    for (uint32_t a = 0; st == LMB_OK && a < count; a++) {
-        l->width[base + a] = w[a];
-        l->height[base + a] = h[a];
-    }
-    if (st == LMB_OK)
-        l->atlas_count += count;
-    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
-        lmb_layout_instance *li = &l->instances[list[j]];
-        const lmb_charts *c = &l->meshes[s->instances[list[j]].mesh].charts;
-        li->atlas = base + atlas_of[j];
-        double W = l->width[li->atlas], H = l->height[li->atlas];
-        li->scale_offset[0] = side[j] / W;
-        li->scale_offset[1] = side[j] / H;
-        li->scale_offset[2] = x[j] / W;
-        li->scale_offset[3] = y[j] / H;
-        for (uint32_t k = 0; k < 6 * c->triangle_count; k++)
-            li->uv1[k] = c->chart_of[k / 6] == UINT32_MAX ? 0 : c->uv[k] * side[j] + (k % 2 ? y[j] : x[j]);
-        l->chart_total++;
-        st = check_kept_uv1(s, l, list[j], side[j], log, err);
-    }
-    free(side);
-    free(w);
-    free(h);
-    return st;
-}
-
 lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progress_fn progress, void *user,
                             const lmb_log *log, lmb_layout *l, lmb_error *err)
 {
@@ -374,10 +275,11 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
         li->uv1 = calloc(li->uv1_count + 1, sizeof *li->uv1);
         if (!li->uv1)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-        else if (!l->meshes[s->instances[list[j]].mesh].kept_uv1)
-            scale_instance(s, l, list[j]);
+        else if (!l->meshes[s->instances[list[j]].mesh].kept_uv1 && s->instances[list[j]].gpu_instance < 0)
+            lmb_layout_scale_instance(s, l, list[j]);
     }
-    /* kept TEXCOORD_1: squares of shared atlases, after the packed ones; the rest is packed */
+    /* kept TEXCOORD_1 and instanced copies: rectangles of shared atlases, after the packed ones;
+     * the rest is packed chart by chart */
     uint32_t packed = 0, kept = 0;
     uint32_t *kept_list = malloc(((size_t)n + 1) * sizeof *kept_list);
     if (st == LMB_OK && !kept_list)
@@ -385,7 +287,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
         lmb_layout_instance *li = &l->instances[list[j]];
         li->scale_offset[0] = li->scale_offset[1] = 1;
-        if (l->meshes[s->instances[list[j]].mesh].kept_uv1)
+        if (l->meshes[s->instances[list[j]].mesh].kept_uv1 || s->instances[list[j]].gpu_instance >= 0)
             kept_list[kept++] = list[j];
         else
             list[packed++] = list[j];
@@ -395,7 +297,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     if (st == LMB_OK && n)
         st = pack_level(s, cfg, l, list, n, log, err);
     if (st == LMB_OK && kept)
-        st = kept_uv1_atlases(s, cfg, l, kept_list, kept, log, err);
+        st = lmb_layout_rect_instances(s, cfg, l, kept_list, kept, log, err);
     free(kept_list);
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <map>
 #include <utility>
+#include <vector>
 
 namespace {
 
@@ -308,6 +309,49 @@ extern "C" int32_t lmb_gltf_add_direction_texture(lmb_gltf_doc *doc, const char 
     } catch (const std::exception &e) {
         lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: %s", e.what());
         return -1;
+    }
+}
+
+extern "C" lmb_status lmb_gltf_lightmap_instanced_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
+                                                       uint32_t count, int32_t texture, int32_t direction_texture,
+                                                       const float *scale_offsets, uint32_t copies, lmb_error *err)
+{
+    static const double identity[4] = {1, 1, 0, 0};
+    lmb_status st = lmb_gltf_lightmap_node(doc, node, prims, count, texture, direction_texture, identity, err);
+    if (st != LMB_OK)
+        return st;
+    try {
+        tinygltf::Model &m = doc->model;
+        writer w{m, new_buffer(m)};
+        tinygltf::Node &n = m.nodes[node];
+        std::vector<float> scale(2 * (size_t)copies), offset(2 * (size_t)copies);
+        for (uint32_t k = 0; k < copies; k++) {
+            scale[2 * k] = scale_offsets[4 * k];
+            scale[2 * k + 1] = scale_offsets[4 * k + 1];
+            offset[2 * k] = scale_offsets[4 * k + 2];
+            offset[2 * k + 1] = scale_offsets[4 * k + 3];
+        }
+        int a_scale = add_float_accessor(w, scale.data(), copies, 2, false);
+        int a_offset = add_float_accessor(w, offset.data(), copies, 2, false);
+        m.bufferViews[(size_t)m.accessors[(size_t)a_scale].bufferView].target = 0; /* instance data, not a vertex buffer */
+        m.bufferViews[(size_t)m.accessors[(size_t)a_offset].bufferView].target = 0;
+        Value::Object ext = n.extensions["EXT_mesh_gpu_instancing"].Get<Value::Object>();
+        Value::Object attrs = ext.count("attributes") && ext["attributes"].IsObject() ? ext["attributes"].Get<Value::Object>()
+                                                                                      : Value::Object();
+        attrs["_LIGHTMAP_SCALE"] = Value(a_scale);
+        attrs["_LIGHTMAP_OFFSET"] = Value(a_offset);
+        ext["attributes"] = Value(attrs);
+        n.extensions["EXT_mesh_gpu_instancing"] = Value(ext);
+        Value::Object extras = n.extras.Get<Value::Object>();
+        Value::Object lm = extras["lightmap"].Get<Value::Object>();
+        lm.erase("scaleOffset");
+        lm["perInstance"] = Value(std::string("EXT_mesh_gpu_instancing attributes _LIGHTMAP_SCALE, _LIGHTMAP_OFFSET: "
+                                              "uv_atlas = TEXCOORD_1 * scale + offset"));
+        extras["lightmap"] = Value(lm);
+        n.extras = Value(extras);
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: node %u's instance rectangles: %s", node, e.what());
     }
 }
 

@@ -63,6 +63,16 @@ lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gl
                                   int32_t texture, int32_t direction_texture, const double scale_offset[4],
                                   lmb_error *err);
 
+/* An EXT_mesh_gpu_instancing node: as lmb_gltf_lightmap_node (its mesh's TEXCOORD_1 is the layout
+ * every copy shares; no KHR_texture_transform), and each copy's rectangle as per-instance
+ * attributes _LIGHTMAP_SCALE (VEC2 sx, sy) and _LIGHTMAP_OFFSET (VEC2 ox, oy) of the extension,
+ * the convention of Third Room's MX_lightmap (the extension allows custom attributes that start
+ * with '_'): uv_atlas = uv * scale + offset. scale_offsets: 4 per copy, in the extension's order
+ * (a copy without a lightmap: 0, 0, 0, 0). The node's extras.lightmap names the attributes. */
+lmb_status lmb_gltf_lightmap_instanced_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
+                                            uint32_t count, int32_t texture, int32_t direction_texture,
+                                            const float *scale_offsets, uint32_t copies, lmb_error *err);
+
 /* Mixed lighting: each KHR_lights_punctual light that lights (its first node's) gets
  * extras.lightmap {mode, shadowmaskChannel ("R".."A", when it has one)}, so an engine knows
  * which lights to draw in real time; and with a shadowmask, every lightmap texture's

@@ -4,8 +4,12 @@
 // BAKE_GLTF: a bake with output.formats [..., hdr, ktx2], whose lightmap textures name both
 // files in extras.lightmap.files. The lit and lightmap views are shot with ?lightmap=hdr and
 // ?lightmap=ktx2 from one camera and must agree (8-bit, bounds below); the page must say it
-// read the KTX2 files; the float texels it decoded from each KTX2 must equal the .hdr's within
-// both formats' precision (E5B9G9R9: 2^-7 + 2^-9 of the texel's largest channel; below).
+// read the KTX2 files with three's KTX2Loader (lmbInfo.atlases[i].loader, format "... (KTX2Loader)",
+// gpu: the loader's texture or half floats), loaded KTX2Loader.js from node_modules and fetched
+// no Basis transcoder (libs/basis/) and nothing off the server; the float texels it decoded from
+// the loader's texture must equal the .hdr's within both formats' precision (E5B9G9R9: 2^-7 +
+// 2^-9 of the texel's largest channel; below). A copy of the bake whose KTX2 says vkFormat 0
+// (Basis) must fall back to the .hdr, fetching no transcoder either.
 // KEEP_UV1_GLTF: a bake with atlas.keep_uv1, every node a rectangle of a shared atlas (node
 // extras.lightmap.scaleOffset = its material's MOZ_lightmap KHR_texture_transform). At pixels of
 // the lightmap view the colour must be sRGB(E x intensity / pi x 2^EV), E read bilinearly from
@@ -15,6 +19,7 @@
 // view draws the pixel (both place the node's triangles at its rectangle).
 // Exit 0: every check passed; 1: a check failed (or a page did not load).
 import fs from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
 import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
@@ -90,14 +95,17 @@ async function sourcesAgree(gltfPath) {
       shots[`${mode}-${src}`] = v;
       console.log(`shot ${file} (${v.url.replace(srv.url, '/')})`);
     }
-    // the page says which files it read
+    // the page says which files it read, and with which three.js loader
     for (const src of ['hdr', 'ktx2']) {
       const a = shots[`lit-${src}`].info.atlases;
       const want = named.map((t) => ({ atlas: t.extras.atlas, uri: t.extras.files[src] }));
-      const ok = a.length === named.length && a.every((x) => x.source === src && want.some((w) => w.uri === x.uri));
-      check(`lightmap=${src}: the page read the ${src === 'ktx2' ? 'KTX2' : '.hdr'} files`, ok,
-        `lmbInfo.lightmap ${shots[`lit-${src}`].info.lightmap}; atlases ${JSON.stringify(a.map((x) => ({ index: x.index, source: x.source, uri: x.uri, format: x.format, fallback: x.fallback })))}`);
+      const loader = src === 'ktx2' ? 'KTX2Loader' : 'HDRLoader';
+      const ok = a.length === named.length && a.every((x) => x.source === src && want.some((w) => w.uri === x.uri) &&
+        x.loader === loader && x.format.endsWith(`(${loader})`) && !x.fallback);
+      check(`lightmap=${src}: the page read the ${src === 'ktx2' ? 'KTX2' : '.hdr'} files with ${loader}`, ok,
+        `lmbInfo.lightmap ${shots[`lit-${src}`].info.lightmap}; atlases ${JSON.stringify(a.map((x) => ({ index: x.index, source: x.source, uri: x.uri, format: x.format, loader: x.loader, gpu: x.gpu, fallback: x.fallback })))}`);
     }
+    for (const mode of ['lit', 'lightmap']) await ktx2LoaderOnly(shots[`${mode}-ktx2`], srv.url, `lightmap=ktx2 ${mode} view`, true);
     // the shots agree
     for (const mode of ['lit', 'lightmap']) {
       const d = diff(shots[`${mode}-hdr`].png, shots[`${mode}-ktx2`].png);
@@ -131,6 +139,50 @@ async function sourcesAgree(gltfPath) {
     for (const v of Object.values(shots)) await v.context.close();
   } finally {
     await srv.close();
+  }
+  await fallback(gltfPath, named);
+}
+
+// The resources a page fetched (performance entries, the page's own module scripts included):
+// KTX2Loader.js from node_modules through the server, no Basis transcoder, nothing elsewhere
+async function ktx2LoaderOnly(v, base, what, wantKtx2) {
+  const urls = await v.page.evaluate(() => [location.href, ...performance.getEntriesByType('resource').map((e) => e.name)]);
+  const origin = new URL(base).origin;
+  const foreign = urls.filter((u) => !u.startsWith(origin + '/') && !u.startsWith('data:') && !u.startsWith('blob:'));
+  const basis = urls.filter((u) => /\/libs\/basis\//.test(u));
+  const loaderJs = urls.some((u) => u === origin + '/three/examples/jsm/loaders/KTX2Loader.js');
+  const ktx2 = urls.filter((u) => /\.ktx2$/.test(u));
+  check(`${what}: KTX2Loader.js from node_modules, ${wantKtx2 ? 'the KTX2 read, ' : ''}no Basis transcoder, nothing from elsewhere`,
+    loaderJs && basis.length === 0 && foreign.length === 0 && (ktx2.length > 0) === wantKtx2 && v.info.atlases.every((a) => !a.gpu || /^(RGB9_E5|R11F_G11F_B10F|RGBA16F)\b/.test(a.gpu)),
+    `${urls.length} resources; KTX2Loader.js ${loaderJs ? 'loaded' : 'NOT loaded'}; KTX2 files ${ktx2.map((u) => path.basename(u)).join(', ') || 'none'}; ` +
+    `transcoder files ${basis.join(', ') || 'none'}; off the server ${foreign.join(', ') || 'none'}; on the GPU ${v.info.atlases.map((a) => a.gpu).join(', ')}`);
+}
+
+// A copy of the bake whose KTX2 files say vkFormat 0 (Basis, which KTX2Loader would transcode
+// with its worker): the page must not hand them to the loader but fall back to the .hdr
+async function fallback(gltfPath, named) {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'lmb-ktx2-fallback-'));
+  try {
+    fs.cpSync(path.dirname(gltfPath), dir, { recursive: true });
+    for (const t of named) {
+      const f = path.join(dir, decodeURIComponent(t.extras.files.ktx2)), b = fs.readFileSync(f);
+      b.writeUInt32LE(0, 12); // vkFormat: VK_FORMAT_UNDEFINED (Basis Universal)
+      fs.writeFileSync(f, b);
+    }
+    const srv = await startServer(path.join(dir, path.basename(gltfPath)));
+    try {
+      const v = await openPreview(browser, srv.url, { mode: 'lightmap', tonemap: 'none', view: 'front', lightmap: 'ktx2' });
+      const a = v.info.atlases;
+      check('lightmap=ktx2, a KTX2 of vkFormat 0: the page falls back to the .hdr', a.length === named.length &&
+        a.every((x) => x.source === 'hdr' && x.loader === 'HDRLoader' && /vkFormat 0 is not a lightmap format/.test(x.fallback || '')),
+        `atlases ${JSON.stringify(a.map((x) => ({ index: x.index, source: x.source, uri: x.uri, loader: x.loader, fallback: x.fallback })))}`);
+      await ktx2LoaderOnly(v, srv.url, 'lightmap=ktx2, a KTX2 of vkFormat 0', true);
+      await v.context.close();
+    } finally {
+      await srv.close();
+    }
+  } finally {
+    fs.rmSync(dir, { recursive: true, force: true });
   }
 }
 
@@ -243,8 +295,8 @@ async function rectangles(gltfPath) {
     await c3.context.close();
     await ck.context.close();
     const d = diff(lm.png, views['lightmap-ktx2'].png);
-    check('keep_uv1: lightmap=ktx2 shot = lightmap=hdr shot', views['lightmap-ktx2'].info.atlases.every((a) => a.source === 'ktx2') && d.over <= PIX_FRAC * d.n && d.max.every((m) => m <= PIX_MAX),
-      `sources ${views['lightmap-ktx2'].info.atlases.map((a) => a.uri + ' ' + a.source).join(', ')}; max |diff| ${d.max.join(' ')}, mean ${d.mean.map((m) => m.toFixed(4)).join(' ')}; ${d.over} pixels off by > ${PIX_TOL}`);
+    check('keep_uv1: lightmap=ktx2 shot = lightmap=hdr shot', views['lightmap-ktx2'].info.atlases.every((a) => a.source === 'ktx2' && a.loader === 'KTX2Loader') && d.over <= PIX_FRAC * d.n && d.max.every((m) => m <= PIX_MAX),
+      `sources ${views['lightmap-ktx2'].info.atlases.map((a) => `${a.uri} ${a.source} ${a.loader}, ${a.gpu}`).join('; ')}; max |diff| ${d.max.join(' ')}, mean ${d.mean.map((m) => m.toFixed(4)).join(' ')}; ${d.over} pixels off by > ${PIX_TOL}`);
     for (const v of Object.values(views)) await v.context.close();
   } finally {
     await srv.close();

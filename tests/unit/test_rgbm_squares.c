@@ -1,12 +1,13 @@
 /*
  * RGBM encoding (baker/write/rgbm.c): the round trip within 1% of the texel's largest
  * channel from range 1e-5 to the range, zero, clamping counted only for valid texels, the
- * auto range; and the squares of kept-TEXCOORD_1 instances (baker/pack/keep_uv1.c): placed
- * without overlap, padding apart, inside their atlases, a new atlas when one is full.
+ * auto range; and the rectangles of instances with a fixed layout (baker/pack/rects.c): placed
+ * without overlap, padding apart, inside their atlases, a group in one atlas, a new atlas when
+ * one is full, a group too large for any atlas refused.
  */
 #include "check.h"
 
-#include "pack/keep_uv1.h"
+#include "pack/rects.h"
 #include "post/dilate.h"
 #include "write/rgbm.h"
 
@@ -51,35 +52,44 @@ static void test_rgbm_clamp(void)
     CHECK_NEAR(lmb_rgbm_range(0, dark, valid, 1), 1, 0);
 }
 
-static void test_squares(void)
+static void test_rects(void)
 {
-    const uint32_t n = 7, side[7] = {100, 40, 40, 64, 16, 100, 30}, pad = 2, max = 128;
-    uint32_t atlas_of[7], x[7], y[7], count = 0, *w = NULL, *h = NULL;
+    /* groups: {0: 100, 20}, {1: 40}, {2: 64 x 32, 16}, {3: 100}, {4: 30} */
+    const lmb_rect_item items[7] = {{100, 100, 0}, {20, 20, 0}, {40, 40, 1}, {64, 32, 2}, {16, 16, 2}, {100, 100, 3},
+                                    {30, 30, 4}};
+    const uint32_t n = 7, pad = 2, max = 128;
+    lmb_rect_result r;
     lmb_error err;
-    CHECK_INT(lmb_place_squares(side, n, pad, max, atlas_of, x, y, &count, &w, &h, &err), LMB_OK);
-    CHECK(count >= 2); /* two 100s cannot share a 128 atlas */
+    CHECK_INT(lmb_place_rects(items, n, pad, max, &r, &err), LMB_OK);
+    CHECK(r.atlas_count >= 2); /* two 100s cannot share a 128 atlas */
     for (uint32_t i = 0; i < n; i++) {
-        CHECK(atlas_of[i] < count);
-        CHECK(x[i] + side[i] <= w[atlas_of[i]] && y[i] + side[i] <= h[atlas_of[i]]);
-        CHECK(w[atlas_of[i]] <= max && h[atlas_of[i]] <= max);
+        CHECK(r.atlas[i] < r.atlas_count);
+        CHECK(r.x[i] + items[i].w <= r.width[r.atlas[i]] && r.y[i] + items[i].h <= r.height[r.atlas[i]]);
+        CHECK(r.width[r.atlas[i]] <= max && r.height[r.atlas[i]] <= max);
         for (uint32_t j = i + 1; j < n; j++) {
-            if (atlas_of[i] != atlas_of[j])
+            if (items[i].group == items[j].group)
+                CHECK_INT(r.atlas[i], r.atlas[j]); /* a group shares one atlas */
+            if (r.atlas[i] != r.atlas[j])
                 continue;
-            int apart = x[i] + side[i] + pad <= x[j] || x[j] + side[j] + pad <= x[i] || y[i] + side[i] + pad <= y[j] ||
-                        y[j] + side[j] + pad <= y[i];
+            int apart = r.x[i] + items[i].w + pad <= r.x[j] || r.x[j] + items[j].w + pad <= r.x[i] ||
+                        r.y[i] + items[i].h + pad <= r.y[j] || r.y[j] + items[j].h + pad <= r.y[i];
             CHECK(apart);
         }
     }
-    for (uint32_t a = 0; a < count; a++)
-        CHECK(w[a] % 4 == 0 && h[a] % 4 == 0);
-    free(w);
-    free(h);
+    for (uint32_t a = 0; a < r.atlas_count; a++)
+        CHECK(r.width[a] % 4 == 0 && r.height[a] % 4 == 0);
+    lmb_rect_result_free(&r);
+    /* a group larger than an atlas: refused, naming it */
+    const lmb_rect_item big[3] = {{10, 10, 0}, {100, 100, 1}, {100, 100, 1}};
+    CHECK_INT(lmb_place_rects(big, 3, pad, max, &r, &err), LMB_ERR_INPUT);
+    CHECK_INT(r.failed_group, 1);
+    lmb_rect_result_free(&r);
 }
 
 int main(void)
 {
     test_rgbm_round_trip();
     test_rgbm_clamp();
-    test_squares();
+    test_rects();
     return check_failures();
 }

@@ -1,24 +1,37 @@
 // GLTFLoader plugin for lmbake's lightmaps: MOZ_lightmap on materials ({index, texCoord,
 // intensity} -> material.lightMap / lightMapIntensity, its KHR_texture_transform -> the
 // texture's offset / repeat) and, on the lightmap texture, either the KTX2 file its
-// extras.lightmap.files.ktx2 names (read as three's KTX2Loader reads raw formats: ktx-parse and
-// its Zstandard decoder) or MOZ_texture_rgbe (a Radiance .hdr read with three's HDRLoader),
-// both holding linear irradiance E in lux (or E/pi with extras.lightmap.scale "radiance" and
-// MOZ_lightmap.intensity pi). Every lightmap becomes an "atlas" record in `atlases`, with its
-// float data kept for the CPU (hover values, invalid-texel mask).
+// extras.lightmap.files.ktx2 names (loaded by three's KTX2Loader, raw formats with its Zstandard
+// decoder, no Basis transcoder) or MOZ_texture_rgbe (a Radiance .hdr read with three's
+// HDRLoader), both holding linear irradiance E in lux (or E/pi with extras.lightmap.scale
+// "radiance" and MOZ_lightmap.intensity pi). Every lightmap becomes an "atlas" record in
+// `atlases`, with its float data kept for the CPU (hover values, invalid-texel mask).
 import * as THREE from 'three';
 import { HDRLoader } from 'three/addons/loaders/HDRLoader.js';
-import { read as readKtx2, KHR_SUPERCOMPRESSION_NONE, KHR_SUPERCOMPRESSION_ZSTD } from 'three/addons/libs/ktx-parse.module.js';
-import { ZSTDDecoder } from 'three/addons/libs/zstddec.module.js';
+import { KTX2Loader } from 'three/addons/loaders/KTX2Loader.js';
+import { read as readKtx2Header, KHR_SUPERCOMPRESSION_NONE, KHR_SUPERCOMPRESSION_ZSTD } from 'three/addons/libs/ktx-parse.module.js';
 
 export const LIGHTMAP_SOURCES = ['ktx2', 'hdr'];
-const VK_FORMATS = { 123: 'E5B9G9R9_UFLOAT_PACK32', 122: 'B10G11R11_UFLOAT_PACK32', 97: 'R16G16B16A16_SFLOAT' };
+// The KTX2 lightmap formats (docs/output.md#ktx2): the vkFormat, the three.js type and format
+// KTX2Loader gives its texture (createRawTexture), and the WebGL 2 internal format three
+// uploads it as (all three filterable)
+const KTX2_FORMATS = {
+  123: { name: 'E5B9G9R9_UFLOAT_PACK32', type: THREE.UnsignedInt5999Type, format: THREE.RGBFormat, gl: 'RGB9_E5' },
+  122: { name: 'B10G11R11_UFLOAT_PACK32', type: THREE.UnsignedInt101111Type, format: THREE.RGBFormat, gl: 'R11F_G11F_B10F' },
+  97: { name: 'R16G16B16A16_SFLOAT', type: THREE.HalfFloatType, format: THREE.RGBAFormat, gl: 'RGBA16F' },
+};
 
 // Returns a function to pass to GLTFLoader.register(); `atlases` is filled while loading.
 // source: 'ktx2' (the default: the KTX2 file when the glTF names one, else the .hdr) or 'hdr'.
-export function lightmapPlugin(atlases, { source = 'ktx2' } = {}) {
+// renderer: the page's WebGLRenderer, for KTX2Loader.detectSupport() (parse() refuses to run
+// without it); without one a KTX2 cannot be loaded and the .hdr is used.
+export function lightmapPlugin(atlases, { source = 'ktx2', renderer = null } = {}) {
   if (!LIGHTMAP_SOURCES.includes(source)) throw new Error(`unknown lightmap source '${source}' (one of ${LIGHTMAP_SOURCES.join(', ')})`);
-  return (parser) => new LightmapPlugin(parser, atlases, source);
+  // One KTX2Loader for every lightmap of the page. Its Basis transcoder (a worker fetching
+  // libs/basis/) starts only for vkFormat 0 (and ASTC HDR), which readKtx2 never passes it:
+  // raw formats go through createRawTexture, so no transcoder path is set.
+  const ktx2Loader = source === 'ktx2' && renderer ? new KTX2Loader().detectSupport(renderer) : null;
+  return (parser) => new LightmapPlugin(parser, atlases, source, ktx2Loader);
 }
 
 // The lightmap rectangle of a lightmap texture as [scaleU, scaleV, offsetU, offsetV]: the atlas
@@ -28,10 +41,11 @@ export function lightmapScaleOffset(tex) {
 }
 
 class LightmapPlugin {
-  constructor(parser, atlases, source) {
+  constructor(parser, atlases, source, ktx2Loader) {
     this.parser = parser;
     this.atlases = atlases;
     this.source = source;
+    this.ktx2Loader = ktx2Loader;
     this.name = 'MOZ_lightmap';
     this.byTexture = new Map(); // texture index -> Promise<THREE.Texture>
     this.byTransform = new Map(); // texture index + rectangle -> Promise<THREE.Texture> (a clone)
@@ -112,15 +126,14 @@ class LightmapPlugin {
     if (extras.width !== undefined && (extras.width !== width || extras.height !== height)) {
       throw new Error(`lightmap ${uri}: ${width}x${height}, the glTF's extras.lightmap says ${extras.width}x${extras.height}`);
     }
-    // Upload as half float (always filterable in WebGL 2), whatever the file held; glTF UVs
-    // have v down: no flip.
-    const half = new Uint16Array(data.length);
-    for (let i = 0; i < data.length; i++) half[i] = THREE.DataUtils.toHalfFloat(data[i]);
-    const tex = new THREE.DataTexture(half, width, height, THREE.RGBAFormat, THREE.HalfFloatType);
+    // The GPU texture: KTX2Loader's own (its texels as the file holds them), else the floats as
+    // half floats (always filterable in WebGL 2). Either way bilinear without mipmaps (they would
+    // blur across charts), clamped, linear, and not flipped: glTF UVs have v down, row 0 on top.
+    const tex = decoded.texture || halfFloatTexture(data, width, height);
     tex.colorSpace = THREE.LinearSRGBColorSpace;
     tex.flipY = false;
     tex.magFilter = THREE.LinearFilter;
-    tex.minFilter = THREE.LinearFilter; // no mipmaps: they would blur across charts
+    tex.minFilter = THREE.LinearFilter;
     tex.generateMipmaps = false;
     tex.wrapS = tex.wrapT = THREE.ClampToEdgeWrapping;
     tex.name = uri;
@@ -140,6 +153,8 @@ class LightmapPlugin {
     const hdrUri = rgbe && json.images[rgbe.source] ? json.images[rgbe.source].uri ?? null : null;
     const atlas = {
       index, textureIndex, uri, source: decoded.source, format: decoded.format, hdr: hdrUri, files,
+      loader: decoded.loader, // the three.js loader that read the file: KTX2Loader or HDRLoader
+      gpu: decoded.texture ? `${decoded.gpu} (the KTX2Loader texture)` : 'RGBA16F (half floats from the decoded texels)',
       fallback: why ? why.replace(/; $/, '') : null, // why the KTX2 file was not used, when asked for
       // radiance: the files hold E/pi (MOZ_lightmap.intensity is pi); toLux makes a texel E
       scale: extras.scale || 'irradiance', toLux: extras.scale === 'radiance' ? Math.PI : 1,
@@ -147,7 +162,7 @@ class LightmapPlugin {
     };
     this.atlases[atlas.index] = atlas;
     tex.userData.atlas = atlas.index;
-    console.log(`lmbake preview: atlas ${index} from ${uri} (${decoded.format}${atlas.fallback ? '; not KTX2: ' + atlas.fallback : ''})`);
+    console.log(`lmbake preview: atlas ${index} from ${uri} (${decoded.format}, on the GPU ${atlas.gpu}${atlas.fallback ? '; not KTX2: ' + atlas.fallback : ''})`);
     return tex;
   }
 
@@ -164,37 +179,40 @@ class LightmapPlugin {
       buffer = await this.fetchFile(uri);
     }
     const { width, height, data } = new HDRLoader().setDataType(THREE.FloatType).parse(buffer);
-    return { width, height, data, uri, source: 'hdr', format: 'RGBE' };
+    return { width, height, data, uri, source: 'hdr', format: 'RGBE (HDRLoader)', loader: 'HDRLoader' };
   }
 
-  // A KTX2 lightmap, decoded to RGBA float32 (alpha 1) like the .hdr: one 2D level of vkFormat
-  // 123, 122 or 97, zstd-supercompressed or not. KTX2Loader.parse() refuses to run before
-  // detectSupport(renderer), so this is its raw-format path (createRawTexture) without the loader.
+  // A KTX2 lightmap through three's KTX2Loader: {width, height, data (RGBA float32 decoded from
+  // the loader's texels, alpha 1, row 0 = top), texture (the loader's DataTexture), uri, ...}.
+  // One 2D level of vkFormat 123, 122 or 97, zstd-supercompressed or not. The header is looked
+  // at first (ktx-parse, the loader's own reader) for what the loader's texture does not say:
+  // that the format is one of those (anything else, Basis above all, would make the loader fetch
+  // its transcoder, or is no lightmap), the supercompression and KTXorientation.
   async readKtx2(uri) {
-    const c = readKtx2(new Uint8Array(await this.fetchFile(uri)));
-    const format = VK_FORMATS[c.vkFormat];
-    if (!format) throw new Error(`vkFormat ${c.vkFormat} is not a lightmap format (123, 122 or 97)`);
-    if (c.pixelDepth > 0 || c.layerCount > 1 || c.faceCount !== 1 || !c.levels.length) throw new Error('not a single 2D image');
-    const level = c.levels[0];
-    let bytes = level.levelData;
-    if (c.supercompressionScheme === KHR_SUPERCOMPRESSION_ZSTD) bytes = (await zstd()).decode(bytes, level.uncompressedByteLength);
-    else if (c.supercompressionScheme !== KHR_SUPERCOMPRESSION_NONE) throw new Error(`supercompression scheme ${c.supercompressionScheme} (only none and zstd)`);
-    const width = c.pixelWidth, height = Math.max(1, c.pixelHeight), n = width * height;
-    if (bytes.byteLength < n * (c.vkFormat === 97 ? 8 : 4)) throw new Error(`level 0 holds ${bytes.byteLength} bytes, ${width}x${height} needs ${n * (c.vkFormat === 97 ? 8 : 4)}`);
-    const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
-    const data = new Float32Array(4 * n);
-    let orient = c.keyValue.KTXorientation || 'rd'; // absent: KTX2's default, rows top to bottom as glTF's
-    if (typeof orient !== 'string') orient = new TextDecoder().decode(orient);
-    const up = orient[1] === 'u'; // rows bottom to top: flipped here
-    for (let y = 0; y < height; y++) {
-      const row = up ? height - 1 - y : y;
-      for (let x = 0; x < width; x++) {
-        const i = row * width + x, o = 4 * (y * width + x);
-        decodeTexel(c.vkFormat, view, i, data, o);
-        data[o + 3] = 1;
-      }
+    if (!this.ktx2Loader) throw new Error('no renderer for KTX2Loader.detectSupport()');
+    const buffer = await this.fetchFile(uri);
+    const c = readKtx2Header(new Uint8Array(buffer));
+    const f = KTX2_FORMATS[c.vkFormat];
+    if (!f) throw new Error(`vkFormat ${c.vkFormat} is not a lightmap format (123, 122 or 97)`);
+    if (c.pixelDepth > 0 || c.layerCount > 1 || c.faceCount !== 1) throw new Error('not a single 2D image');
+    if (c.supercompressionScheme !== KHR_SUPERCOMPRESSION_NONE && c.supercompressionScheme !== KHR_SUPERCOMPRESSION_ZSTD) throw new Error(`supercompression scheme ${c.supercompressionScheme} (only none and zstd)`);
+    const tex = await new Promise((resolve, reject) => this.ktx2Loader.parse(buffer, resolve, (e) => reject(e instanceof Error ? e : new Error(String(e)))));
+    if (!tex.isDataTexture || tex.type !== f.type || tex.format !== f.format || !tex.mipmaps.length) {
+      throw new Error(`KTX2Loader made a ${tex.constructor.name} of type ${tex.type}, format ${tex.format}, ${tex.mipmaps.length} levels; expected a DataTexture of type ${f.type}, format ${f.format}`);
     }
-    return { width, height, data, uri, source: 'ktx2', format: format + (c.supercompressionScheme === KHR_SUPERCOMPRESSION_ZSTD ? ' zstd' : '') };
+    const width = tex.image.width, height = tex.image.height, n = width * height, src = tex.mipmaps[0].data;
+    const per = c.vkFormat === 97 ? 4 : 1; // array elements per texel: Uint16Array RGBA, Uint32Array packed
+    if (src.length < n * per) throw new Error(`level 0 holds ${src.length} values, ${width}x${height} needs ${n * per}`);
+    tex.mipmaps = [tex.mipmaps[0]]; // level 0 only (bilinear, no mipmaps)
+    // KTX2Loader keeps the file's row order (it reads no KTXorientation): row 0 first, uploaded
+    // unflipped at v = 0, glTF's top. lmbake writes "rd" (rows down, as glTF); rows written
+    // bottom to top ("ru") are reversed here, in the loader's texture and thus on the GPU too.
+    const orient = typeof c.keyValue.KTXorientation === 'string' ? c.keyValue.KTXorientation : 'rd'; // absent: KTX2's default, rd
+    if (orient[1] === 'u') flipRows(src, width * per, height);
+    const data = new Float32Array(4 * n);
+    decodeTexels(c.vkFormat, src, n, data);
+    const zstd = c.supercompressionScheme === KHR_SUPERCOMPRESSION_ZSTD ? ' zstd' : '';
+    return { width, height, data, uri, texture: tex, gpu: f.gl, source: 'ktx2', format: `${f.name}${zstd} (KTX2Loader)`, loader: 'KTX2Loader' };
   }
 
   async fetchFile(uri) {
@@ -211,10 +229,21 @@ function lightmapExtras(json, textureIndex) {
   return t && t.extras && t.extras.lightmap && typeof t.extras.lightmap === 'object' ? t.extras.lightmap : null;
 }
 
-let zstdPending = null; // one decoder (WebAssembly from a data: URL, no network) for every file
-function zstd() {
-  if (!zstdPending) { const z = new ZSTDDecoder(); zstdPending = z.init().then(() => z); }
-  return zstdPending;
+// RGBA float32 texels as a half-float texture (the .hdr's GPU copy)
+function halfFloatTexture(data, width, height) {
+  const half = new Uint16Array(data.length);
+  for (let i = 0; i < data.length; i++) half[i] = THREE.DataUtils.toHalfFloat(data[i]);
+  return new THREE.DataTexture(half, width, height, THREE.RGBAFormat, THREE.HalfFloatType);
+}
+
+// Reverses the order of `height` rows of `stride` elements, in place
+function flipRows(a, stride, height) {
+  const tmp = a.slice(0, stride);
+  for (let y = 0, z = height - 1; y < z; y++, z--) {
+    tmp.set(a.subarray(y * stride, (y + 1) * stride));
+    a.copyWithin(y * stride, z * stride, (z + 1) * stride);
+    a.set(tmp, z * stride);
+  }
 }
 
 // Unsigned float of a 5-bit exponent (bias 15) and m mantissa bits (Vulkan's 11/10-bit floats)
@@ -225,20 +254,24 @@ function ufloat(v, m) {
   return (1 + f / (1 << m)) * 2 ** (e - 15);
 }
 
-// Texel i of a level into out[o..o+2], per the Vulkan specification's formats:
+// n texels of KTX2Loader's level data (src: Uint32Array for 123 / 122, Uint16Array RGBA for 97)
+// into out, RGBA float32 with alpha 1, per the Vulkan specification's formats:
 //   123 E5B9G9R9: R, G, B 9-bit mantissas at bits 0, 9, 18, shared exponent at 27 (bias 15):
 //       value = mantissa x 2^(exponent - 15 - 9)
 //   122 B10G11R11: R 11 bits at 0, G 11 at 11, B 10 at 22 (5-bit exponent, 6/6/5-bit mantissa)
 //    97 R16G16B16A16_SFLOAT: half floats
-function decodeTexel(vkFormat, view, i, out, o) {
-  if (vkFormat === 123) {
-    const v = view.getUint32(4 * i, true), s = 2 ** ((v >>> 27) - 24);
-    out[o] = (v & 511) * s; out[o + 1] = ((v >>> 9) & 511) * s; out[o + 2] = ((v >>> 18) & 511) * s;
-  } else if (vkFormat === 122) {
-    const v = view.getUint32(4 * i, true);
-    out[o] = ufloat(v & 0x7ff, 6); out[o + 1] = ufloat((v >>> 11) & 0x7ff, 6); out[o + 2] = ufloat((v >>> 22) & 0x3ff, 5);
-  } else {
-    for (let k = 0; k < 3; k++) out[o + k] = THREE.DataUtils.fromHalfFloat(view.getUint16(8 * i + 2 * k, true));
+function decodeTexels(vkFormat, src, n, out) {
+  for (let i = 0, o = 0; i < n; i++, o += 4) {
+    if (vkFormat === 123) {
+      const v = src[i], s = 2 ** ((v >>> 27) - 24);
+      out[o] = (v & 511) * s; out[o + 1] = ((v >>> 9) & 511) * s; out[o + 2] = ((v >>> 18) & 511) * s;
+    } else if (vkFormat === 122) {
+      const v = src[i];
+      out[o] = ufloat(v & 0x7ff, 6); out[o + 1] = ufloat((v >>> 11) & 0x7ff, 6); out[o + 2] = ufloat((v >>> 22) & 0x3ff, 5);
+    } else {
+      for (let k = 0; k < 3; k++) out[o + k] = THREE.DataUtils.fromHalfFloat(src[4 * i + k]);
+    }
+    out[o + 3] = 1;
   }
 }
 

@@ -57,7 +57,8 @@ const sceneInfo = await (await fetch('/scene.json')).json();
 document.title = `lmbake preview: ${sceneInfo.name}`;
 $('title').textContent = sceneInfo.name;
 const atlases = [];
-const loader = new GLTFLoader().register(lightmapPlugin(atlases, { source: state.lightmap }));
+// the renderer: KTX2 lightmaps load through three's KTX2Loader, which needs detectSupport(renderer)
+const loader = new GLTFLoader().register(lightmapPlugin(atlases, { source: state.lightmap, renderer }));
 const gltf = await loader.loadAsync(sceneInfo.gltf);
 const root = gltf.scene;
 const directionalMaterials = state.directional ? await applyDirectionalLightmaps(gltf) : 0;
@@ -181,8 +182,9 @@ function updateInfo() {
     camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
     bounds: { min: box.min.toArray(), max: box.max.toArray() },
     canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
-    // uri: the file read (source ktx2 or hdr; format: its texel format); hdr: the .hdr's uri either way
-    atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, source: a.source, format: a.format, hdr: a.hdr, fallback: a.fallback, scale: a.scale, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
+    // uri: the file read (source ktx2 or hdr; format: its texel format; loader: KTX2Loader or
+    // HDRLoader; gpu: the texture the views sample); hdr: the .hdr's uri either way
+    atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, source: a.source, format: a.format, loader: a.loader, gpu: a.gpu, hdr: a.hdr, fallback: a.fallback, scale: a.scale, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
     lightmap: state.lightmap,
     meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
     charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),

@@ -1,0 +1,296 @@
+/*
+ * Instances as rectangles of shared atlases (see rect_instances.h). Instances form groups that
+ * share one TEXCOORD_1 layout, the "block" (normalized to [0, 1]^2, W x H texels at the group's
+ * first instance's density):
+ *  - a kept-TEXCOORD_1 mesh (atlas.keep_uv1): the block is its UVs as they are, W = H = S,
+ *    S = density x sqrt(world area / UV area) (keep_uv1.c); every instance is a group of its own,
+ *    or, for EXT_mesh_gpu_instancing copies, the copies of one node are one group;
+ *  - the copies of an EXT_mesh_gpu_instancing node with a mesh lmbake unwraps: the mesh's charts
+ *    are packed once (pack.h), at the first copy's density, into one W x H block.
+ * Each member m of a group gets the block at s_m = sqrt(A_m / A_0) x d_m / d_0 (A world area, d
+ * texel density; 0 the group's first instance), rounded up to whole texels, and every member of a
+ * group lands in one atlas (the copies of a node share its material, so one lightmap texture).
+ * A copy that is not a uniformly scaled version of the first (its triangles' area ratios spread)
+ * has stretched texels: the log says how many. With an automatic density, a group too large for
+ * one atlas is lowered (x 0.85, a warning) and the placement redone.
+ */
+#include "rect_instances.h"
+
+#include "keep_uv1.h"
+#include "pack.h"
+#include "rects.h"
+#include "unwrap/metrics.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* World area of instance i's lightmapped triangles. */
+static double world_area(const lmb_scene *s, const lmb_layout *l, uint32_t i)
+{
+    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+    double q[9], world = 0;
+    for (uint32_t f = 0; f < c->triangle_count; f++)
+        if (c->chart_of[f] != UINT32_MAX) {
+            lmb_layout_world_triangle(s, l, i, f, q);
+            world += lmb_triangle_area(q);
+        }
+    return world;
+}
+
+/* Instance i's own TEXCOORD_1 checked in its side x side square: overlapping texels and UVs
+ * outside [0, 1] (they would read a neighbour's texels) are reported. */
+static lmb_status check_kept_uv1(const lmb_scene *s, const lmb_layout *l, uint32_t i, uint32_t side,
+                                 const lmb_log *log, lmb_error *err)
+{
+    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+    double *pos = malloc(sizeof(double) * 9 * c->triangle_count + 1);
+    double *uv = malloc(sizeof(double) * 6 * c->triangle_count + 1);
+    if (!pos || !uv) {
+        free(pos);
+        free(uv);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    }
+    uint32_t outside = 0;
+    for (uint32_t f = 0; f < c->triangle_count; f++) {
+        lmb_layout_world_triangle(s, l, i, f, pos + 9 * f);
+        int out = 0;
+        for (int k = 0; k < 6; k++) {
+            double u = c->chart_of[f] == UINT32_MAX ? 0 : c->uv[6 * f + k];
+            out |= u < 0 || u > 1;
+            uv[6 * f + k] = u * side;
+        }
+        outside += out && c->chart_of[f] != UINT32_MAX;
+    }
+    lmb_uv_layout lay = {c->triangle_count, pos, uv, side, side};
+    lmb_uv_metrics m;
+    lmb_status st = lmb_uv_metrics_compute(&lay, &m, err);
+    free(pos);
+    free(uv);
+    if (st == LMB_OK && m.overlapping_texels)
+        lmb_warn(log, "instance '%s': its own TEXCOORD_1 (atlas.keep_uv1) overlaps itself on %llu texels of its %ux%u "
+                 "square: those texels mix light from two places",
+                 s->instances[i].name, (unsigned long long)m.overlapping_texels, side, side);
+    if (st == LMB_OK && outside)
+        lmb_warn(log, "instance '%s': %u triangles of its own TEXCOORD_1 (atlas.keep_uv1) leave [0, 1]: their texels "
+                 "fall outside its square, on padding or a neighbour's texels", s->instances[i].name, outside);
+    return st;
+}
+
+typedef struct group {
+    uint32_t first, count; /* members: order[first .. first + count) */
+    double *block;         /* 6 per mesh triangle: the shared layout in [0, 1]^2 (0 for skipped triangles) */
+    double w, h;           /* the block's size at the first member's density, texels */
+} group;
+
+/* Group g's block from an unwrapped mesh: its first member's charts, packed alone. */
+static lmb_status pack_block(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, uint32_t i, group *g,
+                             lmb_error *err)
+{
+    const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+    lmb_layout_scale_instance(s, l, i); /* chart-local texel units in uv1 */
+    const double *uv1 = l->instances[i].uv1;
+    lmb_pack_chart *charts = calloc((size_t)c->chart_count + 1, sizeof *charts);
+    double *buf = malloc(sizeof(double) * 6 * c->triangle_count + 1);
+    lmb_pack_result r;
+    memset(&r, 0, sizeof r);
+    lmb_status st = charts && buf ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    for (uint32_t k = 0, at = 0; st == LMB_OK && k < c->chart_count; k++) {
+        uint32_t len = c->first[k + 1] - c->first[k];
+        for (uint32_t t = 0; t < len; t++)
+            memcpy(buf + 6 * (at + t), uv1 + 6 * c->order[c->first[k] + t], 6 * sizeof(double));
+        charts[k].triangle_count = len;
+        charts[k].uv = buf + 6 * at;
+        charts[k].group = 0;
+        at += len;
+    }
+    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1};
+    if (st == LMB_OK)
+        st = lmb_pack_charts(charts, c->chart_count, &opt, &r, err);
+    if (st == LMB_OK) {
+        g->w = r.width[0];
+        g->h = r.height[0];
+        for (uint32_t k = 0; k < c->chart_count; k++) {
+            const double *m = r.placements[k].m;
+            for (uint32_t t = c->first[k]; t < c->first[k + 1]; t++) {
+                uint32_t f = c->order[t];
+                for (int v = 0; v < 3; v++) {
+                    double x = uv1[6 * f + 2 * v], y = uv1[6 * f + 2 * v + 1];
+                    g->block[6 * f + 2 * v] = (m[0] * x + m[1] * y + m[2]) / g->w;
+                    g->block[6 * f + 2 * v + 1] = (m[3] * x + m[4] * y + m[5]) / g->h;
+                }
+            }
+        }
+    }
+    lmb_pack_result_free(&r);
+    free(charts);
+    free(buf);
+    return st;
+}
+
+/* Group g's block: the kept TEXCOORD_1, or the packed charts. */
+static lmb_status make_block(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, uint32_t i, group *g,
+                             const lmb_log *log, lmb_error *err)
+{
+    const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
+    const lmb_charts *c = &lm->charts;
+    g->block = calloc((size_t)6 * c->triangle_count + 1, sizeof *g->block);
+    if (!g->block)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    if (!lm->kept_uv1)
+        return pack_block(s, cfg, l, i, g, err);
+    uint32_t side = lmb_uv1_atlas_size(world_area(s, l, i), c, l->instances[i].texel_density, cfg->max_atlas_size);
+    g->w = g->h = side;
+    for (uint32_t k = 0; k < 6 * c->triangle_count; k++)
+        g->block[k] = c->chart_of[k / 6] == UINT32_MAX ? 0 : c->uv[k];
+    return check_kept_uv1(s, l, i, side, log, err);
+}
+
+/* Copies whose triangles' world areas are not in one ratio to the first member's: stretched. */
+static uint32_t stretched_members(const lmb_scene *s, const lmb_layout *l, const uint32_t *order, const group *g)
+{
+    const lmb_charts *c = &l->meshes[s->instances[order[g->first]].mesh].charts;
+    uint32_t stretched = 0;
+    for (uint32_t j = 1; j < g->count; j++) {
+        double lo = INFINITY, hi = 0, q[9];
+        for (uint32_t f = 0; f < c->triangle_count; f++) {
+            if (c->chart_of[f] == UINT32_MAX)
+                continue;
+            lmb_layout_world_triangle(s, l, order[g->first], f, q);
+            double a0 = lmb_triangle_area(q);
+            lmb_layout_world_triangle(s, l, order[g->first + j], f, q);
+            double r = a0 > 0 ? lmb_triangle_area(q) / a0 : 1;
+            lo = r < lo ? r : lo;
+            hi = r > hi ? r : hi;
+        }
+        stretched += hi > 1.1 * lo;
+    }
+    return stretched;
+}
+
+/* Groups: consecutive runs of order[] (EXT_mesh_gpu_instancing copies of one node together, in
+ * instance order; any other instance alone). Returns the group count. */
+static uint32_t make_groups(const lmb_scene *s, const uint32_t *list, uint32_t n, uint32_t *order, group *groups)
+{
+    uint32_t ng = 0, placed = 0;
+    uint8_t *taken = calloc((size_t)n + 1, 1);
+    if (!taken)
+        return UINT32_MAX;
+    for (uint32_t j = 0; j < n; j++) {
+        if (taken[j])
+            continue;
+        const lmb_instance *in = &s->instances[list[j]];
+        groups[ng].first = placed;
+        groups[ng].count = 0;
+        for (uint32_t k = j; k < n; k++) {
+            const lmb_instance *o = &s->instances[list[k]];
+            if (k == j || (in->gpu_instance >= 0 && o->gpu_instance >= 0 && o->node == in->node && !taken[k])) {
+                taken[k] = 1;
+                order[placed++] = list[k];
+                groups[ng].count++;
+            }
+            if (in->gpu_instance < 0)
+                break;
+        }
+        ng++;
+    }
+    free(taken);
+    return ng;
+}
+
+lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                                     uint32_t n, const lmb_log *log, lmb_error *err)
+{
+    uint32_t *order = malloc(((size_t)n + 1) * sizeof *order);
+    group *groups = calloc((size_t)n + 1, sizeof *groups);
+    lmb_rect_item *items = calloc((size_t)n + 1, sizeof *items);
+    double *area = malloc(((size_t)n + 1) * sizeof *area);
+    lmb_rect_result r;
+    memset(&r, 0, sizeof r);
+    uint32_t ng = order && groups && items && area ? make_groups(s, list, n, order, groups) : UINT32_MAX;
+    lmb_status st = ng != UINT32_MAX ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++)
+        area[j] = world_area(s, l, order[j]);
+    for (uint32_t g = 0; st == LMB_OK && g < ng; g++) {
+        st = make_block(s, cfg, l, order[groups[g].first], &groups[g], log, err);
+        uint32_t stretched = st == LMB_OK ? stretched_members(s, l, order, &groups[g]) : 0;
+        if (stretched)
+            lmb_warn(log, "node '%s': %u of its %u instanced copies are not uniformly scaled versions of the first: "
+                     "they share its lightmap layout, so their texels are stretched",
+                     s->instances[order[groups[g].first]].name, stretched, groups[g].count);
+    }
+    /* place; an automatic density lowers a group that does not fit one atlas and retries */
+    for (int attempt = 0; st == LMB_OK; attempt++) {
+        for (uint32_t g = 0; g < ng; g++)
+            for (uint32_t j = groups[g].first; j < groups[g].first + groups[g].count; j++) {
+                uint32_t first = order[groups[g].first];
+                double sc = sqrt(area[j] / fmax(area[groups[g].first], 1e-300)) * l->instances[order[j]].texel_density /
+                            l->instances[first].texel_density;
+                items[j].w = (uint32_t)fmax(1.0, ceil(groups[g].w * sc - 1e-9));
+                items[j].h = (uint32_t)fmax(1.0, ceil(groups[g].h * sc - 1e-9));
+                items[j].group = g;
+            }
+        lmb_rect_result_free(&r);
+        st = lmb_place_rects(items, n, cfg->padding, cfg->max_atlas_size, &r, err);
+        if (st != LMB_ERR_INPUT || !l->density.automatic || attempt >= 24 || r.failed_group >= ng)
+            break;
+        group *g = &groups[r.failed_group];
+        uint32_t first = order[g->first];
+        lmb_warn(log, "'%s' and its %u copies lowered to %.4g texels per unit to fit one %ux%u atlas",
+                 s->instances[first].name, g->count - 1, 0.85 * l->instances[first].texel_density, cfg->max_atlas_size,
+                 cfg->max_atlas_size);
+        for (uint32_t j = g->first; j < g->first + g->count; j++)
+            l->instances[order[j]].texel_density *= 0.85;
+        g->w *= 0.85;
+        g->h *= 0.85;
+        st = LMB_OK;
+    }
+    if (st == LMB_ERR_INPUT && r.failed_group < ng)
+        st = lmb_error_set(err, LMB_ERR_INPUT,
+                           "instance '%s' (mesh '%s') and the copies that share its layout do not fit in one %ux%u "
+                           "atlas at %g texels per unit: lower texel_density (or a density_overrides entry), use "
+                           "texel_density: auto, or raise atlas.max_size",
+                           s->instances[order[groups[r.failed_group].first]].name,
+                           s->meshes[s->instances[order[groups[r.failed_group].first]].mesh].name, cfg->max_atlas_size,
+                           cfg->max_atlas_size, l->instances[order[groups[r.failed_group].first]].texel_density);
+    uint32_t base = l->atlas_count;
+    if (st == LMB_OK) {
+        uint32_t *nw = realloc(l->width, (base + r.atlas_count + 1) * sizeof *nw);
+        if (nw) l->width = nw;
+        uint32_t *nh = realloc(l->height, (base + r.atlas_count + 1) * sizeof *nh);
+        if (nh) l->height = nh;
+        if (!nw || !nh)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    }
+    for (uint32_t a = 0; st == LMB_OK && a < r.atlas_count; a++) {
+        l->width[base + a] = r.width[a];
+        l->height[base + a] = r.height[a];
+    }
+    if (st == LMB_OK)
+        l->atlas_count += r.atlas_count;
+    for (uint32_t g = 0; st == LMB_OK && g < ng; g++)
+        for (uint32_t j = groups[g].first; j < groups[g].first + groups[g].count; j++) {
+            lmb_layout_instance *li = &l->instances[order[j]];
+            const double *b = groups[g].block;
+            const lmb_charts *c = &l->meshes[s->instances[order[j]].mesh].charts;
+            size_t nt = li->uv1_count / 6;
+            li->atlas = base + r.atlas[j];
+            double W = l->width[li->atlas], H = l->height[li->atlas], rw = items[j].w, rh = items[j].h;
+            li->scale_offset[0] = rw / W;
+            li->scale_offset[1] = rh / H;
+            li->scale_offset[2] = r.x[j] / W;
+            li->scale_offset[3] = r.y[j] / H;
+            for (size_t k = 0; k < 6 * nt; k++) /* skipped (zero-area) triangles: 0, as packed instances */
+                li->uv1[k] = c->chart_of[k / 6] == UINT32_MAX ? 0 : k % 2 ? b[k] * rh + r.y[j] : b[k] * rw + r.x[j];
+            l->chart_total++;
+        }
+    for (uint32_t g = 0; groups && g < ng; g++)
+        free(groups[g].block);
+    lmb_rect_result_free(&r);
+    free(order);
+    free(groups);
+    free(items);
+    free(area);
+    return st;
+}
