@@ -112,12 +112,21 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
             st = LMB_ERR_INTERNAL;
     }
     uint8_t *node_done = calloc((size_t)s->node_count + 1, 1);
-    if (!node_done)
+    int64_t *shared_by = malloc(((size_t)s->mesh_count + 1) * sizeof *shared_by); /* mesh -> its first node's index */
+    if (!node_done || !shared_by)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+    for (uint32_t m = 0; shared_by && m < s->mesh_count; m++)
+        shared_by[m] = -1;
     for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
         const lmb_instance *in = &s->instances[i];
-        if (!l->instances[i].lightmapped || (in->gpu_instance >= 0 && node_done[in->node]))
+        const lmb_layout_instance *li = &l->instances[i];
+        if (!li->lightmapped || (in->gpu_instance >= 0 && node_done[in->node]))
             continue;
+        if (in->gpu_instance < 0 && li->shared_layout && shared_by[in->mesh] >= 0) { /* atlas.share_meshes */
+            st = lmb_gltf_share_lightmapped_mesh(s->doc, in->node, (uint32_t)shared_by[in->mesh], tex[li->atlas],
+                                                 li->scale_offset, err);
+            continue;
+        }
         lmb_gltf_prim_out *prims = NULL;
         uint32_t n = 0, owned_n = 0;
         void **owned = NULL;
@@ -125,7 +134,10 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
         int32_t t = tex[l->instances[i].atlas], d = dir_tex[l->instances[i].atlas];
         if (st == LMB_OK && in->gpu_instance >= 0) /* every copy of the node: one mesh, a rectangle each */
             st = instanced_node(s, l, in->node, prims, n, t, d, err);
-        else if (st == LMB_OK)
+        else if (st == LMB_OK && li->shared_layout) { /* the first node of a shared mesh */
+            st = lmb_gltf_lightmap_shared_mesh(s->doc, in->node, prims, n, t, d, li->scale_offset, err);
+            shared_by[in->mesh] = in->node;
+        } else if (st == LMB_OK)
             st = lmb_gltf_lightmap_node(s->doc, in->node, prims, n, t, d, l->instances[i].scale_offset, err);
         node_done[in->node] = 1;
         for (uint32_t k = 0; k < owned_n; k++)
@@ -134,6 +146,7 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
         free(prims);
     }
     free(node_done);
+    free(shared_by);
     if (st == LMB_OK)
         st = lmb_gltf_set_light_modes(s->doc, s->lights, s->light_count, err);
     char path[8600], bin[512], rec[512];
@@ -232,7 +245,7 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
             if (lm->kept_uv1) { /* its own TEXCOORD_1, untouched: the node's rectangle places it */
                 uv1[2 * (size_t)lo] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3)];
                 uv1[2 * (size_t)lo + 1] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3) + 1];
-            } else if (s->instances[i].gpu_instance >= 0) { /* the layout its copies share: back through its rectangle */
+            } else if (li->shared_layout) { /* the layout it shares: back through its rectangle */
                 const double *so = li->scale_offset;
                 uv1[2 * (size_t)lo] = (float)((li->uv1[6 * (size_t)f + 2 * (c % 3)] / w - so[2]) / so[0]);
                 uv1[2 * (size_t)lo + 1] = (float)((li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h - so[3]) / so[1]);

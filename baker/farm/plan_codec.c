@@ -87,6 +87,7 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
         put_u32(&w, (uint32_t)in->lightmapped);
         put_u32(&w, in->atlas);
         put_f64(&w, in->texel_density);
+        put_u32(&w, (uint32_t)in->shared_layout);
         for (int k = 0; k < 4; k++)
             put_f64(&w, in->scale_offset[k]);
         /* uv1: 6 per triangle of the instance's mesh; the count is stored with it */
@@ -212,6 +213,7 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
         in->lightmapped = (int)get_u32(&r);
         in->atlas = get_u32(&r);
         in->texel_density = get_f64(&r);
+        in->shared_layout = (int)get_u32(&r);
         for (int k = 0; k < 4; k++)
             in->scale_offset[k] = get_f64(&r);
         uint64_t n = 0;

@@ -74,6 +74,7 @@ static const key_spec config_keys[] = {
     U32("atlas.max_size", OFF(max_atlas_size), 16, 16384),
     U32("atlas.padding", OFF(padding), 0, 64),
     BOOL("atlas.keep_uv1", OFF(keep_uv1)),
+    BOOL("atlas.share_meshes", OFF(share_meshes)),
     U32("samples.texel", OFF(texel_samples), 1, 256),
     U32("samples.direct", OFF(direct_samples), 1, 65536),
     U32("samples.gather", OFF(gather_rays), 1, 1048576),

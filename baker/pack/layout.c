@@ -268,6 +268,18 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     lmb_status st = unwrap_meshes(s, cfg, l, progress, user, err);
     if (st == LMB_OK)
         st = lmb_density_choose(s, cfg, l, list, n, log, &l->density, err);
+    /* atlas.share_meshes: the lightmapped nodes (not instanced copies) of each mesh */
+    uint32_t *users = calloc((size_t)s->mesh_count + 1, sizeof *users);
+    uint8_t *as_rect = calloc((size_t)s->instance_count + 1, 1);
+    if (st == LMB_OK && (!users || !as_rect))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++)
+        users[s->instances[list[j]].mesh] += s->instances[list[j]].gpu_instance < 0;
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
+        const lmb_instance *in = &s->instances[list[j]];
+        as_rect[list[j]] = l->meshes[in->mesh].kept_uv1 || in->gpu_instance >= 0 ||
+                           (cfg->share_meshes && users[in->mesh] >= 2);
+    }
     for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
         lmb_layout_instance *li = &l->instances[list[j]];
         li->lightmapped = 1;
@@ -275,9 +287,10 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
         li->uv1 = calloc(li->uv1_count + 1, sizeof *li->uv1);
         if (!li->uv1)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-        else if (!l->meshes[s->instances[list[j]].mesh].kept_uv1 && s->instances[list[j]].gpu_instance < 0)
+        else if (!as_rect[list[j]])
             lmb_layout_scale_instance(s, l, list[j]);
     }
+    free(users);
     /* kept TEXCOORD_1 and instanced copies: rectangles of shared atlases, after the packed ones;
      * the rest is packed chart by chart */
     uint32_t packed = 0, kept = 0;
@@ -287,7 +300,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
         lmb_layout_instance *li = &l->instances[list[j]];
         li->scale_offset[0] = li->scale_offset[1] = 1;
-        if (l->meshes[s->instances[list[j]].mesh].kept_uv1 || s->instances[list[j]].gpu_instance >= 0)
+        if (as_rect[list[j]])
             kept_list[kept++] = list[j];
         else
             list[packed++] = list[j];
@@ -299,6 +312,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     if (st == LMB_OK && kept)
         st = lmb_layout_rect_instances(s, cfg, l, kept_list, kept, log, err);
     free(kept_list);
+    free(as_rect);
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);

@@ -46,6 +46,8 @@ typedef struct lmb_layout_instance {
     uint32_t atlas;
     double texel_density; /* texels per world unit used for it */
     double *uv1;          /* 6 per mesh triangle, atlas texel coordinates; 0 for skipped triangles */
+    int shared_layout;    /* its TEXCOORD_1 is a layout other instances share (EXT_mesh_gpu_instancing copies,
+                             atlas.share_meshes): the output writes it once, uv = (atlas uv - o) / s */
     double scale_offset[4]; /* (sx, sy, ox, oy): the output TEXCOORD_1 uv lands at uv * s + o in the atlas ([0,1]):
                                (1, 1, 0, 0) for unwrapped meshes (their TEXCOORD_1 is written in atlas space), the
                                instance's rectangle for a mesh that kept its own TEXCOORD_1 */

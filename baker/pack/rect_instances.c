@@ -5,8 +5,9 @@
  *  - a kept-TEXCOORD_1 mesh (atlas.keep_uv1): the block is its UVs as they are, W = H = S,
  *    S = density x sqrt(world area / UV area) (keep_uv1.c); every instance is a group of its own,
  *    or, for EXT_mesh_gpu_instancing copies, the copies of one node are one group;
- *  - the copies of an EXT_mesh_gpu_instancing node with a mesh lmbake unwraps: the mesh's charts
- *    are packed once (pack.h), at the first copy's density, into one W x H block.
+ *  - the copies of an EXT_mesh_gpu_instancing node, or (atlas.share_meshes) the nodes of one mesh,
+ *    with a mesh lmbake unwraps: the mesh's charts are packed once (pack.h), at the first
+ *    instance's density, into one W x H block.
  * Each member m of a group gets the block at s_m = sqrt(A_m / A_0) x d_m / d_0 (A world area, d
  * texel density; 0 the group's first instance), rounded up to whole texels, and every member of a
  * group lands in one atlas (the copies of a node share its material, so one lightmap texture).
@@ -169,9 +170,20 @@ static uint32_t stretched_members(const lmb_scene *s, const lmb_layout *l, const
     return stretched;
 }
 
-/* Groups: consecutive runs of order[] (EXT_mesh_gpu_instancing copies of one node together, in
- * instance order; any other instance alone). Returns the group count. */
-static uint32_t make_groups(const lmb_scene *s, const uint32_t *list, uint32_t n, uint32_t *order, group *groups)
+/* Instances a and b share one layout: copies of one instanced node, or (atlas.share_meshes) nodes of
+ * one mesh that lmbake unwraps. */
+static int same_layout(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, uint32_t a, uint32_t b)
+{
+    const lmb_instance *x = &s->instances[a], *y = &s->instances[b];
+    if (x->gpu_instance >= 0 || y->gpu_instance >= 0)
+        return x->gpu_instance >= 0 && y->gpu_instance >= 0 && x->node == y->node;
+    return cfg->share_meshes && x->mesh == y->mesh && !l->meshes[x->mesh].kept_uv1;
+}
+
+/* Groups: consecutive runs of order[] (instances that share a layout together, in instance
+ * order; any other instance alone). Returns the group count. */
+static uint32_t make_groups(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const uint32_t *list,
+                            uint32_t n, uint32_t *order, group *groups)
 {
     uint32_t ng = 0, placed = 0;
     uint8_t *taken = calloc((size_t)n + 1, 1);
@@ -180,19 +192,14 @@ static uint32_t make_groups(const lmb_scene *s, const uint32_t *list, uint32_t n
     for (uint32_t j = 0; j < n; j++) {
         if (taken[j])
             continue;
-        const lmb_instance *in = &s->instances[list[j]];
         groups[ng].first = placed;
         groups[ng].count = 0;
-        for (uint32_t k = j; k < n; k++) {
-            const lmb_instance *o = &s->instances[list[k]];
-            if (k == j || (in->gpu_instance >= 0 && o->gpu_instance >= 0 && o->node == in->node && !taken[k])) {
+        for (uint32_t k = j; k < n; k++)
+            if (k == j || (!taken[k] && same_layout(s, cfg, l, list[j], list[k]))) {
                 taken[k] = 1;
                 order[placed++] = list[k];
                 groups[ng].count++;
             }
-            if (in->gpu_instance < 0)
-                break;
-        }
         ng++;
     }
     free(taken);
@@ -208,7 +215,7 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
     double *area = malloc(((size_t)n + 1) * sizeof *area);
     lmb_rect_result r;
     memset(&r, 0, sizeof r);
-    uint32_t ng = order && groups && items && area ? make_groups(s, list, n, order, groups) : UINT32_MAX;
+    uint32_t ng = order && groups && items && area ? make_groups(s, cfg, l, list, n, order, groups) : UINT32_MAX;
     lmb_status st = ng != UINT32_MAX ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     for (uint32_t j = 0; st == LMB_OK && j < n; j++)
         area[j] = world_area(s, l, order[j]);
@@ -216,9 +223,9 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
         st = make_block(s, cfg, l, order[groups[g].first], &groups[g], log, err);
         uint32_t stretched = st == LMB_OK ? stretched_members(s, l, order, &groups[g]) : 0;
         if (stretched)
-            lmb_warn(log, "node '%s': %u of its %u instanced copies are not uniformly scaled versions of the first: "
-                     "they share its lightmap layout, so their texels are stretched",
-                     s->instances[order[groups[g].first]].name, stretched, groups[g].count);
+            lmb_warn(log, "'%s': %u of the %u instances that share its lightmap layout are not uniformly scaled "
+                     "versions of it: their texels are stretched", s->instances[order[groups[g].first]].name,
+                     stretched, groups[g].count);
     }
     /* place; an automatic density lowers a group that does not fit one atlas and retries */
     for (int attempt = 0; st == LMB_OK; attempt++) {
@@ -276,6 +283,7 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
             const lmb_charts *c = &l->meshes[s->instances[order[j]].mesh].charts;
             size_t nt = li->uv1_count / 6;
             li->atlas = base + r.atlas[j];
+            li->shared_layout = !l->meshes[s->instances[order[j]].mesh].kept_uv1;
             double W = l->width[li->atlas], H = l->height[li->atlas], rw = items[j].w, rh = items[j].h;
             li->scale_offset[0] = rw / W;
             li->scale_offset[1] = rh / H;

@@ -355,40 +355,82 @@ extern "C" lmb_status lmb_gltf_lightmap_instanced_node(lmb_gltf_doc *doc, uint32
     }
 }
 
-extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
-                                             uint32_t count, int32_t texture, int32_t direction_texture,
-                                             const double scale_offset[4], lmb_error *err)
+namespace {
+
+/* Node `node`'s extras.lightmap: its atlas, texCoord, rectangle and files (from the texture). */
+void node_lightmap_extras(tinygltf::Model &m, tinygltf::Node &n, int texture, const double so[4])
 {
+    Value::Object tex = texture_lightmap_extras(m, texture), lm;
+    lm["atlas"] = tex.count("atlas") ? tex["atlas"] : Value(0);
+    lm["texCoord"] = Value(1);
+    lm["scaleOffset"] = Value(Value::Array{Value(so[0]), Value(so[1]), Value(so[2]), Value(so[3])});
+    lm["scale"] = tex.count("scale") ? tex["scale"] : Value(std::string("irradiance"));
+    lm["files"] = tex.count("files") ? tex["files"] : Value(Value::Object());
+    Value::Object extras = n.extras.IsObject() ? n.extras.Get<Value::Object>() : Value::Object();
+    extras["lightmap"] = Value(lm);
+    n.extras = Value(extras);
+}
+
+/* The lightmapped copy of node's mesh; material_rect (NULL: none) goes into its materials'
+ * MOZ_lightmap as KHR_texture_transform, node_rect into the node's extras. */
+lmb_status lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims, uint32_t count, int32_t texture,
+                         int32_t direction_texture, const double *material_rect, const double node_rect[4],
+                         const char *label, lmb_error *err)
+{
+    static const double identity[4] = {1, 1, 0, 0};
+    const double *mr = material_rect ? material_rect : identity;
     try {
         tinygltf::Model &m = doc->model;
         writer w{m, new_buffer(m)};
         tinygltf::Node &n = m.nodes[node];
         tinygltf::Mesh mesh = m.meshes[(size_t)n.mesh];
         mesh.name = (mesh.name.empty() ? std::string("mesh") : mesh.name) + " (" +
-                    (n.name.empty() ? "node " + std::to_string(node) : n.name) + " lightmap)";
+                    (label ? std::string(label) : n.name.empty() ? "node " + std::to_string(node) : n.name) +
+                    " lightmap)";
         mesh.weights.clear();
         for (uint32_t k = 0; k < count; k++) {
             const lmb_gltf_prim_out &p = prims[k];
             tinygltf::Primitive q = rebuild(w, mesh.primitives[p.gltf_primitive], p);
-            q.material = lightmapped_material(*doc, m, q.material, texture, direction_texture, scale_offset,
-                                              doc->lightmap_materials);
+            q.material = lightmapped_material(*doc, m, q.material, texture, direction_texture, mr, doc->lightmap_materials);
             mesh.primitives[p.gltf_primitive] = q;
         }
-        if (!identity_rect(scale_offset))
+        if (!identity_rect(mr))
             use_extension(m, "KHR_texture_transform");
-        Value::Object tex = texture_lightmap_extras(m, texture), lm;
-        lm["atlas"] = tex.count("atlas") ? tex["atlas"] : Value(0);
-        lm["texCoord"] = Value(1);
-        lm["scaleOffset"] = Value(Value::Array{Value(scale_offset[0]), Value(scale_offset[1]), Value(scale_offset[2]),
-                                               Value(scale_offset[3])});
-        lm["scale"] = tex.count("scale") ? tex["scale"] : Value(std::string("irradiance"));
-        lm["files"] = tex.count("files") ? tex["files"] : Value(Value::Object());
-        Value::Object extras = n.extras.IsObject() ? n.extras.Get<Value::Object>() : Value::Object();
-        extras["lightmap"] = Value(lm);
-        n.extras = Value(extras);
+        node_lightmap_extras(m, n, texture, node_rect);
         m.meshes.push_back(mesh);
         doc->replaced_meshes.push_back(m.nodes[node].mesh);
         m.nodes[node].mesh = (int)m.meshes.size() - 1;
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: node %u: %s", node, e.what());
+    }
+}
+
+} // namespace
+
+extern "C" lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
+                                             uint32_t count, int32_t texture, int32_t direction_texture,
+                                             const double scale_offset[4], lmb_error *err)
+{
+    return lightmap_node(doc, node, prims, count, texture, direction_texture, scale_offset, scale_offset, nullptr, err);
+}
+
+extern "C" lmb_status lmb_gltf_lightmap_shared_mesh(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
+                                                    uint32_t count, int32_t texture, int32_t direction_texture,
+                                                    const double scale_offset[4], lmb_error *err)
+{
+    return lightmap_node(doc, node, prims, count, texture, direction_texture, nullptr, scale_offset, "shared", err);
+}
+
+extern "C" lmb_status lmb_gltf_share_lightmapped_mesh(lmb_gltf_doc *doc, uint32_t node, uint32_t from_node,
+                                                      int32_t texture, const double scale_offset[4], lmb_error *err)
+{
+    try {
+        tinygltf::Model &m = doc->model;
+        tinygltf::Node &n = m.nodes[node];
+        doc->replaced_meshes.push_back(n.mesh);
+        n.mesh = m.nodes[from_node].mesh;
+        node_lightmap_extras(m, n, texture, scale_offset);
         return LMB_OK;
     } catch (const std::exception &e) {
         return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: node %u: %s", node, e.what());

@@ -63,6 +63,16 @@ lmb_status lmb_gltf_lightmap_node(lmb_gltf_doc *doc, uint32_t node, const lmb_gl
                                   int32_t texture, int32_t direction_texture, const double scale_offset[4],
                                   lmb_error *err);
 
+/* atlas.share_meshes: the first node of a mesh that several nodes share gets the lightmapped copy
+ * of the mesh (its TEXCOORD_1 the layout they share; no KHR_texture_transform in its materials,
+ * which every node shares), and its rectangle in its extras.lightmap.scaleOffset; the other
+ * nodes then point at that mesh with lmb_gltf_share_lightmapped_mesh, each with its rectangle. */
+lmb_status lmb_gltf_lightmap_shared_mesh(lmb_gltf_doc *doc, uint32_t node, const lmb_gltf_prim_out *prims,
+                                         uint32_t count, int32_t texture, int32_t direction_texture,
+                                         const double scale_offset[4], lmb_error *err);
+lmb_status lmb_gltf_share_lightmapped_mesh(lmb_gltf_doc *doc, uint32_t node, uint32_t from_node, int32_t texture,
+                                           const double scale_offset[4], lmb_error *err);
+
 /* An EXT_mesh_gpu_instancing node: as lmb_gltf_lightmap_node (its mesh's TEXCOORD_1 is the layout
  * every copy shares; no KHR_texture_transform), and each copy's rectangle as per-instance
  * attributes _LIGHTMAP_SCALE (VEC2 sx, sy) and _LIGHTMAP_OFFSET (VEC2 ox, oy) of the extension,

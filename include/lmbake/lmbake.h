@@ -270,6 +270,7 @@ typedef struct lmb_config {
     uint32_t max_atlas_size;       /* texels per side */
     uint32_t padding;              /* texels between charts */
     int keep_uv1;                  /* keep a mesh's own TEXCOORD_1 */
+    int share_meshes;              /* atlas.share_meshes: nodes that share a mesh keep sharing it, a rectangle each */
     /* samples */
     uint32_t texel_samples;        /* gather points per texel (stratified) */
     uint32_t direct_samples;       /* shadow rays per area-light evaluation */

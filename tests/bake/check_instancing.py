@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Lightmaps for EXT_mesh_gpu_instancing copies (docs/unwrap.md "Instanced copies").
 
-usage: check_instancing.py LMBAKE WORKDIR
+usage: check_instancing.py LMBAKE WORKDIR CASE   (CASE: copies, shared)
 
+copies:
 instanced-boxes.gltf (tools/make_scenes.py): a 30 x 30 ground, 576 boxes drawn through one
 EXT_mesh_gpu_instancing node (every other one 1.5 x larger), a roof 3 above the x < 0 half, a sun
 30 degrees off vertical. Baked with no config but a smaller texel budget:
@@ -15,6 +16,11 @@ EXT_mesh_gpu_instancing node (every other one 1.5 x larger), a roof 3 above the 
     degrees) plus what bounces, within [866, 1.3 x 866]; copies under the roof are darker than a
     third of that;
   - Khronos' validator finds 0 errors.
+shared: seams.gltf (two floor tiles, nodes tile and tile_b, one mesh; a point light) with
+atlas.share_meshes: one lightmapped mesh in the output used by both nodes, two disjoint
+rectangles in extras.lightmap.scaleOffset, and the light at 400 points of each tile (the
+lightmap through the node's rectangle) equal to a bake with a copy per node within the two
+bakes' noise: the rms difference at most 1.5 x that between two seeds of the copies' bake.
 """
 import json
 import math
@@ -49,8 +55,70 @@ def bilinear(img, u, v):
             (1 - fx) * fy * img[y0 + 1, x0] + fx * fy * img[y0 + 1, x0 + 1])
 
 
-def main():
-    lmbake, work = sys.argv[1:3]
+def bake(lmbake, work, scene, name, config):
+    out = os.path.join(work, name)
+    shutil.rmtree(out, ignore_errors=True)
+    cfg = os.path.join(work, name + ".yaml")
+    with open(cfg, "w") as f:
+        f.write(config)
+    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out], capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit("bake %s failed: %s" % (name, p.stderr[-2000:]))
+    gltf = [f for f in os.listdir(out) if f.endswith(".gltf")][0]
+    doc = json.load(open(os.path.join(out, gltf)))
+    return out, doc, [open(os.path.join(out, b["uri"]), "rb").read() for b in doc["buffers"]]
+
+
+def tile_light(out, doc, bins, name, grid=20):
+    """Luminance of the lightmap at grid x grid points of node `name`'s surface, through its rectangle."""
+    node = next(n for n in doc["nodes"] if n.get("name") == name)
+    so = node["extras"]["lightmap"]["scaleOffset"]
+    prim = doc["meshes"][node["mesh"]]["primitives"][0]
+    uv = _accessor(doc, bins, prim["attributes"]["TEXCOORD_1"])
+    idx = _accessor(doc, bins, prim["indices"]).reshape(-1).astype(int)
+    tex = doc["materials"][prim["material"]]["extensions"]["MOZ_lightmap"]["index"]
+    exr = _image(os.path.join(out, doc["textures"][tex]["extras"]["lightmap"]["files"]["exr"]))[..., :3]
+    vals = []
+    for t in uv[idx].reshape(-1, 3, 2):
+        for a in range(grid):
+            for b in range(grid - a):
+                w = np.array([(a + 1 / 3) / grid, (b + 1 / 3) / grid])
+                p = t[0] + w[0] * (t[1] - t[0]) + w[1] * (t[2] - t[0])
+                vals.append(p * so[:2] + so[2:])
+    vals = np.array(vals)
+    return bilinear(exr, vals[:, 0], vals[:, 1]) @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def shared(lmbake, work):
+    scenes = os.path.join(work, "scenes")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
+                   stdout=subprocess.DEVNULL)
+    scene = os.path.join(scenes, "seams.gltf")
+    base = "texel_density: 32\noutput: {formats: [exr], directional: false}\n"
+    o1, d1, b1 = bake(lmbake, work, scene, "shared", base + "atlas: {share_meshes: true}\n")
+    o2, d2, b2 = bake(lmbake, work, scene, "copies", base)
+    o3, d3, b3 = bake(lmbake, work, scene, "copies-seed2", base + "seed: 2\n")
+    tiles = [n for n in d1["nodes"] if n.get("name") in ("tile", "tile_b")]
+    check(len(tiles) == 2 and tiles[0]["mesh"] == tiles[1]["mesh"] and
+          sum(1 for m in d1["meshes"] if m["name"].startswith("tile")) == 1,
+          "one lightmapped mesh for both nodes (%s)" % [m["name"] for m in d1["meshes"]])
+    r = [n["extras"]["lightmap"]["scaleOffset"] for n in tiles]
+    apart = (r[0][2] + r[0][0] <= r[1][2] + 1e-9 or r[1][2] + r[1][0] <= r[0][2] + 1e-9 or
+             r[0][3] + r[0][1] <= r[1][3] + 1e-9 or r[1][3] + r[1][1] <= r[0][3] + 1e-9)
+    check(apart and all(0 <= x <= 1 for q in r for x in q), "two disjoint rectangles: %s" % r)
+    for name in ("tile", "tile_b"):
+        a, b, c = tile_light(o1, d1, b1, name), tile_light(o2, d2, b2, name), tile_light(o3, d3, b3, name)
+        diff = np.sqrt(np.mean(((a - b) / b) ** 2))
+        noise = np.sqrt(np.mean(((c - b) / b) ** 2))
+        check(diff <= 1.5 * noise + 0.002 and abs(a.mean() / b.mean() - 1) <= 0.01,
+              "%s: shared vs copies %.2f%% rms, mean ratio %.4f (two seeds of the copies: %.2f%% rms)"
+              % (name, 100 * diff, a.mean() / b.mean(), 100 * noise))
+    v = subprocess.run(["node", os.path.join(HERE, "validate_gltf.js"), os.path.join(o1, "seams.gltf")],
+                       capture_output=True, text=True)
+    check(v.returncode == 0, "Khronos' validator: %s" % v.stdout.splitlines()[0].split(": ", 1)[-1])
+
+
+def copies(lmbake, work):
     scenes = os.path.join(work, "scenes")
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
                    stdout=subprocess.DEVNULL)
@@ -142,6 +210,12 @@ def main():
     v = subprocess.run(["node", os.path.join(HERE, "validate_gltf.js"), os.path.join(out, "instanced-boxes.gltf")],
                        capture_output=True, text=True)
     check(v.returncode == 0, "Khronos' validator: %s" % v.stdout.splitlines()[0].split(": ", 1)[-1])
+
+
+def main():
+    lmbake, work, case = sys.argv[1:4]
+    os.makedirs(work, exist_ok=True)
+    {"copies": copies, "shared": shared}[case](lmbake, work)
     if failures:
         sys.exit("%d check(s) failed" % len(failures))
 

@@ -256,7 +256,7 @@ static void test_value_errors(void)
 static void test_structure_errors(void)
 {
     expect_error("texel_density: 8\natlas:\n  maxsize: 512\n", "level.yaml:3: ",
-                 "unknown key 'atlas.maxsize' (known keys under 'atlas': texels, max_size, padding, keep_uv1)");
+                 "unknown key 'atlas.maxsize' (known keys under 'atlas': texels, max_size, padding, keep_uv1, share_meshes)");
     expect_error("bouncez: 3\n", "level.yaml:1: ",
                  "unknown key 'bouncez' (known keys: texel_density, density_overrides, atlas");
     expect_error("seed: 1\nthreads: 2\nseed: 2\n", "level.yaml:3: ", "key 'seed' is given twice (first on line 1)");
@@ -450,6 +450,9 @@ static void test_output_keys(void)
     CHECK_NEAR(c.rgbm_range, 0, 0);
     CHECK_INT(c.output_scale, LMB_SCALE_IRRADIANCE); /* the default */
     CHECK_INT(c.shadowmask, 0);
+    CHECK_INT(c.share_meshes, 0);
+    CHECK_INT(parse("atlas: {share_meshes: true}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.share_meshes, 1);
     CHECK_INT(parse("output: {shadowmask: true}\nlights:\n  modes:\n    - {match: \"Sun*\", mode: indirect}\n"
                     "    - {match: Lamp, mode: realtime}\n", &c, &err), LMB_OK);
     CHECK_INT(c.shadowmask, 1);
