@@ -371,6 +371,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
+    if (st == LMB_OK && !shard)
+        lmb_info(log, "ray tracing: %llu triangles placed, %llu stored (meshes used more than once are Embree "
+                 "instances), built in %.2f s", (unsigned long long)rt.placed_triangles,
+                 (unsigned long long)rt.stored_triangles, rt.build_seconds);
     if (st == LMB_OK)
         st = lmb_textures_load(s, &tx, log, err);
     if (st == LMB_OK)

@@ -2,7 +2,7 @@
 """Generates level-sized test scenes for the unwrap/pack benchmark and the real-level tests
 (issue 10), as binary glTF (.glb). Deterministic: the same arguments give the same bytes.
 
-usage: make_levels.py OUTDIR [single|instances|furnace|all|single:ROOMS|instances:COUNT] ...
+usage: make_levels.py OUTDIR [single|instances|furnace|gpu|all|single:ROOMS|instances:COUNT|gpu:COUNT] ...
   (single:ROOMS: ROOMS x ROOMS rooms, level-single-ROOMS.glb; instances:COUNT: COUNT props,
    level-instances-COUNT.glb; the benchmark's size series)
 
@@ -14,6 +14,8 @@ usage: make_levels.py OUTDIR [single|instances|furnace|all|single:ROOMS|instance
   level-instances.glb  ~1M triangles in 2,000 instances of 40 meshes (bumpy rocks, columns,
                        crates; 100-1,000 triangles each) on a 45 x 45 grid over 900 units,
                        turned and scaled; a ground of 20k triangles; a sun.
+  level-gpu.glb        1,900 copies of a ~4,000-triangle prop through one EXT_mesh_gpu_instancing
+                       node on a ground, a sun (gpu:COUNT: COUNT copies, level-gpu-COUNT.glb)
   furnace-08.glb       a closed 2 m box (inward faces), every face albedo 0.8 and emitting
                        1 nit: E converges to pi / (1 - 0.8) = 15.708 lux (bounces: auto test).
 """
@@ -274,6 +276,43 @@ def level_instances(path, count=2000):
     return total
 
 
+def level_gpu(path, count=1900):
+    """A ground and `count` copies of one ~4,000-triangle bumpy sphere drawn through a single
+    EXT_mesh_gpu_instancing node (like Blender's 24_gpu_instancing test: 1,900 teapots), turned
+    and uniformly scaled, under a sun."""
+    rng = np.random.default_rng(3)
+    g = Glb()
+    mat = g.material("Stone", 0.5)
+    prop = Mesh()
+    bumpy_sphere(prop, 64, 32, 1.0, 0.15, 7)
+    mesh = g.mesh("Prop", prop, mat)
+    ground = Mesh()
+    side = int(math.ceil(math.sqrt(count)))
+    grid(ground, -2.0, -2.0, side * 4.0 + 4.0, side * 4.0 + 4.0, 20, 20)
+    g.node({"name": "Ground", "mesh": g.mesh("Ground", ground, mat)})
+    t, r, sc = [], [], []
+    for n in range(count):
+        i, j = divmod(n, side)
+        ang = rng.uniform(0, 2 * math.pi)
+        k = float(rng.uniform(0.6, 1.4))
+        t += [i * 4.0 + 2.0, 1.2 * k, j * 4.0 + 2.0]
+        r += [0.0, math.sin(ang / 2), 0.0, math.cos(ang / 2)]
+        sc += [k, k, k]
+    acc = g.doc["accessors"]
+    attrs = {}
+    for name, vals, comps in (("TRANSLATION", t, 3), ("ROTATION", r, 4), ("SCALE", sc, 3)):
+        v = g.view(np.array(vals, dtype=np.float32).tobytes(), None)
+        del g.doc["bufferViews"][v]["target"]
+        acc.append({"bufferView": v, "componentType": 5126, "count": count, "type": "VEC%d" % comps})
+        attrs[name] = len(acc) - 1
+    g.doc.setdefault("extensionsUsed", []).append("EXT_mesh_gpu_instancing")
+    g.node({"name": "Props", "mesh": mesh, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": attrs}}})
+    g.lights([{"type": "directional", "intensity": 3.0, "name": "Sun"}],
+             [(0, {"name": "Sun", "rotation": sun_rotation()})])
+    g.write(path)
+    return ground.triangles() + count * prop.triangles()
+
+
 def furnace(path, rho=0.8):
     g = Glb()
     mat = g.material("Furnace", rho, [1.0, 1.0, 1.0])
@@ -291,7 +330,7 @@ def main():
     which = sys.argv[2:] or ["all"]
     os.makedirs(out, exist_ok=True)
     jobs = {"single": ("level-single.glb", level_single), "instances": ("level-instances.glb", level_instances),
-            "furnace": ("furnace-08.glb", furnace)}
+            "furnace": ("furnace-08.glb", furnace), "gpu": ("level-gpu.glb", level_gpu)}
     for key, (name, fn) in jobs.items():
         if "all" in which or key in which:
             n = fn(os.path.join(out, name))

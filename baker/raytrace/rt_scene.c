@@ -1,11 +1,13 @@
 /*
  * Embree 3 scene of the whole level (see rt_scene.h). One triangle geometry per
- * (instance, primitive), vertices transformed to world space at build time (simpler than
- * Embree instancing, and the scenes lmbake bakes fit easily in memory); built with
+ * (instance, primitive) of a mesh used once, vertices transformed to world space at build
+ * time; a mesh several instances use gets one object-space scene (a geometry per primitive)
+ * and an Embree instance per placement (rtcSetGeometryTransform). Built with
  * RTC_SCENE_FLAG_ROBUST so rays along shared edges do not slip through.
  */
 #include "rt_scene.h"
 
+#include "../util/clock.h"
 #include "../util/mat4.h"
 
 #include <math.h>
@@ -24,71 +26,182 @@ void lmb_rt_free(lmb_rt *rt)
 {
     if (rt->scene)
         rtcReleaseScene(rt->scene);
+    for (uint32_t m = 0; rt->mesh_scenes && m < rt->mesh_count; m++)
+        if (rt->mesh_scenes[m])
+            rtcReleaseScene(rt->mesh_scenes[m]);
+    free(rt->mesh_scenes);
     if (rt->device)
         rtcReleaseDevice(rt->device);
     free(rt->geoms);
     memset(rt, 0, sizeof *rt);
 }
 
-static lmb_status add_geometry(lmb_rt *rt, const lmb_scene *s, uint32_t i, uint32_t p, uint32_t first, double lo[3],
-                               double hi[3], lmb_error *err)
+/* A triangle geometry of primitive p, its vertices through `world` (NULL: object space), attached
+ * to `scene` with id `id`; the world bounds grow by its vertices. */
+static lmb_status attach_triangles(lmb_rt *rt, RTCScene scene, unsigned id, const lmb_primitive *pr,
+                                   const double *world, double lo[3], double hi[3], lmb_error *err)
 {
-    const lmb_instance *in = &s->instances[i];
-    const lmb_primitive *pr = &s->primitives[p];
     RTCGeometry g = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), pr->vertex_count);
     unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
                                            pr->triangle_count);
     if (!v || !ix) {
         rtcReleaseGeometry(g);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "ray tracing: out of memory for instance '%s'", in->name);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "ray tracing: out of memory");
     }
     for (uint32_t k = 0; k < pr->vertex_count; k++) {
         double q[3] = {pr->positions[3 * k], pr->positions[3 * k + 1], pr->positions[3 * k + 2]}, w[3];
-        lmb_mat4_point(in->world, q, w);
+        if (world)
+            lmb_mat4_point(world, q, w);
+        else
+            memcpy(w, q, sizeof w);
         for (int d = 0; d < 3; d++) {
             v[3 * k + d] = (float)w[d];
-            lo[d] = fmin(lo[d], w[d]);
-            hi[d] = fmax(hi[d], w[d]);
+            if (world) {
+                lo[d] = fmin(lo[d], w[d]);
+                hi[d] = fmax(hi[d], w[d]);
+            }
         }
     }
     memcpy(ix, pr->indices, (size_t)pr->triangle_count * 3 * sizeof(unsigned));
     rtcCommitGeometry(g);
-    unsigned id = rtcAttachGeometry(rt->scene, g);
+    rtcAttachGeometryByID(scene, g, id);
     rtcReleaseGeometry(g);
-    rt->geoms[id].instance = i;
-    rt->geoms[id].primitive = p;
-    rt->geoms[id].first_triangle = first;
-    rt->geoms[id].flips_winding = in->flips_winding;
     return LMB_OK;
+}
+
+/* Mesh m's object-space scene: a geometry per primitive with triangles, ids 0, 1, ... */
+static lmb_status mesh_scene(lmb_rt *rt, const lmb_scene *s, uint32_t m, lmb_error *err)
+{
+    const lmb_mesh *mesh = &s->meshes[m];
+    RTCScene sc = rtcNewScene(rt->device);
+    rtcSetSceneFlags(sc, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(sc, RTC_BUILD_QUALITY_MEDIUM);
+    lmb_status st = LMB_OK;
+    unsigned id = 0;
+    for (uint32_t p = 0; p < mesh->primitive_count && st == LMB_OK; p++) {
+        const lmb_primitive *pr = &s->primitives[mesh->first_primitive + p];
+        if (pr->triangle_count) {
+            st = attach_triangles(rt, sc, id++, pr, NULL, NULL, NULL, err);
+            rt->stored_triangles += pr->triangle_count;
+        }
+    }
+    rtcCommitScene(sc);
+    rt->mesh_scenes[m] = sc;
+    return st;
+}
+
+/* Instance i as an Embree instance of its mesh's scene, with id `slot` (its first slot); the
+ * world bounds grow by its mesh's transformed bounding box. */
+static lmb_status attach_instance(lmb_rt *rt, const lmb_scene *s, uint32_t i, unsigned slot, double lo[3], double hi[3])
+{
+    const lmb_instance *in = &s->instances[i];
+    const lmb_mesh *mesh = &s->meshes[in->mesh];
+    RTCGeometry g = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(g, rt->mesh_scenes[in->mesh]);
+    float m[16];
+    for (int k = 0; k < 16; k++)
+        m[k] = (float)in->world[k];
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, m);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(rt->scene, g, slot);
+    rtcReleaseGeometry(g);
+    double blo[3] = {1e300, 1e300, 1e300}, bhi[3] = {-1e300, -1e300, -1e300};
+    for (uint32_t p = 0; p < mesh->primitive_count; p++) {
+        const lmb_primitive *pr = &s->primitives[mesh->first_primitive + p];
+        for (uint32_t k = 0; k < pr->vertex_count; k++)
+            for (int d = 0; d < 3; d++) {
+                blo[d] = fmin(blo[d], pr->positions[3 * k + d]);
+                bhi[d] = fmax(bhi[d], pr->positions[3 * k + d]);
+            }
+    }
+    for (int c = 0; c < 8 && blo[0] <= bhi[0]; c++) {
+        double q[3] = {c & 1 ? bhi[0] : blo[0], c & 2 ? bhi[1] : blo[1], c & 4 ? bhi[2] : blo[2]}, w[3];
+        lmb_mat4_point(in->world, q, w);
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fmin(lo[d], w[d]);
+            hi[d] = fmax(hi[d], w[d]);
+        }
+    }
+    return LMB_OK;
+}
+
+/* The inverse transpose of world's upper 3 x 3, row-major (the cofactor matrix over the
+ * determinant); normals through it are then normalized. */
+static void normal_matrix(const double w[16], float out[9])
+{
+    double a[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            a[r][c] = w[4 * c + r];
+    double cof[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            cof[r][c] = a[r1][c1] * a[r2][c2] - a[r1][c2] * a[r2][c1];
+        }
+    double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            out[3 * r + c] = (float)(det != 0 ? cof[r][c] / det : 0);
 }
 
 lmb_status lmb_rt_build(const lmb_scene *s, lmb_rt *rt, lmb_error *err)
 {
+    double t0 = lmb_seconds();
     memset(rt, 0, sizeof *rt);
     uint32_t n = 0;
     for (uint32_t i = 0; i < s->instance_count; i++)
         n += s->meshes[s->instances[i].mesh].primitive_count;
+    uint32_t *uses = calloc((size_t)s->mesh_count + 1, sizeof *uses);
     rt->geoms = calloc((size_t)n + 1, sizeof *rt->geoms);
+    rt->mesh_scenes = calloc((size_t)s->mesh_count + 1, sizeof *rt->mesh_scenes);
+    rt->mesh_count = s->mesh_count;
     rt->device = rtcNewDevice(NULL);
-    if (!rt->geoms || !rt->device) {
+    if (!uses || !rt->geoms || !rt->mesh_scenes || !rt->device) {
+        free(uses);
         lmb_rt_free(rt);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "ray tracing: cannot create the Embree device");
     }
     rt->scene = rtcNewScene(rt->device);
     rtcSetSceneFlags(rt->scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(rt->scene, RTC_BUILD_QUALITY_MEDIUM);
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        uses[s->instances[i].mesh]++;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     lmb_status st = LMB_OK;
+    uint32_t slot = 0;
     for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
-        const lmb_mesh *m = &s->meshes[s->instances[i].mesh];
+        const lmb_instance *in = &s->instances[i];
+        const lmb_mesh *m = &s->meshes[in->mesh];
+        int instanced = uses[in->mesh] >= 2;
+        if (instanced && !rt->mesh_scenes[in->mesh])
+            st = mesh_scene(rt, s, in->mesh, err);
+        if (instanced && st == LMB_OK && m->triangle_count)
+            st = attach_instance(rt, s, i, slot, lo, hi);
         uint32_t first = 0;
         for (uint32_t p = 0; p < m->primitive_count && st == LMB_OK; p++) {
-            if (s->primitives[m->first_primitive + p].triangle_count)
-                st = add_geometry(rt, s, i, m->first_primitive + p, first, lo, hi, err);
-            first += s->primitives[m->first_primitive + p].triangle_count;
+            const lmb_primitive *pr = &s->primitives[m->first_primitive + p];
+            if (pr->triangle_count) {
+                lmb_rt_geom *g = &rt->geoms[slot];
+                if (!instanced) {
+                    st = attach_triangles(rt, rt->scene, slot, pr, in->world, lo, hi, err);
+                    rt->stored_triangles += pr->triangle_count;
+                }
+                g->instance = i;
+                g->primitive = m->first_primitive + p;
+                g->first_triangle = first;
+                g->flips_winding = in->flips_winding;
+                g->instanced = instanced;
+                if (instanced)
+                    normal_matrix(in->world, g->normal_matrix);
+                rt->placed_triangles += pr->triangle_count;
+                slot++;
+            }
+            first += pr->triangle_count;
         }
     }
+    free(uses);
     if (st != LMB_OK) {
         lmb_rt_free(rt);
         return st;
@@ -100,6 +213,7 @@ lmb_status lmb_rt_build(const lmb_scene *s, lmb_rt *rt, lmb_error *err)
         d2 += hi[d] > lo[d] ? (hi[d] - lo[d]) * (hi[d] - lo[d]) : 0;
     rt->extent = d2 > 0 ? sqrt(d2) : 1.0;
     rt->eps = 1e-5 * rt->extent;
+    rt->build_seconds = lmb_seconds() - t0;
     return LMB_OK;
 }
 
@@ -137,13 +251,22 @@ int lmb_rt_intersect(const lmb_rt *rt, const double o[3], const double d[3], dou
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     hit->t = rh.ray.tfar;
-    hit->geom = rh.hit.geomID;
+    int instanced = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID;
+    hit->geom = instanced ? rh.hit.instID[0] + rh.hit.geomID : rh.hit.geomID; /* the slot */
     hit->prim = rh.hit.primID;
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
-    /* Embree's Ng = (v1 - v0) x (v2 - v0) over the stored (world) winding */
-    double ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, l = sqrt(ng[0] * ng[0] + ng[1] * ng[1] + ng[2] * ng[2]);
-    double sg = rt->geoms[hit->geom].flips_winding ? -1.0 : 1.0;
+    const lmb_rt_geom *g = &rt->geoms[hit->geom];
+    double ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, sg = 1.0;
+    if (instanced) { /* Ng in object space: world = M^-T Ng, which also follows a mirrored instance's winding */
+        const float *nm = g->normal_matrix;
+        double o[3] = {ng[0], ng[1], ng[2]};
+        for (int r = 0; r < 3; r++)
+            ng[r] = nm[3 * r] * o[0] + nm[3 * r + 1] * o[1] + nm[3 * r + 2] * o[2];
+    } else { /* Embree's Ng = (v1 - v0) x (v2 - v0) over the stored (world) winding */
+        sg = g->flips_winding ? -1.0 : 1.0;
+    }
+    double l = sqrt(ng[0] * ng[0] + ng[1] * ng[1] + ng[2] * ng[2]);
     for (int k = 0; k < 3; k++)
         hit->ng[k] = (float)(l > 0 ? sg * ng[k] / l : 0);
     hit->backface = hit->ng[0] * d[0] + hit->ng[1] * d[1] + hit->ng[2] * d[2] > 0;

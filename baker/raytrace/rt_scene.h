@@ -1,7 +1,10 @@
 /*
- * The ray-tracing scene: every instance of the level (lightmapped or not) as world-space
- * triangles in one Embree 3 scene, committed once and then shared read-only by all
- * threads. Embree's C API is used directly (no adapter needed).
+ * The ray-tracing scene: every instance of the level (lightmapped or not) in one Embree 3
+ * scene, committed once and then shared read-only by all threads. A mesh used once is stored
+ * as world-space triangles; a mesh several instances use (EXT_mesh_gpu_instancing copies, a
+ * mesh on several nodes) is stored once, in object space, and placed by Embree instances, so
+ * memory grows with the unique triangles, not the placed ones. Embree's C API is used directly
+ * (no adapter needed).
  */
 #ifndef LMBAKE_RT_SCENE_H
 #define LMBAKE_RT_SCENE_H
@@ -10,18 +13,27 @@
 
 #include <embree3/rtcore.h>
 
+/* One (instance, primitive) with triangles: a "geometry slot". A world-space geometry's Embree id
+ * is its slot; an instanced one is hit as (instance geometry id = the instance's first slot) +
+ * (the primitive's place among its mesh's primitives with triangles). */
 typedef struct lmb_rt_geom {
     uint32_t instance;       /* lmb_scene instance */
     uint32_t primitive;      /* lmb_scene primitive */
     uint32_t first_triangle; /* its first triangle in the instance mesh's triangle list */
     int flips_winding;
+    int instanced;           /* placed by an Embree instance: hit normals come in object space */
+    float normal_matrix[9];  /* instanced: the world matrix's inverse transpose (row-major 3 x 3) */
 } lmb_rt_geom;
 
 typedef struct lmb_rt {
     RTCDevice device;
     RTCScene scene;
-    lmb_rt_geom *geoms; /* by Embree geometry id */
+    RTCScene *mesh_scenes; /* per lmb_scene mesh: its object-space scene when instanced, else NULL */
+    uint32_t mesh_count;
+    lmb_rt_geom *geoms; /* by geometry slot */
     uint32_t geom_count;
+    uint64_t placed_triangles, stored_triangles; /* triangles in the level, and in memory */
+    double build_seconds;
     double extent;      /* diagonal of the scene's bounding box */
     double eps;         /* ray offset: 1e-5 x extent */
 } lmb_rt;

@@ -146,3 +146,25 @@ export function lightmapTriangles(gltfFile, hdrName) {
 
 export const srgb = (x) => { x = Math.min(1, Math.max(0, x)); return 255 * (x <= 0.0031308 ? 12.92 * x : 1.055 * x ** (1 / 2.4) - 0.055); };
 export const luma = (p) => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+
+// A glTF's JSON and its accessors: {json, dir, read(accessorIndex)} where read gives the
+// accessor's values as a flat array of numbers (float, normalized or integer components, byte
+// strides honoured) and its number of components per element (itemSize).
+export function gltfAccessors(gltfFile) {
+  const json = JSON.parse(fs.readFileSync(gltfFile, 'utf8')), dir = path.dirname(gltfFile);
+  const bufs = json.buffers.map((bf) => fs.readFileSync(path.join(dir, decodeURIComponent(bf.uri))));
+  const read = (ai) => {
+    const a = json.accessors[ai], bv = json.bufferViews[a.bufferView], n = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4 }[a.type];
+    const cs = { 5121: 1, 5123: 2, 5125: 4, 5126: 4 }[a.componentType], stride = bv.byteStride || cs * n;
+    const buf = bufs[bv.buffer], base = (bv.byteOffset || 0) + (a.byteOffset || 0), out = [];
+    for (let i = 0; i < a.count; i++) for (let k = 0; k < n; k++) {
+      const o = base + i * stride + k * cs;
+      let v = a.componentType === 5126 ? buf.readFloatLE(o) : a.componentType === 5125 ? buf.readUInt32LE(o) : a.componentType === 5123 ? buf.readUInt16LE(o) : buf[o];
+      if (a.normalized) v /= a.componentType === 5123 ? 65535 : 255;
+      out.push(v);
+    }
+    out.itemSize = n;
+    return out;
+  };
+  return { json, dir, read };
+}

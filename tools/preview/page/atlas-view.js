@@ -11,7 +11,7 @@ export const ATLAS_BACKGROUND = 0x141428; // sRGB (20, 20, 40): texels no chart 
 export class AtlasView {
   constructor(atlases, chartMeshes) {
     this.atlases = atlases;
-    this.chartMeshes = chartMeshes; // [{atlas, checkerGeometry, scaleOffset (the mesh's rectangle in the atlas)}]
+    this.chartMeshes = chartMeshes; // [{atlas, checkerGeometry, scaleOffset (the mesh's rectangle in the atlas), rects (an InstancedMesh's: one per copy) or null}]
     this.camera = new THREE.OrthographicCamera(0, 1, 0, -1, -10, 10);
     this.scenes = new Map();
     this.atlas = 0; this.layer = 'lightmap'; this.zoom = 1; this.originX = 0; this.originY = 0;
@@ -25,7 +25,7 @@ export class AtlasView {
     scene.background = new THREE.Color(ATLAS_BACKGROUND);
     if (layer === 'checker') {
       const mat = checkerMaterial(a);
-      for (const cm of this.chartMeshes) if (cm.atlas === atlasIndex) scene.add(new THREE.Mesh(atlasLayoutGeometry(cm.checkerGeometry, a, cm.scaleOffset), mat));
+      for (const cm of this.chartMeshes) if (cm.atlas === atlasIndex) scene.add(new THREE.Mesh(atlasLayoutGeometry(cm.checkerGeometry, a, cm.rects || cm.scaleOffset), mat));
     } else {
       const g = new THREE.BufferGeometry();
       const w = a.width, h = a.height;

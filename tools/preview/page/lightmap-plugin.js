@@ -40,6 +40,109 @@ export function lightmapScaleOffset(tex) {
   return tex ? [tex.repeat.x, tex.repeat.y, tex.offset.x, tex.offset.y] : [1, 1, 0, 0];
 }
 
+// Per-instance lightmap rectangles of an EXT_mesh_gpu_instancing node (docs/output.md): the
+// extension's attributes _LIGHTMAP_SCALE and _LIGHTMAP_OFFSET (VEC2, one per copy), which three's
+// GLTFMeshGpuInstancing puts on the InstancedMesh's geometry as InstancedBufferAttributes under
+// those names. The page's shaders read them under the names INSTANCE_RECT_ATTRIBUTES gives them.
+export const INSTANCE_RECT_SOURCES = ['_LIGHTMAP_SCALE', '_LIGHTMAP_OFFSET'];
+export const INSTANCE_RECT_ATTRIBUTES = ['lmbLightmapScale', 'lmbLightmapOffset'];
+
+// Adds a shader patch to a material, after any it already has (onBeforeCompile chains; the
+// program cache key names every patch, so a patched material never shares an unpatched program).
+export function addShaderPatch(material, key, patch) {
+  const prev = material.onBeforeCompile, prevKey = material.customProgramCacheKey();
+  material.onBeforeCompile = function (shader, renderer) { prev.call(this, shader, renderer); patch(shader, renderer); };
+  material.customProgramCacheKey = () => `${prevKey}|${key}`;
+  material.needsUpdate = true;
+  return material;
+}
+
+// A clone of a material that keeps its shader patches (Material.clone() drops them)
+export function cloneWithPatches(material) {
+  const m = material.clone();
+  if (Object.prototype.hasOwnProperty.call(material, 'onBeforeCompile')) m.onBeforeCompile = material.onBeforeCompile;
+  if (Object.prototype.hasOwnProperty.call(material, 'customProgramCacheKey')) m.customProgramCacheKey = material.customProgramCacheKey;
+  return m;
+}
+
+// The patch that makes three's lightMap (lit and lightmap views) read an InstancedMesh's copy at
+// its own rectangle: vLightMapUv = lightMapTransform x (uv1 x scale_k + offset_k), k the instance
+// (three's uv_vertex computes it from uv1 alone). A directional lightmap reads the same vLightMapUv.
+export function patchInstanceRectangles(material) {
+  const [scale, offset] = INSTANCE_RECT_ATTRIBUTES;
+  return addShaderPatch(material, 'lmbake-instance-rect', (shader) => {
+    if (!shader.vertexShader.includes('#include <uv_vertex>')) throw new Error(`lmbake preview: ${material.type} has no uv_vertex to patch for per-instance lightmap rectangles`);
+    shader.vertexShader = `#ifdef USE_INSTANCING\nattribute vec2 ${scale};\nattribute vec2 ${offset};\n#endif\n` + shader.vertexShader.replace('#include <uv_vertex>', `#include <uv_vertex>
+#if defined( USE_LIGHTMAP ) && defined( USE_INSTANCING )
+  vLightMapUv = ( lightMapTransform * vec3( LIGHTMAP_UV * ${scale} + ${offset}, 1 ) ).xy;
+#endif`);
+  });
+}
+
+// The glTF node index a three.js object belongs to (a multi-primitive mesh's meshes are children
+// of the node's group; GLTFLoader's parser.associations maps each node's object, clones of a
+// shared mesh and InstancedMeshes included, to {nodes: index}), or -1
+export function gltfNodeIndex(parser, o) {
+  for (; o; o = o.parent) { const a = parser.associations.get(o); if (a && a.nodes !== undefined) return a.nodes; }
+  return -1;
+}
+
+const validScaleOffset = (so) => Array.isArray(so) && so.length === 4 && so.every(Number.isFinite) && so[0] > 0 && so[1] > 0;
+
+// Lightmap rectangles that the lightMap textures GLTFLoader made do not carry, put on the
+// objects (call once, after loading, before anything copies the materials):
+//  - an InstancedMesh whose geometry has _LIGHTMAP_SCALE and _LIGHTMAP_OFFSET: its own clone of
+//    the material (a material it shares with other meshes stays as it is for them) with
+//    patchInstanceRectangles; the attributes are also set under INSTANCE_RECT_ATTRIBUTES'
+//    names. object.userData.lightmapInstances = {count, scale, offset} (Float32Arrays, 2 per copy).
+//  - a mesh whose glTF node has extras.lightmap.scaleOffset other than the rectangle its
+//    lightMap texture carries (atlas.share_meshes: several nodes share one mesh and one
+//    material, the material has no KHR_texture_transform): a clone of the material per
+//    (material, rectangle) with a clone of the texture at that offset / repeat, as
+//    KHR_texture_transform does. When both say a rectangle they are the same (keep_uv1 bakes);
+//    the node's is used.
+// Returns {instanced: [{object, node, count}], perNode: [{object, node, scaleOffset}]}.
+export function applyLightmapRectangles(gltf) {
+  const parser = gltf.parser, json = parser.json;
+  const meshes = [];
+  gltf.scene.traverse((o) => { if (o.isMesh && !Array.isArray(o.material) && o.material && o.material.lightMap) meshes.push(o); });
+  const out = { instanced: [], perNode: [] };
+  const clones = new Map(); // material uuid + rectangle -> the clone for nodes at that rectangle
+  for (const o of meshes) {
+    const g = o.geometry, node = gltfNodeIndex(parser, o), mat = o.material;
+    const [sa, oa] = INSTANCE_RECT_SOURCES.map((n) => g.getAttribute(n));
+    if (o.isInstancedMesh && sa && oa) {
+      if (!sa.isInstancedBufferAttribute || !oa.isInstancedBufferAttribute || sa.itemSize !== 2 || oa.itemSize !== 2 || sa.count < o.count || oa.count < o.count) {
+        throw new Error(`node ${node} '${o.name}': ${INSTANCE_RECT_SOURCES.join(' and ')} must be VEC2 per-instance attributes, one per copy (${o.count})`);
+      }
+      INSTANCE_RECT_ATTRIBUTES.forEach((n, k) => g.setAttribute(n, [sa, oa][k]));
+      const get = (a) => Float32Array.from({ length: 2 * o.count }, (_, i) => (i & 1 ? a.getY(i >> 1) : a.getX(i >> 1)));
+      o.userData.lightmapInstances = { count: o.count, scale: get(sa), offset: get(oa) };
+      o.material = patchInstanceRectangles(mat.clone());
+      out.instanced.push({ object: o, node, count: o.count });
+      continue;
+    }
+    const x = node >= 0 && json.nodes[node].extras && json.nodes[node].extras.lightmap;
+    const so = x && validScaleOffset(x.scaleOffset) ? x.scaleOffset.map(Number) : null;
+    if (!so) continue;
+    const cur = lightmapScaleOffset(mat.lightMap);
+    if (so.every((v, k) => Math.abs(v - cur[k]) <= 1e-7 * Math.max(1, Math.abs(v)))) continue;
+    const key = `${mat.uuid}:${so}`;
+    if (!clones.has(key)) {
+      const tex = mat.lightMap.clone(); // shares the image and the GPU texture
+      tex.offset.set(so[2], so[3]);
+      tex.repeat.set(so[0], so[1]);
+      tex.updateMatrix();
+      const m = mat.clone();
+      m.lightMap = tex;
+      clones.set(key, m);
+    }
+    o.material = clones.get(key);
+    out.perNode.push({ object: o, node, scaleOffset: so });
+  }
+  return out;
+}
+
 class LightmapPlugin {
   constructor(parser, atlases, source, ktx2Loader) {
     this.parser = parser;
@@ -297,7 +400,9 @@ export async function applyDirectionalLightmaps(gltf) {
     tex.minFilter = THREE.LinearFilter; // no mipmaps: they would blur across charts
     tex.generateMipmaps = false;
     tex.needsUpdate = true;
-    m.onBeforeCompile = (shader) => {
+    // (added to the material's other patches: an InstancedMesh's per-instance rectangle sets the
+    // vLightMapUv this reads)
+    addShaderPatch(m, 'lmbake-directional', (shader) => {
       shader.uniforms.lightDirectionMap = { value: tex };
       shader.fragmentShader = 'uniform sampler2D lightDirectionMap;\n' + shader.fragmentShader.replace(
         '#include <lights_fragment_maps>',
@@ -305,9 +410,7 @@ export async function applyDirectionalLightmaps(gltf) {
     vec3 lightMapIrradiance = lightMapTexel.rgb * lightMapIntensity;
     vec3 lmDir = (viewMatrix * vec4(texture2D(lightDirectionMap, vLightMapUv).rgb * 2.0 - 1.0, 0.0)).xyz;
     lightMapIrradiance *= max(0.0, 1.0 + 1.5 * dot(lmDir, normal)) / max(1e-3, 1.0 + 1.5 * dot(lmDir, nonPerturbedNormal));`));
-    };
-    m.customProgramCacheKey = () => 'lmbake-directional';
-    m.needsUpdate = true;
+    });
   }
   return materials.size;
 }

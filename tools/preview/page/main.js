@@ -6,7 +6,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { lightmapPlugin, lightmapScaleOffset, applyDirectionalLightmaps, LIGHTMAP_SOURCES } from './lightmap-plugin.js';
+import { lightmapPlugin, lightmapScaleOffset, applyDirectionalLightmaps, applyLightmapRectangles, patchInstanceRectangles, gltfNodeIndex, LIGHTMAP_SOURCES } from './lightmap-plugin.js';
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
@@ -61,6 +61,10 @@ const atlases = [];
 const loader = new GLTFLoader().register(lightmapPlugin(atlases, { source: state.lightmap, renderer }));
 const gltf = await loader.loadAsync(sceneInfo.gltf);
 const root = gltf.scene;
+// Rectangles the lightMap textures do not carry: an InstancedMesh's per-copy _LIGHTMAP_SCALE /
+// _LIGHTMAP_OFFSET, a node's extras.lightmap.scaleOffset on a mesh nodes share (before the
+// directional lightmaps, which patch the materials this clones)
+const rectangles = applyLightmapRectangles(gltf);
 const directionalMaterials = state.directional ? await applyDirectionalLightmaps(gltf) : 0;
 const lights = [];
 root.traverse((o) => { if (o.isLight) lights.push(o); });
@@ -87,9 +91,15 @@ if (evAuto) {
 
 // The glTF node index an object belongs to (a multi-primitive mesh's meshes are children of
 // the node's group), or -1
-function gltfNode(o) {
-  for (; o; o = o.parent) { const a = gltf.parser.associations.get(o); if (a && a.nodes !== undefined) return a.nodes; }
-  return -1;
+const gltfNode = (o) => gltfNodeIndex(gltf.parser, o);
+
+// The lightmap rectangle of an entry's copy k (an InstancedMesh with per-instance rectangles:
+// uv1 x scale_k + offset_k, then the texture's own rectangle), else the entry's rectangle
+function rectOf(e, k) {
+  const [S, T, O, P] = e.scaleOffset;
+  if (!e.instances || k === undefined || k === null) return e.scaleOffset;
+  const i = e.instances, sx = i.scale[2 * k], sy = i.scale[2 * k + 1], ox = i.offset[2 * k], oy = i.offset[2 * k + 1];
+  return [sx * S, sy * T, ox * S + O, oy * T + P];
 }
 
 // Each mesh and its materials per mode
@@ -103,17 +113,26 @@ root.traverse((o) => {
   const lit = o.material, lm = lit.lightMap;
   // scaleOffset: the mesh's rectangle in its atlas (uv1 x scale + offset), from the lightMap's offset / repeat
   const e = { mesh: o, lit, geometry: o.geometry, atlas: lm && lm.userData.atlas !== undefined ? lm.userData.atlas : -1, scaleOffset: lightmapScaleOffset(lm), node: gltfNode(o) };
-  if (lm) e.lightmap = cached(`lm:${lm.uuid}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(lightmapMaterial(lm, lit.lightMapIntensity), { side: lit.side }));
+  // an InstancedMesh with per-instance rectangles: {count, scale, offset} (lightmap-plugin.js)
+  e.instances = (lm && o.isInstancedMesh && o.userData.lightmapInstances) || null;
+  const inst = e.instances ? 'inst' : '';
+  if (lm) e.lightmap = cached(`lm:${lm.uuid}:${lit.lightMapIntensity}:${lit.side}:${inst}`, () => {
+    const m = Object.assign(lightmapMaterial(lm, lit.lightMapIntensity), { side: lit.side });
+    return e.instances ? patchInstanceRectangles(m) : m;
+  });
   if (e.atlas >= 0 && o.geometry.attributes.uv1) {
-    const a = atlases[e.atlas], so = e.scaleOffset;
-    e.invalid = cached(`inv:${e.atlas}:${so}:${lit.lightMapIntensity}:${lit.side}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity, { scaleOffset: so }), { side: lit.side }));
-    e.checker = cached(`chk:${e.atlas}:${so}:${lit.side}`, () => Object.assign(checkerMaterial(a, so), { side: lit.side }));
+    const a = atlases[e.atlas], so = e.scaleOffset, instanced = !!e.instances;
+    e.invalid = cached(`inv:${e.atlas}:${so}:${lit.lightMapIntensity}:${lit.side}:${inst}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity, { scaleOffset: so, instanced }), { side: lit.side }));
+    e.checker = cached(`chk:${e.atlas}:${so}:${lit.side}:${inst}`, () => Object.assign(checkerMaterial(a, so, { instanced }), { side: lit.side }));
     e.checkerGeometry = checkerGeometry(o.geometry, charts);
     charts += e.checkerGeometry.userData.charts;
   }
   entries.push(e);
 });
-const chartMeshes = entries.filter((e) => e.checkerGeometry).map((e) => ({ atlas: e.atlas, checkerGeometry: e.checkerGeometry, scaleOffset: e.scaleOffset }));
+const chartMeshes = entries.filter((e) => e.checkerGeometry).map((e) => ({
+  atlas: e.atlas, checkerGeometry: e.checkerGeometry, scaleOffset: e.scaleOffset,
+  rects: e.instances ? Array.from({ length: e.instances.count }, (_, k) => rectOf(e, k)) : null,
+}));
 const atlasView = new AtlasView(atlases, chartMeshes);
 // atlases[i] is undefined for a lightmap without its .hdr or KTX2 (PNG only): no data to show
 if (state.mode === 'atlas' && !atlases[state.atlas]) throw new Error(`atlas ${state.atlas} does not exist or has no .hdr (MOZ_texture_rgbe) or KTX2 file (${atlases.filter(Boolean).length} atlases)`);
@@ -176,6 +195,7 @@ function apply() {
   requestRender();
 }
 
+const isInstancePatched = (m) => m.customProgramCacheKey().includes('lmbake-instance-rect');
 function updateInfo() {
   Object.assign(info, {
     gltf: sceneInfo.name, mode: state.mode, ev: state.ev, evAuto, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
@@ -187,6 +207,16 @@ function updateInfo() {
     atlases: atlases.filter(Boolean).map((a) => ({ index: a.index, uri: a.uri, source: a.source, format: a.format, loader: a.loader, gpu: a.gpu, hdr: a.hdr, fallback: a.fallback, scale: a.scale, width: a.width, height: a.height, zeroTexels: a.zeroTexels })),
     lightmap: state.lightmap,
     meshes: entries.length, lightmapped: entries.filter((e) => e.atlas >= 0).length,
+    // InstancedMeshes: copies, their per-instance attributes (geometry.attributes, InstancedBufferAttribute),
+    // whether each copy reads its own rectangle (_LIGHTMAP_SCALE / _LIGHTMAP_OFFSET)
+    instancedMeshes: entries.filter((e) => e.mesh.isInstancedMesh).map((e) => ({
+      object: e.mesh.name, node: e.node, count: e.mesh.count, atlas: e.atlas, rectangles: !!e.instances,
+      instanceAttributes: Object.entries(e.geometry.attributes).filter(([, a]) => a.isInstancedBufferAttribute).map(([k, a]) => ({ name: k, itemSize: a.itemSize, count: a.count })),
+      litPatched: isInstancePatched(e.lit), sharesMaterial: entries.some((x) => x !== e && x.lit === e.lit),
+    })),
+    patchedOthers: entries.filter((e) => !e.mesh.isInstancedMesh && isInstancePatched(e.lit)).length, // 0: the patch stays on InstancedMeshes' own materials
+    // meshes given their node's extras.lightmap.scaleOffset (one mesh shared by several nodes)
+    perNodeRectangles: rectangles.perNode.map((r) => ({ object: r.object.name, node: r.node, scaleOffset: r.scaleOffset })),
     charts: chartMeshes.reduce((s, c) => s + c.checkerGeometry.userData.charts, 0),
     directionalMaterials,
     records: records ? { count: records.count, reachMin: records.reachMin, reachMax: records.reachMax, uri: records.uri } : { count: 0 },
@@ -261,10 +291,13 @@ function pick(px, py) {
   const e = entries.find((x) => x.mesh === hit.object);
   const r = { object: hit.object.name, point: hit.point.toArray(), distance: hit.distance, atlas: e ? e.atlas : -1 };
   if (e) r.node = e.node;
+  if (hit.instanceId !== undefined) r.instance = hit.instanceId; // an InstancedMesh's copy
   if (hit.uv1) {
     // uv1: the mesh's TEXCOORD_1; lightmapUv: where the atlas is read, uv1 x scale + offset
+    // (an InstancedMesh's copy: its own rectangle, scaleOffset)
     r.uv1 = [hit.uv1.x, hit.uv1.y];
-    const so = e ? e.scaleOffset : [1, 1, 0, 0];
+    const so = e ? rectOf(e, hit.instanceId) : [1, 1, 0, 0];
+    r.scaleOffset = so;
     r.lightmapUv = [hit.uv1.x * so[0] + so[2], hit.uv1.y * so[1] + so[3]];
     const a = atlases[r.atlas];
     const clamp = (t, n) => Math.max(0, Math.min(n - 1, Math.floor(t * n)));
@@ -280,7 +313,7 @@ addEventListener('pointermove', (e) => {
   }
   let t = null;
   if (state.mode === 'atlas') t = atlasView.texelAt(e.offsetX, e.offsetY);
-  else { const h = pick(e.offsetX, e.offsetY); if (h && h.texel) t = { atlas: h.atlas, x: h.texel[0], y: h.texel[1], object: h.object }; }
+  else { const h = pick(e.offsetX, e.offsetY); if (h && h.texel) t = { atlas: h.atlas, x: h.texel[0], y: h.texel[1], object: h.instance !== undefined ? `${h.object} #${h.instance}` : h.object }; }
   if (t && !t.rgb) { const a = atlases[t.atlas], i = 4 * (t.y * a.width + t.x); t.rgb = Array.from(a.data.subarray(i, i + 3), (v) => v * a.toLux); }
   const f = (v) => v.toPrecision(4);
   $('hover').textContent = t ? `atlas ${t.atlas} texel (${t.x}, ${t.y})${t.object ? '  ' + t.object : ''}\nE = ${t.rgb.map(f).join(' ')} lux   E/pi = ${t.rgb.map((v) => f(v / Math.PI)).join(' ')}` : '';
@@ -295,37 +328,49 @@ window.lmbProject = (x, y, z) => {
   const v = new THREE.Vector3(x, y, z).project(camera);
   return { x: (v.x + 1) / 2 * innerWidth, y: (1 - v.y) / 2 * innerHeight, inFront: v.z < 1 };
 };
-// What the centre of pixel (px, py) sees: object, glTF node, world point, uv1, lightmapUv (the
-// atlas uv: uv1 through the mesh's lightmap rectangle), atlas and texel.
+// What the centre of pixel (px, py) sees: object, glTF node, instance (an InstancedMesh's copy),
+// world point, uv1, scaleOffset and lightmapUv (the atlas uv: uv1 through the mesh's or the
+// copy's lightmap rectangle), atlas and texel.
 window.lmbPick = (px, py) => pick(px + 0.5, py + 0.5);
 // Where the centre of texel (x, y) of an atlas is drawn: in the atlas view, the pixel; in
 // the 3D views, the projection of the surface point with that UV1 (visible: a pick there
-// sees the same atlas within a texel). Triangles are matched in atlas uv (uv1 x scale + offset).
+// sees the same atlas within a texel). Triangles are matched in atlas uv (uv1 x scale + offset,
+// an InstancedMesh's copies each at its own rectangle; instance: the copy's index).
 window.lmbTexelToScreen = (atlasIndex, x, y) => {
   if (state.mode === 'atlas') return { ...atlasView.texelToScreen(x, y), visible: atlasIndex === atlasView.atlas };
   const a = atlases[atlasIndex];
-  const p = new THREE.Vector2((x + 0.5) / a.width, (y + 0.5) / a.height);
+  const p = new THREE.Vector3((x + 0.5) / a.width, (y + 0.5) / a.height, 0);
+  const A = new THREE.Vector3(), B = new THREE.Vector3(), C = new THREE.Vector3(), bc = new THREE.Vector3(), im = new THREE.Matrix4();
   for (const e of entries) {
     if (e.atlas !== atlasIndex) continue;
-    const g = e.geometry, uv = g.attributes.uv1, pos = g.attributes.position, [su, sv, ou, ov] = e.scaleOffset;
+    const g = e.geometry, uv = g.attributes.uv1, pos = g.attributes.position;
     if (!uv) continue;
-    const toAtlas = (v) => v.set(v.x * su + ou, v.y * sv + ov);
     const idx = g.index ? g.index.array : null, n = idx ? idx.length : pos.count;
-    const A = new THREE.Vector2(), B = new THREE.Vector2(), C = new THREE.Vector2(), bc = new THREE.Vector3();
-    for (let t = 0; t < n; t += 3) {
-      const i0 = idx ? idx[t] : t, i1 = idx ? idx[t + 1] : t + 1, i2 = idx ? idx[t + 2] : t + 2;
-      toAtlas(A.fromBufferAttribute(uv, i0)); toAtlas(B.fromBufferAttribute(uv, i1)); toAtlas(C.fromBufferAttribute(uv, i2));
-      if (!THREE.Triangle.containsPoint(new THREE.Vector3(p.x, p.y, 0), new THREE.Vector3(A.x, A.y, 0), new THREE.Vector3(B.x, B.y, 0), new THREE.Vector3(C.x, C.y, 0))) continue;
-      THREE.Triangle.getBarycoord(new THREE.Vector3(p.x, p.y, 0), new THREE.Vector3(A.x, A.y, 0), new THREE.Vector3(B.x, B.y, 0), new THREE.Vector3(C.x, C.y, 0), bc);
-      const w = new THREE.Vector3().fromBufferAttribute(pos, i0).multiplyScalar(bc.x)
-        .add(new THREE.Vector3().fromBufferAttribute(pos, i1).multiplyScalar(bc.y))
-        .add(new THREE.Vector3().fromBufferAttribute(pos, i2).multiplyScalar(bc.z))
-        .applyMatrix4(e.mesh.matrixWorld);
-      const s = window.lmbProject(w.x, w.y, w.z);
-      const h = pick(s.x, s.y);
-      const visible = s.inFront && s.x >= 0 && s.y >= 0 && s.x < innerWidth && s.y < innerHeight && !!h && h.atlas === atlasIndex &&
-        !!h.texel && Math.abs(h.texel[0] - x) <= 1 && Math.abs(h.texel[1] - y) <= 1;
-      return { x: s.x, y: s.y, visible, object: e.mesh.name, point: w.toArray() };
+    // the uv1 bounds: a copy whose rectangle does not hold p is skipped
+    let u0 = Infinity, v0 = Infinity, u1 = -Infinity, v1 = -Infinity;
+    for (let i = 0; i < uv.count; i++) { u0 = Math.min(u0, uv.getX(i)); u1 = Math.max(u1, uv.getX(i)); v0 = Math.min(v0, uv.getY(i)); v1 = Math.max(v1, uv.getY(i)); }
+    for (let k = 0; k < (e.instances ? e.instances.count : 1); k++) {
+      const [su, sv, ou, ov] = rectOf(e, e.instances ? k : null);
+      if (p.x < u0 * su + ou || p.x > u1 * su + ou || p.y < v0 * sv + ov || p.y > v1 * sv + ov) continue;
+      const toAtlas = (v, i) => v.set(uv.getX(i) * su + ou, uv.getY(i) * sv + ov, 0);
+      for (let t = 0; t < n; t += 3) {
+        const i0 = idx ? idx[t] : t, i1 = idx ? idx[t + 1] : t + 1, i2 = idx ? idx[t + 2] : t + 2;
+        toAtlas(A, i0); toAtlas(B, i1); toAtlas(C, i2);
+        if (!THREE.Triangle.containsPoint(p, A, B, C)) continue;
+        THREE.Triangle.getBarycoord(p, A, B, C, bc);
+        const w = new THREE.Vector3().fromBufferAttribute(pos, i0).multiplyScalar(bc.x)
+          .add(new THREE.Vector3().fromBufferAttribute(pos, i1).multiplyScalar(bc.y))
+          .add(new THREE.Vector3().fromBufferAttribute(pos, i2).multiplyScalar(bc.z));
+        if (e.mesh.isInstancedMesh) w.applyMatrix4(e.mesh.getMatrixAt(k, im));
+        w.applyMatrix4(e.mesh.matrixWorld);
+        const s = window.lmbProject(w.x, w.y, w.z);
+        const h = pick(s.x, s.y);
+        const visible = s.inFront && s.x >= 0 && s.y >= 0 && s.x < innerWidth && s.y < innerHeight && !!h && h.atlas === atlasIndex &&
+          !!h.texel && Math.abs(h.texel[0] - x) <= 1 && Math.abs(h.texel[1] - y) <= 1;
+        const r = { x: s.x, y: s.y, visible, object: e.mesh.name, point: w.toArray() };
+        if (e.mesh.isInstancedMesh) r.instance = k;
+        return r;
+      }
     }
   }
   return null;

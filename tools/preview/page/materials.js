@@ -7,16 +7,25 @@
 //   checker:  a texel checkerboard of the UV1 atlas (tinted per chart, darker every other 8x8
 //             block), texel grid lines when zoomed in, chart borders in red-orange.
 // The invalid and checker views read the atlas at uv1 x scale + offset, the mesh's lightmap
-// rectangle (MOZ_lightmap's KHR_texture_transform; lightmap-plugin.js lightmapScaleOffset), as
-// three's lightMap does for the lightmap and lit views.
+// rectangle (MOZ_lightmap's KHR_texture_transform or the node's extras.lightmap.scaleOffset;
+// lightmap-plugin.js lightmapScaleOffset), as three's lightMap does for the lightmap and lit
+// views. On an InstancedMesh with per-instance rectangles ({instanced: true}) each copy reads
+// uv1 x scale_k + offset_k first (lightmap-plugin.js INSTANCE_RECT_ATTRIBUTES), and every
+// copy is placed by its instance matrix.
 import * as THREE from 'three';
+import { INSTANCE_RECT_ATTRIBUTES } from './lightmap-plugin.js';
 
 export const INVALID_COLOR = new THREE.Color(1, 0, 1);       // magenta, linear = sRGB
 export const BORDER_COLOR = new THREE.Color(1, 0.1, 0.0);    // linear; sRGB (255, 89, 0)
 
+const [I_SCALE, I_OFFSET] = INSTANCE_RECT_ATTRIBUTES;
 const VERT = /* glsl */`
 uniform vec4 uvScaleOffset; // the lightmap rectangle: atlas uv = uv1 * xy + zw
 varying vec2 vUv1;
+#if defined( INSTANCE_RECT ) && defined( USE_INSTANCING )
+attribute vec2 ${I_SCALE};  // the copy's own rectangle (per instance)
+attribute vec2 ${I_OFFSET};
+#endif
 #ifdef CHECKER
 attribute vec3 bary;
 attribute vec3 edge;
@@ -26,11 +35,19 @@ varying vec3 vEdge;
 varying vec3 vTint;
 #endif
 void main() {
-  vUv1 = uv1 * uvScaleOffset.xy + uvScaleOffset.zw;
+  vec2 uv = uv1;
+#if defined( INSTANCE_RECT ) && defined( USE_INSTANCING )
+  uv = uv * ${I_SCALE} + ${I_OFFSET};
+#endif
+  vUv1 = uv * uvScaleOffset.xy + uvScaleOffset.zw;
 #ifdef CHECKER
   vBary = bary; vEdge = edge; vTint = tint;
 #endif
-  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+  vec4 p = vec4(position, 1.0);
+#ifdef USE_INSTANCING
+  p = instanceMatrix * p; // an InstancedMesh's copy
+#endif
+  gl_Position = projectionMatrix * modelViewMatrix * p;
 }`;
 
 // ATLAS_NEAREST: the 2D atlas view reads the texel itself (texelFetch), no filtering.
@@ -85,10 +102,14 @@ export function lightmapMaterial(tex, intensity) {
   return new THREE.MeshBasicMaterial({ color: 0xffffff, lightMap: tex, lightMapIntensity: intensity, side: THREE.FrontSide });
 }
 
-// scaleOffset: [scaleU, scaleV, offsetU, offsetV], the mesh's lightmap rectangle in the atlas
-export function invalidMaterial(atlas, intensity, { nearest = false, showInvalid = true, scaleOffset = [1, 1, 0, 0] } = {}) {
+// scaleOffset: [scaleU, scaleV, offsetU, offsetV], the mesh's lightmap rectangle in the atlas;
+// instanced: an InstancedMesh with per-instance rectangles (applied before scaleOffset)
+export function invalidMaterial(atlas, intensity, { nearest = false, showInvalid = true, scaleOffset = [1, 1, 0, 0], instanced = false } = {}) {
+  const defines = { USE_UV1: '' };
+  if (nearest) defines.ATLAS_NEAREST = '';
+  if (instanced) defines.INSTANCE_RECT = '';
   return new THREE.ShaderMaterial({
-    defines: nearest ? { USE_UV1: '', ATLAS_NEAREST: '' } : { USE_UV1: '' },
+    defines,
     uniforms: {
       lightMap: { value: atlas.texture }, invalidMask: { value: atlas.maskTexture },
       intensity: { value: intensity }, atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) },
@@ -98,9 +119,9 @@ export function invalidMaterial(atlas, intensity, { nearest = false, showInvalid
   });
 }
 
-export function checkerMaterial(atlas, scaleOffset = [1, 1, 0, 0]) {
+export function checkerMaterial(atlas, scaleOffset = [1, 1, 0, 0], { instanced = false } = {}) {
   return new THREE.ShaderMaterial({
-    defines: { USE_UV1: '', CHECKER: '' },
+    defines: instanced ? { USE_UV1: '', CHECKER: '', INSTANCE_RECT: '' } : { USE_UV1: '', CHECKER: '' },
     uniforms: {
       atlasSize: { value: new THREE.Vector2(atlas.width, atlas.height) }, borderColor: { value: BORDER_COLOR },
       uvScaleOffset: { value: new THREE.Vector4(...scaleOffset) },
@@ -111,8 +132,16 @@ export function checkerMaterial(atlas, scaleOffset = [1, 1, 0, 0]) {
 
 // Non-indexed copy of a geometry with uv1, plus the checker attributes. Corners are welded
 // by (position, uv1) value (lmbake writes every corner as its own vertex); an edge is a chart
-// border when only one triangle uses it, and charts are the connected components.
-export function checkerGeometry(geom, firstChart = 0) {
+// border when only one triangle uses it, and charts are the connected components. Per-instance
+// attributes (an InstancedMesh's) are carried over as they are.
+export function checkerGeometry(source, firstChart = 0) {
+  const perInstance = Object.entries(source.attributes).filter(([, a]) => a.isInstancedBufferAttribute);
+  let geom = source;
+  if (perInstance.length) { // toNonIndexed() would expand them per vertex
+    geom = new THREE.BufferGeometry();
+    for (const [k, a] of Object.entries(source.attributes)) if (!a.isInstancedBufferAttribute) geom.setAttribute(k, a);
+    if (source.index) geom.setIndex(source.index);
+  }
   const pos = geom.attributes.position, uv = geom.attributes.uv1;
   const n = pos.count;
   const raw = geom.index ? Array.from(geom.index.array) : Array.from({ length: n }, (_, i) => i);
@@ -159,25 +188,36 @@ export function checkerGeometry(geom, firstChart = 0) {
   out.setAttribute('bary', new THREE.BufferAttribute(bary, 3));
   out.setAttribute('edge', new THREE.BufferAttribute(edge, 3));
   out.setAttribute('tint', new THREE.BufferAttribute(tint, 3));
+  for (const [k, a] of perInstance) out.setAttribute(k, a);
   out.userData.charts = chartOf.size;
   return out;
 }
 
 // The same triangles laid out flat in the atlas: x = u * width, y = -v * height (texel units),
 // (u, v) = uv1 x scale + offset (the mesh's lightmap rectangle); uv1 becomes (u, v) too, so the
-// checker material draws it with the identity rectangle.
-export function atlasLayoutGeometry(checkerGeom, atlas, [su, sv, ou, ov] = [1, 1, 0, 0]) {
-  const g = checkerGeom.clone();
-  const uv = g.attributes.uv1;
-  const pos = new Float32Array(uv.count * 3), auv = new Float32Array(uv.count * 2);
-  for (let i = 0; i < uv.count; i++) {
-    auv[2 * i] = uv.getX(i) * su + ou;
-    auv[2 * i + 1] = uv.getY(i) * sv + ov;
-    pos[3 * i] = auv[2 * i] * atlas.width;
-    pos[3 * i + 1] = -auv[2 * i + 1] * atlas.height;
+// checker material draws it with the identity rectangle. rects: one [su, sv, ou, ov] or a list
+// of them (an InstancedMesh's copies: the triangles once per copy, at its rectangle).
+export function atlasLayoutGeometry(checkerGeom, atlas, rects = [1, 1, 0, 0]) {
+  const list = Array.isArray(rects[0]) ? rects : [rects];
+  const n = checkerGeom.attributes.uv1.count, copies = list.length;
+  const g = new THREE.BufferGeometry();
+  for (const k of ['bary', 'edge', 'tint']) { // checkerGeometry's own (plain Float32Arrays), repeated per copy
+    const a = checkerGeom.attributes[k], src = a.array, arr = new Float32Array(src.length * copies);
+    for (let c = 0; c < copies; c++) arr.set(src, c * src.length);
+    g.setAttribute(k, new THREE.BufferAttribute(arr, a.itemSize));
   }
+  const uv = checkerGeom.attributes.uv1;
+  const pos = new Float32Array(n * copies * 3), auv = new Float32Array(n * copies * 2);
+  list.forEach(([su, sv, ou, ov], c) => {
+    for (let i = 0; i < n; i++) {
+      const j = c * n + i;
+      auv[2 * j] = uv.getX(i) * su + ou;
+      auv[2 * j + 1] = uv.getY(i) * sv + ov;
+      pos[3 * j] = auv[2 * j] * atlas.width;
+      pos[3 * j + 1] = -auv[2 * j + 1] * atlas.height;
+    }
+  });
   g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
   g.setAttribute('uv1', new THREE.BufferAttribute(auv, 2));
-  g.deleteAttribute('normal');
   return g;
 }

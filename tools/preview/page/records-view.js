@@ -5,6 +5,7 @@
 // little-endian float32, x y z (world) and the reach (world units).
 import * as THREE from 'three';
 import { RECORD_RAMP } from './record-ramp.js';
+import { cloneWithPatches } from './lightmap-plugin.js';
 
 export { RECORD_RAMP };
 
@@ -42,7 +43,8 @@ export async function loadRecords(json, gltfUrl) {
 }
 
 // The mesh material under the dots: the lightmap view pushed back in depth, so that a dot on
-// the surface is drawn over it and one behind a wall is not.
+// the surface is drawn over it and one behind a wall is not. (Its shader patches, an
+// InstancedMesh's per-instance rectangles, kept.)
 export function recordsBaseMaterial(lightmap) {
-  return Object.assign(lightmap.clone(), { polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 8 });
+  return Object.assign(cloneWithPatches(lightmap), { polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 8 });
 }
