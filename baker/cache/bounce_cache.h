@@ -10,7 +10,7 @@
  * (no light is counted twice).
  * A hit on the back of a surface returns nothing (no lightmap holds the back side; a single-
  * sided glTF surface is seen from behind only from inside geometry). A hit on a surface with
- * no lightmap (excluded by the config, or a GPU-instanced copy) is reported as such: the
+ * no lightmap (excluded by the config, or with a singular transform) is reported as such: the
  * gather stage then computes direct light at the hit with shadow rays, so those surfaces
  * still bounce their direct light (one bounce; their own indirect light is left out).
  */

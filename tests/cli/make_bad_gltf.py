@@ -159,10 +159,36 @@ def cases():
     yield "required-basisu-fallback", d
 
 
+def gpu_instanced(ok, translations, scales):
+    """ok's mesh drawn through EXT_mesh_gpu_instancing with these TRANSLATION and SCALE lists."""
+    d = copy.deepcopy(ok)
+    blob = base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1])
+    attrs = {}
+    for name, vals in (("TRANSLATION", translations), ("SCALE", scales)):
+        data = b"".join(struct.pack("<3f", *v) for v in vals)
+        d["bufferViews"].append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+        blob += data
+        d["accessors"].append({"bufferView": len(d["bufferViews"]) - 1, "componentType": 5126, "count": len(vals),
+                               "type": "VEC3"})
+        attrs[name] = len(d["accessors"]) - 1
+    d["buffers"][0] = {"byteLength": len(blob),
+                       "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}
+    d["nodes"][0]["extensions"] = {"EXT_mesh_gpu_instancing": {"attributes": attrs}}
+    d["extensionsUsed"] = ["EXT_mesh_gpu_instancing"]
+    return d
+
+
+def gpu_cases(ok):
+    # the instancing extension's accessors disagree in count; a copy with a zero scale
+    yield "gpu-count-mismatch", gpu_instanced(ok, [(0, 0, 0), (2, 0, 0), (4, 0, 0)], [(1, 1, 1), (1, 1, 1)])
+    yield "gpu-zero-scale", gpu_instanced(ok, [(0, 0, 0), (2, 0, 0), (4, 0, 0)], [(1, 1, 1), (0, 0, 0), (1, 1, 1)])
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
-    for name, doc in cases():
+    ok = base_doc(QUAD, QUAD_IDX)
+    for name, doc in list(cases()) + list(gpu_cases(ok)):
         with open(os.path.join(out, name + ".gltf"), "w") as f:
             f.write(doc if isinstance(doc, str) else json.dumps(doc, indent=1))
 

@@ -420,7 +420,10 @@ async function checkerAgrees(url, c3Png, probed, what, prefix, atlasSize) {
   let onScreen = 0, differ = 0, background = 0, border = 0, shots = 0, first = null;
   const left = new Set(todo);
   while (left.size && shots < 8) {
-    const c = [...left][0];
+    // centre on the probe with the most others left within the view (120 x 90 texels at zoom 8)
+    const rest = [...left], cand = rest.filter((_, i) => i % Math.max(1, Math.floor(rest.length / 400)) === 0);
+    const near = (c) => rest.reduce((k, p) => k + (Math.abs(p.texel[0] - c.texel[0]) < VIEW[0] / ZOOM / 2 - 1 && Math.abs(p.texel[1] - c.texel[1]) < VIEW[1] / ZOOM / 2 - 1), 0);
+    const c = cand.reduce((best, q) => { const k = near(q); return k > best.k ? { q, k } : best; }, { q: cand[0], k: -1 }).q;
     const ck = await openPreview(browser, url, { mode: 'atlas', layer: 'checker', atlas, zoom: ZOOM, at: c.texel.join(',') });
     const ckPng = decodePng(await ck.page.screenshot({ path: path.join(shotsDir, `${prefix}-atlas-checker-${shots}.png`) }));
     await ck.context.close();

@@ -356,8 +356,8 @@ window.lmbTexelToScreen = (atlasIndex, x, y) => {
       for (let t = 0; t < n; t += 3) {
         const i0 = idx ? idx[t] : t, i1 = idx ? idx[t + 1] : t + 1, i2 = idx ? idx[t + 2] : t + 2;
         toAtlas(A, i0); toAtlas(B, i1); toAtlas(C, i2);
-        if (!THREE.Triangle.containsPoint(p, A, B, C)) continue;
-        THREE.Triangle.getBarycoord(p, A, B, C, bc);
+        // inside, or on an edge within rounding (a texel centre on the diagonal two triangles share)
+        if (THREE.Triangle.getBarycoord(p, A, B, C, bc) === null || Math.min(bc.x, bc.y, bc.z) < -1e-6) continue;
         const w = new THREE.Vector3().fromBufferAttribute(pos, i0).multiplyScalar(bc.x)
           .add(new THREE.Vector3().fromBufferAttribute(pos, i1).multiplyScalar(bc.y))
           .add(new THREE.Vector3().fromBufferAttribute(pos, i2).multiplyScalar(bc.z));
