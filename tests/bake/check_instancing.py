@@ -94,7 +94,7 @@ def shared(lmbake, work):
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
                    stdout=subprocess.DEVNULL)
     scene = os.path.join(scenes, "seams.gltf")
-    base = "texel_density: 32\noutput: {formats: [exr], directional: false}\n"
+    base = "texel_density: 20\noutput: {formats: [exr], directional: false}\n"
     o1, d1, b1 = bake(lmbake, work, scene, "shared", base + "atlas: {share_meshes: true}\n")
     o2, d2, b2 = bake(lmbake, work, scene, "copies", base)
     o3, d3, b3 = bake(lmbake, work, scene, "copies-seed2", base + "seed: 2\n")
