@@ -72,21 +72,46 @@ static void add_light(point_ctx *c, const lmb_light *l, const double d[3], const
     }
 }
 
-/* Adds the light's contribution times `weight` to e. */
-static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
+int lmb_light_direction(const point_ctx *c, const lmb_light *l, double d[3], double *dist)
 {
-    double scale = c->d->cfg->light_intensity_scale, d[3], dist = 1e300, cosang, w = 1.0;
+    *dist = 1e300;
     if (l->type == LMB_LIGHT_DIRECTIONAL) {
         for (int k = 0; k < 3; k++)
             d[k] = -l->direction[k];
-    } else {
-        for (int k = 0; k < 3; k++)
-            d[k] = l->position[k] - c->p[k];
-        dist = sqrt(lmb_dot3(d, d));
-        if (!(dist > 0))
-            return;
-        for (int k = 0; k < 3; k++)
-            d[k] /= dist;
+        return 1;
+    }
+    for (int k = 0; k < 3; k++)
+        d[k] = l->position[k] - c->p[k];
+    *dist = sqrt(lmb_dot3(d, d));
+    if (!(*dist > 0))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        d[k] /= *dist;
+    return 1;
+}
+
+uint32_t lmb_cdf_pick(const double *cdf, uint32_t count, double u, double *prob)
+{
+    double total = cdf[count], target = u * total;
+    uint32_t lo = 0, hi = count - 1;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (cdf[mid + 1] <= target)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    *prob = (cdf[lo + 1] - cdf[lo]) / total;
+    return lo;
+}
+
+/* Adds the light's contribution times `weight` to e. */
+static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
+{
+    double scale = c->d->cfg->light_intensity_scale, d[3], dist, cosang, w = 1.0;
+    if (!lmb_light_direction(c, l, d, &dist))
+        return;
+    if (l->type != LMB_LIGHT_DIRECTIONAL) {
         w = 1.0 / (dist * dist);
         if (l->range > 0) {
             double r = dist / l->range, f = 1.0 - r * r * r * r;
@@ -157,19 +182,10 @@ static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
         return;
     }
     uint32_t n = c->samples;
-    double total = ls->cdf[ls->local_count];
     for (uint32_t s = 0; s < n; s++) {
-        double target = lmb_rng_next(rng) * total;
-        uint32_t lo = 0, hi = ls->local_count - 1;
-        while (lo < hi) {
-            uint32_t mid = (lo + hi) / 2;
-            if (ls->cdf[mid + 1] <= target)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        double p = (ls->cdf[lo + 1] - ls->cdf[lo]) / total;
-        punctual(c, &all[ls->local[lo]], 1.0 / (p * n), e);
+        double p;
+        uint32_t k = lmb_cdf_pick(ls->cdf, ls->local_count, lmb_rng_next(rng), &p);
+        punctual(c, &all[ls->local[k]], 1.0 / (p * n), e);
     }
 }
 

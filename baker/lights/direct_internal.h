@@ -56,6 +56,14 @@ typedef struct point_ctx {
     double deferred[3]; /* the part of e from `indirect` lights (not in the lightmap, not in dir) */
 } point_ctx;
 
+/* Index k of cdf[0..count] (cdf[0] = 0, increasing) with cdf[k] <= u cdf[count] < cdf[k + 1];
+ * *prob its probability. Sampling in proportion to power (lights, emitters). */
+uint32_t lmb_cdf_pick(const double *cdf, uint32_t count, double u, double *prob);
+
+/* The unit direction from c's point toward light l and its distance (1e300 for a directional
+ * light); 0 when the point is at the light. */
+int lmb_light_direction(const point_ctx *c, const lmb_light *l, double d[3], double *dist);
+
 /* Emitter index chosen in proportion to power for u in [0, 1); *prob its probability. */
 uint32_t lmb_emitter_pick(const lmb_emitters *es, double u, double *prob);
 

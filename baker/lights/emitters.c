@@ -122,16 +122,6 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const l
 
 uint32_t lmb_emitter_pick(const lmb_emitters *es, double u, double *prob)
 {
-    double target = u * es->cdf[es->count];
-    uint32_t lo = 0, hi = es->count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (es->cdf[mid + 1] <= target)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    *prob = (es->cdf[lo + 1] - es->cdf[lo]) / es->cdf[es->count];
-    return lo;
+    return lmb_cdf_pick(es->cdf, es->count, u, prob);
 }
 

@@ -26,18 +26,8 @@ static double visibility(point_ctx *c, const lmb_light *l, lmb_rng *rng)
         }
         return c->samples ? (double)seen / c->samples : 0;
     }
-    if (l->type == LMB_LIGHT_DIRECTIONAL) {
-        for (int k = 0; k < 3; k++)
-            d[k] = -l->direction[k];
-    } else {
-        for (int k = 0; k < 3; k++)
-            d[k] = l->position[k] - c->p[k];
-        dist = sqrt(lmb_dot3(d, d));
-        if (!(dist > 0))
-            return 0;
-        for (int k = 0; k < 3; k++)
-            d[k] /= dist;
-    }
+    if (!lmb_light_direction(c, l, d, &dist))
+        return 0;
     if (lmb_dot3(c->n, d) <= 0 || lmb_dot3(c->ng, d) <= 0)
         return 0;
     c->rays++;
