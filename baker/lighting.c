@@ -3,6 +3,7 @@
 
 #include "farm/steps.h"
 #include "gather/gather.h"
+#include "lights/direct_refine.h"
 #include "lights/direct_step.h"
 #include "irradiance_cache/ic_pass.h"
 #include "post/rim.h"
@@ -23,6 +24,8 @@ typedef struct atlas_work {
     float *indirect_dir; /* output.directional: 3 per listed texel, the indirect part, then the direction */
     float *deferred; /* mixed lighting: 3 per listed texel, the `indirect` lights' part of direct; else NULL */
     float *shadowmask; /* output.shadowmask: 4 per listed texel; else NULL */
+    float *variance; /* per listed texel: variance of a round of its sampled direct light (direct_refine.h) */
+    uint64_t direct_rays; /* what the direct step traced for this atlas */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -35,6 +38,7 @@ static void work_free(atlas_work *w, uint32_t n)
         free(w[a].indirect_dir);
         free(w[a].deferred);
         free(w[a].shadowmask);
+        free(w[a].variance);
     }
     free(w);
 }
@@ -138,7 +142,7 @@ static lmb_status texel_pass_range(void *user, uint64_t first, uint64_t last, lm
         float *e = calloc(3 * (size_t)t->count + 1, sizeof *e);
         if (!e)
             return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-        lmb_gather_stats gs = {0, 0, 0, 0};
+        lmb_gather_stats gs = {0};
         uint64_t before = 0;
         for (uint32_t b = 0; b < a; b++)
             before += tp->env->w[b].t.count;
@@ -197,6 +201,40 @@ static lmb_status texel_step(const pass_env *env, const char *name, uint32_t dir
     return st;
 }
 
+/* Adaptive direct light (direct_refine.h): every atlas's direct light computed again where it is
+ * noisier than samples.noise x the light shown, result (+ direct - deferred when with_direct
+ * is 0: result holds the gathered light only) ; stats and the log get what the bake reached. */
+static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_error *err)
+{
+    const lmb_config *cfg = env->cfg;
+    lmb_direct_noise noise = {0};
+    float *estimates = NULL;
+    uint64_t estimate_count = 0;
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < env->cache->atlas_count && st == LMB_OK; a++) {
+        atlas_work *w = &env->w[a];
+        size_t n = 3 * (size_t)w->t.count;
+        float *shown = malloc((n + 1) * sizeof *shown);
+        if (!shown) {
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+            break;
+        }
+        for (size_t k = 0; k < n; k++) {
+            float v = result_has_direct ? w->result[k] : w->result[k] + w->direct[k] - (w->deferred ? w->deferred[k] : 0.0f);
+            shown[k] = v > 0 ? v : 0.0f;
+        }
+        lmb_direct_atlas da = {w->t, w->direct, w->direct_dir, w->deferred, NULL, w->variance, 0, w->direct_rays};
+        st = lmb_direct_refine_step(env->job->steps, cfg, env->job->direct, env->cache->scene, env->cache->layout, a,
+                                    shown, &da, env->job->progress, env->job->progress_user, &env->stats->rays, &noise,
+                                    &estimates, &estimate_count, err);
+        free(shown);
+    }
+    lmb_direct_noise_finish(&noise, estimates, estimate_count);
+    if (st == LMB_OK)
+        lmb_direct_noise_report(&noise, cfg, env->stats, env->log);
+    return st;
+}
+
 /* One gather pass over every atlas: result = gather(cache) (+ direct with add_direct), then
  * (store) the cache := result. The gather runs at every texel, or at irradiance-cache records
  * (irradiance_cache.error > 0). */
@@ -213,6 +251,8 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
         st = cached_gather(env, gs, err);
     else
         st = texel_step(env, job->stage, 0, offsetof(atlas_work, result), gs, err);
+    if (st == LMB_OK && add_direct && !job->reference) /* the final gather: the light shown is known */
+        st = refine_direct(env, 0, err);
     /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */
     for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++)
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
@@ -298,7 +338,7 @@ static lmb_status bounce_passes(const pass_env *env, uint32_t *passes, lmb_error
     uint32_t done = 0;
     double tail_factor[3] = {0, 0, 0};
     for (uint32_t b = 1; b <= max_passes && st == LMB_OK; b++) {
-        lmb_gather_stats gs = {0, 0, 0, 0};
+        lmb_gather_stats gs = {0};
         lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
         job->estimator = e;
         job->pass = b;
@@ -389,7 +429,7 @@ static lmb_status light_directions(const pass_env *env, lmb_error *err)
         if (!w[a].indirect_dir)
             return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u's directions", a);
     }
-    lmb_gather_stats gs = {0, 0, 0, 0};
+    lmb_gather_stats gs = {0};
     if (!stats->no_light && stats->bounces > 0) /* bounces: 0 has no indirect light to point to */
         st = texel_step(env, "directions", cfg->directional_rays, offsetof(atlas_work, indirect_dir), &gs, err);
     stats->rays += gs.rays;
@@ -434,6 +474,8 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         w[a].direct_dir = da.direction;
         w[a].deferred = da.deferred;
         w[a].shadowmask = da.shadowmask;
+        w[a].variance = da.variance;
+        w[a].direct_rays = da.rays;
         if (st == LMB_OK)
             st = lmb_rim_limit(&w[a].t, w[a].direct, &rim, err);
         if (st != LMB_OK)
@@ -481,7 +523,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     stats->bounces = bounces;
     /* the final gather, or the reference */
     if (bounces > 0 && st == LMB_OK) {
-        lmb_gather_stats gs = {0, 0, 0, 0};
+        lmb_gather_stats gs = {0};
         lmb_estimator_options e = {.method = cfg->gather_method,
                                    .rays = cfg->gather_rays,
                                    .iterations = cfg->amis_iterations,
@@ -497,6 +539,13 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         job.reference = cfg->reference;
         job.depth = bounces;
         job.stage = cfg->reference ? "reference" : "final gather";
+        if (cfg->adaptive) { /* records gather more where their noise asks (gather.c, more_rays) */
+            job.noise_target = cfg->noise_target;
+            /* at most twice a record's base rays (and samples.max_rays): the gather at most doubles */
+            uint64_t base = (uint64_t)cfg->gather_rays * cfg->ic_ray_scale, most = 2 * base;
+            most = most < cfg->max_rays ? most : (cfg->max_rays > base ? cfg->max_rays : base);
+            job.max_rays = (uint32_t)(most < UINT32_MAX ? most : UINT32_MAX);
+        }
         double t0 = lmb_seconds();
         env.points = records;
         if (st == LMB_OK)
@@ -506,11 +555,23 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         stats->gather_seconds = lmb_seconds() - t0;
         stats->gather_rays = gs.rays;
         stats->amis_adapted = gs.adapted;
+        stats->records_extended = gs.extended;
+        stats->records_capped = gs.capped;
+        if (gs.extended)
+            lmb_info(log, "final gather: %llu of %llu records (%.1f%%) gathered more rays for samples.noise %g%%, %llu of "
+                     "them stopped at samples.max_rays %u",
+                     (unsigned long long)gs.extended, (unsigned long long)gs.records,
+                     gs.records ? 100.0 * (double)gs.extended / (double)gs.records : 0.0, 100.0 * cfg->noise_target,
+                     (unsigned long long)gs.capped, job.max_rays);
     }
     /* no gather ran: the lightmap is the direct light without the `indirect` lights' */
-    for (uint32_t a = 0; a < n && st == LMB_OK && bounces == 0 && w[a].deferred; a++) {
+    for (uint32_t a = 0; a < n && st == LMB_OK && bounces == 0; a++)
+        memset(w[a].result, 0, 3 * sizeof *w[a].result * (size_t)w[a].t.count);
+    if (st == LMB_OK && bounces == 0 && !dark)
+        st = refine_direct(&env, 0, err);
+    for (uint32_t a = 0; a < n && st == LMB_OK && bounces == 0 && (w[a].deferred || !dark); a++) {
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
-            float v = w[a].direct[k] - w[a].deferred[k];
+            float v = w[a].direct[k] - (w[a].deferred ? w[a].deferred[k] : 0.0f);
             w[a].direct[k] = v > 0 ? v : 0.0f;
         }
         st = lmb_cache_store(cache, a, &w[a].t, w[a].direct, err);

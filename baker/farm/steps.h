@@ -33,7 +33,7 @@
 #define LMB_STEP_STOPPED ((lmb_status)100)
 
 /* Counters a step adds up over its items (rays, texels, ...; meaning is the caller's). */
-#define LMB_STEP_COUNTERS 4
+#define LMB_STEP_COUNTERS 6
 
 /* A growable byte buffer (owned: lmb_buf_free). */
 typedef struct lmb_buf {

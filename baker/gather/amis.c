@@ -214,6 +214,9 @@ lmb_status lmb_amis_unbiased(const lmb_estimator_options *opt, const lmb_lobe *c
             }
         }
     }
+    out->var = 0;
+    for (uint32_t t = 0; t < T; t++)
+        out->var += nk[t] > 0 ? out->share[t] * out->share[t] * var[t] / nk[t] : 0;
     for (uint32_t q = 0; q < s->count; q++) {
         uint32_t t = s->iteration[q];
         double denom = nk[t] * s->own[q], x[3];
@@ -245,7 +248,7 @@ void lmb_amis_guided(const lmb_estimator_options *opt, const lmb_lobe *cosine, c
     proposal prop;
     proposal_init(&prop, cosine, opt->defensive);
     proposal_add(&prop, opt->guide, 1.0 - opt->defensive);
-    double w[4][3], q[4], inv_n = 1.0 / (double)opt->rays;
+    double w[4][3], q[4], inv_n = 1.0 / (double)opt->rays, sum = 0, sum2 = 0;
     for (uint32_t j = 0; j < opt->rays; j++) {
         if (j % 4 == 0)
             draw_four(&prop, cosine, rng, j, w, q);
@@ -258,6 +261,9 @@ void lmb_amis_guided(const lmb_estimator_options *opt, const lmb_lobe *cosine, c
         double inv_q = 1.0 / q[j % 4], scale = c * inv_q * inv_n, x[3];
         for (int k = 0; k < 3; k++)
             out->e[k] += x[k] = l[k] * scale;
+        double y = lmb_luminance(x) * opt->rays;
+        sum += y;
+        sum2 += y * y;
         if (opt->gradient) { /* a record: its rotation gradient and its harmonic mean distance */
             add_rotation(out, cosine->axis, wj, c, x);
             double wc = c * LMB_INV_PI * inv_q; /* p_cos / q */
@@ -267,5 +273,6 @@ void lmb_amis_guided(const lmb_estimator_options *opt, const lmb_lobe *cosine, c
     }
     if (prop.count)
         out->last = prop.lobe[0];
+    out->var = lmb_sample_variance_of_mean(sum, sum2, opt->rays);
 }
 

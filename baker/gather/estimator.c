@@ -53,6 +53,7 @@ void lmb_estimate_classic(const lmb_estimator_options *opt, const lmb_lobe *cosi
 {
     double frame[2][3]; /* the cosine lobe's, once per point */
     lmb_frame(cosine->axis, frame[0], frame[1]);
+    double sum = 0, sum2 = 0; /* of lum(f) / p_cos, for the variance */
     for (uint32_t j = 0; j < opt->rays; j++) {
         double u[3], w[3], l[3], c, dist;
         sample_uniforms(rng, j, u);
@@ -61,12 +62,16 @@ void lmb_estimate_classic(const lmb_estimator_options *opt, const lmb_lobe *cosi
         double denom = (double)opt->rays * lmb_lobe_pdf(cosine, w), x[3];
         for (int k = 0; k < 3; k++)
             out->e[k] += x[k] = l[k] * c / denom;
+        double y = lmb_luminance(x) * opt->rays;
+        sum += y;
+        sum2 += y * y;
         if (opt->gradient) {
             add_rotation(out, cosine->axis, w, c, x);
             out->cos_weight += 1; /* p_cos / q = 1 */
             out->cos_inverse_distance += dist > 0 && isfinite(dist) ? 1 / dist : 0;
         }
     }
+    out->var = lmb_sample_variance_of_mean(sum, sum2, opt->rays);
 }
 
 int lmb_estimator_can_guide(const lmb_estimator_options *opt)

@@ -87,6 +87,8 @@ typedef struct lmb_estimate {
      * p_cos / q over its traced samples: sum of p_cos/q and of p_cos/q / t (t = inf adds 0) */
     double cos_weight, cos_inverse_distance;
     double share[LMB_AMIS_MAX_ITERATIONS]; /* unbiased AMIS: the weight a_t given to iteration t */
+    double var; /* the estimated variance of lum(e), from the samples themselves: classic and guided,
+                   var(lum f / q) / N; unbiased AMIS, sum_t a_t^2 var_t / N_t; 0 for balance weights */
 } lmb_estimate;
 
 void lmb_estimator_scratch_free(lmb_estimator_scratch *s);

@@ -20,6 +20,15 @@ static inline double luminance(const double c[3])
     return lmb_luminance(c);
 }
 
+/* The variance of the mean of n samples y from their sum and sum of squares (0 when n < 2). */
+static inline double lmb_sample_variance_of_mean(double sum, double sum2, uint32_t n)
+{
+    if (n < 2)
+        return 0;
+    double v = (sum2 - sum * sum / n) / ((double)n - 1);
+    return v > 0 ? v / n : 0;
+}
+
 /* The numbers of sample j: counter-based, whatever the method. */
 static inline void sample_uniforms(lmb_rng rng, uint32_t j, double u[3])
 {

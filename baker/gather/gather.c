@@ -119,12 +119,13 @@ static void point_setup(const lmb_gather_job *job, uint32_t atlas, const lmb_tex
         pr->o[k] = pr->sp.p[k] + pr->sp.ng[k] * pr->sp.eps;
 }
 
-/* The estimator at the point (the same stream whether a texel or a record asks). */
+/* The estimator at the point (the same stream whether a texel or a record asks); `more` picks
+ * the stream of a record's second gather (lmb_gather_record). */
 static lmb_status estimate_at(const lmb_gather_job *job, point_rays *pr, lmb_estimator_scratch *scratch,
-                              const lmb_estimator_options *opt, lmb_estimate *est)
+                              const lmb_estimator_options *opt, lmb_estimate *est, int more)
 {
-    /* stream b = pass << 32 | 0xFFFFFFFF: apart from the per-sample streams of hits */
-    lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | 0xFFFFFFFFu);
+    /* stream b = pass << 32 | 0xFFFFFFFF (0xFFFFFFFE: more): apart from the per-sample streams of hits */
+    lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | (0xFFFFFFFFu - (more != 0)));
     return lmb_estimate_irradiance(opt, pr->sp.n, pr->sp.ng, rng, cached_radiance, pr, scratch, est);
 }
 
@@ -158,7 +159,7 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
         else if (gp->guide && lmb_guide_find(gp->guide, t, i, pr.sp.p, pr.sp.n, &guide))
             opt.guide = &guide;
         lmb_estimate est;
-        if (estimate_at(job, &pr, scratch, &opt, &est) != LMB_OK)
+        if (estimate_at(job, &pr, scratch, &opt, &est, 0) != LMB_OK)
             return LMB_ERR_INTERNAL;
         memcpy(e, est.e, sizeof e);
         st->adapted += est.adapted;
@@ -177,6 +178,49 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
     return LMB_OK;
 }
 
+/*
+ * A record's rays by its own noise (samples.noise, final gather): its error is copied to every
+ * texel it serves, so when its estimated standard error sqrt(est->var) is above noise_target x
+ * the light there (the last pass's, from the cache), it gathers again with the rays that bring
+ * the error to the target, est->var / target^2 x N in all (at most max_rays), from a stream of
+ * its own and guided by what it was guided by or learned; out->e and out->rot become the
+ * ray-weighted mean of both gathers (each unbiased).
+ */
+static lmb_status more_rays(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
+                            const lmb_estimator_options *opt, const lmb_estimate *est, int guided, point_rays *pr,
+                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st)
+{
+    if (!(job->noise_target > 0) || !(est->var > 0) || !job->cache || job->reference)
+        return LMB_OK;
+    double shown = lmb_luminance_f(job->cache->irradiance[atlas] + 3 * (size_t)t->texel[i]);
+    double target = job->noise_target * shown;
+    if (!(target > 0) || est->var <= target * target)
+        return LMB_OK;
+    double want = ceil(opt->rays * est->var / (target * target));
+    st->extended++;
+    if (want > job->max_rays) {
+        want = job->max_rays;
+        st->capped++;
+    }
+    if (want <= opt->rays)
+        return LMB_OK;
+    lmb_estimator_options again = *opt;
+    again.rays = (uint32_t)(want - opt->rays);
+    again.learn_lobes = 0;
+    if (!guided && est->learned.count)
+        again.guide = &est->learned;
+    lmb_estimate second;
+    if (estimate_at(job, pr, scratch, &again, &second, 1) != LMB_OK)
+        return LMB_ERR_INTERNAL;
+    double a = (double)opt->rays / want, b = 1 - a;
+    for (int k = 0; k < 3; k++) {
+        out->e[k] = a * est->e[k] + b * second.e[k];
+        for (int c = 0; c < 3; c++)
+            out->rot[k][c] = a * est->rot[k][c] + b * second.rot[k][c];
+    }
+    return LMB_OK;
+}
+
 lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
                             const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
                             lmb_gather_point_result *out, lmb_gather_stats *st)
@@ -190,7 +234,7 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     opt.learn_lobes = guided ? 0 : learn_lobes;
     pr.cosine_samples = lmb_estimator_cosine_samples(&opt);
     lmb_estimate est;
-    if (estimate_at(job, &pr, scratch, &opt, &est) != LMB_OK)
+    if (estimate_at(job, &pr, scratch, &opt, &est, 0) != LMB_OK)
         return LMB_ERR_INTERNAL;
     memcpy(out->p, pr.sp.p, sizeof out->p);
     memcpy(out->n, pr.sp.n, sizeof out->n);
@@ -201,6 +245,8 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     else
         out->harmonic = pr.inverse_distances > 0 ? pr.distances / pr.inverse_distances : HUGE_VAL;
     out->learned = est.learned;
+    if (more_rays(job, atlas, t, i, &opt, &est, guided, &pr, scratch, out, st) != LMB_OK)
+        return LMB_ERR_INTERNAL;
     st->rays += pr.rays;
     st->texels++;
     st->adapted += est.adapted;
@@ -271,7 +317,7 @@ static int sweep(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t,
         {
             lmb_rt_thread_init();
             lmb_estimator_scratch scratch = {0};
-            lmb_gather_stats st = {0, 0, 0, 0};
+            lmb_gather_stats st = {0};
 #pragma omp for schedule(dynamic, 4)
             for (uint32_t i = start; i < end; i++)
                 if (gather_texel(job, atlas, t, i, gp, &scratch, out, &st) != LMB_OK)

@@ -40,6 +40,10 @@ typedef struct lmb_gather_job {
     void *progress_user;
     uint64_t progress_done, progress_total; /* texels before this atlas, texels of the whole pass */
     struct lmb_steps *steps;    /* where the pass's gathers run (farm/steps.h) */
+    double noise_target;        /* > 0 (the final gather with samples.adaptive): a record whose estimated
+                                   standard error is above this share of the light there (the last pass's,
+                                   in the cache) gathers more rays, up to max_rays in all */
+    uint32_t max_rays;
 } lmb_gather_job;
 
 typedef struct lmb_gather_stats {
@@ -47,6 +51,8 @@ typedef struct lmb_gather_stats {
     uint64_t texels;    /* texels gathered */
     uint64_t adapted;   /* AMIS: lobe updates that changed the lobe */
     uint64_t records;   /* irradiance cache: records placed (texels counts their gathers too) */
+    uint64_t extended;  /* records that gathered more rays for noise_target */
+    uint64_t capped;    /* of those, stopped at max_rays short of it */
 } lmb_gather_stats;
 
 /* One gather at listed texel i's gather point, as an irradiance-cache record needs it. */

@@ -148,12 +148,13 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
     if (!rec || (c->guided && !mix))
         failed = 1;
     for (uint64_t start = first; start < last && !failed && st == LMB_OK; start += block) {
-        uint64_t end = start + block < last ? start + block : last, rays = 0, texels = 0, adapted = 0;
-#pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, failed)
+        uint64_t end = start + block < last ? start + block : last, rays = 0, texels = 0, adapted = 0, extended = 0,
+                 capped = 0;
+#pragma omp parallel num_threads(c->threads) reduction(+ : rays, texels, adapted, extended, capped, failed)
         {
             lmb_rt_thread_init();
             lmb_estimator_scratch scratch = {0};
-            lmb_gather_stats gs = {0, 0, 0, 0};
+            lmb_gather_stats gs = {0};
 #pragma omp for schedule(dynamic, 1)
             for (uint64_t k = start; k < end; k++) {
                 lmb_mixture guide;
@@ -189,10 +190,14 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
             rays += gs.rays;
             texels += gs.texels;
             adapted += gs.adapted;
+            extended += gs.extended;
+            capped += gs.capped;
         }
         counters[0] += rays;
         counters[1] += texels;
         counters[2] += adapted;
+        counters[3] += extended;
+        counters[4] += capped;
         for (uint64_t k = start; k < end && !failed && st == LMB_OK; k++) {
             if (rs->candidates) { /* a flag byte: covered (nothing follows) or a record */
                 uint8_t flag = !covered[k - start];
@@ -231,6 +236,8 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
     stats->rays += counters[0];
     stats->texels += counters[1];
     stats->adapted += counters[2];
+    stats->extended += counters[3];
+    stats->capped += counters[4];
     uint64_t n = 0; /* records made */
     for (uint64_t k = 0; k < m && st == LMB_OK; k++) {
         uint8_t flag = 1;

@@ -23,6 +23,7 @@
 
 #include "../util/frame.h"
 #include "../util/lmb_math.h"
+#include "../util/qmc.h"
 #include "../util/rng.h"
 
 
@@ -44,6 +45,12 @@ const lmb_config *lmb_direct_config(const lmb_direct *d)
 int lmb_direct_any_light(const lmb_direct *d)
 {
     return (d->lights.local_count + d->lights.directional_count > 0 && d->cfg->light_intensity_scale > 0) ||
+           lmb_emitters_count(d->emitters) > 0 || d->sky != NULL;
+}
+
+int lmb_direct_has_sampled(const lmb_direct *d)
+{
+    return (d->lights.directional_count > 0 && d->cfg->sun_angle > 0) || d->lights.local_count > EXACT_LOCAL_LIGHTS ||
            lmb_emitters_count(d->emitters) > 0 || d->sky != NULL;
 }
 
@@ -149,15 +156,18 @@ void lmb_sun_disc_direction(const lmb_config *cfg, const lmb_light *l, double u1
 }
 
 /* A directional light as a disc of angular diameter lights.sun_angle: c->samples directions
- * uniform in its cone (solid angle), each with a shadow ray. */
-static void sun_disc(point_ctx *c, const lmb_light *l, lmb_rng *rng, double e[3])
+ * uniform in its cone (solid angle), each with a shadow ray, at scrambled Sobol points (a
+ * stratified disc: its penumbrae converge faster than with independent directions). */
+static void sun_disc(point_ctx *c, const lmb_light *l, uint32_t which, double e[3])
 {
     double cos_max = cos(0.5 * c->d->cfg->sun_angle * LMB_PI / 180.0);
     uint32_t n = c->samples;
     double scale = c->d->cfg->light_intensity_scale * l->intensity / (0.5 * (1 + cos_max)) / n;
+    uint64_t key = lmb_mix64(c->sequence ^ (0x53554e00ull + which));
     for (uint32_t s = 0; s < n; s++) {
-        double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), d[3];
-        lmb_sun_disc_direction(c->d->cfg, l, u1, u2, d);
+        double u[2], d[3];
+        lmb_qmc_2d(key, c->first + s, u);
+        lmb_sun_disc_direction(c->d->cfg, l, u[0], u[1], d);
         double cosang = lmb_dot3(c->n, d);
         if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
             continue;
@@ -209,21 +219,34 @@ static int emitted(const emitter *x, double b1, double b2, const double d[3], do
     return 1;
 }
 
-/* Area lights by multiple importance sampling (Veach 1997, power heuristic with beta = 2, one
- * sample of each technique per round; the balance heuristic left 4x the variance under a disk
- * light, where light sampling alone is nearly exact): a point on an emitter chosen by power (pdf in solid angle
- * p_l = P(tri) / A_tri x d^2 / cos_y) and a cosine-distributed direction (p_b = cos_x / pi)
- * that counts when its first hit is an emitter. Light sampling alone has unbounded variance
- * where an emitter meets the surface (corners of an emissive room); the cosine rays cover it. */
-static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
+/* Area lights by multiple importance sampling (Veach 1997, power heuristic with beta = 2 and
+ * sample counts n_l, n_b: w_l = (n_l p_l)^2 / ((n_l p_l)^2 + (n_b p_b)^2); the balance heuristic
+ * left 4x the variance under a disk light, where light sampling alone is nearly exact): n_l
+ * points on emitters chosen by power (pdf in solid angle p_l = P(tri) / A_tri x d^2 / cos_y)
+ * and n_b = n_l / COSINE_SHARE cosine-distributed directions (p_b = cos_x / pi) that count when
+ * their first hit is an emitter. Light sampling alone has unbounded variance where an emitter
+ * meets the surface (corners of an emissive room); the cosine rays cover it. They are a
+ * quarter of the light samples: under a light that is small in the sky (a ceiling lamp) they
+ * rarely hit it, and at one each they were half the rays for a few percent of the light.
+ * Both techniques draw scrambled Sobol points (util/qmc.h): the light sample's first
+ * coordinate picks the triangle and, rescaled to its share of the CDF, is reused for the
+ * point on it, so the 2D points stay stratified over the lights' whole area. */
+#define COSINE_SHARE 4
+
+static void area_lights(point_ctx *c, double e[3])
 {
     const lmb_emitters *es = c->d->emitters;
-    uint32_t n = c->samples;
+    uint32_t n = c->samples, m = (n + COSINE_SHARE - 1) / COSINE_SHARE;
     double total = es->cdf[es->count];
+    uint64_t light_key = lmb_mix64(c->sequence ^ 0x41524541ull), cos_key = lmb_mix64(c->sequence ^ 0x434f5300ull);
     for (uint32_t s = 0; s < n; s++) {
         /* light sample */
-        double prob, u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), u3 = lmb_rng_next(rng);
-        const emitter *x = &es->e[lmb_emitter_pick(es, u1, &prob)];
+        double prob, u[2];
+        lmb_qmc_2d(light_key, c->first + s, u);
+        uint32_t pick = lmb_emitter_pick(es, u[0], &prob);
+        const emitter *x = &es->e[pick];
+        double lo = es->cdf[pick] / total, u2 = prob > 0 ? (u[0] - lo) / prob : 0.5, u3 = u[1];
+        u2 = u2 < 0 ? 0 : (u2 > 1 ? 1 : u2);
         double su = sqrt(u2), b1 = su * (1 - u3), b2 = su * u3, y[3], d[3], le[3], cy;
         for (int k = 0; k < 3; k++) {
             y[k] = (1 - b1 - b2) * x->p[k] + b1 * x->p[3 + k] + b2 * x->p[6 + k];
@@ -238,15 +261,20 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
                 c->rays++;
                 if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
                     double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
-                    double g = cx * pl / (pl * pl + pb * pb) / n, rgb[3]; /* (cx / pl) x power weight */
+                    double nl = n * pl, mb = m * pb;
+                    double g = cx * nl / (nl * nl + mb * mb), rgb[3]; /* (cx / (n pl)) x power weight */
                     for (int k = 0; k < 3; k++)
                         rgb[k] = le[k] * g;
                     add_light(c, NULL, d, rgb, e);
                 }
             }
         }
+    }
+    for (uint32_t s = 0; s < m; s++) {
         /* cosine sample */
-        double v1 = lmb_rng_next(rng), v2 = lmb_rng_next(rng), t1[3], t2[3], w[3];
+        double v[2], t1[3], t2[3], w[3];
+        lmb_qmc_2d(cos_key, c->first / n * m + s, v); /* round r: cosine points r m .. */
+        double v1 = v[0], v2 = v[1];
         double r = sqrt(v1), phi = 2 * LMB_PI * v2, cz = sqrt(fmax(0, 1 - v1));
         lmb_frame(c->n, t1, t2);
         for (int k = 0; k < 3; k++)
@@ -261,12 +289,14 @@ static void area_lights(point_ctx *c, lmb_rng *rng, double e[3])
         uint32_t k1 = map ? map[h.prim] : 0;
         if (!k1)
             continue;
-        x = &es->e[k1 - 1];
+        const emitter *x = &es->e[k1 - 1];
+        double le[3], cy;
         if (!emitted(x, h.u, h.v, w, &cy, le))
             continue;
         double pt = (es->cdf[k1] - es->cdf[k1 - 1]) / total;
         double pl = pt / x->area * h.t * h.t / cy, pb = cz * LMB_INV_PI;
-        double g = cz * pb / (pl * pl + pb * pb) / n, rgb[3]; /* (cz / pb) x power weight */
+        double nl = n * pl, mb = m * pb;
+        double g = cz * mb / (nl * nl + mb * mb), rgb[3]; /* (cz / (m pb)) x power weight */
         for (int k = 0; k < 3; k++)
             rgb[k] = le[k] * g;
         add_light(c, NULL, w, rgb, e);
@@ -322,23 +352,35 @@ uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_
 uint32_t lmb_direct_at_split(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng,
                              double e[3], double dir[3], double deferred[3])
 {
+    /* one draw at the start of the caller's stream: its QMC points are scrambled by the stream */
+    lmb_direct_draw draw = {LMB_DIRECT_ALL, samples, samples, lmb_mix64(rng->key ^ rng->counter), 0};
+    return lmb_direct_eval(d, sp, &draw, rng, e, dir, deferred);
+}
+
+uint32_t lmb_direct_eval(const lmb_direct *d, const lmb_shading_point *sp, const lmb_direct_draw *draw, lmb_rng *rng,
+                         double e[3], double dir[3], double deferred[3])
+{
     point_ctx c;
     lmb_point_init(&c, d, sp);
-    c.samples = samples ? samples : d->cfg->direct_samples;
+    c.samples = draw->samples ? draw->samples : d->cfg->direct_samples;
+    c.sequence = draw->sequence;
+    c.first = draw->first;
+    int exact = (draw->parts & LMB_DIRECT_EXACT) != 0, sampled = (draw->parts & LMB_DIRECT_SAMPLED) != 0;
     e[0] = e[1] = e[2] = 0;
     for (uint32_t l = 0; l < d->lights.directional_count; l++) {
         const lmb_light *sun = &d->scene->lights[d->lights.directional[l]];
-        if (d->cfg->sun_angle > 0)
-            sun_disc(&c, sun, rng, e);
-        else
+        if (d->cfg->sun_angle > 0 && sampled)
+            sun_disc(&c, sun, l, e);
+        else if (d->cfg->sun_angle <= 0 && exact)
             punctual(&c, sun, 1.0, e);
     }
-    local_lights(&c, rng, e);
-    if (lmb_emitters_count(d->emitters))
-        area_lights(&c, rng, e);
-    if (d->sky)
-        c.rays += lmb_sky_irradiance(d->sky, d->rt, c.o, c.n, c.ng, c.eps, samples ? samples : d->cfg->sky_samples, rng,
-                                     e, c.dir);
+    if (d->lights.local_count <= EXACT_LOCAL_LIGHTS ? exact : sampled)
+        local_lights(&c, rng, e);
+    if (lmb_emitters_count(d->emitters) && sampled)
+        area_lights(&c, e);
+    if (d->sky && sampled)
+        c.rays += lmb_sky_irradiance(d->sky, d->rt, c.o, c.n, c.ng, c.eps,
+                                     draw->sky_samples ? draw->sky_samples : d->cfg->sky_samples, rng, e, c.dir);
     if (dir)
         memcpy(dir, c.dir, sizeof c.dir);
     if (deferred)

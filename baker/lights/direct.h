@@ -58,6 +58,24 @@ uint32_t lmb_direct_at(const lmb_direct *d, const lmb_shading_point *sp, uint32_
 uint32_t lmb_direct_at_split(const lmb_direct *d, const lmb_shading_point *sp, uint32_t samples, lmb_rng *rng,
                              double e[3], double dir[3], double deferred[3]);
 
+/* Which lights lmb_direct_draw evaluates: those without noise (up to 8 point and spot lights
+ * evaluated one by one, suns without a disc) and those that are sampled (emissive triangles,
+ * sun discs, many point lights, the sky). A texel evaluates the first once and the second in
+ * rounds until its noise target (texel_direct.c). */
+enum { LMB_DIRECT_EXACT = 1, LMB_DIRECT_SAMPLED = 2, LMB_DIRECT_ALL = 3 };
+
+typedef struct lmb_direct_draw {
+    uint32_t parts;       /* LMB_DIRECT_EXACT | LMB_DIRECT_SAMPLED */
+    uint32_t samples;     /* area-light, sun-disc and many-light samples (0: samples.direct) */
+    uint32_t sky_samples; /* 0: sky.samples */
+    uint64_t sequence;    /* key of the point's scrambled Sobol points (util/qmc.h) for area lights and sun discs */
+    uint32_t first;       /* index of this draw's first sample in them: a later round continues the sequence */
+} lmb_direct_draw;
+
+/* lmb_direct_at_split with the draw spelled out (what, how many, which QMC points). */
+uint32_t lmb_direct_eval(const lmb_direct *d, const lmb_shading_point *sp, const lmb_direct_draw *draw, lmb_rng *rng,
+                         double e[3], double dir[3], double deferred[3]);
+
 /* 1 when some light is `indirect` (lmb_direct_at_split's deferred part can be non-zero). */
 int lmb_direct_has_deferred(const lmb_direct *d);
 
@@ -88,10 +106,23 @@ typedef struct lmb_direct_job {
                             texel's points as the irradiance is (directional lightmaps) */
     float *deferred;     /* NULL, or 3 floats per listed texel: the `indirect` lights' part of the irradiance */
     float *shadowmask;   /* NULL, or 4 floats per listed texel: lmb_shadowmask_at averaged over the points */
+    float *variance;     /* NULL, or per listed texel: the variance of one round's estimate of its mean
+                            luminance (texel_direct.c; 0: no sampled light) */
+    const uint32_t *rounds; /* NULL: 2 rounds of half samples.direct at every texel (the direct step);
+                               else per listed texel the rounds of a refinement (>= 2), after the
+                               direct step's two and without them; 0: the texel is left as it is */
 } lmb_direct_job;
 
-/* Fills irradiance (3 floats per listed texel of t), t->valid and t->gather_at. Counts rays. */
+/* Fills irradiance (3 floats per listed texel of t), t->valid and t->gather_at. Counts rays
+ * and adds the sampled lights' samples to *samples. */
 lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays,
-                              lmb_error *err);
+                              uint64_t *samples, lmb_error *err);
+
+/* Samples per point in one round of the sampled lights: half samples.direct (rounded up). */
+uint32_t lmb_direct_round_samples(const lmb_config *cfg);
+
+/* 1 when some light is sampled (emissive triangles, sun discs, more than 8 point lights, the sky):
+ * direct light has noise, and adaptive sampling has something to do. */
+int lmb_direct_has_sampled(const lmb_direct *d);
 
 #endif

@@ -51,6 +51,8 @@ typedef struct point_ctx {
     double p[3], n[3], ng[3];
     double eps;
     uint32_t samples; /* area-light and many-light samples */
+    uint64_t sequence; /* QMC key of the point (util/qmc.h); each light and technique hashes its own from it */
+    uint32_t first;    /* index of the first sample in the QMC sequences */
     uint64_t rays;
     double dir[3];    /* sum of each contribution's luminance times its direction (unit, toward the light) */
     double deferred[3]; /* the part of e from `indirect` lights (not in the lightmap, not in dir) */

@@ -28,9 +28,10 @@ static void band_progress(void *user, const char *stage, uint64_t done, uint64_t
 
 /* A band's bytes: u32 count; per texel u32 texel, f32 size, lmb_point_ref, u8 valid, u8 partly;
  * then 3 f32 direct light per texel, 3 f32 direction sum per texel when directional, 3 f32
- * deferred light (mixed lighting) and 4 f32 shadowmask visibilities when those are on. */
-static lmb_status put_band(const lmb_texels *t, const float *e, const float *dir, const float *deferred,
-                           const float *mask, lmb_buf *out, lmb_error *err)
+ * deferred light (mixed lighting) and 4 f32 shadowmask visibilities when those are on; 1 f32
+ * round variance per texel (lmb_direct_job). */
+static lmb_status put_band(const lmb_texels *t, const float *e, const float *variance, const float *dir,
+                           const float *deferred, const float *mask, lmb_buf *out, lmb_error *err)
 {
     lmb_status st = lmb_buf_append(out, &t->count, 4, err);
     for (uint32_t i = 0; i < t->count && st == LMB_OK; i++) {
@@ -51,6 +52,8 @@ static lmb_status put_band(const lmb_texels *t, const float *e, const float *dir
         st = lmb_buf_append(out, deferred, 3 * sizeof *deferred * t->count, err);
     if (st == LMB_OK && mask)
         st = lmb_buf_append(out, mask, LMB_SHADOWMASK_CHANNELS * sizeof *mask * t->count, err);
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, variance, sizeof *variance * t->count, err);
     return st;
 }
 
@@ -66,20 +69,22 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
         if (st != LMB_OK)
             break;
         float *e = calloc(3 * (size_t)band.count + 1, sizeof *e);
+        float *variance = calloc((size_t)band.count + 1, sizeof *variance);
         float *dir = c->cfg->directional ? calloc(3 * (size_t)band.count + 1, sizeof *dir) : NULL;
         int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
         float *deferred = has_deferred ? calloc(3 * (size_t)band.count + 1, sizeof *deferred) : NULL;
         float *mask = has_mask ? calloc(LMB_SHADOWMASK_CHANNELS * (size_t)band.count + 1, sizeof *mask) : NULL;
-        if (!e || (c->cfg->directional && !dir) || (has_deferred && !deferred) || (has_mask && !mask))
+        if (!e || !variance || (c->cfg->directional && !dir) || (has_deferred && !deferred) || (has_mask && !mask))
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
         c->row0 = y0;
         c->band_rows = y1 - y0;
-        lmb_direct_job job = {c->direct, c->atlas, c->progress ? band_progress : NULL, c, dir, deferred, mask};
+        lmb_direct_job job = {c->direct, c->atlas, c->progress ? band_progress : NULL, c, dir, deferred, mask, variance, NULL};
         if (st == LMB_OK)
-            st = lmb_direct_compute(&job, &band, e, &counters[0], err);
+            st = lmb_direct_compute(&job, &band, e, &counters[0], &counters[1], err);
         if (st == LMB_OK)
-            st = put_band(&band, e, dir, deferred, mask, out, err);
+            st = put_band(&band, e, variance, dir, deferred, mask, out, err);
         free(e);
+        free(variance);
         free(dir);
         free(deferred);
         free(mask);
@@ -122,11 +127,14 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     float *d = realloc(out->direct, (3 * total + 1) * sizeof *d);
     if (d)
         out->direct = d;
+    float *nz = realloc(out->variance, (total + 1) * sizeof *nz);
+    if (nz)
+        out->variance = nz;
     float *dd = directional ? realloc(out->direction, (3 * total + 1) * sizeof *dd) : NULL;
     if (dd)
         out->direction = dd;
     lmb_status st = LMB_OK;
-    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.partly_covered || !band.gather_at || !d ||
+    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.partly_covered || !band.gather_at || !d || !nz ||
         (directional && !dd))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
     for (uint32_t i = 0; i < n && st == LMB_OK; i++) {
@@ -147,7 +155,8 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
                          (has_deferred && !lmb_buf_take(in, out->deferred + 3 * (size_t)out->t.count,
                                                         3 * sizeof(float) * n)) ||
                          (has_mask && !lmb_buf_take(in, out->shadowmask + LMB_SHADOWMASK_CHANNELS * (size_t)out->t.count,
-                                                    LMB_SHADOWMASK_CHANNELS * sizeof(float) * n))))
+                                                    LMB_SHADOWMASK_CHANNELS * sizeof(float) * n)) ||
+                         !lmb_buf_take(in, out->variance + out->t.count, sizeof(float) * n)))
         st = lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
     if (st == LMB_OK)
         st = lmb_texels_append(&out->t, &band, err);
@@ -181,6 +190,8 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     uint64_t counters[LMB_STEP_COUNTERS];
     lmb_status st = lmb_steps_run(steps, &d, &bytes, counters, err);
     *rays += counters[0];
+    out->rays = counters[0];
+    out->samples = counters[1];
     for (uint64_t b = 0; b < bands && st == LMB_OK; b++)
         st = take_band(&bytes, cfg->directional, out, &c, err);
     if (st == LMB_OK && !out->t.texel) { /* an atlas without texels: empty arrays, not NULL */
@@ -193,13 +204,15 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     }
     if (st == LMB_OK && !out->direct)
         out->direct = calloc(1, sizeof *out->direct);
+    if (st == LMB_OK && !out->variance)
+        out->variance = calloc(1, sizeof *out->variance);
     if (st == LMB_OK && lmb_direct_has_deferred(direct) && !out->deferred)
         out->deferred = calloc(1, sizeof *out->deferred);
     if (st == LMB_OK && lmb_direct_shadowmask_channels(direct) && !out->shadowmask)
         out->shadowmask = calloc(1, sizeof *out->shadowmask);
     if (st == LMB_OK && cfg->directional && !out->direction)
         out->direction = calloc(1, sizeof *out->direction);
-    if (st == LMB_OK && (!out->direct || (cfg->directional && !out->direction)))
+    if (st == LMB_OK && (!out->direct || !out->variance || (cfg->directional && !out->direction)))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
     free(cost);
     lmb_buf_free(&bytes);

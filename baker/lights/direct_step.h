@@ -19,6 +19,10 @@ typedef struct lmb_direct_atlas {
     float *deferred;     /* `indirect` lights (lmb_direct_has_deferred): 3 per listed texel, their part of
                             direct; else NULL */
     float *shadowmask;   /* output.shadowmask with channels in use: 4 per listed texel, visibilities; else NULL */
+    float *variance;     /* per listed texel: variance of one round's estimate of its luminance
+                            (lmb_direct_job; 0: no sampled light), for lmb_direct_refine_step */
+    uint64_t samples;    /* sampled lights' samples taken */
+    uint64_t rays;       /* rays the step traced for this atlas */
 } lmb_direct_atlas;
 
 /* *out := atlas a's texels and direct light (owned: free its arrays and lmb_texels_free). */

@@ -1,6 +1,6 @@
 /*
  * Direct light texel by texel (see direct.h, lmb_direct_compute): each of a texel's points is
- * tested for lying inside geometry, the others get direct light (lmb_direct_at), and the
+ * tested for lying inside geometry, the others get direct light (lmb_direct_eval), and the
  * texel keeps their mean, the point indirect light is gathered at, whether geometry covers it
  * in part (post/rim.c) and, for directional lightmaps, the light's direction sum; with mixed
  * lighting also the `indirect` lights' part and the shadowmask lights' visibility.
@@ -9,41 +9,118 @@
 
 #include <omp.h>
 
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
-static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, float *out, uint64_t *rays)
+#include "../util/lmb_math.h"
+#include "../util/rng.h"
+
+/* A point's light in progress: its exact part once, its sampled part summed over rounds (with
+ * the luminance of each round's estimate, for the variance). */
+typedef struct point_sum {
+    lmb_shading_point sp;
+    lmb_rng rng;
+    uint64_t sequence;
+    double e[3], dir[3], deferred[3];            /* exact part */
+    double se[3], sdir[3], sdeferred[3];         /* sampled part, summed over rounds */
+    double lum, lum2;                            /* sum over rounds of the sampled luminance, and of its square */
+} point_sum;
+
+/* The variance of one round's estimate of the texel's mean luminance: per point, the variance
+ * of its rounds' estimates (their spread at one place: what another seed changes), pooled over
+ * the points. The texel's standard error after R rounds is sqrt(variance / R). Scrambled Sobol
+ * rounds of one sequence are negatively correlated, so this overstates the error a little. */
+static double round_variance(const point_sum *ps, uint32_t used, uint32_t rounds)
 {
-    double sum[3] = {0, 0, 0}, dir_sum[3] = {0, 0, 0}, deferred_sum[3] = {0, 0, 0}, mask_sum[LMB_SHADOWMASK_CHANNELS] = {0};
+    double var = 0;
+    for (uint32_t k = 0; k < used && rounds > 1; k++) {
+        double m = ps[k].lum / rounds, v = (ps[k].lum2 - rounds * m * m) / (rounds - 1);
+        var += v > 0 ? v : 0;
+    }
+    return used ? var / ((double)used * used) : 0;
+}
+
+uint32_t lmb_direct_round_samples(const lmb_config *cfg)
+{
+    return cfg->direct_samples > 1 ? (cfg->direct_samples + 1) / 2 : 1;
+}
+
+/*
+ * Direct light of listed texel i with `rounds` (>= 2) rounds of the sampled lights. Each usable
+ * point evaluates its exact lights once and its sampled lights (area lights, sun discs, many
+ * lights, the sky) in rounds of half samples.direct (and half sky.samples) along one scrambled
+ * Sobol sequence per point: the direct step's two rounds (first = 0) are samples.direct's
+ * samples. A refinement (first = 2) takes the rounds after them and its own random stream, and
+ * its estimate is those rounds alone: the rounds that decided how many it needs are left out,
+ * so a texel that drew low or high there is not kept low or high (the bias of adaptive
+ * sampling that reuses its pilot). Every draw is keyed by texel, point and sample index: no
+ * state is stored between the steps. job->variance gets round_variance. Adds the sampled
+ * lights' samples to *samples.
+ */
+static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, uint32_t first, uint32_t rounds,
+                         float *out, uint64_t *rays, point_sum *ps, uint64_t *samples)
+{
+    const lmb_config *cfg = lmb_direct_config(job->direct);
+    double mask_sum[LMB_SHADOWMASK_CHANNELS] = {0};
     uint32_t used = 0, r = 0;
     int near_back = 0;
     uint64_t key = ((uint64_t)job->atlas << 32) | t->texel[i];
     t->gather_at[i] = 0;
     for (uint32_t k = 0; k < t->points_in[i]; k++) {
-        lmb_shading_point sp;
-        lmb_texel_shading_point(job->direct, t, i, k, &sp);
-        lmb_rng rng = lmb_rng_make(lmb_direct_config(job->direct)->seed, key, k);
+        point_sum *p = &ps[used];
+        memset(p, 0, sizeof *p);
+        lmb_texel_shading_point(job->direct, t, i, k, &p->sp);
+        p->rng = lmb_rng_make(cfg->seed, key, k);
         int sees_back;
-        if (lmb_point_inside_geometry(job->direct, &sp, &rng, &r, &sees_back))
+        if (lmb_point_inside_geometry(job->direct, &p->sp, &p->rng, &r, &sees_back))
             continue;
         near_back |= sees_back;
         if (!used)
             t->gather_at[i] = (uint8_t)k;
-        double e[3], dir[3], deferred[3];
-        r += lmb_direct_at_split(job->direct, &sp, 0, &rng, e, dir, deferred);
-        for (int d = 0; d < 3; d++) {
-            sum[d] += e[d];
-            dir_sum[d] += dir[d];
-            deferred_sum[d] += deferred[d];
-        }
+        p->sequence = lmb_mix64(p->rng.key ^ 0x51u);
+        lmb_direct_draw exact = {LMB_DIRECT_EXACT, 0, 0, p->sequence, 0};
+        r += lmb_direct_eval(job->direct, &p->sp, &exact, &p->rng, p->e, p->dir, p->deferred);
+        if (first) /* the refinement's own stream for the sky and many lights */
+            p->rng = lmb_rng_make(cfg->seed, key, 0x6000u + k);
         if (job->shadowmask) { /* a stream of its own: the lightmap does not change with output.shadowmask */
-            lmb_rng mask_rng = lmb_rng_make(lmb_direct_config(job->direct)->seed, key, 0x5000u + k);
+            lmb_rng mask_rng = lmb_rng_make(cfg->seed, key, 0x5000u + k);
             double vis[LMB_SHADOWMASK_CHANNELS];
-            r += lmb_shadowmask_at(job->direct, &sp, &mask_rng, vis);
+            r += lmb_shadowmask_at(job->direct, &p->sp, &mask_rng, vis);
             for (int c = 0; c < LMB_SHADOWMASK_CHANNELS; c++)
                 mask_sum[c] += vis[c];
         }
         used++;
     }
+    uint32_t per_round = lmb_direct_round_samples(cfg);
+    uint32_t sky_round = cfg->sky_samples > 1 ? (cfg->sky_samples + 1) / 2 : 1;
+    if (!used || !lmb_direct_has_sampled(job->direct))
+        rounds = 0;
+    for (uint32_t round = 0; round < rounds; round++)
+        for (uint32_t k = 0; k < used; k++) {
+            point_sum *p = &ps[k];
+            lmb_direct_draw draw = {LMB_DIRECT_SAMPLED, per_round, sky_round, p->sequence, (first + round) * per_round};
+            double e[3], dir[3], deferred[3];
+            r += lmb_direct_eval(job->direct, &p->sp, &draw, &p->rng, e, dir, deferred);
+            double l = lmb_luminance(e);
+            p->lum += l;
+            p->lum2 += l * l;
+            for (int d = 0; d < 3; d++) {
+                p->se[d] += e[d];
+                p->sdir[d] += dir[d];
+                p->sdeferred[d] += deferred[d];
+            }
+            *samples += per_round;
+        }
+    if (job->variance)
+        job->variance[i] = (float)round_variance(ps, used, rounds);
+    double sum[3] = {0, 0, 0}, dir_sum[3] = {0, 0, 0}, deferred_sum[3] = {0, 0, 0};
+    for (uint32_t k = 0; k < used; k++)
+        for (int d = 0; d < 3; d++) {
+            sum[d] += ps[k].e[d] + (rounds ? ps[k].se[d] / rounds : 0);
+            dir_sum[d] += ps[k].dir[d] + (rounds ? ps[k].sdir[d] / rounds : 0);
+            deferred_sum[d] += ps[k].deferred[d] + (rounds ? ps[k].sdeferred[d] / rounds : 0);
+        }
     t->valid[i] = used > 0;
     t->partly_covered[i] = used > 0 && (used < t->points_in[i] || near_back);
     for (int d = 0; d < 3; d++) {
@@ -58,26 +135,35 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, f
     *rays += r;
 }
 
-lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays, lmb_error *err)
+lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays,
+                              uint64_t *samples, lmb_error *err)
 {
     const uint32_t block = 1024;
     uint64_t total = 0;
     int threads = lmb_direct_config(job->direct)->threads ? (int)lmb_direct_config(job->direct)->threads : omp_get_max_threads();
-    for (uint32_t start = 0; start < t->count; start += block) {
+    int failed = 0;
+    for (uint32_t start = 0; start < t->count && !failed; start += block) {
         uint32_t end = start + block < t->count ? start + block : t->count;
-        uint64_t block_rays = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : block_rays)
+        uint64_t block_rays = 0, block_samples = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : block_rays, block_samples, failed)
         {
             lmb_rt_thread_init();
+            point_sum *ps = malloc(((size_t)t->samples + 1) * sizeof *ps);
+            failed += !ps;
 #pragma omp for schedule(dynamic, 16)
             for (uint32_t i = start; i < end; i++)
-                texel_direct(job, t, i, irradiance, &block_rays);
+                if (ps && (!job->rounds || job->rounds[i]))
+                    texel_direct(job, t, i, job->rounds ? 2 : 0, job->rounds ? job->rounds[i] : 2, irradiance,
+                                 &block_rays, ps, &block_samples);
+            free(ps);
         }
         total += block_rays;
+        *samples += block_samples;
         if (job->progress)
             job->progress(job->progress_user, "direct", end, t->count);
     }
     *rays += total;
-    (void)err;
+    if (failed)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory for %u points per texel", t->samples);
     return LMB_OK;
 }

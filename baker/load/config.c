@@ -77,6 +77,9 @@ static const key_spec config_keys[] = {
     BOOL("atlas.share_meshes", OFF(share_meshes)),
     U32("samples.texel", OFF(texel_samples), 1, 256),
     U32("samples.direct", OFF(direct_samples), 1, 65536),
+    BOOL("samples.adaptive", OFF(adaptive)),
+    FLOAT("samples.noise", OFF(noise_target), 0, 1, OPEN_LO | OPEN_HI),
+    U32("samples.max_rays", OFF(max_rays), 64, 16777216),
     U32("samples.gather", OFF(gather_rays), 1, 1048576),
     U32("samples.bounce", OFF(bounce_rays), 1, 1048576),
     U32("samples.bounce_high", OFF(bounce_rays_high), 0, 1048576),
@@ -176,6 +179,9 @@ void lmb_config_default(lmb_config *cfg)
     cfg->keep_uv1 = 0;
     cfg->texel_samples = 4;
     cfg->direct_samples = 16;
+    cfg->adaptive = 1;
+    cfg->noise_target = 0.01;
+    cfg->max_rays = 4096;
     cfg->gather_rays = 256;
     cfg->bounce_rays = 64;
     cfg->bounce_rays_high = 16; /* docs/defaults.md: no measurable loss, 15% faster */

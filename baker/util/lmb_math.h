@@ -12,4 +12,9 @@ static inline double lmb_luminance(const double c[3])
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 
+static inline double lmb_luminance_f(const float c[3])
+{
+    return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+}
+
 #endif

@@ -274,6 +274,9 @@ typedef struct lmb_config {
     /* samples */
     uint32_t texel_samples;        /* gather points per texel (stratified) */
     uint32_t direct_samples;       /* shadow rays per area-light evaluation */
+    int adaptive;                  /* samples.adaptive: more samples where an estimate's own variance says so */
+    double noise_target;           /* samples.noise: relative standard error per texel aimed at */
+    uint32_t max_rays;             /* samples.max_rays: adaptive sampling stops at this many samples per estimate */
     uint32_t gather_rays;          /* final gather rays per texel (reference: paths per texel) */
     uint32_t bounce_rays;          /* rays per texel of each bounce pass before the final gather */
     uint32_t bounce_rays_high;     /* rays per texel of bounce passes 3 and later; 0 = bounce_rays */
@@ -434,6 +437,12 @@ typedef struct lmb_bake_stats {
     double texel_density;   /* the scene's density (auto: what the budget gave) */
     int density_auto;       /* texel_density: auto */
     uint32_t density_capped; /* auto: instances lowered to fit one atlas */
+    double direct_noise_median, direct_noise_p95; /* estimated relative standard error of texels' direct light,
+                                                     of the light shown */
+    uint64_t direct_refined; /* texels whose direct light took more samples (samples.noise) */
+    uint64_t direct_capped; /* of those, stopped by samples.max_rays short of samples.noise */
+    uint64_t records_extended; /* final gather: records that gathered more rays for samples.noise */
+    uint64_t records_capped;   /* of those, stopped by samples.max_rays */
     uint64_t rim_limited;   /* partly covered texels limited to their neighbours (post/rim.c) */
     double rim_energy;      /* the direct light that removed, as a share of all direct light */
     uint64_t firefly_texels; /* fireflies spread to their neighbours (post/fireflies.c) */
