@@ -55,7 +55,7 @@ def bake(lmbake, scene, out, config, seed):
                        text=True)
     if r.returncode != 0:
         raise SystemExit("bake failed (%s):\n%s" % (out, r.stderr[-3000:]))
-    seconds = float(re.search(r"^bake: ([0-9.]+) s", r.stderr, re.M).group(1))
+    seconds = float(re.search(r"^bake: ([0-9.]+) s", r.stdout + r.stderr, re.M).group(1))
     exrs = sorted(f for f in os.listdir(out) if re.search(r"-lightmap-\d+\.exr$", f))
     return seconds, [os.path.join(out, f) for f in exrs], r.stderr
 
