@@ -223,10 +223,9 @@ static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_
             float v = result_has_direct ? w->result[k] : w->result[k] + w->direct[k] - (w->deferred ? w->deferred[k] : 0.0f);
             shown[k] = v > 0 ? v : 0.0f;
         }
-        lmb_direct_atlas da = {w->t, w->direct, w->direct_dir, w->deferred, NULL, w->variance, 0, w->direct_rays};
+        lmb_direct_atlas da = {w->t, w->direct, w->direct_dir, w->deferred, NULL, w->variance, w->direct_rays};
         st = lmb_direct_refine_step(env->job->steps, cfg, env->job->direct, env->cache->scene, env->cache->layout, a,
-                                    shown, &da, env->job->progress, env->job->progress_user, &env->stats->rays, &noise,
-                                    &estimates, &estimate_count, err);
+                                    shown, &da, &env->stats->rays, &noise, &estimates, &estimate_count, err);
         free(shown);
     }
     lmb_direct_noise_finish(&noise, estimates, estimate_count);

@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define REFINE_BAND_TEXELS 16384
 /* The refinement's rays are at most this many times the direct step's over the atlas: on a level
  * where most texels are in penumbra under little other light (an outdoor level under a sky),
  * samples.max_rays alone would let the bake take many times as long. Past it, every refined
@@ -195,13 +194,11 @@ static lmb_status take_refined(lmb_buf *in, uint64_t bands, lmb_direct_atlas *da
 
 lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
                                   const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const float *shown,
-                                  lmb_direct_atlas *da, lmb_progress_fn progress, void *progress_user, uint64_t *rays,
-                                  lmb_direct_noise *noise, float **estimates, uint64_t *estimate_count, lmb_error *err)
+                                  lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
+                                  uint64_t *estimate_count, lmb_error *err)
 {
-    (void)progress;
-    (void)progress_user;
     uint32_t count = da->t.count, width = layout->width[a], height = layout->height[a];
-    uint32_t rows = width ? (REFINE_BAND_TEXELS + width - 1) / width : 1;
+    uint32_t rows = width ? (LMB_DIRECT_BAND_TEXELS + width - 1) / width : 1;
     rows = rows ? rows : 1;
     uint64_t bands = height ? (height + (uint64_t)rows - 1) / rows : 0;
     uint32_t *rounds = calloc((size_t)count + 1, sizeof *rounds);

@@ -29,8 +29,8 @@ typedef struct lmb_direct_noise {
  * Adds to *rays and to noise (median and p95 are set by lmb_direct_noise_finish). */
 lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
                                   const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const float *shown,
-                                  lmb_direct_atlas *da, lmb_progress_fn progress, void *progress_user, uint64_t *rays,
-                                  lmb_direct_noise *noise, float **estimates, uint64_t *estimate_count, lmb_error *err);
+                                  lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
+                                  uint64_t *estimate_count, lmb_error *err);
 
 /* noise->median and p95 from the estimates collected over every atlas (frees them). */
 void lmb_direct_noise_finish(lmb_direct_noise *noise, float *estimates, uint64_t count);

@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define BAND_TEXELS 16384
 
 typedef struct band_ctx {
     const lmb_config *cfg;
@@ -170,7 +169,7 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
 {
     memset(out, 0, sizeof *out);
     band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user, 0, 0};
-    c.rows = c.width ? (BAND_TEXELS + c.width - 1) / c.width : c.height;
+    c.rows = c.width ? (LMB_DIRECT_BAND_TEXELS + c.width - 1) / c.width : c.height;
     if (!c.rows)
         c.rows = 1;
     uint64_t bands = c.height ? (c.height + (uint64_t)c.rows - 1) / c.rows : 0;
@@ -191,7 +190,6 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     lmb_status st = lmb_steps_run(steps, &d, &bytes, counters, err);
     *rays += counters[0];
     out->rays = counters[0];
-    out->samples = counters[1];
     for (uint64_t b = 0; b < bands && st == LMB_OK; b++)
         st = take_band(&bytes, cfg->directional, out, &c, err);
     if (st == LMB_OK && !out->t.texel) { /* an atlas without texels: empty arrays, not NULL */

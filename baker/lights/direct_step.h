@@ -12,6 +12,9 @@
 #include "lights/direct.h"
 #include "texels/texels.h"
 
+/* Texels per band of the direct step and of its refinement (rows of about this many texels). */
+#define LMB_DIRECT_BAND_TEXELS 16384
+
 typedef struct lmb_direct_atlas {
     lmb_texels t;        /* the atlas's listed texels, one gather point each */
     float *direct;       /* 3 per listed texel */
@@ -21,7 +24,6 @@ typedef struct lmb_direct_atlas {
     float *shadowmask;   /* output.shadowmask with channels in use: 4 per listed texel, visibilities; else NULL */
     float *variance;     /* per listed texel: variance of one round's estimate of its luminance
                             (lmb_direct_job; 0: no sampled light), for lmb_direct_refine_step */
-    uint64_t samples;    /* sampled lights' samples taken */
     uint64_t rays;       /* rays the step traced for this atlas */
 } lmb_direct_atlas;
 
