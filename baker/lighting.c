@@ -6,6 +6,7 @@
 #include "lights/direct_refine.h"
 #include "lights/direct_step.h"
 #include "irradiance_cache/ic_pass.h"
+#include "post/denoise.h"
 #include "post/rim.h"
 #include "util/clock.h"
 #include "util/lmb_math.h"
@@ -26,6 +27,7 @@ typedef struct atlas_work {
     float *shadowmask; /* output.shadowmask: 4 per listed texel; else NULL */
     float *variance; /* per listed texel: variance of a round of its sampled direct light (direct_refine.h) */
     uint64_t direct_rays; /* what the direct step traced for this atlas */
+    double gather_noise;  /* the last cached gather's records: median relative standard error (ic_pass.h) */
 } atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
@@ -90,8 +92,9 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     const lmb_texels **t = calloc((size_t)n + 1, sizeof *t);
     float **out = calloc((size_t)n + 1, sizeof *out);
     uint64_t *records = calloc((size_t)n + 1, sizeof *records), *valid = calloc((size_t)n + 1, sizeof *valid);
+    double *noise = calloc((size_t)n + 1, sizeof *noise);
     lmb_status st = LMB_OK;
-    if (!t || !out || !records || !valid)
+    if (!t || !out || !records || !valid || !noise)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
     for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
         t[a] = &env->w[a].t;
@@ -99,12 +102,13 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     }
     lmb_ic_options opt = {env->cfg->ic_error, env->cfg->ic_min_spacing, env->cfg->ic_max_spacing,
                           env->cfg->ic_ray_scale};
-    lmb_ic_pass_stats ps = {records, valid, env->points};
+    lmb_ic_pass_stats ps = {records, valid, env->points, noise};
     if (st == LMB_OK)
         st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, env->shared, gs, err);
     uint64_t all = 0;
     for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
         all += records[a];
+        env->w[a].gather_noise = noise[a];
         lmb_info(env->log, "%s, atlas %u: %llu records, %.1f%% of %llu valid texels interpolated", env->job->stage, a,
                  (unsigned long long)records[a], valid[a] ? 100.0 * (double)(valid[a] - records[a]) / (double)valid[a] : 0.0,
                  (unsigned long long)valid[a]);
@@ -114,6 +118,38 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     free(out);
     free(records);
     free(valid);
+    free(noise);
+    return st;
+}
+
+/* Every atlas's `field` (3 floats per listed texel) through the edge-aware filter
+ * (post/denoise.h) at the relative noise `noise` (atlas by atlas when NULL: each atlas's
+ * records' gather_noise) with `levels` passes; `what` names the light in the log line. */
+static lmb_status denoise_light(const pass_env *env, size_t field, const double *noise, int own_variance,
+                                uint32_t levels, const char *what, lmb_error *err)
+{
+    const lmb_config *cfg = env->cfg;
+    lmb_denoise_stats ds = {0};
+    double most = 0;
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < env->cache->atlas_count && st == LMB_OK; a++) {
+        atlas_work *w = &env->w[a];
+        double level = noise ? *noise : w->gather_noise;
+        most = level > most ? level : most;
+        if (!(level > 0))
+            continue;
+        float *light = *(float **)(void *)((char *)w + field);
+        if (own_variance && !w->variance)
+            continue;
+        lmb_denoise_options opt = {levels, level, own_variance ? w->variance : NULL, cfg->denoise_strength,
+                                   (int)cfg->threads};
+        st = lmb_denoise_atlas(&w->t, light, &opt, &ds, err);
+    }
+    env->stats->denoised_texels += ds.texels;
+    if (st == LMB_OK && ds.texels)
+        lmb_info(env->log, "denoise: %s of %llu texels filtered at %.2f%% noise (%u levels, strength %g); its mean "
+                 "moved %+.3f%%", what, (unsigned long long)ds.texels, 100 * most, levels, cfg->denoise_strength,
+                 ds.before > 0 ? 100 * (ds.after / ds.before - 1) : 0.0);
     return st;
 }
 
@@ -250,6 +286,12 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
         st = cached_gather(env, gs, err);
     else
         st = texel_step(env, job->stage, 0, offsetof(atlas_work, result), gs, err);
+    for (uint32_t a = 0; add_direct && through_cache && a < cache->atlas_count; a++)
+        if (env->w[a].gather_noise > stats->indirect_noise)
+            stats->indirect_noise = env->w[a].gather_noise;
+    if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference)
+        st = denoise_light(env, offsetof(atlas_work, result), NULL, 0, env->cfg->denoise_levels,
+                           "the final gather's light (its records' median noise)", err);
     if (st == LMB_OK && add_direct && !job->reference) /* the final gather: the light shown is known */
         st = refine_direct(env, 0, err);
     /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */
@@ -258,6 +300,9 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
             float v = w[a].result[k] + w[a].direct[k] - (w[a].deferred ? w[a].deferred[k] : 0.0f);
             w[a].result[k] = v > 0 ? v : 0.0f;
         }
+    if (st == LMB_OK && add_direct && !job->reference && env->cfg->denoise_direct && stats->direct_noise_median > 0)
+        st = denoise_light(env, offsetof(atlas_work, result), &stats->direct_noise_median, 1, LMB_DENOISE_DIRECT_LEVELS,
+                           "the light with its direct part (each texel's direct light's own variance)", err);
     if (st == LMB_OK && store)
         st = store_pass(w, cache, err);
     stats->rays += gs->rays;

@@ -213,6 +213,7 @@ static lmb_status more_rays(const lmb_gather_job *job, uint32_t atlas, const lmb
     if (estimate_at(job, pr, scratch, &again, &second, 1) != LMB_OK)
         return LMB_ERR_INTERNAL;
     double a = (double)opt->rays / want, b = 1 - a;
+    out->var = a * a * est->var + b * b * (second.var > 0 ? second.var : 0);
     for (int k = 0; k < 3; k++) {
         out->e[k] = a * est->e[k] + b * second.e[k];
         for (int c = 0; c < 3; c++)
@@ -240,6 +241,7 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     memcpy(out->n, pr.sp.n, sizeof out->n);
     memcpy(out->e, est.e, sizeof out->e);
     memcpy(out->rot, est.rot, sizeof out->rot);
+    out->var = est.var > 0 ? est.var : 0;
     if (guided)
         out->harmonic = est.cos_inverse_distance > 0 ? est.cos_weight / est.cos_inverse_distance : HUGE_VAL;
     else

@@ -60,6 +60,7 @@ typedef struct lmb_gather_point_result {
     double p[3], n[3];  /* the gather point and its shading normal */
     double e[3];        /* irradiance (the same value lmb_gather_atlas gives the texel) */
     double rot[3][3];   /* rotation gradient per channel (estimator.h) */
+    double var;         /* the variance of lum(e) as an estimate (0: not estimated), for the denoiser */
     double harmonic;    /* harmonic mean hit distance of its cosine-distributed rays (HUGE_VAL: none hit;
                            guided: of all its rays, weighted p_cos / q) */
     lmb_mixture learned; /* with learn_lobes: what it learned for its neighbours (guide.h) */

@@ -328,6 +328,34 @@ static lmb_status export_points(const lmb_ic_records *s, lmb_ic_points *out, lmb
     return LMB_OK;
 }
 
+static int compare_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Per atlas, the median of sqrt(var) / lum(e) over its records with light and an estimated
+ * variance (0 when it has none): how noisy the interpolated light is, for the denoiser. */
+static lmb_status records_noise(const lmb_ic_records *s, uint32_t atlas_count, double *noise, lmb_error *err)
+{
+    double *rel = malloc(((size_t)s->count + 1) * sizeof *rel);
+    if (!rel)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", s->count);
+    for (uint32_t a = 0; a < atlas_count; a++) {
+        uint32_t n = 0;
+        for (uint32_t k = 0; k < s->count; k++) {
+            const lmb_ic_record *r = &s->rec[k];
+            double lum = lmb_luminance(r->e);
+            if (r->atlas == a && lum > 0 && r->var > 0)
+                rel[n++] = sqrt(r->var) / lum;
+        }
+        qsort(rel, n, sizeof *rel, compare_double);
+        noise[a] = n ? (n % 2 ? rel[n / 2] : 0.5 * (rel[n / 2 - 1] + rel[n / 2])) : 0;
+    }
+    free(rel);
+    return LMB_OK;
+}
+
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
                               lmb_ic_records *shared, lmb_gather_stats *stats, lmb_error *err)
@@ -409,6 +437,8 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     }
     if (st == LMB_OK && pass && pass->points)
         st = export_points(&c.records, pass->points, err);
+    if (st == LMB_OK && pass && pass->noise)
+        st = records_noise(&c.records, atlas_count, pass->noise, err);
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);

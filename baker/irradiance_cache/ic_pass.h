@@ -47,6 +47,8 @@ typedef struct lmb_ic_pass_stats {
     uint64_t *records;     /* records placed in the atlas */
     uint64_t *valid;       /* valid texels of the atlas */
     lmb_ic_points *points; /* when not NULL: receives the records (previous contents freed) */
+    double *noise;         /* when not NULL: per atlas, the median relative standard error of its records'
+                              gathers, sqrt(var) / lum(e) (0 when none was estimated): post/denoise.h */
 } lmb_ic_pass_stats;
 
 /* Indirect irradiance of every listed texel of every atlas (t[a], out[a]: 3 floats per listed

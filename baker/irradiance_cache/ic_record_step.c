@@ -44,6 +44,7 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     r->r_min = c->opt->min_spacing * size;
     r->r_max = c->opt->max_spacing * size;
     r->harmonic = g->harmonic;
+    r->var = g->var;
     r->r = lmb_ic_reach(&c->records, r);
     double turn = sqrt(2.0) * c->records.normal_limit; /* |n_i x n| at the largest difference */
     for (int ch = 0; ch < 3; ch++) {
@@ -56,10 +57,10 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     r->texel = x.index;
 }
 
-/* A record's bytes in a step (farm/steps.h): its doubles p .. r (31, contiguous), atlas, texel. */
-#define RECORD_DOUBLES 31
-_Static_assert(offsetof(lmb_ic_record, r) - offsetof(lmb_ic_record, p) == (RECORD_DOUBLES - 1) * sizeof(double),
-               "lmb_ic_record: p .. r are contiguous doubles");
+/* A record's bytes in a step (farm/steps.h): its doubles p .. var (32, contiguous), atlas, texel. */
+#define RECORD_DOUBLES 32
+_Static_assert(offsetof(lmb_ic_record, var) - offsetof(lmb_ic_record, p) == (RECORD_DOUBLES - 1) * sizeof(double),
+               "lmb_ic_record: p .. var are contiguous doubles");
 
 static lmb_status put_record(lmb_buf *out, const lmb_ic_record *r, lmb_error *err)
 {

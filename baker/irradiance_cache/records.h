@@ -36,6 +36,7 @@ typedef struct lmb_ic_record {
     double harmonic;       /* harmonic mean distance of its gather rays (neighbour-clamped) */
     double r_min, r_max;   /* the reach's clamps in world units (spacing x the texel's size) */
     double r;              /* reach: clamp(error x harmonic, r_min, r_max) */
+    double var;            /* variance of lum(e) as an estimate (0: unknown): post/denoise.h's noise level */
     uint32_t atlas, texel; /* where it was gathered: atlas and listed-texel index */
     uint32_t group;        /* placement order: the level (of all rounds) that placed it */
 } lmb_ic_record;

@@ -286,6 +286,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
         double v = da->variance[i], lum = lmb_luminance_f(&shown[3 * (size_t)i]);
         if (da->t.valid[i] && v > 0)
             (*estimates)[(*estimate_count)++] = lum > 0 ? (float)(sqrt(v / (rounds[i] ? rounds[i] : 2)) / lum) : 0.0f;
+        da->variance[i] = (float)(v / (rounds[i] ? rounds[i] : 2)); /* now the estimate's own (denoise.h) */
     }
     free(rounds);
     free(first);

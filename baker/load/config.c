@@ -94,6 +94,10 @@ static const key_spec config_keys[] = {
     U32("gather.guide_stride", OFF(guide_stride), 0, 64),
     U32("gather.lobes", OFF(guide_lobes), 1, 3),
     BOOL("gather.direct_at_hits", OFF(direct_at_hits)),
+    BOOL("denoise.indirect", OFF(denoise_indirect)),
+    U32("denoise.levels", OFF(denoise_levels), 1, 8),
+    BOOL("denoise.direct", OFF(denoise_direct)),
+    FLOAT("denoise.strength", OFF(denoise_strength), 0, 100, OPEN_LO),
     FLOAT("irradiance_cache.error", OFF(ic_error), 0, 10, 0),
     FLOAT("irradiance_cache.min_spacing", OFF(ic_min_spacing), 0.5, 4096, 0),
     FLOAT("irradiance_cache.max_spacing", OFF(ic_max_spacing), 1, 4096, 0),
@@ -182,6 +186,10 @@ void lmb_config_default(lmb_config *cfg)
     cfg->adaptive = 1;
     cfg->noise_target = 0.01;
     cfg->max_rays = 4096;
+    cfg->denoise_indirect = 1;
+    cfg->denoise_levels = 4;
+    cfg->denoise_direct = 1;
+    cfg->denoise_strength = 2;
     cfg->gather_rays = 256;
     cfg->bounce_rays = 64;
     cfg->bounce_rays_high = 16; /* docs/defaults.md: no measurable loss, 15% faster */

@@ -290,6 +290,10 @@ typedef struct lmb_config {
     uint32_t guide_stride;         /* guided gathering: pilot texels every N texels (0: off) */
     uint32_t guide_lobes;          /* lobes a pilot learns (1..3) */
     int direct_at_hits;            /* final gather: direct light at each hit by shadow rays, the cache only for indirect */
+    int denoise_indirect;          /* denoise.indirect: the final gather's light through the edge-aware filter */
+    uint32_t denoise_levels;       /* denoise.levels: its a-trous passes */
+    int denoise_direct;            /* denoise.direct: the lightmap's light through it again at the direct light's noise */
+    double denoise_strength;       /* denoise.strength: luminance differences up to this many times the noise average */
     int reference;                 /* path-trace indirect light with no cache (ground truth) */
     /* irradiance cache (Ward): gathers at records, interpolation elsewhere */
     double ic_error;               /* Ward's a; 0 = a gather at every texel */
@@ -443,6 +447,8 @@ typedef struct lmb_bake_stats {
     uint64_t direct_capped; /* of those, stopped by samples.max_rays short of samples.noise */
     uint64_t records_extended; /* final gather: records that gathered more rays for samples.noise */
     uint64_t records_capped;   /* of those, stopped by samples.max_rays */
+    double indirect_noise;     /* final gather with the cache: its records' median relative standard error */
+    uint64_t denoised_texels;  /* texels the denoiser filtered, summed over its filters (indirect, then all) */
     uint64_t rim_limited;   /* partly covered texels limited to their neighbours (post/rim.c) */
     double rim_energy;      /* the direct light that removed, as a share of all direct light */
     uint64_t firefly_texels; /* fireflies spread to their neighbours (post/fireflies.c) */

@@ -1,0 +1,208 @@
+/* The edge-aware a-trous filter of an atlas's indirect light (see denoise.h). */
+#include "denoise.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* What the filter reads of a valid listed texel: where it is and how it faces. */
+typedef struct texel_guide {
+    float p[3], n[3];
+    float size;        /* world units per texel */
+    uint32_t instance;
+} texel_guide;
+
+#define LIGHT_CUT 16.0f /* the light term's cut-off, in its scale (exp(-16) = 1e-7) */
+
+static const float B3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
+
+static float luminance(const float *c)
+{
+    return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+}
+
+/* The surface part of w(p, q) (denoise.h) for texels `atlas_distance` texels apart; 0 when q
+ * is on another surface. */
+static float surface_weight(const texel_guide *gp, const texel_guide *gq, float atlas_distance, float step)
+{
+    if (gp->instance != gq->instance)
+        return 0;
+    float d[3] = {gq->p[0] - gp->p[0], gq->p[1] - gp->p[1], gq->p[2] - gp->p[2]};
+    float far = 2.0f * (atlas_distance + 1.0f) * gp->size;
+    if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > far * far)
+        return 0;
+    float plane = fabsf(d[0] * gp->n[0] + d[1] * gp->n[1] + d[2] * gp->n[2]) / (gp->size * step);
+    float cosine = gp->n[0] * gq->n[0] + gp->n[1] * gq->n[1] + gp->n[2] * gq->n[2];
+    if (cosine <= 0)
+        return 0;
+    return expf(-plane * plane) * powf(cosine, (float)LMB_DENOISE_NORMAL_POWER);
+}
+
+/*
+ * The light at the centre tap from a plane fitted to the weighted taps (weighted least squares
+ * of E = a + b u + c v; out = a, kept within the taps' range): a weighted mean is biased
+ * wherever the taps are one-sided and the light has a slope (a chart's border at a corner, the
+ * floor beside a block), a plane is not. Taps that cannot fix a plane (a line of texels) give
+ * their weighted mean.
+ */
+static void plane_fit(const double m[6], double r[3][3], const float lo[3], const float hi[3], float *out)
+{
+    /* the inverse's first row of [[m0 m1 m2] [m1 m3 m4] [m2 m4 m5]], by cofactors */
+    double c0 = m[3] * m[5] - m[4] * m[4], c1 = m[2] * m[4] - m[1] * m[5], c2 = m[1] * m[4] - m[2] * m[3];
+    double det = m[0] * c0 + m[1] * c1 + m[2] * c2;
+    int plane = det > 1e-6 * m[0] * m[0] * m[0];
+    for (int c = 0; c < 3; c++) {
+        double a = plane ? (c0 * r[c][0] + c1 * r[c][1] + c2 * r[c][2]) / det : r[c][0] / m[0];
+        out[c] = (float)(a < lo[c] ? lo[c] : a > hi[c] ? hi[c] : a);
+    }
+}
+
+/* One a-trous pass with taps `step` texels apart: out from in, over the valid listed texels. */
+static void atrous_pass(const lmb_texels *t, const int64_t *listed, const texel_guide *g, const float *in, float *out,
+                        uint32_t step, double light_scale, const float *variance, int threads)
+{
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 256)
+    for (uint32_t i = 0; i < t->count; i++) {
+        const float *cp = in + 3 * (size_t)i;
+        float *o = out + 3 * (size_t)i;
+        if (!t->valid[i]) {
+            memcpy(o, cp, 3 * sizeof *o);
+            continue;
+        }
+        long x = (long)(t->texel[i] % t->width), y = (long)(t->texel[i] / t->width);
+        float lp = luminance(cp);
+        /* weighted moments for the local plane fit: m[0..5] = sum w (1, u, v, uu, uv, vv),
+         * r[c] = sum w E_c (1, u, v), u and v the tap's offset in taps */
+        double m[6] = {0, 0, 0, 0, 0, 0}, r[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+        float lo[3] = {cp[0], cp[1], cp[2]}, hi[3] = {cp[0], cp[1], cp[2]};
+        for (int ky = 0; ky < 5; ky++) {
+            long yy = y + (long)(ky - 2) * step;
+            if (yy < 0 || yy >= (long)t->height)
+                continue;
+            for (int kx = 0; kx < 5; kx++) {
+                long xx = x + (long)(kx - 2) * step;
+                if (xx < 0 || xx >= (long)t->width)
+                    continue;
+                int64_t j = listed[(size_t)yy * t->width + (size_t)xx];
+                if (j < 0 || !t->valid[j])
+                    continue;
+                const float *cq = in + 3 * (size_t)j;
+                float w = B3[kx] * B3[ky];
+                if (j != (int64_t)i) {
+                    float dx = (float)(kx - 2) * step, dy = (float)(ky - 2) * step;
+                    w *= surface_weight(&g[i], &g[j], sqrtf(dx * dx + dy * dy), (float)step);
+                    float lq = luminance(cq);
+                    float scale = variance ? (float)light_scale * sqrtf(variance[i] + variance[j])
+                                           : (float)(light_scale * 0.5 * (lp + lq));
+                    if (w > 0 && lp != lq) { /* past LIGHT_CUT the weight is 0, not 1e-7: dark stays dark */
+                        float z = scale > 0 ? fabsf(lp - lq) / scale : LIGHT_CUT;
+                        w *= z < LIGHT_CUT ? expf(-z) : 0.0f;
+                    }
+                }
+                if (w <= 0)
+                    continue;
+                double u = kx - 2, v = ky - 2;
+                m[0] += w, m[1] += w * u, m[2] += w * v, m[3] += w * u * u, m[4] += w * u * v, m[5] += w * v * v;
+                for (int c = 0; c < 3; c++) {
+                    r[c][0] += (double)w * cq[c], r[c][1] += (double)w * cq[c] * u, r[c][2] += (double)w * cq[c] * v;
+                    lo[c] = cq[c] < lo[c] ? cq[c] : lo[c];
+                    hi[c] = cq[c] > hi[c] ? cq[c] : hi[c];
+                }
+            }
+        }
+        plane_fit(m, r, lo, hi, o);
+    }
+}
+
+/* Each valid texel's variance averaged over the valid texels of its 3 x 3 neighbourhood on
+ * the same instance (SVGF's prefilter, Schied et al. 2017 sec. 4.3): a variance estimated
+ * from a texel's two rounds alone is itself noisy, and 0 by chance would pin the texel. */
+static void smooth_variance(const lmb_texels *t, const int64_t *listed, const texel_guide *g, const float *variance,
+                            float *out, int threads)
+{
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
+    for (uint32_t i = 0; i < t->count; i++) {
+        out[i] = variance[i];
+        if (!t->valid[i])
+            continue;
+        long x = (long)(t->texel[i] % t->width), y = (long)(t->texel[i] / t->width);
+        double sum = 0;
+        int n = 0;
+        for (long yy = y - 1; yy <= y + 1; yy++)
+            for (long xx = x - 1; xx <= x + 1; xx++) {
+                if (xx < 0 || yy < 0 || xx >= (long)t->width || yy >= (long)t->height)
+                    continue;
+                int64_t j = listed[(size_t)yy * t->width + (size_t)xx];
+                if (j >= 0 && t->valid[j] && g[j].instance == g[i].instance) {
+                    sum += variance[j];
+                    n++;
+                }
+            }
+        out[i] = (float)(sum / n);
+    }
+}
+
+lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_options *opt,
+                             lmb_denoise_stats *stats, lmb_error *err)
+{
+    if (opt->levels < 1 || opt->levels > 8 || !(opt->variance || opt->noise > 0) || !(opt->sigma_light > 0))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: levels %u, noise %g, sigma %g out of range", opt->levels,
+                             opt->noise, opt->sigma_light);
+    size_t n = (size_t)t->width * t->height, m = 3 * (size_t)t->count;
+    int64_t *listed = malloc((n + 1) * sizeof *listed); /* atlas texel -> listed index, or -1 */
+    texel_guide *g = malloc(((size_t)t->count + 1) * sizeof *g);
+    float *work = malloc((m + 1) * sizeof *work);
+    float *variance = opt->variance ? malloc(((size_t)t->count + 1) * sizeof *variance) : NULL;
+    if (!listed || !g || !work || (opt->variance && !variance)) {
+        free(listed);
+        free(g);
+        free(work);
+        free(variance);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for a %ux%u atlas", t->width, t->height);
+    }
+    for (size_t k = 0; k < n; k++)
+        listed[k] = -1;
+    int threads = opt->threads > 0 ? opt->threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
+    for (uint32_t i = 0; i < t->count; i++) {
+        listed[t->texel[i]] = i;
+        memset(&g[i], 0, sizeof g[i]);
+        if (!t->valid[i])
+            continue;
+        lmb_gather_point gp;
+        lmb_texels_point(t, i, 0, &gp);
+        for (int k = 0; k < 3; k++) {
+            g[i].p[k] = (float)gp.p[k];
+            g[i].n[k] = gp.n[k];
+        }
+        g[i].size = t->texel_size[i];
+        g[i].instance = gp.instance;
+    }
+    double light_scale = opt->variance ? opt->sigma_light : opt->sigma_light * opt->noise;
+    if (variance)
+        smooth_variance(t, listed, g, opt->variance, variance, threads);
+    for (uint32_t i = 0; i < t->count; i++)
+        if (t->valid[i]) {
+            stats->texels++;
+            stats->before += luminance(rgb + 3 * (size_t)i);
+        }
+    /* passes alternate between rgb and work; an odd count ends in work and is copied back */
+    float *from = rgb, *to = work;
+    for (uint32_t level = 0; level < opt->levels; level++) {
+        atrous_pass(t, listed, g, from, to, 1u << level, light_scale, variance, threads);
+        float *swap = from;
+        from = to;
+        to = swap;
+    }
+    if (from != rgb)
+        memcpy(rgb, from, m * sizeof *rgb);
+    for (uint32_t i = 0; i < t->count; i++)
+        if (t->valid[i])
+            stats->after += luminance(rgb + 3 * (size_t)i);
+    free(listed);
+    free(g);
+    free(work);
+    free(variance);
+    return LMB_OK;
+}
