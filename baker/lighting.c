@@ -134,7 +134,7 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
     lmb_status st = LMB_OK;
     for (uint32_t a = 0; a < env->cache->atlas_count && st == LMB_OK; a++) {
         atlas_work *w = &env->w[a];
-        double level = noise ? *noise : w->gather_noise;
+        double level = noise ? *noise : LMB_DENOISE_TEXEL_SHARE * w->gather_noise;
         most = level > most ? level : most;
         if (!(level > 0))
             continue;

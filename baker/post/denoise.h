@@ -37,6 +37,8 @@
 #include "texels/texels.h"
 
 #define LMB_DENOISE_NORMAL_POWER 64.0
+/* a texel's noise in the interpolated light, as a share of its records' median estimate */
+#define LMB_DENOISE_TEXEL_SHARE 0.25
 /* passes for the direct light's noise, which is white (a texel's own samples): 5 x 5 at 1 */
 #ifndef LMB_DENOISE_DIRECT_LEVELS
 #define LMB_DENOISE_DIRECT_LEVELS 2
