@@ -291,7 +291,7 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
             stats->indirect_noise = env->w[a].gather_noise;
     if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference)
         st = denoise_light(env, offsetof(atlas_work, result), NULL, 0, env->cfg->denoise_levels,
-                           "the final gather's light (its records' median noise)", err);
+                           "the final gather's light (a quarter of its records' median noise)", err);
     if (st == LMB_OK && add_direct && !job->reference) /* the final gather: the light shown is known */
         st = refine_direct(env, 0, err);
     /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */

@@ -13,6 +13,7 @@ typedef struct texel_guide {
     uint32_t instance;
 } texel_guide;
 
+#define NOT_LISTED UINT32_MAX
 #define LIGHT_CUT 16.0f /* the light term's cut-off, in its scale (exp(-16) = 1e-7) */
 
 static const float B3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
@@ -59,7 +60,7 @@ static void plane_fit(const double m[6], double r[3][3], const float lo[3], cons
 }
 
 /* One a-trous pass with taps `step` texels apart: out from in, over the valid listed texels. */
-static void atrous_pass(const lmb_texels *t, const int64_t *listed, const texel_guide *g, const float *in, float *out,
+static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel_guide *g, const float *in, float *out,
                         uint32_t step, double light_scale, const float *variance, int threads)
 {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256)
@@ -84,12 +85,12 @@ static void atrous_pass(const lmb_texels *t, const int64_t *listed, const texel_
                 long xx = x + (long)(kx - 2) * step;
                 if (xx < 0 || xx >= (long)t->width)
                     continue;
-                int64_t j = listed[(size_t)yy * t->width + (size_t)xx];
-                if (j < 0 || !t->valid[j])
+                uint32_t j = listed[(size_t)yy * t->width + (size_t)xx];
+                if (j == NOT_LISTED || !t->valid[j])
                     continue;
                 const float *cq = in + 3 * (size_t)j;
                 float w = B3[kx] * B3[ky];
-                if (j != (int64_t)i) {
+                if (j != i) {
                     float dx = (float)(kx - 2) * step, dy = (float)(ky - 2) * step;
                     w *= surface_weight(&g[i], &g[j], sqrtf(dx * dx + dy * dy), (float)step);
                     float lq = luminance(cq);
@@ -118,7 +119,7 @@ static void atrous_pass(const lmb_texels *t, const int64_t *listed, const texel_
 /* Each valid texel's variance averaged over the valid texels of its 3 x 3 neighbourhood on
  * the same instance (SVGF's prefilter, Schied et al. 2017 sec. 4.3): a variance estimated
  * from a texel's two rounds alone is itself noisy, and 0 by chance would pin the texel. */
-static void smooth_variance(const lmb_texels *t, const int64_t *listed, const texel_guide *g, const float *variance,
+static void smooth_variance(const lmb_texels *t, const uint32_t *listed, const texel_guide *g, const float *variance,
                             float *out, int threads)
 {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
@@ -133,8 +134,8 @@ static void smooth_variance(const lmb_texels *t, const int64_t *listed, const te
             for (long xx = x - 1; xx <= x + 1; xx++) {
                 if (xx < 0 || yy < 0 || xx >= (long)t->width || yy >= (long)t->height)
                     continue;
-                int64_t j = listed[(size_t)yy * t->width + (size_t)xx];
-                if (j >= 0 && t->valid[j] && g[j].instance == g[i].instance) {
+                uint32_t j = listed[(size_t)yy * t->width + (size_t)xx];
+                if (j != NOT_LISTED && t->valid[j] && g[j].instance == g[i].instance) {
                     sum += variance[j];
                     n++;
                 }
@@ -150,7 +151,7 @@ lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_
         return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: levels %u, noise %g, sigma %g out of range", opt->levels,
                              opt->noise, opt->sigma_light);
     size_t n = (size_t)t->width * t->height, m = 3 * (size_t)t->count;
-    int64_t *listed = malloc((n + 1) * sizeof *listed); /* atlas texel -> listed index, or -1 */
+    uint32_t *listed = malloc((n + 1) * sizeof *listed); /* atlas texel -> listed index, or NOT_LISTED */
     texel_guide *g = malloc(((size_t)t->count + 1) * sizeof *g);
     float *work = malloc((m + 1) * sizeof *work);
     float *variance = opt->variance ? malloc(((size_t)t->count + 1) * sizeof *variance) : NULL;
@@ -162,7 +163,7 @@ lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_
         return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for a %ux%u atlas", t->width, t->height);
     }
     for (size_t k = 0; k < n; k++)
-        listed[k] = -1;
+        listed[k] = NOT_LISTED;
     int threads = opt->threads > 0 ? opt->threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
     for (uint32_t i = 0; i < t->count; i++) {
