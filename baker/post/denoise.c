@@ -1,6 +1,8 @@
 /* The edge-aware a-trous filter of an atlas's indirect light (see denoise.h). */
 #include "denoise.h"
 
+#include "util/lmb_math.h"
+
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -17,11 +19,6 @@ typedef struct texel_guide {
 #define LIGHT_CUT 16.0f /* the light term's cut-off, in its scale (exp(-16) = 1e-7) */
 
 static const float B3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
-
-static float luminance(const float *c)
-{
-    return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
-}
 
 /* The surface part of w(p, q) (denoise.h) for texels `atlas_distance` texels apart; 0 when q
  * is on another surface. */
@@ -72,7 +69,7 @@ static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel
             continue;
         }
         long x = (long)(t->texel[i] % t->width), y = (long)(t->texel[i] / t->width);
-        float lp = luminance(cp);
+        float lp = (float)lmb_luminance_f(cp);
         /* weighted moments for the local plane fit: m[0..5] = sum w (1, u, v, uu, uv, vv),
          * r[c] = sum w E_c (1, u, v), u and v the tap's offset in taps */
         double m[6] = {0, 0, 0, 0, 0, 0}, r[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
@@ -93,7 +90,7 @@ static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel
                 if (j != i) {
                     float dx = (float)(kx - 2) * step, dy = (float)(ky - 2) * step;
                     w *= surface_weight(&g[i], &g[j], sqrtf(dx * dx + dy * dy), (float)step);
-                    float lq = luminance(cq);
+                    float lq = (float)lmb_luminance_f(cq);
                     float scale = variance ? (float)light_scale * sqrtf(variance[i] + variance[j])
                                            : (float)(light_scale * 0.5 * (lp + lq));
                     if (w > 0 && lp != lq) { /* past LIGHT_CUT the weight is 0, not 1e-7: dark stays dark */
@@ -186,7 +183,7 @@ lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_
     for (uint32_t i = 0; i < t->count; i++)
         if (t->valid[i]) {
             stats->texels++;
-            stats->before += luminance(rgb + 3 * (size_t)i);
+            stats->before += lmb_luminance_f(rgb + 3 * (size_t)i);
         }
     /* passes alternate between rgb and work; an odd count ends in work and is copied back */
     float *from = rgb, *to = work;
@@ -200,7 +197,7 @@ lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_
         memcpy(rgb, from, m * sizeof *rgb);
     for (uint32_t i = 0; i < t->count; i++)
         if (t->valid[i])
-            stats->after += luminance(rgb + 3 * (size_t)i);
+            stats->after += lmb_luminance_f(rgb + 3 * (size_t)i);
     free(listed);
     free(g);
     free(work);
