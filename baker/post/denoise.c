@@ -1,4 +1,4 @@
-/* The edge-aware a-trous filter of an atlas's indirect light (see denoise.h). */
+/* The edge-aware a-trous filter of an atlas's baked light (see denoise.h). */
 #include "denoise.h"
 
 #include "util/lmb_math.h"

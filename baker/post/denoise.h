@@ -1,5 +1,6 @@
 /*
- * The denoiser: an edge-aware a-trous filter of one atlas's indirect light, in lightmap space.
+ * The denoiser: an edge-aware a-trous filter of one atlas's light, in lightmap space: the final
+ * gather's light, then all of it with the direct light's own variances (lighting.c).
  *
  * The final gather's noise sits in the irradiance cache's records: each record's error is
  * copied to every texel it serves, so it is correlated over a record's reach (4 to 8 texels)
