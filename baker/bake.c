@@ -324,7 +324,7 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err)
 {
-    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0};
+    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, 0};
     return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
 }
 
@@ -335,9 +335,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_bake_stats unused;
     if (!stats)
         stats = &unused;
-    int shard = run->mode == LMB_FARM_STEP, writes = !shard;
+    int worker = run->mode == LMB_FARM_WORKER, finishes = worker && outdir && run->worker == 0;
+    int shard = run->mode == LMB_FARM_STEP || (worker && !finishes), writes = !shard;
     if (run->mode != LMB_FARM_LOCAL && !plan_path)
-        return lmb_error_set(err, LMB_ERR_USAGE, "a farm step or finish needs the plan ('lmbake plan')");
+        return lmb_error_set(err, LMB_ERR_USAGE, "a farm step, worker or finish needs the plan ('lmbake plan')");
     if (shard && (run->shards == 0 || run->shard >= run->shards))
         return lmb_error_set(err, LMB_ERR_USAGE, "shard %u of %u: out of range", run->shard + 1, run->shards);
     run->ended = 0;
@@ -385,7 +386,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
                                                                                                    : LMB_STEPS_LOCAL;
-    if (st == LMB_OK)
+    lmb_steps_worker sw = {run->shards, run->worker, run->workers, finishes, run->tail_threads, run->wait_timeout};
+    if (st == LMB_OK && worker)
+        st = lmb_steps_create_worker(run->farm_dir, &id, &sw, (double)cfg->farm_min_step_rays, log, &steps, err);
+    else if (st == LMB_OK)
         st = lmb_steps_create(mode, run->farm_dir, &id, run->step, run->shard, run->shards,
                               (double)cfg->farm_min_step_rays, log, &steps, err);
     double tl = lmb_seconds();
@@ -394,6 +398,12 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
                  "lightmaps are black", s->path);
     if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
+    if (st == LMB_OK && worker)
+        st = lmb_steps_worker_end(steps, err);
+    if (worker && !finishes) {
+        run->steps = lmb_steps_count(steps);
+        goto done;
+    }
     if (shard) { /* the shard's part is written (stopped), or the bake ended before its step */
         if (st == LMB_OK) {
             st = lmb_steps_write_end(steps, err);

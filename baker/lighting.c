@@ -82,6 +82,11 @@ typedef struct pass_env {
     lmb_bake_stats *stats;
     lmb_ic_points *points; /* set during the final gather only: where its records go */
     lmb_ic_records *shared; /* irradiance_cache.records: shared: the records passed on; else NULL */
+    /* The denoiser runs after the final gather's last step unless a directions step follows
+     * (it reads the denoised light): a farm process whose light is not used then skips it
+     * (tail_skip), and the one that writes the bake may use the threads the others freed. */
+    int tail_skip;
+    uint32_t tail_threads;
 } pass_env;
 
 /* The pass's gather through the irradiance cache, every atlas at once (records are shared
@@ -142,7 +147,7 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
         if (own_variance && !w->variance)
             continue;
         lmb_denoise_options opt = {levels, level, own_variance ? w->variance : NULL, cfg->denoise_strength,
-                                   (int)cfg->threads};
+                                   (int)env->tail_threads};
         st = lmb_denoise_atlas(&w->t, light, &opt, &ds, err);
     }
     env->stats->denoised_texels += ds.texels;
@@ -289,18 +294,21 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
     for (uint32_t a = 0; add_direct && through_cache && a < cache->atlas_count; a++)
         if (env->w[a].gather_noise > stats->indirect_noise)
             stats->indirect_noise = env->w[a].gather_noise;
-    if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference)
+    /* the final gather: the light shown is known (the direct light's refinement, a step, goes
+     * first: after it no step reads the light unless directions follow; see pass_env) */
+    if (st == LMB_OK && add_direct && !job->reference)
+        st = refine_direct(env, 0, err);
+    if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference && !env->tail_skip)
         st = denoise_light(env, offsetof(atlas_work, result), NULL, 0, env->cfg->denoise_levels,
                            "the final gather's light (a quarter of its records' median noise)", err);
-    if (st == LMB_OK && add_direct && !job->reference) /* the final gather: the light shown is known */
-        st = refine_direct(env, 0, err);
     /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */
     for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++)
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
             float v = w[a].result[k] + w[a].direct[k] - (w[a].deferred ? w[a].deferred[k] : 0.0f);
             w[a].result[k] = v > 0 ? v : 0.0f;
         }
-    if (st == LMB_OK && add_direct && !job->reference && env->cfg->denoise_direct && stats->direct_noise_median > 0)
+    if (st == LMB_OK && add_direct && !job->reference && env->cfg->denoise_direct && stats->direct_noise_median > 0 &&
+        !env->tail_skip)
         st = denoise_light(env, offsetof(atlas_work, result), &stats->direct_noise_median, 1, LMB_DENOISE_DIRECT_LEVELS,
                            "the light with its direct part (each texel's direct light's own variance)", err);
     if (st == LMB_OK && store)
@@ -555,7 +563,12 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.steps = steps;
     lmb_ic_records shared;
     lmb_ic_records_init(&shared, cfg->ic_error > 0 ? cfg->ic_error : 1);
-    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL};
+    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL,
+                    0, cfg->threads};
+    if (!cfg->directional) { /* the final gather's steps are the bake's last */
+        env.tail_skip = lmb_steps_light_unused(steps);
+        env.tail_threads = lmb_steps_tail_threads(steps, cfg->threads);
+    }
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);
     stats->no_light = dark;

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The farm on a real Slurm (issue 13): starts a single-node Slurm on this machine (Debian's
-# slurm-wlm: munged, slurmctld and slurmd on localhost, in a private folder), bakes bevy's
-# Cornell box through the script `lmbake farm slurm` writes (a job array per step chained
-# with --dependency=afterok, a merge job between them), and checks that the output equals
+# The farm on a real Slurm: starts a single-node Slurm on this machine (Debian's slurm-wlm:
+# munged, slurmctld and slurmd on localhost, in a private folder), bakes bevy's Cornell box
+# through the script `lmbake farm slurm` writes, and checks that the output equals
 # `lmbake bake` byte for byte. Then stops the daemons. Not part of .ci/run (it starts system
 # daemons and takes a few minutes); run it as root on a machine without a Slurm of its own.
-#   usage: tools/slurm-test.sh [SHARDS] [SCENE] [CONFIG]      (default: 4, bevy's Cornell box, a small config)
+# The bake runs as one Slurm job of WORKERS tasks (srun starts them together; default: the
+# machine's cores), after a plan job; its wall time is printed against `lmbake bake`'s.
+#   usage: tools/slurm-test.sh [SHARDS] [SCENE] [CONFIG] [WORKERS]  (default: 4, bevy's Cornell box, a small config)
 # docs/farm.md says how to start such a Slurm by hand.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -82,10 +83,13 @@ done
 echo "slurm: $(sinfo -h -o '%P %D node(s) %c cpus %T' | head -1) (slurm-wlm $(slurmctld -V | awk '{print $2}'))"
 
 # --- the bake, on one machine and through Slurm ----------------------------------------------
-"$lmbake" bake "$scene" -c "$config" -o "$work/bake" -q --threads 2
+workers=${4:-$cpus}
+tb=$(date +%s.%N)
+"$lmbake" bake "$scene" -c "$config" -o "$work/bake" -q --threads "$workers"
+bake_s=$(echo "$(date +%s.%N) - $tb" | bc)
 farm=$work/farm
 t0=$(date +%s.%N)
-"$lmbake" farm slurm "$scene" -c "$config" --farm "$farm" -o "$work/out" --shards "$shards" --threads 1
+"$lmbake" farm slurm "$scene" -c "$config" --farm "$farm" -o "$work/out" --shards "$shards" --workers "$workers" --threads 1
 for _ in $(seq 1 1800); do
   [ -f "$farm/finished" ] || [ -f "$farm/failed" ] && break
   sleep 1
@@ -97,9 +101,10 @@ if [ ! -f "$farm/finished" ]; then
   exit 1
 fi
 steps=$(cat "$farm/end")
-arrays=$(ls "$farm"/logs/step-*-1.out 2>/dev/null | wc -l)
-merges=$(ls "$farm"/logs/merge-*.out | wc -l)
-echo "slurm bake: $steps steps, $arrays job arrays of $shards tasks, $merges merge jobs, plan and finish jobs: $(printf '%.1f' "$(echo "$t1 - $t0" | bc)") s"
+slurm_s=$(echo "$t1 - $t0" | bc)
+echo "slurm bake: $steps steps in $shards shards, a plan job and a job of $workers worker tasks x 1 thread:" \
+  "$(printf '%.1f' "$slurm_s") s (submission to DIR/finished); lmbake bake --threads $workers: $(printf '%.1f' "$bake_s") s;" \
+  "ratio $(printf '%.2f' "$(echo "$slurm_s / $bake_s" | bc -l)")"
 differ=0
 n=0
 for f in "$work/bake"/*; do

@@ -51,7 +51,21 @@ typedef struct bake_args {
     int quiet, reference, preview, print_config;
     long long step;               /* -1: not given */
     unsigned long long shard, shards; /* --shard K/N (K 1-based), --shards N */
+    unsigned long long worker, workers, tail_threads, wait_timeout; /* --worker W/J (W 1-based), ... */
+    int outdir_given;
 } bake_args;
+
+/* "K/N" with 1 <= K <= N <= 100000 into *k, *n; 0 on junk. */
+static int parse_fraction(const char *v, unsigned long long *k, unsigned long long *n)
+{
+    char head[32];
+    const char *slash = v ? strchr(v, '/') : NULL;
+    if (!slash || (size_t)(slash - v) >= sizeof head)
+        return 0;
+    memcpy(head, v, (size_t)(slash - v));
+    head[slash - v] = 0;
+    return cli_parse_uint(head, 100000, k) && cli_parse_uint(slash + 1, 100000, n) && *k >= 1 && *k <= *n;
+}
 
 static int parse_args(int argc, char **argv, bake_args *a)
 {
@@ -73,6 +87,7 @@ static int parse_args(int argc, char **argv, bake_args *a)
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
             a->outdir = v;
+            a->outdir_given = 1;
         } else if ((r = cli_opt_value(argc, argv, &i, "--threads", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 1024, &n))
                 return cli_usage_error("bake", "--threads needs a number 0..1024");
@@ -110,15 +125,17 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 return cli_usage_error("bake", "--step needs a number 0..1000000");
             a->step = (long long)n;
         } else if ((r = cli_opt_value(argc, argv, &i, "--shard", NULL, &v)) != 0) {
-            char k[32];
-            const char *slash = r > 0 ? strchr(v, '/') : NULL;
-            if (slash && (size_t)(slash - v) < sizeof k) {
-                memcpy(k, v, (size_t)(slash - v));
-                k[slash - v] = 0;
-            }
-            if (!slash || (size_t)(slash - v) >= sizeof k || !cli_parse_uint(k, 100000, &a->shard) ||
-                !cli_parse_uint(slash + 1, 100000, &a->shards) || a->shard < 1 || a->shard > a->shards)
+            if (r < 0 || !parse_fraction(v, &a->shard, &a->shards))
                 return cli_usage_error("bake", "--shard needs K/N with 1 <= K <= N <= 100000, e.g. 2/4");
+        } else if ((r = cli_opt_value(argc, argv, &i, "--worker", NULL, &v)) != 0) {
+            if (r < 0 || !parse_fraction(v, &a->worker, &a->workers))
+                return cli_usage_error("worker", "--worker needs W/J with 1 <= W <= J <= 100000, e.g. 1/2");
+        } else if ((r = cli_opt_value(argc, argv, &i, "--tail-threads", NULL, &v)) != 0) {
+            if (r < 0 || !cli_parse_uint(v, 1024, &a->tail_threads))
+                return cli_usage_error("worker", "--tail-threads needs a number 0..1024");
+        } else if ((r = cli_opt_value(argc, argv, &i, "--wait-timeout", NULL, &v)) != 0) {
+            if (r < 0 || !cli_parse_uint(v, 100000000, &a->wait_timeout))
+                return cli_usage_error("worker", "--wait-timeout needs seconds 0..100000000 (0: wait for ever)");
         } else if ((r = cli_opt_value(argc, argv, &i, "--shards", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 100000, &a->shards) || a->shards < 1)
                 return cli_usage_error("bake", "--shards needs a number 1..100000");
@@ -210,7 +227,28 @@ static const char finish_help[] =
     "\n"
     "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
 
-typedef enum stage_kind { STAGE_BAKE, STAGE_PLAN, STAGE_STEP, STAGE_MERGE, STAGE_FINISH } stage_kind;
+static const char worker_help[] =
+    "usage: lmbake worker SCENE [-c CONFIG] --farm DIR --shards N [--worker W/J] [-o OUTDIR] [options]\n"
+    "\n"
+    "A worker of the staged bake in DIR (made by 'lmbake plan --farm DIR') that lives for the\n"
+    "whole bake: J workers run at once, one per machine (or per core group); at every step,\n"
+    "worker W computes shards W, W+J, W+2J, ... of N and writes their parts, waits until every\n"
+    "part of the step is in DIR, merges them into the step's state and goes on. Worker 1 with\n"
+    "-o writes OUTDIR at the end, byte for byte as 'lmbake bake' does. A worker that dies can\n"
+    "be started again: it reads the merged steps and carries on where the bake is.\n"
+    "\n"
+    "  --worker W/J         this worker of J (default 1/1); J <= N\n"
+    "  -o, --output DIR     worker 1 writes the bake there after the last step (the other\n"
+    "                       workers ignore it: one command line serves them all)\n"
+    "  --tail-threads T     worker 1's threads after the last step, when the others are done\n"
+    "                       (default: --threads)\n"
+    "  --wait-timeout S     fail when another worker's part is S seconds late (default 0: wait;\n"
+    "                       a worker says every minute which part it waits for)\n"
+    "  --threads T, -q      as for 'lmbake bake'\n"
+    "\n"
+    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
+
+typedef enum stage_kind { STAGE_BAKE, STAGE_PLAN, STAGE_STEP, STAGE_MERGE, STAGE_FINISH, STAGE_WORKER } stage_kind;
 
 static int run(int argc, char **argv, stage_kind stage);
 
@@ -249,12 +287,27 @@ int cmd_finish(int argc, char **argv)
     return with_help(argc, argv, finish_help, STAGE_FINISH);
 }
 
+int cmd_worker(int argc, char **argv)
+{
+    return with_help(argc, argv, worker_help, STAGE_WORKER);
+}
+
 /* The farm stages' checks of their options; returns 0 when fine. */
 static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, size_t size)
 {
-    static const char *const names[] = {"bake", "plan", "step", "merge", "finish"};
+    static const char *const names[] = {"bake", "plan", "step", "merge", "finish", "worker"};
     const char *name = names[stage];
-    int farm_stage = stage == STAGE_STEP || stage == STAGE_MERGE || stage == STAGE_FINISH;
+    int farm_stage = stage == STAGE_STEP || stage == STAGE_MERGE || stage == STAGE_FINISH || stage == STAGE_WORKER;
+    if (stage != STAGE_WORKER && (a->worker || a->tail_threads || a->wait_timeout))
+        return cli_usage_error(name, "--worker, --tail-threads and --wait-timeout are options of 'lmbake worker'");
+    if (stage == STAGE_WORKER && (a->step >= 0 || a->shard || !a->shards))
+        return cli_usage_error(name, "a worker takes --shards N (and --worker W/J), not --step or --shard");
+    if (stage == STAGE_WORKER && !a->worker)
+        a->worker = a->workers = 1;
+    if (stage == STAGE_WORKER && a->workers > a->shards)
+        return cli_usage_error(name, "--worker %llu/%llu: at most as many workers as shards (%llu)", a->worker,
+                               a->workers, a->shards);
+
     if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config))
         return cli_usage_error(name, "--plan, --reference and --print-config are 'lmbake bake' options");
     if (stage != STAGE_BAKE && stage != STAGE_FINISH && a->preview)
@@ -367,16 +420,28 @@ static int run(int argc, char **argv, stage_kind stage)
                    (unsigned long long)mr.items);
         return LMB_OK;
     }
-    lmb_farm_run fr = {stage == STAGE_STEP ? LMB_FARM_STEP : stage == STAGE_FINISH ? LMB_FARM_FINISH : LMB_FARM_LOCAL,
+    lmb_farm_run fr = {stage == STAGE_STEP     ? LMB_FARM_STEP
+                       : stage == STAGE_FINISH ? LMB_FARM_FINISH
+                       : stage == STAGE_WORKER ? LMB_FARM_WORKER
+                                               : LMB_FARM_LOCAL,
                        a.farm, (uint32_t)(a.step > 0 ? a.step : 0), (uint32_t)(a.shard ? a.shard - 1 : 0),
-                       (uint32_t)(a.shards ? a.shards : 1), 0, 0};
+                       (uint32_t)(a.shards ? a.shards : 1), 0, 0,
+                       (uint32_t)(a.worker ? a.worker - 1 : 0), (uint32_t)(a.workers ? a.workers : 1),
+                       (uint32_t)a.tail_threads, (double)a.wait_timeout};
+    int writes_bake = stage != STAGE_STEP && (stage != STAGE_WORKER || (a.outdir_given && a.worker == 1));
     lmb_bake_stats bs;
     double ts = cli_now();
-    lmb_status rc = lmb_bake_farm(scene, &cfg, a.farm ? plan_path : a.plan, &fr, a.outdir, cli_progress_update,
+    lmb_status rc = lmb_bake_farm(scene, &cfg, a.farm ? plan_path : a.plan, &fr, writes_bake ? a.outdir : NULL,
+                                  cli_progress_update,
                                   &progress, &bs, &log, &err);
     lmb_scene_free(scene);
     if (rc != LMB_OK)
         return cli_fail(&err);
+    if (!writes_bake && stage == STAGE_WORKER) {
+        if (!a.quiet)
+            printf("worker %llu/%llu: %u steps, %.2f s\n", a.worker, a.workers, fr.steps, cli_now() - ts);
+        return LMB_OK;
+    }
     if (stage == STAGE_STEP) {
         if (!a.quiet && fr.ended)
             printf("step %lld: the bake has %u steps: nothing to do (an end part was written)\n", a.step, fr.steps);

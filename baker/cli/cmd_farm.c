@@ -1,18 +1,18 @@
 /*
  * `lmbake farm parallel|slurm SCENE [-c CONFIG] --farm DIR -o OUTDIR --shards N`: drivers for
  * schedulers a studio already has (docs/farm.md). Each writes a bash script into the farm
- * folder that runs the staged bake (plan, then per step N shards and a merge, then finish)
- * through that scheduler; lmbake schedules nothing itself.
- *   parallel: DIR/parallel.sh, run at once (unless --script-only): GNU parallel runs each
- *             step's missing shards on local cores or on ssh hosts (--sshloginfile), then the
- *             merge; rerunning it resumes where it stopped (merged steps, finished parts kept).
- *   slurm:    DIR/slurm.sh, submitted at once (unless --script-only): a plan job, then per step
- *             a job array (--array=1-N, --dependency=afterok:<previous merge>) and a merge job
- *             (afterok:<array>). The number of steps is known only as the bake runs (bounces:
- *             auto, irradiance-cache rounds), so each merge job submits the next step's array
- *             and merge, or the finish job after the last step. A failed shard cancels the
- *             jobs after it; submitting the script again resumes (merged steps and finished
- *             parts are kept; the jobs for them exit at once).
+ * folder that runs the staged bake through that scheduler; lmbake schedules nothing itself.
+ * The bake runs as J workers (lmbake worker) that live for the whole bake: the plan, then all
+ * J at once, each running its shards of every step and merging each step from the parts in
+ * DIR; worker 1 writes OUTDIR after the last step.
+ *   parallel: DIR/parallel.sh, run at once (unless --script-only): the plan, then GNU parallel
+ *             runs the J workers on local cores or on ssh hosts (--sshloginfile); one that
+ *             fails stops the others, and rerunning the script resumes from the merged steps.
+ *   slurm:    DIR/slurm.sh, submitted at once (unless --script-only): a plan job, then one job
+ *             of J tasks (--ntasks, srun: Slurm starts them together) after it; DIR/finished or
+ *             DIR/failed says how it ended. Submitting the script again resumes.
+ * J workers must run at the same time (each waits for the others' parts): --workers J is
+ * at most N, and on ssh hosts or Slurm they need J slots at once.
  * Every path in the scripts is absolute: on a farm DIR must be a folder every node sees at the
  * same path, and so must SCENE, CONFIG and the lmbake binary.
  */
@@ -35,20 +35,23 @@ static const char help[] =
     "       lmbake farm slurm    SCENE [-c CONFIG] --farm DIR -o OUTDIR --shards N [options]\n"
     "\n"
     "Bakes SCENE in N shards per step through an existing scheduler, into the same files\n"
-    "'lmbake bake' writes, byte for byte. DIR is the shared folder (plan, parts, merged steps,\n"
-    "logs); every machine must see it, SCENE, CONFIG and lmbake at the same paths.\n"
+    "'lmbake bake' writes, byte for byte. J workers ('lmbake worker') run at once for the\n"
+    "whole bake, each computing its shards of every step; DIR is the shared folder (plan,\n"
+    "parts, merged steps, logs); every machine must see it, SCENE, CONFIG and lmbake at the\n"
+    "same paths.\n"
     "\n"
-    "  parallel   writes DIR/parallel.sh and runs it: GNU parallel runs each step's shards\n"
-    "             on this machine's cores or on ssh hosts; rerun it to resume after a failure\n"
-    "  slurm      writes DIR/slurm.sh and submits it: per step a job array and a merge job\n"
-    "             chained with --dependency=afterok; DIR/finished appears when OUTDIR is done\n"
+    "  parallel   writes DIR/parallel.sh and runs it: the plan, then GNU parallel runs the\n"
+    "             workers on this machine's cores or on ssh hosts; rerun it to resume\n"
+    "  slurm      writes DIR/slurm.sh and submits it: a plan job, then one job of J tasks\n"
+    "             (srun); DIR/finished (or DIR/failed) appears when OUTDIR is done\n"
     "\n"
     "  -c, --config FILE     bake config, as for 'lmbake bake'\n"
     "      --farm DIR        the shared folder (created)\n"
     "  -o, --output DIR      where the finish stage writes the bake\n"
     "      --shards N        shards per step\n"
-    "      --threads T       threads per shard (default 0: all cores of its machine)\n"
-    "      --jobs J          parallel: shards at once (default N)\n"
+    "      --threads T       threads per worker (default 0: all cores of its machine)\n"
+    "      --workers J       workers, all running at once (default N; at most N); --jobs J\n"
+    "                        is the same\n"
     "      --sshloginfile F  parallel: run shards on the ssh hosts listed in F (GNU parallel's option)\n"
     "      --partition P     slurm: the partition to submit to\n"
     "      --script-only     write the script, do not run or submit it\n"
@@ -87,9 +90,10 @@ static int parse(int argc, char **argv, farm_args *a)
         } else if ((r = cli_opt_value(argc, argv, &i, "--shards", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 100000, &a->shards) || !a->shards)
                 return cli_usage_error("farm", "--shards needs a number 1..100000");
-        } else if ((r = cli_opt_value(argc, argv, &i, "--jobs", NULL, &v)) != 0) {
+        } else if ((r = cli_opt_value(argc, argv, &i, "--jobs", NULL, &v)) != 0 ||
+                   (r = cli_opt_value(argc, argv, &i, "--workers", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 100000, &a->jobs) || !a->jobs)
-                return cli_usage_error("farm", "--jobs needs a number 1..100000");
+                return cli_usage_error("farm", "--workers needs a number 1..100000");
         } else if ((r = cli_opt_value(argc, argv, &i, "--threads", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 1024, &a->threads))
                 return cli_usage_error("farm", "--threads needs a number 0..1024");
@@ -179,71 +183,40 @@ static const char parallel_body[] =
     "mkdir -p \"$FARM/logs\"\n"
     "stamp() { printf '%s\\t%s\\n' \"$1\" \"$(date +%s.%N)\" >>\"$FARM/logs/times.tsv\"; }  # what each stage took\n"
     "stamp start\n"
-    "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" \"${QUIET[@]}\"\n"
+    "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" --threads \"$TAIL\" --farm \"$FARM\" \"${QUIET[@]}\"\n"
     "stamp plan\n"
-    "step=0\n"
-    "while :; do  # steps 0, 1, ... up to the one whose merge found the end (DIR/end: its number)\n"
-    "  [ -f \"$FARM/end\" ] && [ \"$step\" -ge \"$(cat \"$FARM/end\")\" ] && break\n"
-    "  if [ ! -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$step\")\" ]; then\n"
-    "    todo=()  # shards whose part is missing (a rerun after a failure runs only those)\n"
-    "    for k in $(seq 1 \"$SHARDS\"); do\n"
-    "      [ -f \"$(printf '%s/parts/%04d.%d-of-%d.part' \"$FARM\" \"$step\" \"$k\" \"$SHARDS\")\" ] || todo+=(\"$k\")\n"
-    "    done\n"
-    "    if ((${#todo[@]})); then\n"
-    "      parallel --will-cite --halt now,fail=1 -j \"$JOBS\" \"${HOSTS[@]}\" --joblog \"$FARM/logs/step-$step.joblog\" -q \\\n"
-    "        \"$LMBAKE\" step \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --step \"$step\" --shard \"{}/$SHARDS\" -q \\\n"
-    "        ::: \"${todo[@]}\"\n"
-    "    fi\n"
-    "    stamp \"shards $step\"\n"
-    "    \"$LMBAKE\" merge \"$SCENE\" \"${CONFIG[@]}\" --farm \"$FARM\" --step \"$step\" --shards \"$SHARDS\" -q\n"
-    "    stamp \"merge $step\"\n"
-    "  fi\n"
-    "  step=$((step + 1))\n"
-    "done\n"
-    "\"$LMBAKE\" finish \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" -o \"$OUT\" \"${QUIET[@]}\"\n"
-    "stamp finish\n";
+    "# the workers, all at once, for the whole bake: worker W runs shards W, W+J, ... of every step,\n"
+    "# merges each step from the parts in the farm folder; worker 1 writes OUT after the last step.\n"
+    "# One that fails stops the others; running this script again resumes from the merged steps.\n"
+    "parallel --will-cite --halt now,fail=1 -j \"$WORKERS\" \"${HOSTS[@]}\" --joblog \"$FARM/logs/workers.joblog\" -q \\\n"
+    "  \"$LMBAKE\" worker \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --shards \"$SHARDS\" \\\n"
+    "  --worker \"{}/$WORKERS\" --tail-threads \"$TAIL\" -o \"$OUT\" \"${QUIET[@]}\" ::: $(seq 1 \"$WORKERS\")\n"
+    "stamp workers\n";
 
 static const char slurm_body[] =
     "SELF=\"$FARM/slurm.sh\"\n"
-    "submit_step() {  # step $1's job array after job $2, then its merge job after the array\n"
-    "  local array\n"
-    "  array=$(\"${SBATCH[@]}\" --job-name=\"lmbake-step-$1\" --array=\"1-$SHARDS\" --dependency=\"afterok:$2\" \\\n"
-    "    --cpus-per-task=\"$CPUS\" --output=\"$FARM/logs/step-$1-%a.out\" \"$SELF\" shard \"$1\")\n"
-    "  \"${SBATCH[@]}\" --job-name=\"lmbake-merge-$1\" --dependency=\"afterok:${array%%;*}\" \\\n"
-    "    --output=\"$FARM/logs/merge-$1.out\" \"$SELF\" merge \"$1\" >/dev/null\n"
-    "  echo \"${array%%;*}\"\n"
-    "}\n"
     "case \"${1:-submit}\" in\n"
-    "  submit)\n"
+    "  submit)  # the plan job, then one job of WORKERS tasks (srun) after it\n"
     "    command -v sbatch >/dev/null || { echo \"lmbake farm slurm: sbatch not found (Debian: slurm-client)\" >&2; exit 3; }\n"
     "    mkdir -p \"$FARM/logs\"\n"
     "    rm -f \"$FARM/finished\" \"$FARM/failed\"\n"
     "    plan=$(\"${SBATCH[@]}\" --job-name=lmbake-plan --cpus-per-task=\"$CPUS\" --output=\"$FARM/logs/plan.out\" \"$SELF\" plan)\n"
-    "    array=$(submit_step 0 \"${plan%%;*}\")\n"
-    "    echo \"submitted: plan job ${plan%%;*}, step 0 array $array (each merge job submits the next step)\";;\n"
+    "    work=$(\"${SBATCH[@]}\" --job-name=lmbake-workers --dependency=\"afterok:${plan%%;*}\" --ntasks=\"$WORKERS\" \\\n"
+    "      --cpus-per-task=\"$CPUS\" --output=\"$FARM/logs/workers.out\" \"$SELF\" workers)\n"
+    "    \"${SBATCH[@]}\" --job-name=lmbake-failed --dependency=\"afternotok:${plan%%;*}\" --output=/dev/null \\\n"
+    "      --wrap=\"touch '$FARM/failed'\" >/dev/null\n"
+    "    echo \"submitted: plan job ${plan%%;*}, workers job ${work%%;*} ($WORKERS tasks)\";;\n"
     "  plan)\n"
     "    [ -f \"$FARM/plan.lmbp\" ] || exec \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" -q;;\n"
-    "  shard)  # a merged step or a finished part is kept: resubmitting resumes\n"
-    "    [ -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$2\")\" ] && exit 0\n"
-    "    [ -f \"$(printf '%s/parts/%04d.%d-of-%d.part' \"$FARM\" \"$2\" \"$SLURM_ARRAY_TASK_ID\" \"$SHARDS\")\" ] && exit 0\n"
-    "    exec \"$LMBAKE\" step \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --step \"$2\" \\\n"
-    "      --shard \"$SLURM_ARRAY_TASK_ID/$SHARDS\" -q;;\n"
-    "  merge)\n"
-    "    [ -f \"$(printf '%s/steps/%04d.state' \"$FARM\" \"$2\")\" ] ||\n"
-    "      \"$LMBAKE\" merge \"$SCENE\" \"${CONFIG[@]}\" --farm \"$FARM\" --step \"$2\" --shards \"$SHARDS\" -q ||\n"
-    "      { touch \"$FARM/failed\"; exit 1; }\n"
-    "    if [ -f \"$FARM/end\" ] && [ $(($2 + 1)) -ge \"$(cat \"$FARM/end\")\" ]; then\n"
-    "      \"${SBATCH[@]}\" --job-name=lmbake-finish --dependency=\"afterok:$SLURM_JOB_ID\" --cpus-per-task=\"$CPUS\" \\\n"
-    "        --output=\"$FARM/logs/finish.out\" \"$SELF\" finish >/dev/null\n"
-    "    else\n"
-    "      submit_step $(($2 + 1)) \"$SLURM_JOB_ID\" >/dev/null\n"
-    "    fi;;\n"
-    "  finish)\n"
-    "    if \"$LMBAKE\" finish \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" -o \"$OUT\"; then\n"
+    "  workers)  # all tasks start together; one that fails ends the job step (--kill-on-bad-exit)\n"
+    "    if srun --kill-on-bad-exit=1 --output=\"$FARM/logs/worker-%t.out\" bash \"$SELF\" worker; then\n"
     "      touch \"$FARM/finished\"\n"
     "    else\n"
     "      touch \"$FARM/failed\"; exit 1\n"
     "    fi;;\n"
+    "  worker)\n"
+    "    exec \"$LMBAKE\" worker \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --shards \"$SHARDS\" \\\n"
+    "      --worker \"$((SLURM_PROCID + 1))/$WORKERS\" -o \"$OUT\";;\n"
     "  *) echo \"usage: bash $SELF [submit]\" >&2; exit 1;;\n"
     "esac\n";
 
@@ -276,6 +249,7 @@ int cmd_farm(int argc, char **argv)
     if (!absolute(a.farm, farm, sizeof farm) || !absolute(a.outdir, out, sizeof out))
         return cli_fail(&(lmb_error){LMB_ERR_INPUT, "path too long"});
     int slurm = !strcmp(a.driver, "slurm");
+    unsigned long long workers = a.jobs && a.jobs < a.shards ? a.jobs : a.shards;
     char path[PATH_MAX + 32];
     snprintf(path, sizeof path, "%s/%s.sh", farm, slurm ? "slurm" : "parallel");
     FILE *f = fopen(path, "w");
@@ -294,9 +268,11 @@ int cmd_farm(int argc, char **argv)
             fprintf(f, " --partition=");
             shq(f, a.partition);
         }
-        fprintf(f, ")\n%s", slurm_body);
+        fprintf(f, ")\nWORKERS=%llu\n%s", workers, slurm_body);
     } else {
-        fprintf(f, "JOBS=%llu\nHOSTS=(", a.jobs ? a.jobs : a.shards);
+        /* on this machine's cores, worker 1's tail (and the plan) may use every worker's threads */
+        unsigned long long tail = a.sshloginfile || !a.threads ? a.threads : a.threads * workers;
+        fprintf(f, "WORKERS=%llu\nTAIL=%llu\nHOSTS=(", workers, tail);
         if (a.sshloginfile) {
             fprintf(f, "--sshloginfile ");
             shq(f, hosts);

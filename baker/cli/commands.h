@@ -9,6 +9,7 @@ int cmd_plan(int argc, char **argv);   /* cmd_bake.c: the staged bake's stages (
 int cmd_step(int argc, char **argv);
 int cmd_merge(int argc, char **argv);
 int cmd_finish(int argc, char **argv);
+int cmd_worker(int argc, char **argv);
 int cmd_farm(int argc, char **argv);   /* cmd_farm.c: scripts for GNU parallel and Slurm */
 int cmd_unwrap(int argc, char **argv);
 int cmd_preview(int argc, char **argv);

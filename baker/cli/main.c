@@ -23,6 +23,7 @@ static const char usage[] =
     "  step SCENE --farm DIR --step S --shard K/N   one shard of one step\n"
     "  merge SCENE --farm DIR --step S --shards N   a step's parts into its state\n"
     "  finish SCENE --farm DIR -o OUTDIR    the outputs, byte for byte as 'bake' writes them\n"
+    "  worker SCENE --farm DIR --shards N --worker W/J [-o OUTDIR]   a worker for every step\n"
     "  inspect SCENE [-c CONFIG] [--json]   list meshes, instances, materials, lights and\n"
     "                                       what will be lightmapped (and why not)\n"
     "  unwrap SCENE [-c CONFIG] [--png DIR] lightmap UV layout and its quality report\n"
@@ -63,6 +64,8 @@ int main(int argc, char **argv)
         return cmd_step(argc - 1, argv + 1);
     if (!strcmp(cmd, "merge"))
         return cmd_merge(argc - 1, argv + 1);
+    if (!strcmp(cmd, "worker"))
+        return cmd_worker(argc - 1, argv + 1);
     if (!strcmp(cmd, "finish"))
         return cmd_finish(argc - 1, argv + 1);
     if (!strcmp(cmd, "farm"))

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 struct lmb_steps {
@@ -17,6 +18,11 @@ struct lmb_steps {
     uint32_t next;        /* the step lmb_steps_run meets next */
     double min_rays;
     const lmb_log *log;
+    /* worker mode (lmb_steps_create_worker) */
+    uint32_t worker, workers;
+    int finishes;
+    uint32_t tail_threads;
+    double wait_timeout;
 };
 
 /* The body of a part or a state:
@@ -102,6 +108,33 @@ lmb_status lmb_steps_create(lmb_steps_mode mode, const char *dir, const lmb_part
     }
     *out = s;
     return LMB_OK;
+}
+
+lmb_status lmb_steps_create_worker(const char *dir, const lmb_part_identity *id, const lmb_steps_worker *w,
+                                   double min_rays, const lmb_log *log, lmb_steps **out, lmb_error *err)
+{
+    if (!w->shards || !w->workers || w->worker >= w->workers || w->workers > w->shards)
+        return lmb_error_set(err, LMB_ERR_USAGE, "worker %u of %u with %u shards: out of range", w->worker + 1,
+                             w->workers, w->shards);
+    lmb_status st = lmb_steps_create(LMB_STEPS_WORKER, dir, id, 0, 0, w->shards, min_rays, log, out, err);
+    if (st == LMB_OK) {
+        (*out)->worker = w->worker;
+        (*out)->workers = w->workers;
+        (*out)->finishes = w->finishes;
+        (*out)->tail_threads = w->tail_threads;
+        (*out)->wait_timeout = w->wait_timeout;
+    }
+    return st;
+}
+
+int lmb_steps_light_unused(const lmb_steps *s)
+{
+    return s && (s->mode == LMB_STEPS_SHARD || (s->mode == LMB_STEPS_WORKER && !s->finishes));
+}
+
+uint32_t lmb_steps_tail_threads(const lmb_steps *s, uint32_t threads)
+{
+    return s && s->mode == LMB_STEPS_WORKER && s->finishes && s->tail_threads ? s->tail_threads : threads;
 }
 
 void lmb_steps_free(lmb_steps *s)
@@ -199,42 +232,57 @@ static uint64_t cut(const lmb_step_desc *d, uint32_t k, uint32_t n)
     return d->items;
 }
 
-lmb_status lmb_steps_run(lmb_steps *s, const lmb_step_desc *d, lmb_buf *out, uint64_t counters[LMB_STEP_COUNTERS],
-                         lmb_error *err)
+static int exists(const char *path)
 {
+    struct stat sb;
+    return stat(path, &sb) == 0;
+}
+
+static double seconds_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Computes shard `shard`'s range of step `step` into out and writes it as its part. */
+static lmb_status run_shard(lmb_steps *s, const lmb_step_desc *d, uint32_t step, uint32_t shard, lmb_buf *out,
+                            uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    char path[4400];
     out->size = out->read = 0;
     memset(counters, 0, LMB_STEP_COUNTERS * sizeof *counters);
-    if (!d->items) /* nothing to do: no step (every process sees the same count) */
-        return LMB_OK;
-    if (d->rays < s->min_rays) /* cheaper here than a farm step: every process computes it */
-        return d->fn(d->user, 0, d->items, out, counters, err);
-    uint32_t step = s->next++;
-    if (s->mode == LMB_STEPS_LOCAL || (s->mode == LMB_STEPS_SHARD && step > s->step))
-        return d->fn(d->user, 0, d->items, out, counters, err);
+    uint64_t first = cut(d, shard, s->shards), last = cut(d, shard + 1, s->shards);
+    lmb_info(s->log, "step %u (%s): shard %u of %u, items %llu-%llu of %llu", step, d->name, shard + 1, s->shards,
+             (unsigned long long)first, (unsigned long long)last, (unsigned long long)d->items);
+    double t0 = seconds_now();
+    lmb_status st = first < last ? d->fn(d->user, first, last, out, counters, err) : LMB_OK;
+    if (st != LMB_OK)
+        return st;
+    double took = seconds_now() - t0;
+    step_body b = {0, d->items, first, last, {0}, {0}, out->data, out->size};
+    memcpy(b.counters, counters, sizeof b.counters);
+    snprintf(b.name, sizeof b.name, "%s", d->name);
+    size_t size;
+    uint8_t *body = encode_body(&b, &size);
+    if (!body)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory for step %u's part", step);
+    part_path(s->dir, step, shard, s->shards, path, sizeof path);
+    lmb_part_place place = {LMB_PART_SHARD, step, shard, s->shards};
+    st = lmb_part_write(path, &s->id, &place, body, size, err);
+    free(body);
+    if (st == LMB_OK) /* the farm benchmark reads this line's time */
+        lmb_info(s->log, "step %u: shard %u of %u computed in %.4f s, wrote %s", step, shard + 1, s->shards, took, path);
+    return st;
+}
+
+/* Step `step`'s merged state into out and counters, checked against d. */
+static lmb_status read_state(lmb_steps *s, const lmb_step_desc *d, uint32_t step, lmb_buf *out,
+                             uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
     char path[4400];
-    if (s->mode == LMB_STEPS_SHARD && step == s->step) {
-        uint64_t first = cut(d, s->shard, s->shards), last = cut(d, s->shard + 1, s->shards);
-        lmb_info(s->log, "step %u (%s): shard %u of %u, items %llu-%llu of %llu", step, d->name, s->shard + 1,
-                 s->shards, (unsigned long long)first, (unsigned long long)last, (unsigned long long)d->items);
-        lmb_status st = first < last ? d->fn(d->user, first, last, out, counters, err) : LMB_OK;
-        if (st != LMB_OK)
-            return st;
-        step_body b = {0, d->items, first, last, {0}, {0}, out->data, out->size};
-        memcpy(b.counters, counters, sizeof b.counters);
-        snprintf(b.name, sizeof b.name, "%s", d->name);
-        size_t size;
-        uint8_t *body = encode_body(&b, &size);
-        if (!body)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory for step %u's part", step);
-        part_path(s->dir, step, s->shard, s->shards, path, sizeof path);
-        lmb_part_place place = {LMB_PART_SHARD, step, s->shard, s->shards};
-        st = lmb_part_write(path, &s->id, &place, body, size, err);
-        free(body);
-        if (st == LMB_OK)
-            lmb_info(s->log, "step %u: wrote %s", step, path);
-        return st == LMB_OK ? LMB_STEP_STOPPED : st;
-    }
-    /* an earlier step (shard mode) or any step (finish): its merged state */
+    out->size = out->read = 0;
+    memset(counters, 0, LMB_STEP_COUNTERS * sizeof *counters);
     state_path(s->dir, step, path, sizeof path);
     struct stat sb;
     if (stat(path, &sb) != 0)
@@ -257,6 +305,81 @@ lmb_status lmb_steps_run(lmb_steps *s, const lmb_step_desc *d, lmb_buf *out, uin
     }
     free(raw);
     return st;
+}
+
+/* Worker mode: unless step `step` is merged already (a worker restarted, or another worker got
+ * there first), computes this worker's shards of it (those whose part is not in place), waits
+ * until every shard's part is in the farm folder, and merges them into the step's state. */
+static lmb_status work_step(lmb_steps *s, const lmb_step_desc *d, uint32_t step, lmb_buf *out,
+                            uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    char path[4400];
+    state_path(s->dir, step, path, sizeof path);
+    if (exists(path))
+        return LMB_OK;
+    lmb_status st = LMB_OK;
+    for (uint32_t k = s->worker; k < s->shards && st == LMB_OK; k += s->workers) {
+        part_path(s->dir, step, k, s->shards, path, sizeof path);
+        if (!exists(path)) /* one in place was written before a restart: the merge checks it */
+            st = run_shard(s, d, step, k, out, counters, err);
+    }
+    double start = seconds_now(), said = start;
+    useconds_t nap = 500;
+    for (uint32_t k = 0; k < s->shards && st == LMB_OK;) {
+        part_path(s->dir, step, k, s->shards, path, sizeof path);
+        if (exists(path)) {
+            k++;
+            continue;
+        }
+        state_path(s->dir, step, path, sizeof path);
+        if (exists(path)) /* merged by another worker */
+            return LMB_OK;
+        double t = seconds_now();
+        if (s->wait_timeout > 0 && t - start > s->wait_timeout)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "step %u (%s): waited %.0f s for parts/%04u.%u-of-%u.part: "
+                                 "is worker %u of %u running? (restart it: 'lmbake worker ... --worker %u/%u')", step,
+                                 d->name, t - start, step, k + 1, s->shards, k % s->workers + 1, s->workers,
+                                 k % s->workers + 1, s->workers);
+        if (t - said >= 60) {
+            lmb_info(s->log, "step %u (%s): waiting %.0f s for parts/%04u.%u-of-%u.part (worker %u of %u)", step,
+                     d->name, t - start, step, k + 1, s->shards, k % s->workers + 1, s->workers);
+            said = t;
+        }
+        usleep(nap);
+        nap = nap < 50000 ? 2 * nap : 100000;
+    }
+    if (st != LMB_OK)
+        return st;
+    state_path(s->dir, step, path, sizeof path);
+    if (exists(path))
+        return LMB_OK;
+    lmb_merge_report report;
+    return lmb_steps_merge(s->dir, &s->id, step, s->shards, &report, err);
+}
+
+lmb_status lmb_steps_run(lmb_steps *s, const lmb_step_desc *d, lmb_buf *out, uint64_t counters[LMB_STEP_COUNTERS],
+                         lmb_error *err)
+{
+    out->size = out->read = 0;
+    memset(counters, 0, LMB_STEP_COUNTERS * sizeof *counters);
+    if (!d->items) /* nothing to do: no step (every process sees the same count) */
+        return LMB_OK;
+    if (d->rays < s->min_rays) /* cheaper here than a farm step: every process computes it */
+        return d->fn(d->user, 0, d->items, out, counters, err);
+    uint32_t step = s->next++;
+    if (s->mode == LMB_STEPS_LOCAL || (s->mode == LMB_STEPS_SHARD && step > s->step))
+        return d->fn(d->user, 0, d->items, out, counters, err);
+    if (s->mode == LMB_STEPS_SHARD && step == s->step) {
+        lmb_status st = run_shard(s, d, step, s->shard, out, counters, err);
+        return st == LMB_OK ? LMB_STEP_STOPPED : st;
+    }
+    if (s->mode == LMB_STEPS_WORKER) {
+        lmb_status st = work_step(s, d, step, out, counters, err);
+        if (st != LMB_OK)
+            return st;
+    }
+    /* an earlier step (shard mode), any step (finish), or a step the workers have merged */
+    return read_state(s, d, step, out, counters, err);
 }
 
 lmb_status lmb_steps_write_end(lmb_steps *s, lmb_error *err)
@@ -291,6 +414,29 @@ uint32_t lmb_steps_end_step(const char *dir)
         v = UINT32_MAX;
     fclose(f);
     return v;
+}
+
+/* DIR/end := "step\n" (atomically). */
+static lmb_status write_end_marker(const char *dir, uint32_t step, lmb_error *err)
+{
+    char path[4200], tmp[4500];
+    snprintf(path, sizeof path, "%s/end", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    int ok = f && fprintf(f, "%u\n", step) > 0;
+    ok = (f && fclose(f) == 0) && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        remove(tmp);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write: %s", path, strerror(errno));
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_steps_worker_end(lmb_steps *s, lmb_error *err)
+{
+    if (s->mode != LMB_STEPS_WORKER || lmb_steps_end_step(s->dir) == s->next)
+        return LMB_OK;
+    return write_end_marker(s->dir, s->next, err);
 }
 
 lmb_status lmb_steps_merge(const char *dir, const lmb_part_identity *id, uint32_t step, uint32_t shards,
@@ -365,18 +511,8 @@ lmb_status lmb_steps_merge(const char *dir, const lmb_part_identity *id, uint32_
             st = lmb_part_write(path, id, &place, body, size, err);
         free(body);
     }
-    if (st == LMB_OK && m.end) { /* the marker steps past the end look at */
-        snprintf(path, sizeof path, "%s/end", dir);
-        char tmp[4500];
-        snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
-        FILE *f = fopen(tmp, "w");
-        int ok = f && fprintf(f, "%u\n", step) > 0;
-        ok = (f && fclose(f) == 0) && ok;
-        if (!ok || rename(tmp, path) != 0) {
-            remove(tmp);
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write: %s", path, strerror(errno));
-        }
-    }
+    if (st == LMB_OK && m.end) /* the marker steps past the end look at */
+        st = write_end_marker(dir, step, err);
     if (st == LMB_OK) {
         report->end = m.end;
         report->items = m.items;

@@ -8,7 +8,12 @@
  *   shard  (lmbake step --step S --shard k/N): steps before S are read from the merged
  *          states in the farm folder, step S runs over shard k's range of items (cut by
  *          estimated cost) and is written as a part; then the bake stops (LMB_STEP_STOPPED);
- *   finish (lmbake finish): every step is read from the merged states.
+ *   finish (lmbake finish): every step is read from the merged states;
+ *   worker (lmbake worker --worker W/J): a process for the whole bake. At each step it runs its
+ *          shards (W, W + J, ... of N), waits for the other workers' parts in the farm folder,
+ *          merges them into the step's state itself and goes on, so a step costs it its own
+ *          items, a wait and a read, not a process start and a replay. A step already merged
+ *          is read (a restarted worker catches up by replaying the merged states).
  * The code between steps (rim limits, record placement, k-d trees, interpolation, dilation)
  * runs in every process on the same bytes, so a shard and a one-machine bake see the same
  * state before each step, and the finish stage writes exactly what lmbake bake writes.
@@ -60,7 +65,7 @@ typedef struct lmb_step_desc {
     void *user;
 } lmb_step_desc;
 
-typedef enum lmb_steps_mode { LMB_STEPS_LOCAL, LMB_STEPS_SHARD, LMB_STEPS_FINISH } lmb_steps_mode;
+typedef enum lmb_steps_mode { LMB_STEPS_LOCAL, LMB_STEPS_SHARD, LMB_STEPS_FINISH, LMB_STEPS_WORKER } lmb_steps_mode;
 
 typedef struct lmb_steps lmb_steps;
 
@@ -71,6 +76,27 @@ lmb_status lmb_steps_create(lmb_steps_mode mode, const char *dir, const lmb_part
                             uint32_t shard, uint32_t shards, double min_rays, const lmb_log *log, lmb_steps **out,
                             lmb_error *err);
 void lmb_steps_free(lmb_steps *s);
+
+/* A worker's place in the farm (0-based worker of workers; its shards: worker, worker + workers, ...). */
+typedef struct lmb_steps_worker {
+    uint32_t shards, worker, workers;
+    int finishes;           /* this worker writes the bake after the last step */
+    uint32_t tail_threads;  /* its threads after the last step, when the others are done (0: the bake's) */
+    double wait_timeout;    /* seconds to wait for another worker's part before failing (0: for ever) */
+} lmb_steps_worker;
+
+lmb_status lmb_steps_create_worker(const char *dir, const lmb_part_identity *id, const lmb_steps_worker *w,
+                                   double min_rays, const lmb_log *log, lmb_steps **out, lmb_error *err);
+
+/* 1 when this process's light after the last step is never used: a shard, or a worker that
+ * does not write the bake (work after the last step that no step reads can be skipped). */
+int lmb_steps_light_unused(const lmb_steps *s);
+
+/* Threads for the work after the last step: the finishing worker's tail_threads, else `threads`. */
+uint32_t lmb_steps_tail_threads(const lmb_steps *s, uint32_t threads);
+
+/* Worker mode, the lighting done: writes DIR/end (the number of steps) unless it is there. */
+lmb_status lmb_steps_worker_end(lmb_steps *s, lmb_error *err);
 
 /* Runs (or reads) the next step: *out := all its items' bytes (reset first), counters := their
  * sums. Shard mode, at its own step: writes the part and returns LMB_STEP_STOPPED. */

@@ -485,7 +485,10 @@ lmb_status lmb_bake_planned(lmb_scene *scene, const lmb_config *cfg, const char 
 typedef enum lmb_farm_mode {
     LMB_FARM_LOCAL = 0,  /* every step in this process: lmb_bake */
     LMB_FARM_STEP = 1,   /* one shard of one step: reads earlier steps' states from farm_dir, writes its part */
-    LMB_FARM_FINISH = 2  /* every step from farm_dir's states, then post-processing and the outputs */
+    LMB_FARM_FINISH = 2, /* every step from farm_dir's states, then post-processing and the outputs */
+    LMB_FARM_WORKER = 3  /* a worker for the whole bake: shards worker, worker + workers, ... of every
+                            step, waiting for the other workers' parts and merging each step itself;
+                            worker 0 with an outdir writes the outputs as LMB_FARM_FINISH does */
 } lmb_farm_mode;
 
 typedef struct lmb_farm_run {
@@ -495,6 +498,10 @@ typedef struct lmb_farm_run {
     uint32_t shard, shards;   /* LMB_FARM_STEP: shard (0-based) of shards */
     int ended;                /* out, LMB_FARM_STEP: the bake has fewer steps (an "end" part was written) */
     uint32_t steps;           /* out: steps met */
+    uint32_t worker, workers; /* LMB_FARM_WORKER: 0-based worker of workers (workers <= shards) */
+    uint32_t tail_threads;    /* LMB_FARM_WORKER: worker 0's threads after the last step, when the other
+                                 workers are done (0: cfg's) */
+    double wait_timeout;      /* LMB_FARM_WORKER: seconds to wait for another worker's part (0: for ever) */
 } lmb_farm_run;
 
 /* lmb_bake_planned through the farm: plan_path is required unless mode is LMB_FARM_LOCAL.

@@ -1,16 +1,19 @@
 #!/usr/bin/env python3
 """The farm (issue 13; docs/farm.md).
 
-1. Identity: `lmbake farm parallel` in 4 shards (GNU parallel, 2 at a time, 1 thread each)
+1. Identity: `lmbake farm parallel` in 4 shards (GNU parallel runs 2 workers of 1 thread)
    writes the same files as `lmbake bake` (2 threads), byte for byte: EXR, .hdr, PNG, glTF,
    buffers, records. Configs: the irradiance cache on with AMIS (guided, the default method)
    and directional maps; the cache off (per-texel gathers; guided AMIS shards by atlas); and
    the default farm.min_step_rays (cheap steps computed in every process).
-2. Faults, driving the stages by hand (plan, step, merge, finish): at every step one shard is
+2. Workers by hand (lmbake worker): one killed mid-bake while the other waits, started
+   again: the same bytes; one left alone times out naming the part and the worker it waits
+   for; one with another config refuses to start, naming the key.
+3. Faults, driving the stages by hand (plan, step, merge, finish): at every step one shard is
    killed (SIGKILL) half-way through its run and leaves no part, then is rerun; another
    shard runs twice and writes the same bytes; finish refuses while a step is not merged and
    nothing appears in the output folder before it; the output equals `lmbake bake`.
-3. Refusals by merge: a part from a farm with another config (named: the part file and the
+4. Refusals by merge: a part from a farm with another config (named: the part file and the
    config key with both values), a damaged part, a missing part (the shard to rerun named).
 
 usage: check_farm.py LMBAKE WORKDIR SCENE [quick]
@@ -73,20 +76,62 @@ def identity(lmbake, work, scene, name, cfg):
           (name, SHARDS, steps_of(farm), time.time() - t0, len(names), " ".join(names)))
     if steps_of(farm) > 1:
         # resume: step 1's state and one of its parts lost, the output gone; the script run
-        # again runs that one shard, merges, finishes: the same files
+        # again replays the merged steps, computes that one part, merges and finishes: the same
+        # files, and no other part rewritten
+        parts = {n: os.stat(os.path.join(farm, "parts", n)).st_mtime_ns for n in os.listdir(os.path.join(farm, "parts"))}
         os.remove(os.path.join(farm, "steps", "0001.state"))
         os.remove(part(farm, 1, 2))
         shutil.rmtree(out)
+        time.sleep(0.05)
         run(["bash", os.path.join(farm, "parallel.sh")])
-        with open(os.path.join(farm, "logs", "step-1.joblog")) as f:
-            lines = f.read().strip().splitlines()
-        last_header = max(i for i, l in enumerate(lines) if l.startswith("Seq"))
-        rerun = lines[last_header + 1:]  # the jobs of the latest run of step 1
-        if len(rerun) != 1 or "--shard 2/4" not in rerun[0]:
-            fail("%s: the resumed script ran %s, not shard 2/4 of step 1 alone" % (name, rerun))
+        rewritten = sorted(n for n, t in parts.items() if os.stat(os.path.join(farm, "parts", n)).st_mtime_ns != t)
+        if rewritten != [os.path.basename(part(farm, 1, 2))]:
+            fail("%s: the resumed script rewrote %s, not step 1's part 2 alone" % (name, rewritten))
         same_files(ref, out, name + " resumed")
-        print("%s: parallel.sh run again after losing step 1's state and part 2: reran that shard alone, "
+        print("%s: parallel.sh run again after losing step 1's state and part 2: wrote that part alone, "
               "output identical" % name)
+
+
+def workers(lmbake, work, scene, cfg):
+    """Workers by hand: 2 workers of 4 shards; worker 2 killed mid-bake while worker 1 waits
+    for its parts, then started again: the same bytes as lmbake bake. A worker late beyond
+    --wait-timeout fails naming the part and the worker; a worker with another config refuses."""
+    ref, farm, out = (os.path.join(work, "workers" + s) for s in ("-bake", "-farm", "-out"))
+    run([lmbake, "bake", scene, "-c", cfg, "-o", ref, "-q", "--threads", "2"])
+    common = [scene, "-c", cfg, "--farm", farm, "--shards", str(SHARDS), "--threads", "1", "-q"]
+    run([lmbake, "plan", scene, "-c", cfg, "--farm", farm, "-q"])
+    # alone, worker 1 computes its shards of step 0 and then waits for worker 2's: timed out
+    r = run([lmbake, "worker"] + common + ["--worker", "1/2", "--wait-timeout", "1"], want=3)
+    if "0000.2-of-4.part" not in r.stderr or "worker 2 of 2" not in r.stderr:
+        fail("a worker that timed out did not name the part and the worker: %r" % r.stderr)
+    print("worker timed out:", r.stderr.strip().splitlines()[-1])
+    w1 = subprocess.Popen([lmbake, "worker"] + common + ["--worker", "1/2", "-o", out], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.PIPE, text=True)
+    w2 = subprocess.Popen([lmbake, "worker"] + common + ["--worker", "2/2"], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.DEVNULL)
+    deadline = time.time() + 600
+    while not os.path.exists(part(farm, 1, 2)) and w2.poll() is None and time.time() < deadline:
+        time.sleep(0.02)
+    if w2.poll() is not None:
+        fail("worker 2 ended (exit %s) before step 1's part 2 appeared" % w2.returncode)
+    w2.send_signal(signal.SIGKILL)
+    w2.wait()
+    time.sleep(1.0)
+    if w1.poll() is not None:
+        fail("worker 1 did not wait for the killed worker's parts (exit %s): %s" % (w1.returncode, w1.stderr.read()))
+    killed_at = max(int(n[:4]) for n in os.listdir(os.path.join(farm, "parts")) if n.endswith(".part"))
+    run([lmbake, "worker"] + common + ["--worker", "2/2"])
+    if w1.wait(timeout=900) != 0:
+        fail("worker 1 failed: %s" % w1.stderr.read())
+    names = same_files(ref, out, "workers")
+    print("workers: worker 2 of 2 killed at step %d of %d while worker 1 waited, started again: output = lmbake "
+          "bake in all %d files" % (killed_at, steps_of(farm), len(names)))
+    # a worker against this farm folder with another config refuses, naming the difference
+    other = write(os.path.join(work, "other-worker.yaml"), open(cfg).read().replace("bounce: 16", "bounce: 32"))
+    r = run([lmbake, "worker", scene, "-c", other, "--farm", farm, "--shards", str(SHARDS), "-q"], want=2)
+    if "samples.bounce" not in r.stderr:
+        fail("a worker with another config: the key is not named in %r" % r.stderr)
+    print("worker with another config refused:", r.stderr.strip().splitlines()[-1])
 
 
 def faults(lmbake, work, scene, cfg):
@@ -202,9 +247,10 @@ def main():
     # quick (sanitizer builds): fewer, larger steps in the fault drill
     faults_cfg = write(os.path.join(work, "faults.yaml"),
                        base + "farm: {min_step_rays: %d}\n" % (300000 if quick else 0))
+    workers(lmbake, work, scene, faults_cfg)
     farm = faults(lmbake, work, scene, faults_cfg)
     refusals(lmbake, work, scene, faults_cfg, farm)
-    print("ok: farm identical, faults survived, foreign parts refused")
+    print("ok: farm identical, workers restarted, faults survived, foreign parts refused")
 
 
 main()
