@@ -10,8 +10,8 @@
 #include <lmbake/lmbake.h>
 
 #include "util/clock.h"
-#include "farm/plan.h"
-#include "farm/steps.h"
+#include "steps/plan.h"
+#include "steps/runner.h"
 #include "lighting.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
@@ -324,7 +324,7 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err)
 {
-    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, 0};
+    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0};
     return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
 }
 
@@ -366,7 +366,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
     st = lmb_sky_create(cfg, s, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
-    if (st == LMB_OK && plan_path) /* the plan stage's layout (farm/plan.h), checked against this scene and config */
+    if (st == LMB_OK && plan_path) /* the plan stage's layout (steps/plan.h), checked against this scene and config */
         st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
     else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
@@ -386,7 +386,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
                                                                                                    : LMB_STEPS_LOCAL;
-    lmb_steps_worker sw = {run->shards, run->worker, run->workers, finishes, run->tail_threads, run->wait_timeout};
+    lmb_steps_worker sw = {run->shards, run->worker, run->workers, run->wait_timeout};
     if (st == LMB_OK && worker)
         st = lmb_steps_create_worker(run->farm_dir, &id, &sw, (double)cfg->farm_min_step_rays, log, &steps, err);
     else if (st == LMB_OK)

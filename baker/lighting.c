@@ -1,7 +1,7 @@
 /* The lighting passes over all atlases (see lighting.h). */
 #include "lighting.h"
 
-#include "farm/steps.h"
+#include "steps/runner.h"
 #include "gather/gather.h"
 #include "lights/direct_refine.h"
 #include "lights/direct_step.h"
@@ -82,11 +82,6 @@ typedef struct pass_env {
     lmb_bake_stats *stats;
     lmb_ic_points *points; /* set during the final gather only: where its records go */
     lmb_ic_records *shared; /* irradiance_cache.records: shared: the records passed on; else NULL */
-    /* The denoiser runs after the final gather's last step unless a directions step follows
-     * (it reads the denoised light): a farm process whose light is not used then skips it
-     * (tail_skip), and the one that writes the bake may use the threads the others freed. */
-    int tail_skip;
-    uint32_t tail_threads;
 } pass_env;
 
 /* The pass's gather through the irradiance cache, every atlas at once (records are shared
@@ -127,29 +122,111 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     return st;
 }
 
+/* The denoiser's passes as steps (steps/runner.h): a step per level over the listed texels of
+ * every atlas it filters, in atlas order; each reads the previous level's light of every texel. */
+typedef struct denoise_job {
+    uint32_t atlases;
+    lmb_denoiser **dn;  /* per atlas; NULL: not filtered */
+    float **from;       /* per atlas: the previous level's light */
+    uint64_t *first;    /* per atlas (+1): its first item */
+    uint32_t level;
+    int threads;
+} denoise_job;
+
+static lmb_status denoise_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    (void)counters;
+    const denoise_job *j = user;
+    lmb_status st = LMB_OK;
+    for (uint32_t a = 0; a < j->atlases && st == LMB_OK; a++) {
+        uint64_t lo = first > j->first[a] ? first : j->first[a], hi = last < j->first[a + 1] ? last : j->first[a + 1];
+        if (!j->dn[a] || lo >= hi)
+            continue;
+        size_t n = 3 * (size_t)(hi - lo);
+        float *o = malloc((n + 1) * sizeof *o);
+        if (!o)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for %zu texels", n / 3);
+        lmb_denoiser_level(j->dn[a], j->level, j->from[a], (uint32_t)(lo - j->first[a]), (uint32_t)(hi - j->first[a]),
+                           o, j->threads);
+        st = lmb_buf_append(out, o, n * sizeof *o, err);
+        free(o);
+    }
+    return st;
+}
+
 /* Every atlas's `field` (3 floats per listed texel) through the edge-aware filter
  * (post/denoise.h) at the relative noise `noise` (atlas by atlas when NULL: each atlas's
- * records' gather_noise) with `levels` passes; `what` names the light in the log line. */
+ * records' gather_noise) with `levels` passes, each a step of the bake; `what` names the
+ * light in the log line. */
 static lmb_status denoise_light(const pass_env *env, size_t field, const double *noise, int own_variance,
                                 uint32_t levels, const char *what, lmb_error *err)
 {
     const lmb_config *cfg = env->cfg;
+    uint32_t n = env->cache->atlas_count;
     lmb_denoise_stats ds = {0};
     double most = 0;
-    lmb_status st = LMB_OK;
-    for (uint32_t a = 0; a < env->cache->atlas_count && st == LMB_OK; a++) {
+    denoise_job j = {n, calloc((size_t)n + 1, sizeof(lmb_denoiser *)), calloc((size_t)n + 1, sizeof(float *)),
+                     calloc((size_t)n + 2, sizeof(uint64_t)), 0, (int)cfg->threads};
+    float **work = calloc((size_t)n + 1, sizeof *work); /* per atlas: the other buffer (owned) */
+    lmb_status st = j.dn && j.from && j.first && work ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory");
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
         atlas_work *w = &env->w[a];
         double level = noise ? *noise : LMB_DENOISE_TEXEL_SHARE * w->gather_noise;
+        j.first[a + 1] = j.first[a];
+        if (!(level > 0) || (own_variance && !w->variance))
+            continue;
         most = level > most ? level : most;
-        if (!(level > 0))
-            continue;
-        float *light = *(float **)(void *)((char *)w + field);
-        if (own_variance && !w->variance)
-            continue;
         lmb_denoise_options opt = {levels, level, own_variance ? w->variance : NULL, cfg->denoise_strength,
-                                   (int)env->tail_threads};
-        st = lmb_denoise_atlas(&w->t, light, &opt, &ds, err);
+                                   (int)cfg->threads};
+        st = lmb_denoiser_create(&w->t, &opt, &j.dn[a], err);
+        j.from[a] = *(float **)(void *)((char *)w + field);
+        work[a] = st == LMB_OK ? malloc((3 * (size_t)w->t.count + 1) * sizeof *work[a]) : NULL;
+        if (st == LMB_OK && !work[a])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for atlas %u", a);
+        j.first[a + 1] += w->t.count;
+        if (st == LMB_OK)
+            lmb_denoise_measure(&w->t, j.from[a], &ds.before, &ds.texels);
     }
+    lmb_buf bytes = {0};
+    for (uint32_t level = 0; level < levels && st == LMB_OK && j.first[n] > 0; level++) {
+        char name[96];
+        snprintf(name, sizeof name, "denoise %s, level %u", own_variance ? "all light" : "gathered light", level + 1);
+        j.level = level;
+        lmb_step_desc d = {name, j.first[n], NULL, LMB_DENOISE_RAYS_PER_TEXEL * (double)j.first[n], denoise_range, &j};
+        uint64_t counters[LMB_STEP_COUNTERS];
+        st = lmb_steps_run(env->job->steps, &d, &bytes, counters, err);
+        if (st == LMB_OK && bytes.size != 3 * sizeof(float) * j.first[n])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: step '%s' gave %zu bytes for %llu texels", name,
+                               bytes.size, (unsigned long long)j.first[n]);
+        for (uint32_t a = 0; a < n && st == LMB_OK; a++) { /* levels alternate between the light and work */
+            if (!j.dn[a])
+                continue;
+            float *light = *(float **)(void *)((char *)&env->w[a] + field);
+            float *next = j.from[a] == light ? work[a] : light;
+            memcpy(next, bytes.data + 3 * sizeof(float) * j.first[a], 3 * sizeof(float) * env->w[a].t.count);
+            j.from[a] = next;
+        }
+    }
+    lmb_buf_free(&bytes);
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+        float *light = *(float **)(void *)((char *)&env->w[a] + field);
+        if (!j.dn[a])
+            continue;
+        if (j.from[a] != light) /* an odd number of levels ends in work */
+            memcpy(light, j.from[a], 3 * sizeof(float) * env->w[a].t.count);
+        lmb_denoise_measure(&env->w[a].t, light, &ds.after, NULL);
+    }
+    for (uint32_t a = 0; a < n; a++) {
+        if (j.dn)
+            lmb_denoiser_free(j.dn[a]);
+        if (work)
+            free(work[a]);
+    }
+    free(j.dn);
+    free(j.from);
+    free(j.first);
+    free(work);
     env->stats->denoised_texels += ds.texels;
     if (st == LMB_OK && ds.texels)
         lmb_info(env->log, "denoise: %s of %llu texels filtered at %.2f%% noise (%u levels, strength %g); its mean "
@@ -158,7 +235,7 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
     return st;
 }
 
-/* A pass over every atlas's listed texels as a step (farm/steps.h): items are the texels in
+/* A pass over every atlas's listed texels as a step (steps/runner.h): items are the texels in
  * atlas order, or whole atlases when the gather is guided (pilots first, lmb_gather_texels). */
 typedef struct texel_pass {
     const pass_env *env;
@@ -294,21 +371,18 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
     for (uint32_t a = 0; add_direct && through_cache && a < cache->atlas_count; a++)
         if (env->w[a].gather_noise > stats->indirect_noise)
             stats->indirect_noise = env->w[a].gather_noise;
-    /* the final gather: the light shown is known (the direct light's refinement, a step, goes
-     * first: after it no step reads the light unless directions follow; see pass_env) */
-    if (st == LMB_OK && add_direct && !job->reference)
-        st = refine_direct(env, 0, err);
-    if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference && !env->tail_skip)
+    if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference)
         st = denoise_light(env, offsetof(atlas_work, result), NULL, 0, env->cfg->denoise_levels,
                            "the final gather's light (a quarter of its records' median noise)", err);
+    if (st == LMB_OK && add_direct && !job->reference) /* the final gather: the light shown is known */
+        st = refine_direct(env, 0, err);
     /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */
     for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++)
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
             float v = w[a].result[k] + w[a].direct[k] - (w[a].deferred ? w[a].deferred[k] : 0.0f);
             w[a].result[k] = v > 0 ? v : 0.0f;
         }
-    if (st == LMB_OK && add_direct && !job->reference && env->cfg->denoise_direct && stats->direct_noise_median > 0 &&
-        !env->tail_skip)
+    if (st == LMB_OK && add_direct && !job->reference && env->cfg->denoise_direct && stats->direct_noise_median > 0)
         st = denoise_light(env, offsetof(atlas_work, result), &stats->direct_noise_median, 1, LMB_DENOISE_DIRECT_LEVELS,
                            "the light with its direct part (each texel's direct light's own variance)", err);
     if (st == LMB_OK && store)
@@ -563,12 +637,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.steps = steps;
     lmb_ic_records shared;
     lmb_ic_records_init(&shared, cfg->ic_error > 0 ? cfg->ic_error : 1);
-    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL,
-                    0, cfg->threads};
-    if (!cfg->directional) { /* the final gather's steps are the bake's last */
-        env.tail_skip = lmb_steps_light_unused(steps);
-        env.tail_threads = lmb_steps_tail_threads(steps, cfg->threads);
-    }
+    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL};
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);
     stats->no_light = dark;

@@ -13,7 +13,7 @@
  *   --reference: E = E_direct + path-traced indirect light of depth k, no cache.
  * The result is left in the cache (its images, dilated), which the writer saves; `records`
  * (may be NULL) receives the final gather's irradiance-cache records (none without the cache).
- * Every expensive loop runs as a step of `steps` (farm/steps.h): in this process, or as a
+ * Every expensive loop runs as a step of `steps` (steps/runner.h): in this process, or as a
  * farm shard (which stops the bake with LMB_STEP_STOPPED once its part is written), or read
  * from the farm's merged states.
  */
@@ -23,7 +23,7 @@
 #include <lmbake/lmbake.h>
 
 #include "cache/bounce_cache.h"
-#include "farm/steps.h"
+#include "steps/runner.h"
 #include "irradiance_cache/ic_pass.h"
 #include "lights/direct.h"
 

@@ -44,7 +44,7 @@ def identical(a, b):
         filecmp.cmp(os.path.join(a, n), os.path.join(b, n), shallow=False) for n in names)
 
 
-SHARD_LINE = re.compile(r"step (\d+): shard (\d+) of (\d+) computed in ([0-9.]+) s")
+SHARD_LINE = re.compile(r"step (\d+) \(.*\): shard (\d+) of (\d+) computed in ([0-9.]+) s")
 
 
 def timed_worker(args):

@@ -51,7 +51,7 @@ typedef struct bake_args {
     int quiet, reference, preview, print_config;
     long long step;               /* -1: not given */
     unsigned long long shard, shards; /* --shard K/N (K 1-based), --shards N */
-    unsigned long long worker, workers, tail_threads, wait_timeout; /* --worker W/J (W 1-based), ... */
+    unsigned long long worker, workers, wait_timeout; /* --worker W/J (W 1-based), --wait-timeout S */
     int outdir_given;
 } bake_args;
 
@@ -130,9 +130,6 @@ static int parse_args(int argc, char **argv, bake_args *a)
         } else if ((r = cli_opt_value(argc, argv, &i, "--worker", NULL, &v)) != 0) {
             if (r < 0 || !parse_fraction(v, &a->worker, &a->workers))
                 return cli_usage_error("worker", "--worker needs W/J with 1 <= W <= J <= 100000, e.g. 1/2");
-        } else if ((r = cli_opt_value(argc, argv, &i, "--tail-threads", NULL, &v)) != 0) {
-            if (r < 0 || !cli_parse_uint(v, 1024, &a->tail_threads))
-                return cli_usage_error("worker", "--tail-threads needs a number 0..1024");
         } else if ((r = cli_opt_value(argc, argv, &i, "--wait-timeout", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 100000000, &a->wait_timeout))
                 return cli_usage_error("worker", "--wait-timeout needs seconds 0..100000000 (0: wait for ever)");
@@ -240,8 +237,6 @@ static const char worker_help[] =
     "  --worker W/J         this worker of J (default 1/1); J <= N\n"
     "  -o, --output DIR     worker 1 writes the bake there after the last step (the other\n"
     "                       workers ignore it: one command line serves them all)\n"
-    "  --tail-threads T     worker 1's threads after the last step, when the others are done\n"
-    "                       (default: --threads)\n"
     "  --wait-timeout S     fail when another worker's part is S seconds late (default 0: wait;\n"
     "                       a worker says every minute which part it waits for)\n"
     "  --threads T, -q      as for 'lmbake bake'\n"
@@ -298,8 +293,8 @@ static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, siz
     static const char *const names[] = {"bake", "plan", "step", "merge", "finish", "worker"};
     const char *name = names[stage];
     int farm_stage = stage == STAGE_STEP || stage == STAGE_MERGE || stage == STAGE_FINISH || stage == STAGE_WORKER;
-    if (stage != STAGE_WORKER && (a->worker || a->tail_threads || a->wait_timeout))
-        return cli_usage_error(name, "--worker, --tail-threads and --wait-timeout are options of 'lmbake worker'");
+    if (stage != STAGE_WORKER && (a->worker || a->wait_timeout))
+        return cli_usage_error(name, "--worker and --wait-timeout are options of 'lmbake worker'");
     if (stage == STAGE_WORKER && (a->step >= 0 || a->shard || !a->shards))
         return cli_usage_error(name, "a worker takes --shards N (and --worker W/J), not --step or --shard");
     if (stage == STAGE_WORKER && !a->worker)
@@ -427,7 +422,7 @@ static int run(int argc, char **argv, stage_kind stage)
                        a.farm, (uint32_t)(a.step > 0 ? a.step : 0), (uint32_t)(a.shard ? a.shard - 1 : 0),
                        (uint32_t)(a.shards ? a.shards : 1), 0, 0,
                        (uint32_t)(a.worker ? a.worker - 1 : 0), (uint32_t)(a.workers ? a.workers : 1),
-                       (uint32_t)a.tail_threads, (double)a.wait_timeout};
+                       (double)a.wait_timeout};
     int writes_bake = stage != STAGE_STEP && (stage != STAGE_WORKER || (a.outdir_given && a.worker == 1));
     lmb_bake_stats bs;
     double ts = cli_now();

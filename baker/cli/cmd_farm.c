@@ -183,14 +183,14 @@ static const char parallel_body[] =
     "mkdir -p \"$FARM/logs\"\n"
     "stamp() { printf '%s\\t%s\\n' \"$1\" \"$(date +%s.%N)\" >>\"$FARM/logs/times.tsv\"; }  # what each stage took\n"
     "stamp start\n"
-    "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" --threads \"$TAIL\" --farm \"$FARM\" \"${QUIET[@]}\"\n"
+    "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" \"${QUIET[@]}\"\n"
     "stamp plan\n"
     "# the workers, all at once, for the whole bake: worker W runs shards W, W+J, ... of every step,\n"
     "# merges each step from the parts in the farm folder; worker 1 writes OUT after the last step.\n"
     "# One that fails stops the others; running this script again resumes from the merged steps.\n"
     "parallel --will-cite --halt now,fail=1 -j \"$WORKERS\" \"${HOSTS[@]}\" --joblog \"$FARM/logs/workers.joblog\" -q \\\n"
     "  \"$LMBAKE\" worker \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" --shards \"$SHARDS\" \\\n"
-    "  --worker \"{}/$WORKERS\" --tail-threads \"$TAIL\" -o \"$OUT\" \"${QUIET[@]}\" ::: $(seq 1 \"$WORKERS\")\n"
+    "  --worker \"{}/$WORKERS\" -o \"$OUT\" \"${QUIET[@]}\" ::: $(seq 1 \"$WORKERS\")\n"
     "stamp workers\n";
 
 static const char slurm_body[] =
@@ -270,9 +270,7 @@ int cmd_farm(int argc, char **argv)
         }
         fprintf(f, ")\nWORKERS=%llu\n%s", workers, slurm_body);
     } else {
-        /* on this machine's cores, worker 1's tail (and the plan) may use every worker's threads */
-        unsigned long long tail = a.sshloginfile || !a.threads ? a.threads : a.threads * workers;
-        fprintf(f, "WORKERS=%llu\nTAIL=%llu\nHOSTS=(", workers, tail);
+        fprintf(f, "WORKERS=%llu\nHOSTS=(", workers);
         if (a.sshloginfile) {
             fprintf(f, "--sshloginfile ");
             shq(f, hosts);

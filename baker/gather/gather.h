@@ -39,7 +39,7 @@ typedef struct lmb_gather_job {
     lmb_progress_fn progress;
     void *progress_user;
     uint64_t progress_done, progress_total; /* texels before this atlas, texels of the whole pass */
-    struct lmb_steps *steps;    /* where the pass's gathers run (farm/steps.h) */
+    struct lmb_steps *steps;    /* where the pass's gathers run (steps/runner.h) */
     double noise_target;        /* > 0 (the final gather with samples.adaptive): a record whose estimated
                                    standard error is above this share of the light there (the last pass's,
                                    in the cache) gathers more rays, up to max_rays in all */

@@ -2,7 +2,7 @@
 #include "ic_pass.h"
 #include "ic_pass_internal.h"
 
-#include "farm/steps.h"
+#include "steps/runner.h"
 #include "gather/guide.h"
 #include "irradiance_cache/records.h"
 #include "util/frame.h"
@@ -247,7 +247,7 @@ static lmb_status fit_gradients(pass_ctx *c, lmb_error *err)
     return st;
 }
 
-/* Interpolation as a step (farm/steps.h): items are every atlas's listed texels in order. */
+/* Interpolation as a step (steps/runner.h): items are every atlas's listed texels in order. */
 typedef struct interp_step {
     const pass_ctx *c;
     uint64_t *first; /* per atlas (+1): its first item */

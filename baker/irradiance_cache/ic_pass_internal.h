@@ -5,7 +5,7 @@
 #ifndef LMBAKE_IC_PASS_INTERNAL_H
 #define LMBAKE_IC_PASS_INTERNAL_H
 
-#include "farm/steps.h"
+#include "steps/runner.h"
 #include "gather/gather.h"
 #include "gather/mixture.h"
 #include "irradiance_cache/ic_pass.h"

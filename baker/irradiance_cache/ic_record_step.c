@@ -57,7 +57,7 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     r->texel = x.index;
 }
 
-/* A record's bytes in a step (farm/steps.h): its doubles p .. var (32, contiguous), atlas, texel. */
+/* A record's bytes in a step (steps/runner.h): its doubles p .. var (32, contiguous), atlas, texel. */
 #define RECORD_DOUBLES 32
 _Static_assert(offsetof(lmb_ic_record, var) - offsetof(lmb_ic_record, p) == (RECORD_DOUBLES - 1) * sizeof(double),
                "lmb_ic_record: p .. var are contiguous doubles");

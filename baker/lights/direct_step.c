@@ -1,6 +1,7 @@
 /* An atlas's gather points and direct light as a step of bands (direct_step.h). */
 #include "direct_step.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -163,6 +164,40 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     return st;
 }
 
+/* Each band's estimated cost: the atlas area its rows hold under the instances' triangles
+ * (each triangle's area spread evenly over the rows it spans; covered texels cast the rays),
+ * plus a little per texel (an empty texel is still visited). Packing leaves whole rows nearly
+ * empty, so the band's area alone would give the farm's shards unequal work. */
+static void band_costs(const lmb_layout *layout, uint32_t a, uint32_t width, uint32_t height, uint32_t rows,
+                       uint64_t bands, double *cost)
+{
+    for (uint64_t b = 0; b < bands; b++) {
+        uint64_t y0 = b * rows, y1 = y0 + rows < height ? y0 + rows : height;
+        cost[b] = 0.05 * (double)((y1 - y0) * width);
+    }
+    for (uint32_t i = 0; i < layout->instance_count; i++) {
+        const lmb_layout_instance *li = &layout->instances[i];
+        if (!li->lightmapped || li->atlas != a || !li->uv1)
+            continue;
+        for (size_t f = 0; f + 6 <= li->uv1_count; f += 6) {
+            const double *q = li->uv1 + f;
+            double area = 0.5 * fabs((q[2] - q[0]) * (q[5] - q[1]) - (q[4] - q[0]) * (q[3] - q[1]));
+            double lo = fmin(q[1], fmin(q[3], q[5])), hi = fmax(q[1], fmax(q[3], q[5]));
+            if (!(area > 0) || hi < 0 || lo >= height)
+                continue;
+            lo = lo < 0 ? 0 : lo;
+            hi = hi > height ? height : hi;
+            uint64_t b0 = (uint64_t)lo / rows, b1 = (uint64_t)(hi > lo ? hi - 1e-9 : lo) / rows;
+            b1 = b1 < bands ? b1 : bands - 1;
+            for (uint64_t b = b0; b <= b1 && b < bands; b++) { /* the share of [lo, hi] in the band's rows */
+                double r0 = (double)(b * rows), r1 = (double)((b + 1) * rows);
+                double part = hi > lo ? (fmin(hi, r1) - fmax(lo, r0)) / (hi - lo) : 1.0;
+                cost[b] += area * (part > 0 ? part : 0);
+            }
+        }
+    }
+}
+
 lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, lmb_progress_fn progress,
                                  void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err)
@@ -176,10 +211,7 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     double *cost = malloc((bands + 1) * sizeof *cost);
     if (!cost)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-    for (uint64_t b = 0; b < bands; b++) { /* texels x sub-samples: each casts the same rays */
-        uint64_t y0 = b * c.rows, y1 = y0 + c.rows < c.height ? y0 + c.rows : c.height;
-        cost[b] = (double)((y1 - y0) * c.width);
-    }
+    band_costs(layout, a, c.width, c.height, c.rows, bands, cost);
     char name[64];
     snprintf(name, sizeof name, "direct, atlas %u", a);
     /* rays: sub-samples x shadow rays, over the atlas's area (an upper bound: not every texel is used) */

@@ -1,5 +1,5 @@
 /*
- * Gather points and direct light of one atlas as a step of the bake (farm/steps.h): its items
+ * Gather points and direct light of one atlas as a step of the bake (steps/runner.h): its items
  * are bands of ~16k texels (rows), each built and lit on its own (memory, issue 10: a band's
  * sub-sampled points live only while its direct light is computed). A band's bytes are its
  * texels as the atlas keeps them (one gather point each) and their direct light; results do
@@ -8,12 +8,14 @@
 #ifndef LMBAKE_DIRECT_STEP_H
 #define LMBAKE_DIRECT_STEP_H
 
-#include "farm/steps.h"
+#include "steps/runner.h"
 #include "lights/direct.h"
 #include "texels/texels.h"
 
-/* Texels per band of the direct step and of its refinement (rows of about this many texels). */
-#define LMB_DIRECT_BAND_TEXELS 16384
+/* Texels per band of the direct step and of its refinement (rows of about this many texels):
+ * small enough that a step of 16 shards still deals each several bands (docs/farm.md#balance);
+ * a texel's light does not depend on its band. */
+#define LMB_DIRECT_BAND_TEXELS 4096
 
 typedef struct lmb_direct_atlas {
     lmb_texels t;        /* the atlas's listed texels, one gather point each */

@@ -56,14 +56,16 @@ static void plane_fit(const double m[6], double r[3][3], const float lo[3], cons
     }
 }
 
-/* One a-trous pass with taps `step` texels apart: out from in, over the valid listed texels. */
+/* One a-trous pass with taps `step` texels apart over listed texels [first, last): out (3
+ * floats per texel of the range) from in (every listed texel's). */
 static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel_guide *g, const float *in, float *out,
-                        uint32_t step, double light_scale, const float *variance, int threads)
+                        uint32_t first, uint32_t last, uint32_t step, double light_scale, const float *variance,
+                        int threads)
 {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256)
-    for (uint32_t i = 0; i < t->count; i++) {
+    for (uint32_t i = first; i < last; i++) {
         const float *cp = in + 3 * (size_t)i;
-        float *o = out + 3 * (size_t)i;
+        float *o = out + 3 * (size_t)(i - first);
         if (!t->valid[i]) {
             memcpy(o, cp, 3 * sizeof *o);
             continue;
@@ -141,30 +143,52 @@ static void smooth_variance(const lmb_texels *t, const uint32_t *listed, const t
     }
 }
 
-lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_options *opt,
-                             lmb_denoise_stats *stats, lmb_error *err)
+struct lmb_denoiser {
+    const lmb_texels *t;
+    uint32_t *listed;   /* atlas texel -> listed index, or NOT_LISTED */
+    texel_guide *g;
+    float *variance;    /* smoothed, or NULL */
+    double light_scale;
+    uint32_t levels;
+};
+
+void lmb_denoiser_free(lmb_denoiser *d)
 {
+    if (!d)
+        return;
+    free(d->listed);
+    free(d->g);
+    free(d->variance);
+    free(d);
+}
+
+lmb_status lmb_denoiser_create(const lmb_texels *t, const lmb_denoise_options *opt, lmb_denoiser **out, lmb_error *err)
+{
+    *out = NULL;
     if (opt->levels < 1 || opt->levels > 8 || !(opt->variance || opt->noise > 0) || !(opt->sigma_light > 0))
         return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: levels %u, noise %g, sigma %g out of range", opt->levels,
                              opt->noise, opt->sigma_light);
-    size_t n = (size_t)t->width * t->height, m = 3 * (size_t)t->count;
-    uint32_t *listed = malloc((n + 1) * sizeof *listed); /* atlas texel -> listed index, or NOT_LISTED */
-    texel_guide *g = malloc(((size_t)t->count + 1) * sizeof *g);
-    float *work = malloc((m + 1) * sizeof *work);
-    float *variance = opt->variance ? malloc(((size_t)t->count + 1) * sizeof *variance) : NULL;
-    if (!listed || !g || !work || (opt->variance && !variance)) {
-        free(listed);
-        free(g);
-        free(work);
-        free(variance);
+    size_t n = (size_t)t->width * t->height;
+    lmb_denoiser *d = calloc(1, sizeof *d);
+    if (d) {
+        d->t = t;
+        d->levels = opt->levels;
+        d->light_scale = opt->variance ? opt->sigma_light : opt->sigma_light * opt->noise;
+        d->listed = malloc((n + 1) * sizeof *d->listed);
+        d->g = malloc(((size_t)t->count + 1) * sizeof *d->g);
+        d->variance = opt->variance ? malloc(((size_t)t->count + 1) * sizeof *d->variance) : NULL;
+    }
+    if (!d || !d->listed || !d->g || (opt->variance && !d->variance)) {
+        lmb_denoiser_free(d);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for a %ux%u atlas", t->width, t->height);
     }
     for (size_t k = 0; k < n; k++)
-        listed[k] = NOT_LISTED;
+        d->listed[k] = NOT_LISTED;
     int threads = opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    texel_guide *g = d->g;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
     for (uint32_t i = 0; i < t->count; i++) {
-        listed[t->texel[i]] = i;
+        d->listed[t->texel[i]] = i;
         memset(&g[i], 0, sizeof g[i]);
         if (!t->valid[i])
             continue;
@@ -177,30 +201,55 @@ lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_
         g[i].size = t->texel_size[i];
         g[i].instance = gp.instance;
     }
-    double light_scale = opt->variance ? opt->sigma_light : opt->sigma_light * opt->noise;
-    if (variance)
-        smooth_variance(t, listed, g, opt->variance, variance, threads);
+    if (d->variance)
+        smooth_variance(t, d->listed, g, opt->variance, d->variance, threads);
+    *out = d;
+    return LMB_OK;
+}
+
+void lmb_denoiser_level(const lmb_denoiser *d, uint32_t level, const float *in, uint32_t first, uint32_t last,
+                        float *out, int threads)
+{
+    atrous_pass(d->t, d->listed, d->g, in, out, first, last, 1u << level, d->light_scale, d->variance,
+                threads > 0 ? threads : omp_get_max_threads());
+}
+
+void lmb_denoise_measure(const lmb_texels *t, const float *rgb, double *sum, uint64_t *texels)
+{
     for (uint32_t i = 0; i < t->count; i++)
         if (t->valid[i]) {
-            stats->texels++;
-            stats->before += lmb_luminance_f(rgb + 3 * (size_t)i);
+            *sum += lmb_luminance_f(rgb + 3 * (size_t)i);
+            if (texels)
+                (*texels)++;
         }
+}
+
+lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_options *opt,
+                             lmb_denoise_stats *stats, lmb_error *err)
+{
+    lmb_denoiser *d;
+    lmb_status st = lmb_denoiser_create(t, opt, &d, err);
+    if (st != LMB_OK)
+        return st;
+    size_t m = 3 * (size_t)t->count;
+    float *work = malloc((m + 1) * sizeof *work);
+    if (!work) {
+        lmb_denoiser_free(d);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for a %ux%u atlas", t->width, t->height);
+    }
+    lmb_denoise_measure(t, rgb, &stats->before, &stats->texels);
     /* passes alternate between rgb and work; an odd count ends in work and is copied back */
     float *from = rgb, *to = work;
     for (uint32_t level = 0; level < opt->levels; level++) {
-        atrous_pass(t, listed, g, from, to, 1u << level, light_scale, variance, threads);
+        lmb_denoiser_level(d, level, from, 0, t->count, to, opt->threads);
         float *swap = from;
         from = to;
         to = swap;
     }
     if (from != rgb)
         memcpy(rgb, from, m * sizeof *rgb);
-    for (uint32_t i = 0; i < t->count; i++)
-        if (t->valid[i])
-            stats->after += lmb_luminance_f(rgb + 3 * (size_t)i);
-    free(listed);
-    free(g);
+    lmb_denoise_measure(t, rgb, &stats->after, NULL);
     free(work);
-    free(variance);
+    lmb_denoiser_free(d);
     return LMB_OK;
 }

@@ -499,8 +499,6 @@ typedef struct lmb_farm_run {
     int ended;                /* out, LMB_FARM_STEP: the bake has fewer steps (an "end" part was written) */
     uint32_t steps;           /* out: steps met */
     uint32_t worker, workers; /* LMB_FARM_WORKER: 0-based worker of workers (workers <= shards) */
-    uint32_t tail_threads;    /* LMB_FARM_WORKER: worker 0's threads after the last step, when the other
-                                 workers are done (0: cfg's) */
     double wait_timeout;      /* LMB_FARM_WORKER: seconds to wait for another worker's part (0: for ever) */
 } lmb_farm_run;
 

@@ -1,12 +1,12 @@
 /*
- * libFuzzer target: the plan's layout decoder (baker/farm/plan_codec.c). Plans come from a
+ * libFuzzer target: the plan's layout decoder (baker/steps/plan_codec.c). Plans come from a
  * farm's shared folder, so their bodies are input too: the checksum catches damage, not
  * malice. Each input is decoded as a plan body for one scene (LMB_FUZZ_PLAN_SCENE, loaded
  * once); a decoded layout is encoded again and must give the same bytes.
  * Seed: `LMB_FUZZ_PLAN_SEED=FILE fuzz_plan -runs=0` writes the scene's own layout to FILE
  * (tools/fuzz.sh does this; exiting inside a callback would count as a crash).
  */
-#include "farm/plan_codec.h"
+#include "steps/plan_codec.h"
 #include "fuzz_common.h"
 
 #include <lmbake/lmbake.h>

@@ -1,5 +1,5 @@
 /*
- * The staged bake's file container (baker/farm/part_file.h): a part reads back as written;
+ * The staged bake's file container (baker/steps/part_file.h): a part reads back as written;
  * a part made from another config, input, lmbake version or plan, or for another step or
  * shard, is refused with a message naming what differs (the config's key and both values);
  * truncated and damaged files are named as such; the thread count is not part of the identity;
@@ -7,7 +7,7 @@
  * usage: test_part_file SCENES_DIR WORKDIR
  */
 #include "check.h"
-#include "farm/part_file.h"
+#include "steps/part_file.h"
 #include "util/file.h"
 
 #include <dirent.h>

@@ -24,10 +24,10 @@
  *   DIR/end                      the step the bake ended at ("S\n"): steps from S on are no-ops
  * A shard whose bake ends before step S writes an "end" part; their merge writes DIR/end.
  */
-#ifndef LMBAKE_FARM_STEPS_H
-#define LMBAKE_FARM_STEPS_H
+#ifndef LMBAKE_STEPS_RUNNER_H
+#define LMBAKE_STEPS_RUNNER_H
 
-#include "farm/part_file.h"
+#include "steps/part_file.h"
 
 #include <lmbake/lmbake.h>
 
@@ -80,20 +80,11 @@ void lmb_steps_free(lmb_steps *s);
 /* A worker's place in the farm (0-based worker of workers; its shards: worker, worker + workers, ...). */
 typedef struct lmb_steps_worker {
     uint32_t shards, worker, workers;
-    int finishes;           /* this worker writes the bake after the last step */
-    uint32_t tail_threads;  /* its threads after the last step, when the others are done (0: the bake's) */
     double wait_timeout;    /* seconds to wait for another worker's part before failing (0: for ever) */
 } lmb_steps_worker;
 
 lmb_status lmb_steps_create_worker(const char *dir, const lmb_part_identity *id, const lmb_steps_worker *w,
                                    double min_rays, const lmb_log *log, lmb_steps **out, lmb_error *err);
-
-/* 1 when this process's light after the last step is never used: a shard, or a worker that
- * does not write the bake (work after the last step that no step reads can be skipped). */
-int lmb_steps_light_unused(const lmb_steps *s);
-
-/* Threads for the work after the last step: the finishing worker's tail_threads, else `threads`. */
-uint32_t lmb_steps_tail_threads(const lmb_steps *s, uint32_t threads);
 
 /* Worker mode, the lighting done: writes DIR/end (the number of steps) unless it is there. */
 lmb_status lmb_steps_worker_end(lmb_steps *s, lmb_error *err);

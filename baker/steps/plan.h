@@ -6,7 +6,7 @@
 #ifndef LMBAKE_FARM_PLAN_H
 #define LMBAKE_FARM_PLAN_H
 
-#include "farm/part_file.h"
+#include "steps/part_file.h"
 #include "pack/layout.h"
 
 #include <lmbake/lmbake.h>

@@ -1,9 +1,9 @@
 /* The plan stage: layout to file and back (plan.h, lmbake.h). */
 #include "plan.h"
 
-#include "farm/part_file.h"
-#include "farm/plan_codec.h"
-#include "farm/steps.h"
+#include "steps/part_file.h"
+#include "steps/plan_codec.h"
+#include "steps/runner.h"
 
 #include <stdio.h>
 

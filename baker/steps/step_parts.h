@@ -1,0 +1,50 @@
+/*
+ * The step runner's files (runner.h): the body of a part or a state, where they live in the
+ * farm folder, how a step's items are cut into chunks, and the merge of a step's parts.
+ * Internal to baker/steps/.
+ */
+#ifndef LMBAKE_STEPS_STEP_PARTS_H
+#define LMBAKE_STEPS_STEP_PARTS_H
+
+#include "runner.h"
+
+/* The body of a part or a state:
+ *   u32 end, u32 name_length, u64 items, u64 chunks, counters[LMB_STEP_COUNTERS], u64 bytes,
+ *   name, chunks x (u64 first, u64 last, u64 size), bytes     (little-endian hosts only, as
+ * part_file.h). A part holds its shard's chunks of items (in item order, their bytes one after
+ * the other); a state holds one chunk, every item. */
+#define BODY_HEADER (2 * 4 + (3 + LMB_STEP_COUNTERS) * 8)
+
+typedef struct step_chunk {
+    uint64_t first, last, size;
+} step_chunk;
+
+typedef struct step_body {
+    uint32_t end;
+    uint64_t items, counters[LMB_STEP_COUNTERS];
+    char name[96];
+    uint64_t chunk_count;
+    step_chunk *chunks;   /* encode: given; decode: malloc'd (free it) */
+    const uint8_t *bytes;
+    uint64_t size;
+} step_body;
+
+/* A step's items are cut into chunks of equal estimated cost, LMB_STEP_CHUNKS_PER_SHARD per
+ * shard, dealt to the shards in turn (chunk c to shard c mod N): a shard's items are spread over
+ * the whole step, so what the cost estimate misses (empty atlas rows, shadowed regions, records
+ * that gather more) evens out across the shards. */
+#define LMB_STEP_CHUNKS_PER_SHARD 8
+
+
+uint8_t *lmb_step_body_encode(const step_body *b, size_t *size);
+/* b->chunks is malloc'd on success (free it); b->bytes points into body. */
+lmb_status lmb_step_body_decode(const char *path, const uint8_t *body, size_t size, step_body *b, lmb_error *err);
+void lmb_step_part_path(const char *dir, uint32_t step, uint32_t shard, uint32_t shards, char *out, size_t n);
+void lmb_step_state_path(const char *dir, uint32_t step, char *out, size_t n);
+uint64_t *lmb_step_chunk_cuts(const lmb_step_desc *d, uint32_t shards, uint64_t *count);
+lmb_status lmb_step_write_end_marker(const char *dir, uint32_t step, lmb_error *err);
+lmb_status lmb_step_merge_parts(const char *dir, const lmb_part_identity *id, uint32_t step, uint32_t shards,
+                                int write_state, lmb_buf *out, uint64_t *counters, lmb_merge_report *report,
+                                lmb_error *err);
+
+#endif
