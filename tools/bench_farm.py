@@ -136,6 +136,8 @@ def main():
     for scene in scenes:
         name = os.path.splitext(os.path.basename(scene))[0]
         sel = [r for r in rows if r["measure"] == "this machine" and r["scene"] == name]
+        if not sel:
+            continue
         print("  %s: farm parallel 2 x 1 thread / bake --threads 2: median %.3fx (%s)" %
               (name, statistics.median(r["ratio"] for r in sel), ", ".join("%.3f" % r["ratio"] for r in sel)))
     for r in rows:

@@ -11,12 +11,6 @@ static float luminance(const float *c)
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-static int float_order(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
-
 /* Median luminance of the valid texels of the 5 x 5 window around (x, y), itself left out;
  * -1 when fewer than 8 are valid (too little to call anything an outlier). */
 static float window_median(const float *lum, const uint8_t *state, uint32_t w, uint32_t h, long x, long y)
@@ -34,8 +28,31 @@ static float window_median(const float *lum, const uint8_t *state, uint32_t w, u
         }
     if (n < 8)
         return -1;
-    qsort(v, (size_t)n, sizeof *v, float_order);
+    for (int a = 1; a < n; a++) { /* insertion sort: at most 24 values, once per texel (qsort's calls cost more) */
+        float x = v[a];
+        int b = a;
+        for (; b > 0 && v[b - 1] > x; b--)
+            v[b] = v[b - 1];
+        v[b] = x;
+    }
     return n % 2 ? v[n / 2] : 0.5f * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* The least luminance of the valid texels in the 5 x 5 window around (x, y), itself left out
+ * (0 when there are none). */
+static float window_min(const float *lum, const uint8_t *state, uint32_t w, uint32_t h, long x, long y)
+{
+    float least = -1;
+    for (long dy = -2; dy <= 2; dy++)
+        for (long dx = -2; dx <= 2; dx++) {
+            long xx = x + dx, yy = y + dy;
+            if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= (long)w || yy >= (long)h)
+                continue;
+            size_t j = (size_t)yy * w + (size_t)xx;
+            if (state[j] == LMB_TEXEL_VALID && (least < 0 || lum[j] < least))
+                least = lum[j];
+        }
+    return least < 0 ? 0 : least;
 }
 
 lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, uint32_t h, lmb_firefly_stats *stats,
@@ -58,6 +75,8 @@ lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, ui
         if (state[i] != LMB_TEXEL_VALID || !(lum[i] > 0))
             continue;
         long x = (long)(i % w), y = (long)(i / w);
+        if (lum[i] <= LMB_FIREFLY_FACTOR * window_min(lum, state, w, h, x, y))
+            continue; /* the median is at least the least: no spike (the cheap test first) */
         float median = window_median(lum, state, w, h, x, y);
         if (median < 0 || lum[i] <= LMB_FIREFLY_FACTOR * median)
             continue;

@@ -277,9 +277,13 @@ lmb_status lmb_step_merge_parts(const char *dir, const lmb_part_identity *id, ui
         if (st == LMB_OK && write_state)
             st = lmb_part_write(path, id, &place, body, size, err);
         free(body);
-        if (st == LMB_OK && out) {
-            out->size = out->read = 0;
-            st = lmb_buf_append(out, bytes, m.size, err);
+        if (st == LMB_OK && out) { /* the merged bytes become out's (no copy) */
+            free(out->data);
+            out->data = bytes;
+            out->size = m.size;
+            out->cap = total + 1;
+            out->read = 0;
+            bytes = NULL;
             memcpy(counters, m.counters, sizeof m.counters);
         }
     }
