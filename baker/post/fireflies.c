@@ -11,11 +11,13 @@ static float luminance(const float *c)
     return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
 }
 
-/* Median luminance of the valid texels of the 5 x 5 window around (x, y), itself left out;
- * -1 when fewer than 8 are valid (too little to call anything an outlier). */
+/* The median luminance of the valid texels of the 5 x 5 window around (x, y), itself left out;
+ * -1 when fewer than 8 are valid (too little to call anything an outlier), or when even the
+ * window's least value is over lum / LMB_FIREFLY_FACTOR (the median is at least the least:
+ * no spike, and no sort). */
 static float window_median(const float *lum, const uint8_t *state, uint32_t w, uint32_t h, long x, long y)
 {
-    float v[24];
+    float v[24], least = 0, spike = lum[(size_t)y * w + (size_t)x];
     int n = 0;
     for (long dy = -2; dy <= 2; dy++)
         for (long dx = -2; dx <= 2; dx++) {
@@ -23,36 +25,21 @@ static float window_median(const float *lum, const uint8_t *state, uint32_t w, u
             if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= (long)w || yy >= (long)h)
                 continue;
             size_t j = (size_t)yy * w + (size_t)xx;
-            if (state[j] == LMB_TEXEL_VALID)
+            if (state[j] == LMB_TEXEL_VALID) {
+                least = n == 0 || lum[j] < least ? lum[j] : least;
                 v[n++] = lum[j];
+            }
         }
-    if (n < 8)
+    if (n < 8 || spike <= LMB_FIREFLY_FACTOR * least)
         return -1;
     for (int a = 1; a < n; a++) { /* insertion sort: at most 24 values, once per texel (qsort's calls cost more) */
-        float x = v[a];
+        float t = v[a];
         int b = a;
-        for (; b > 0 && v[b - 1] > x; b--)
+        for (; b > 0 && v[b - 1] > t; b--)
             v[b] = v[b - 1];
-        v[b] = x;
+        v[b] = t;
     }
     return n % 2 ? v[n / 2] : 0.5f * (v[n / 2 - 1] + v[n / 2]);
-}
-
-/* The least luminance of the valid texels in the 5 x 5 window around (x, y), itself left out
- * (0 when there are none). */
-static float window_min(const float *lum, const uint8_t *state, uint32_t w, uint32_t h, long x, long y)
-{
-    float least = -1;
-    for (long dy = -2; dy <= 2; dy++)
-        for (long dx = -2; dx <= 2; dx++) {
-            long xx = x + dx, yy = y + dy;
-            if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= (long)w || yy >= (long)h)
-                continue;
-            size_t j = (size_t)yy * w + (size_t)xx;
-            if (state[j] == LMB_TEXEL_VALID && (least < 0 || lum[j] < least))
-                least = lum[j];
-        }
-    return least < 0 ? 0 : least;
 }
 
 lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, uint32_t h, lmb_firefly_stats *stats,
@@ -75,8 +62,6 @@ lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, ui
         if (state[i] != LMB_TEXEL_VALID || !(lum[i] > 0))
             continue;
         long x = (long)(i % w), y = (long)(i / w);
-        if (lum[i] <= LMB_FIREFLY_FACTOR * window_min(lum, state, w, h, x, y))
-            continue; /* the median is at least the least: no spike (the cheap test first) */
         float median = window_median(lum, state, w, h, x, y);
         if (median < 0 || lum[i] <= LMB_FIREFLY_FACTOR * median)
             continue;
