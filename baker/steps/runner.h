@@ -6,7 +6,7 @@
  * the bytes come from:
  *   local  (lmbake bake): the function runs over all items, in this process;
  *   shard  (lmbake step --step S --shard k/N): steps before S are read from the merged
- *          states in the farm folder, step S runs over shard k's range of items (cut by
+ *          states in the farm folder, step S runs over shard k's chunks of items (cut by
  *          estimated cost) and is written as a part; then the bake stops (LMB_STEP_STOPPED);
  *   finish (lmbake finish): every step is read from the merged states;
  *   worker (lmbake worker --worker W/J): a process for the whole bake. At each step it runs its
@@ -109,7 +109,7 @@ typedef struct lmb_merge_report {
 } lmb_merge_report;
 
 /* Merges the `shards` parts of step `step` into its state, after checking each against id
- * (naming the part and what differs) and that their ranges cover the items exactly once. */
+ * (naming the part and what differs) and that their chunks cover the items exactly once. */
 lmb_status lmb_steps_merge(const char *dir, const lmb_part_identity *id, uint32_t step, uint32_t shards,
                            lmb_merge_report *report, lmb_error *err);
 
