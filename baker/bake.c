@@ -439,6 +439,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     stats->texel_density = l.density.scene_density;
     stats->density_auto = l.density.automatic;
     stats->density_capped = l.density.capped;
+    stats->density_raised = l.density.raised;
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
         st = write_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,

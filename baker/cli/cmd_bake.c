@@ -457,6 +457,8 @@ static int run(int argc, char **argv, stage_kind stage)
             printf("texel density: %.4g texels per unit", bs.texel_density);
         if (bs.density_capped)
             printf("; %u instance(s) lowered to fit one atlas", bs.density_capped);
+        if (bs.density_raised)
+            printf("; %u small instance(s) raised (atlas.min_chart_texels)", bs.density_raised);
         printf("\n");
         print_bounces(&cfg, &bs);
     }

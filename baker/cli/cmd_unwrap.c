@@ -12,6 +12,7 @@
 #include "unwrap/metrics.h"
 #include "write/image_adapter.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -153,6 +154,87 @@ static void print_topology(const lmb_topology_counts *t)
                t->om_other);
 }
 
+typedef struct chart_box {
+    double x0, y0, x1, y1, area; /* texel units; area: the chart's UV area */
+    uint64_t centres;            /* texel centres its triangles cover */
+} chart_box;
+
+static void count_centre(void *user, uint32_t x, uint32_t y)
+{
+    (void)x;
+    (void)y;
+    ++*(uint64_t *)user;
+}
+
+static int by_short_side(const void *a, const void *b)
+{
+    const chart_box *p = a, *q = b;
+    double x = fmin(p->x1 - p->x0, p->y1 - p->y0), y = fmin(q->x1 - q->x0, q->y1 - q->y0);
+    return x < y ? -1 : x > y;
+}
+
+/* Chart sizes in texels, what atlas.min_chart_texels is about: the smallest chart, the
+ * smallest instance's typical chart (the area-weighted median of its charts' shorter sides,
+ * the measure the floor uses), and the charts that cover no texel centre (lit only by
+ * dilation). */
+static void print_chart_sizes(const lmb_scene *s, const lmb_layout *l)
+{
+    uint64_t charts = 0, empty = 0;
+    double smallest = INFINITY, typical_min = INFINITY;
+    uint32_t smallest_at = 0, typical_at = 0;
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        const lmb_layout_instance *li = &l->instances[i];
+        const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+        if (!li->lightmapped || !li->uv1 || c->chart_count == 0)
+            continue;
+        chart_box *b = malloc(sizeof(chart_box) * c->chart_count);
+        if (!b)
+            return;
+        for (uint32_t k = 0; k < c->chart_count; k++)
+            b[k] = (chart_box){INFINITY, INFINITY, -INFINITY, -INFINITY, 0, 0};
+        for (uint32_t f = 0; f < c->triangle_count; f++) {
+            uint32_t k = c->chart_of[f];
+            if (k == UINT32_MAX)
+                continue;
+            const double *u = li->uv1 + 6 * f;
+            for (int v = 0; v < 3; v++) {
+                b[k].x0 = fmin(b[k].x0, u[2 * v]);
+                b[k].x1 = fmax(b[k].x1, u[2 * v]);
+                b[k].y0 = fmin(b[k].y0, u[2 * v + 1]);
+                b[k].y1 = fmax(b[k].y1, u[2 * v + 1]);
+            }
+            b[k].area += 0.5 * fabs((u[2] - u[0]) * (u[5] - u[1]) - (u[4] - u[0]) * (u[3] - u[1]));
+            lmb_raster_triangle_centres(u, l->width[li->atlas], l->height[li->atlas], count_centre, &b[k].centres);
+        }
+        double total = 0, run = 0;
+        for (uint32_t k = 0; k < c->chart_count; k++) {
+            double side = fmin(b[k].x1 - b[k].x0, b[k].y1 - b[k].y0);
+            charts++;
+            empty += b[k].centres == 0;
+            total += b[k].area;
+            if (side < smallest) {
+                smallest = side;
+                smallest_at = i;
+            }
+        }
+        qsort(b, c->chart_count, sizeof *b, by_short_side);
+        uint32_t k = c->chart_count;
+        while (k > 0 && run < 0.5 * total)
+            run += b[--k].area;
+        double typical = fmin(b[k].x1 - b[k].x0, b[k].y1 - b[k].y0);
+        if (typical < typical_min) {
+            typical_min = typical;
+            typical_at = i;
+        }
+        free(b);
+    }
+    if (charts)
+        printf("chart sizes: smallest %.2f texels across (instance '%s'); smallest typical chart %.2f texels across "
+               "(instance '%s'); %llu of %llu charts (%.1f%%) cover no texel centre\n",
+               smallest, s->instances[smallest_at].name, typical_min, s->instances[typical_at].name,
+               (unsigned long long)empty, (unsigned long long)charts, 100.0 * (double)empty / (double)charts);
+}
+
 static void print_report(const lmb_scene *s, const lmb_layout *l)
 {
     double chart_total = 0;
@@ -178,7 +260,10 @@ static void print_report(const lmb_scene *s, const lmb_layout *l)
         printf("texel density: %.4g texels per unit", l->density.scene_density);
     if (l->density.capped)
         printf("; %u instance(s) lowered to fit one atlas", l->density.capped);
+    if (l->density.raised)
+        printf("; %u small instance(s) raised (atlas.min_chart_texels)", l->density.raised);
     printf("\n");
+    print_chart_sizes(s, l);
 }
 
 int cmd_unwrap(int argc, char **argv)

@@ -21,8 +21,9 @@ double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t
     return a;
 }
 
-/* Per chart of instance i: its box sides in world units (chart box x world/uv scale). */
-static int chart_boxes(const lmb_scene *s, const lmb_layout *l, uint32_t i, double *bw, double *bh)
+/* Per chart of instance i: its box sides in world units (chart box x world/uv scale) and, if
+ * area is not NULL, its world area. */
+static int chart_boxes(const lmb_scene *s, const lmb_layout *l, uint32_t i, double *bw, double *bh, double *area)
 {
     const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
     for (uint32_t k = 0; k < c->chart_count; k++) {
@@ -43,6 +44,8 @@ static int chart_boxes(const lmb_scene *s, const lmb_layout *l, uint32_t i, doub
         lmb_pack_chart_box(&pc, &w, &h);
         bw[k] = w * scale;
         bh[k] = h * scale;
+        if (area)
+            area[k] = aw;
         free(uv);
     }
     return 1;
@@ -65,7 +68,7 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
     if (lm->kept_uv1 || nc == 0)
         return INFINITY;
     double *bw = malloc(sizeof(double) * nc + 1), *bh = malloc(sizeof(double) * nc + 1);
-    if (!bw || !bh || !chart_boxes(s, l, i, bw, bh)) {
+    if (!bw || !bh || !chart_boxes(s, l, i, bw, bh, NULL)) {
         free(bw);
         free(bh);
         return INFINITY; /* out of memory: the packer will say */
@@ -93,6 +96,48 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
     return result;
 }
 
+typedef struct side_area {
+    double side, area;
+} side_area;
+
+static int by_side(const void *a, const void *b)
+{
+    double x = ((const side_area *)a)->side, y = ((const side_area *)b)->side;
+    return x < y ? -1 : x > y;
+}
+
+double lmb_density_floor(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t i)
+{
+    const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
+    uint32_t nc = lm->charts.chart_count;
+    if (cfg->min_chart_texels == 0 || lm->kept_uv1 || nc == 0)
+        return 0;
+    double *bw = malloc(sizeof(double) * nc + 1), *bh = malloc(sizeof(double) * nc + 1),
+           *ca = malloc(sizeof(double) * nc + 1);
+    side_area *sa = malloc(sizeof(side_area) * nc + 1);
+    double result = 0;
+    if (bw && bh && ca && sa && chart_boxes(s, l, i, bw, bh, ca)) {
+        double total = 0, run = 0;
+        for (uint32_t k = 0; k < nc; k++) {
+            sa[k] = (side_area){fmin(bw[k], bh[k]), ca[k]};
+            total += ca[k];
+        }
+        qsort(sa, nc, sizeof *sa, by_side);
+        /* the area-weighted median of the charts' shorter sides, from the largest down: the
+         * charts that hold at least half the surface are at least this wide */
+        uint32_t k = nc;
+        while (k > 0 && run < 0.5 * total)
+            run += sa[--k].area;
+        if (sa[k].side > 0)
+            result = cfg->min_chart_texels / sa[k].side;
+    }
+    free(bw);
+    free(bh);
+    free(ca);
+    free(sa);
+    return result;
+}
+
 double lmb_density_override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t i)
 {
     const lmb_instance *in = &s->instances[i];
@@ -116,15 +161,76 @@ static lmb_status explicit_too_high(const lmb_scene *s, const lmb_config *cfg, u
                          would >= 100 ? 0 : would >= 1 ? 2 : 4, would);
 }
 
+/* Texels the free (non-fixed) instances take at scene density d, each held in [floor, fit]. */
+static double free_texels(double d, uint32_t n, const uint8_t *fixed, const double *area, const double *floor_d,
+                          const double *fit)
+{
+    double t = 0;
+    for (uint32_t k = 0; k < n; k++)
+        if (!fixed[k]) {
+            double dk = fmin(fmax(d, floor_d[k]), fit[k]);
+            t += area[k] * dk * dk;
+        }
+    return t;
+}
+
+/* texel_density: auto. Water filling (instances that cannot take d keep their fit, the rest
+ * share what is left), then, if atlas.min_chart_texels raises some instances above d, the d
+ * at which the raised and the rest together take the budget again (bisection: the texels
+ * grow with d). The floors may take at most half the budget: beyond it they are scaled down. */
+static double auto_density(double left, uint32_t n, const uint8_t *fixed, const double *area, double *floor_d,
+                           const double *fit, double free_area, const lmb_log *log)
+{
+    double d = sqrt(left / free_area);
+    for (int round = 0; round < 32; round++) {
+        double capped_texels = 0, open_area = 0;
+        for (uint32_t k = 0; k < n; k++)
+            if (!fixed[k] && fit[k] < d)
+                capped_texels += area[k] * fit[k] * fit[k];
+            else if (!fixed[k])
+                open_area += area[k];
+        double next = open_area > 0 ? sqrt(fmax(left - capped_texels, 0) / open_area) : d;
+        if (!(next > d * 1.001))
+            break;
+        d = next;
+    }
+    int raised = 0;
+    for (uint32_t k = 0; k < n; k++)
+        raised |= !fixed[k] && floor_d[k] > d && fit[k] > d;
+    if (!raised)
+        return d; /* the floors change nothing: the layout is the one without them */
+    double floors = free_texels(0, n, fixed, area, floor_d, fit);
+    if (floors > 0.5 * left) {
+        double f = sqrt(0.5 * left / floors);
+        for (uint32_t k = 0; k < n; k++)
+            floor_d[k] *= f;
+        lmb_warn(log,
+                 "atlas.min_chart_texels: raising small instances would take %.0f%% of the texel budget; they get "
+                 "%.0f%% of the density it asks, and the budget's half",
+                 100.0 * floors / left, 100.0 * f);
+    }
+    double lo = 0, hi = d;
+    for (int it = 0; it < 64 && hi - lo > 1e-9 * hi; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (free_texels(mid, n, fixed, area, floor_d, fit) <= left)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo > 0 ? lo : hi;
+}
+
 lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
                               uint32_t n, const lmb_log *log, lmb_density_report *rep, lmb_error *err)
 {
     memset(rep, 0, sizeof *rep);
     rep->automatic = !(cfg->texel_density > 0);
     rep->budget = lmb_config_atlas_texels(cfg);
-    double *fit = malloc(sizeof(double) * n + 1), *area = malloc(sizeof(double) * n + 1);
+    double *fit = malloc(sizeof(double) * n + 1), *area = malloc(sizeof(double) * n + 1),
+           *floor_d = calloc((size_t)n + 1, sizeof(double));
     uint8_t *fixed = calloc((size_t)n + 1, 1);
-    lmb_status st = fit && area && fixed ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    lmb_status st =
+        fit && area && floor_d && fixed ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     double fixed_texels = 0, free_area = 0;
     for (uint32_t k = 0; st == LMB_OK && k < n; k++) {
         uint32_t i = list[k];
@@ -141,9 +247,15 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
                                cfg->max_atlas_size);
             break;
         }
-        if (d > 0) { /* explicit: it wins, or it is refused now */
+        if (o <= 0) /* an override is the artist's word for this instance: no floor */
+            floor_d[k] = fmin(lmb_density_floor(s, l, cfg, i), fit[k]);
+        if (d > 0) { /* explicit: it wins (raised to the floor), or it is refused now */
             if (d > fit[k])
                 st = explicit_too_high(s, cfg, i, d, fit[k], o > 0, err);
+            if (floor_d[k] > d) {
+                d = floor_d[k];
+                rep->raised++;
+            }
             l->instances[i].texel_density = d;
             fixed[k] = 1;
             fixed_texels += area[k] * d * d;
@@ -154,30 +266,19 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
     if (st == LMB_OK && !rep->automatic)
         rep->scene_density = cfg->texel_density;
     if (st == LMB_OK && rep->automatic && free_area > 0) {
-        /* water filling: instances that cannot take d keep their fit, the rest share what is left */
-        double left = (double)rep->budget - fixed_texels, d;
+        double left = (double)rep->budget - fixed_texels;
         if (left < 0.1 * (double)rep->budget)
             left = 0.1 * (double)rep->budget; /* overrides took the budget: the rest still gets some */
-        d = sqrt(left / free_area);
-        for (int round = 0; round < 32; round++) {
-            double capped_texels = 0, open_area = 0;
-            for (uint32_t k = 0; k < n; k++)
-                if (!fixed[k] && fit[k] < d)
-                    capped_texels += area[k] * fit[k] * fit[k];
-                else if (!fixed[k])
-                    open_area += area[k];
-            double next = open_area > 0 ? sqrt(fmax(left - capped_texels, 0) / open_area) : d;
-            if (!(next > d * 1.001))
-                break;
-            d = next;
-        }
+        double d = auto_density(left, n, fixed, area, floor_d, fit, free_area, log);
         rep->scene_density = d;
         for (uint32_t k = 0; k < n; k++) {
             if (fixed[k])
                 continue;
             uint32_t i = list[k];
-            double di = fit[k] < d ? fit[k] : d;
+            double di = fmin(fmax(d, floor_d[k]), fit[k]);
             l->instances[i].texel_density = di > 0 ? di : d;
+            if (floor_d[k] > d && di > d)
+                rep->raised++;
             if (fit[k] < d) {
                 rep->capped++;
                 lmb_warn(log,
@@ -188,8 +289,14 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
             }
         }
     }
+    if (st == LMB_OK && rep->raised)
+        lmb_info(log,
+                 "%u instance(s) get more than the scene's %.4g texels per unit so that their charts span at least %u "
+                 "texels (atlas.min_chart_texels)",
+                 rep->raised, rep->scene_density, cfg->min_chart_texels);
     free(fit);
     free(area);
+    free(floor_d);
     free(fixed);
     return st;
 }

@@ -7,7 +7,9 @@
  * scale-free by construction (a level in millimetres and the same in metres get the same
  * texels). Every instance must sit whole in one atlas, so each also has a fit density (an
  * estimate from its charts' boxes and padding, below); an instance whose fit is lower than d
- * gets its fit (a warning names it) and the texels it leaves go to the others.
+ * gets its fit (a warning names it) and the texels it leaves go to the others. An instance
+ * whose charts would be smaller than atlas.min_chart_texels at d is raised to its floor
+ * (lmb_density_floor) and the budget shrinks the rest.
  */
 #ifndef LMBAKE_DENSITY_H
 #define LMBAKE_DENSITY_H
@@ -19,6 +21,12 @@
  * within 80% of the atlas area (what the packer reaches with many charts). Infinite for an
  * instance that keeps its TEXCOORD_1 (it gets its own atlas, clamped). */
 double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t instance);
+
+/* atlas.min_chart_texels' floor for instance i: the density at which the charts that hold
+ * at least half its world area (the area-weighted median of the charts' shorter box sides)
+ * span min_chart_texels texels each way; 0 when the key is 0 or the instance keeps its
+ * TEXCOORD_1. A few-centimetre prop in a 100 m level would otherwise get 1-3 texel charts. */
+double lmb_density_floor(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t instance);
 
 /* Sets l->instances[list[k]].texel_density for the lightmapped instances list[0..n).
  * Explicit densities that are not expected to fit one atlas are LMB_ERR_INPUT naming the

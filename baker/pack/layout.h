@@ -21,6 +21,7 @@ typedef struct lmb_density_report {
     double scene_density;   /* the density instances without an override got (before any fit cap) */
     uint64_t budget;        /* auto: the texel budget */
     uint32_t capped;        /* auto: instances lowered to fit one atlas */
+    uint32_t raised;        /* instances raised above the scene density by atlas.min_chart_texels */
 } lmb_density_report;
 
 /* One mesh's primitives as a single triangle list (vertex ids offset per primitive). */

@@ -59,6 +59,7 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
     put_f64(&w, l->density.scene_density);
     put_u64(&w, l->density.budget);
     put_u32(&w, l->density.capped);
+    put_u32(&w, l->density.raised);
     for (uint32_t m = 0; m < l->mesh_count; m++) {
         const lmb_layout_mesh *lm = &l->meshes[m];
         const lmb_mesh_soup *s = &lm->soup;
@@ -174,6 +175,7 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
     l->density.scene_density = get_f64(&r);
     l->density.budget = get_u64(&r);
     l->density.capped = get_u32(&r);
+    l->density.raised = get_u32(&r);
     for (uint32_t m = 0; m < l->mesh_count && !r.failed; m++) {
         lmb_layout_mesh *lm = &l->meshes[m];
         lmb_mesh_soup *s = &lm->soup;

@@ -271,6 +271,8 @@ typedef struct lmb_config {
     uint32_t padding;              /* texels between charts */
     int keep_uv1;                  /* keep a mesh's own TEXCOORD_1 */
     int share_meshes;              /* atlas.share_meshes: nodes that share a mesh keep sharing it, a rectangle each */
+    uint32_t min_chart_texels;     /* atlas.min_chart_texels: an instance's density is raised so its typical chart
+                                      spans at least this many texels each way (0 = off; docs/defaults.md) */
     /* samples */
     uint32_t texel_samples;        /* gather points per texel (stratified) */
     uint32_t direct_samples;       /* shadow rays per area-light evaluation */
@@ -441,6 +443,7 @@ typedef struct lmb_bake_stats {
     double texel_density;   /* the scene's density (auto: what the budget gave) */
     int density_auto;       /* texel_density: auto */
     uint32_t density_capped; /* auto: instances lowered to fit one atlas */
+    uint32_t density_raised; /* instances raised by atlas.min_chart_texels */
     double direct_noise_median, direct_noise_p95; /* estimated relative standard error of texels' direct light,
                                                      of the light shown */
     uint64_t direct_refined; /* texels whose direct light took more samples (samples.noise) */
