@@ -6,6 +6,11 @@
  * (N, C, A: the chart's area-weighted mean normal, centroid and area), so coplanar
  * regions fill before curved ones and charts grow round rather than in strands. A face
  * joins only if its normal is within max_angle of N at the moment it is taken.
+ *
+ * A chart whose faces all share its seed's plane also grows across the topology's coplanar
+ * links (seams between coplanar triangles of a soup, topology.c); once it has, it takes only
+ * faces of that plane, so it stays a projection (flatten.c) and never needs LSCM, which
+ * could not join the two sides of a seam.
  */
 #include "unwrap_internal.h"
 
@@ -15,7 +20,7 @@
 
 typedef struct entry {
     double cost;
-    uint32_t face;
+    uint32_t face, via_link; /* via_link: reached only across a coplanar link */
 } entry;
 
 typedef struct heap {
@@ -69,9 +74,32 @@ static entry heap_pop(heap *h)
 
 typedef struct chart_state {
     double nsum[3], csum[3], area;
+    const double *seed_normal;
+    int planar; /* every face so far in the seed's plane (SEED_PLANE_DOT) */
+    int linked; /* grown across a link: only faces of the seed's plane may join */
 } chart_state;
 
-static double dot_mean_normal(const chart_state *s, const double *n)
+static double dot_mean_normal(const struct chart_state *s, const double *n);
+
+/* Within half of flatten.c's planar tolerance of the seed, so every face is within it of
+ * the chart's mean normal. */
+#define SEED_PLANE_DOT (1.0 - 2.5e-8)
+
+static int in_seed_plane(const chart_state *s, const double *n)
+{
+    const double *m = s->seed_normal;
+    return n[0] * m[0] + n[1] * m[1] + n[2] * m[2] >= SEED_PLANE_DOT;
+}
+
+/* Whether face f (normal n) may join the chart now, reached through a neighbour or a link. */
+static int may_join(const chart_state *s, const double *n, uint32_t via_link, double cos_max)
+{
+    if (via_link || s->linked)
+        return s->planar && in_seed_plane(s, n);
+    return dot_mean_normal(s, n) >= cos_max;
+}
+
+static double dot_mean_normal(const struct chart_state *s, const double *n)
 {
     double len = sqrt(s->nsum[0] * s->nsum[0] + s->nsum[1] * s->nsum[1] + s->nsum[2] * s->nsum[2]);
     return len > 0 ? (n[0] * s->nsum[0] + n[1] * s->nsum[1] + n[2] * s->nsum[2]) / len : 1.0;
@@ -88,9 +116,11 @@ static double cost_of(const lmb_topology *t, const chart_state *s, uint32_t f)
     return (1.0 - dot_mean_normal(s, t->normal + 3 * f)) + 0.5 * sqrt(d2 / s->area);
 }
 
-static void add_face(const lmb_topology *t, chart_state *s, uint32_t f)
+static void add_face(const lmb_topology *t, chart_state *s, uint32_t f, uint32_t via_link)
 {
     double a = t->area[f];
+    s->planar = s->planar && in_seed_plane(s, t->normal + 3 * f);
+    s->linked |= via_link != 0;
     for (int i = 0; i < 3; i++) {
         s->nsum[i] += a * t->normal[3 * f + i];
         s->csum[i] += a * t->centroid[3 * f + i];
@@ -133,15 +163,17 @@ lmb_status lmb_segment(const lmb_unwrap_input *in, const lmb_topology *t, const 
         uint32_t id = (*next_chart)++;
         chart_state st;
         memset(&st, 0, sizeof st);
+        st.seed_normal = t->normal + 3 * s0;
+        st.planar = 1;
         chart_of[s0] = id;
-        add_face(t, &st, s0);
+        add_face(t, &st, s0, 0);
         h.n = 0;
-        uint32_t f = s0;
+        uint32_t f = s0, via = 0;
         for (;;) {
-            for (int k = 0; k < 3; k++) {
-                uint32_t g = t->neighbor[3 * f + k];
-                if (g != LMB_NONE && chart_of[g] == LMB_NONE) {
-                    entry e = {cost_of(t, &st, g), g};
+            for (int k = 0; k < 6; k++) { /* the three neighbours, then the three links */
+                uint32_t g = k < 3 ? t->neighbor[3 * f + k] : t->link[3 * f + k - 3];
+                if (g != LMB_NONE && chart_of[g] == LMB_NONE && (k < 3 || st.planar)) {
+                    entry e = {cost_of(t, &st, g), g, k >= 3};
                     if (!heap_push(&h, e)) {
                         free(h.e);
                         free(seeds);
@@ -152,13 +184,15 @@ lmb_status lmb_segment(const lmb_unwrap_input *in, const lmb_topology *t, const 
             f = LMB_NONE;
             while (h.n && f == LMB_NONE) {
                 entry e = heap_pop(&h);
-                if (chart_of[e.face] == LMB_NONE && dot_mean_normal(&st, t->normal + 3 * e.face) >= cos_max)
+                if (chart_of[e.face] == LMB_NONE && may_join(&st, t->normal + 3 * e.face, e.via_link, cos_max)) {
                     f = e.face;
+                    via = e.via_link;
+                }
             }
             if (f == LMB_NONE)
                 break;
             chart_of[f] = id;
-            add_face(t, &st, f);
+            add_face(t, &st, f, via);
         }
     }
     free(h.e);

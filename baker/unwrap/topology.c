@@ -5,6 +5,12 @@
  * and gives, per corner, the triangle across its edge. Two triangles are neighbours only
  * across an edge that exactly two triangles share, in opposite directions: a non-manifold
  * edge or a winding flip becomes a chart seam instead of a crash or a fold.
+ *
+ * A soup's seams often run between coplanar triangles: a quad whose second triangle was
+ * re-added on copied vertices, the tops of a row of touching crates (their edges have four
+ * triangles). Those are recorded as links (coplanar_links): a planar chart grows across
+ * them, since a projection needs no shared vertices, while a curved chart (LSCM, which
+ * joins triangles only through shared vertices) does not.
  */
 #include "halfedge_adapter.h"
 #include "unwrap_internal.h"
@@ -52,6 +58,69 @@ static void geometry(const lmb_unwrap_input *in, uint32_t f, lmb_topology *t)
         t->normal[3 * f + i] = len > 0 ? n[i] / len : 0.0;
 }
 
+typedef struct wedge {
+    uint32_t lo, hi, face, k;
+} wedge;
+
+static int cmp_wedge(const void *a, const void *b)
+{
+    const wedge *x = a, *y = b;
+    if (x->lo != y->lo)
+        return x->lo < y->lo ? -1 : 1;
+    if (x->hi != y->hi)
+        return x->hi < y->hi ? -1 : 1;
+    return (x->face > y->face) - (x->face < y->face);
+}
+
+/* t->link: for each seam corner edge, the single other triangle on the same welded edge
+ * (sorted edge list) with the same normal that runs the edge the other way (so it lies on
+ * the far side of the edge, not over the first); none if there are two or more
+ * (overlapping coplanar copies: which to join would be a guess) on either side. */
+static int coplanar_links(lmb_topology *t, uint32_t nt, const uint8_t *skip)
+{
+    wedge *e = malloc(((size_t)nt * 3 + 1) * sizeof *e);
+    if (!e)
+        return 0;
+    uint32_t ne = 0;
+    for (uint32_t f = 0; f < nt; f++)
+        for (uint32_t k = 0; k < 3; k++) {
+            t->link[3 * f + k] = LMB_NONE;
+            uint32_t a = t->weld[3 * f + k], b = t->weld[3 * f + (k + 1) % 3];
+            if (!skip[f] && t->neighbor[3 * f + k] == LMB_NONE && a != b)
+                e[ne++] = (wedge){a < b ? a : b, a < b ? b : a, f, k};
+        }
+    qsort(e, ne, sizeof *e, cmp_wedge);
+    for (uint32_t i = 0, j; i < ne; i = j) {
+        for (j = i + 1; j < ne && e[j].lo == e[i].lo && e[j].hi == e[i].hi;)
+            j++;
+        for (uint32_t x = i; x < j; x++) {
+            const double *nx = t->normal + 3 * e[x].face;
+            uint32_t found = LMB_NONE, count = 0;
+            for (uint32_t y = i; y < j; y++) {
+                const double *ny = t->normal + 3 * e[y].face;
+                /* the edge must run the other way in y: then y lies across it, not over x */
+                if (y != x && t->weld[3 * e[y].face + e[y].k] != t->weld[3 * e[x].face + e[x].k] &&
+                    nx[0] * ny[0] + nx[1] * ny[1] + nx[2] * ny[2] >= LMB_PLANAR_DOT) {
+                    found = e[y].face;
+                    count++;
+                }
+            }
+            if (count == 1)
+                t->link[3 * e[x].face + e[x].k] = found;
+        }
+    }
+    /* keep only links both sides agree on (a duplicate layer makes one side ambiguous) */
+    for (uint32_t i = 0; i < ne; i++) {
+        uint32_t f = e[i].face, g = t->link[3 * f + e[i].k], back = 0;
+        for (int k = 0; g != LMB_NONE && k < 3; k++)
+            back |= t->link[3 * g + k] == f;
+        if (g != LMB_NONE && !back)
+            t->link[3 * f + e[i].k] = LMB_NONE;
+    }
+    free(e);
+    return 1;
+}
+
 /* Welded id per input vertex (ids in order of position) and one position per welded id. */
 static uint32_t weld(const lmb_unwrap_input *in, vkey *vk, uint32_t *id, float *welded)
 {
@@ -76,6 +145,8 @@ lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_
     uint32_t nv = in->vertex_count, nt = in->triangle_count;
     vkey *vk = malloc(((size_t)nv + 1) * sizeof *vk);
     uint32_t *id = malloc(((size_t)nv + 1) * sizeof *id), *faces = malloc(((size_t)nt * 3 + 1) * sizeof *faces);
+    t->weld = faces;
+    t->link = malloc(((size_t)nt * 3 + 1) * sizeof *t->link);
     float *welded = malloc(((size_t)nv * 3 + 1) * sizeof *welded);
     uint8_t *skip = malloc((size_t)nt + 1);
     t->corner = malloc(((size_t)nt * 3 + 1) * sizeof *t->corner);
@@ -84,7 +155,7 @@ lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_
     t->area = calloc((size_t)nt + 1, sizeof *t->area);
     t->centroid = calloc((size_t)nt * 3 + 1, sizeof *t->centroid);
     lmb_status st = LMB_OK;
-    if (!vk || !id || !faces || !welded || !skip || !t->corner || !t->neighbor || !t->normal || !t->area ||
+    if (!vk || !id || !faces || !t->link || !welded || !skip || !t->corner || !t->neighbor || !t->normal || !t->area ||
         !t->centroid) {
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "unwrap: mesh '%s': out of memory for %u triangles",
                            name ? name : "mesh", nt);
@@ -98,10 +169,12 @@ lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_
         }
         lmb_halfedge_input h = {name, nw, welded, nt, faces, skip};
         st = lmb_halfedge_build(&h, t->corner, t->neighbor, &t->vertex_count, &t->counts, err);
+        if (st == LMB_OK && !coplanar_links(t, nt, skip))
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "unwrap: mesh '%s': out of memory for %u triangles",
+                               name ? name : "mesh", nt);
     }
     free(vk);
     free(id);
-    free(faces);
     free(welded);
     free(skip);
     if (st != LMB_OK)
@@ -112,7 +185,9 @@ lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_
 void lmb_topology_free(lmb_topology *t)
 {
     free(t->corner);
+    free(t->weld);
     free(t->neighbor);
+    free(t->link);
     free(t->normal);
     free(t->area);
     free(t->centroid);

@@ -43,8 +43,16 @@ static int crosses(const double *p, const double *q, const double *r, const doub
 
 typedef struct bedge {
     const double *a, *b;
-    uint32_t wa, wb; /* end points' mesh vertex ids */
+    uint32_t wa, wb; /* end points' vertex ids: mesh ids (chart_valid), welded ids (has_hole) */
 } bedge;
+
+/* Whether the edge of corner k of triangle f is inside its chart: the triangle across it
+ * (or across its coplanar link, which planar charts grow over) is in the same chart. */
+static int edge_inside(const lmb_topology *t, uint32_t f, int k, const uint32_t *chart_of)
+{
+    uint32_t id = chart_of[f], g = t->neighbor[3 * f + k], l = t->link[3 * f + k];
+    return (g != LMB_NONE && chart_of[g] == id) || (l != LMB_NONE && chart_of[l] == id);
+}
 
 /* Boundary self-intersection over a uniform grid of the chart's UV bounding box. */
 static int boundary_crosses(const bedge *e, uint32_t ne)
@@ -115,14 +123,13 @@ static int boundary_crosses(const bedge *e, uint32_t ne)
 static int chart_valid(const lmb_topology *t, const uint32_t *tris, uint32_t n,
                        const uint32_t *chart_of, const double *uv, bedge *scratch)
 {
-    uint32_t ne = 0, id = chart_of[tris[0]];
+    uint32_t ne = 0;
     for (uint32_t i = 0; i < n; i++) {
         const double *p = uv + 6 * tris[i];
         if (!(orient(p, p + 2, p + 4) > 0))
             return 0;
         for (int k = 0; k < 3; k++) {
-            uint32_t g = t->neighbor[3 * tris[i] + k];
-            if (g != LMB_NONE && chart_of[g] == id)
+            if (edge_inside(t, tris[i], k, chart_of))
                 continue;
             bedge *b = &scratch[ne++];
             b->a = p + 2 * k;
@@ -136,18 +143,17 @@ static int chart_valid(const lmb_topology *t, const uint32_t *tris, uint32_t n,
 
 /* A chart whose boundary falls into more than one connected piece has a hole (a ring,
  * such as the flat top of a torus): valid, but its hole wastes atlas space, so it is cut.
- * Boundary end points are merged with union-find over the chart's mesh vertex ids. */
+ * Boundary end points are merged with union-find over the chart's welded vertex ids. */
 static int has_hole(const lmb_topology *t, const uint32_t *tris, uint32_t n,
                     const uint32_t *chart_of, bedge *scratch)
 {
-    uint32_t ne = 0, id = chart_of[tris[0]];
+    uint32_t ne = 0;
     for (uint32_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++) {
-            uint32_t g = t->neighbor[3 * tris[i] + k];
-            if (g != LMB_NONE && chart_of[g] == id)
+            if (edge_inside(t, tris[i], k, chart_of))
                 continue;
-            scratch[ne].wa = t->corner[3 * tris[i] + k];
-            scratch[ne].wb = t->corner[3 * tris[i] + (k + 1) % 3];
+            scratch[ne].wa = t->weld[3 * tris[i] + k];
+            scratch[ne].wb = t->weld[3 * tris[i] + (k + 1) % 3];
             ne++;
         }
     if (ne < 6)

@@ -34,12 +34,19 @@ static inline uint32_t lmb_lower_bound(const uint32_t *ids, uint32_t n, uint32_t
 typedef struct lmb_topology {
     uint32_t vertex_count; /* welded vertices and their duplicates */
     uint32_t *corner;      /* 3 per triangle: vertex id, shared by the corners of one chart vertex */
+    uint32_t *weld;        /* 3 per triangle: welded vertex id (equal positions, before any duplicate) */
     uint32_t *neighbor;    /* 3 per triangle */
+    uint32_t *link;        /* 3 per triangle: across a seam edge (neighbor LMB_NONE), the one other
+                              triangle on the same welded edge that is coplanar and faces the same
+                              way (PLANAR_DOT), else LMB_NONE: a planar chart may grow across it */
     double *normal;        /* 3 per triangle, unit (0 for skipped) */
     double *area;          /* per triangle */
     double *centroid;      /* 3 per triangle */
     lmb_topology_counts counts;
 } lmb_topology;
+
+/* Two unit normals this close are one plane for flattening (flatten.c's planar test). */
+#define LMB_PLANAR_DOT (1.0 - 1e-7)
 
 /* name: the mesh, for messages (NULL: "mesh"). */
 lmb_status lmb_topology_build(const lmb_unwrap_input *in, const char *name, lmb_topology *t, lmb_error *err);

@@ -126,7 +126,9 @@ def copies(lmbake, work):
     shutil.rmtree(out, ignore_errors=True)
     cfg = os.path.join(work, "instanced.yaml")
     with open(cfg, "w") as f:
-        f.write("atlas: {texels: 131072}\noutput: {formats: [exr, mask], directional: false}\n")
+        # min_chart_texels 0: one density for every copy, so rectangles scale with the copies (the
+        # floor would raise the small copies' boxes more than the large ones')
+        f.write("atlas: {texels: 131072, min_chart_texels: 0}\noutput: {formats: [exr, mask], directional: false}\n")
     p = subprocess.run([lmbake, "bake", os.path.join(scenes, "instanced-boxes.gltf"), "-c", cfg, "-o", out],
                        capture_output=True, text=True)
     if p.returncode != 0:

@@ -3,8 +3,8 @@
  * input OpenMesh's add_face refuses or accepts only as a non-manifold vertex: a complex
  * edge (3 triangles on one edge), a winding flip, a bowtie vertex and a triangle touching a
  * closed fan at its centre. Checks that every triangle is kept (and charted), which
- * neighbours become seams, which stay, the counts reported, that OpenMesh printed nothing,
- * and that two builds agree.
+ * neighbours become seams, which stay, which seams link coplanar triangles, the counts
+ * reported, that OpenMesh printed nothing, and that two builds agree.
  */
 #define _POSIX_C_SOURCE 200809L
 #include "check.h"
@@ -91,6 +91,15 @@ static void test_topology(void)
                        (int)expect[f][k]);
             CHECK(t.neighbor[3 * f + k] == expect[f][k]);
         }
+    /* coplanar links across seams: only T0 and T1 (same plane, edge 0-1 run both ways); T4/T5
+     * run 6-7 the same way (a flip), T2 stands across the others' plane */
+    for (uint32_t f = 0; f < NT; f++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t want = f == 0 && k == 0 ? 1 : f == 1 && k == 0 ? 0 : LMB_NONE;
+            if (t.link[3 * f + k] != want)
+                printf("T%u corner %d: link %d, expected %d\n", f, k, (int)t.link[3 * f + k], (int)want);
+            CHECK(t.link[3 * f + k] == want);
+        }
     /* 22 distinct positions; three duplicates: vertex 1 for T2, vertex 6 for T5, 15 for T12 */
     CHECK_INT(t.counts.duplicated_vertices, 3);
     CHECK_INT(t.vertex_count, 22 + 3);
@@ -130,7 +139,9 @@ static void test_unwrap_keeps_all(void)
     for (uint32_t f = 0; f < NT; f++)
         CHECK(c.chart_of[f] != UINT32_MAX);
     CHECK(c.chart_of[2] == c.chart_of[3]);          /* neighbours in one plane: one chart */
-    CHECK(c.chart_of[0] != c.chart_of[1]);          /* across the complex edge: a seam */
+    CHECK(c.chart_of[0] == c.chart_of[1]);          /* coplanar across the complex edge: linked */
+    CHECK(c.chart_of[2] != c.chart_of[0]);          /* the fin on that edge: a seam */
+    CHECK(c.chart_of[4] != c.chart_of[5]);          /* across the winding flip: a seam */
     CHECK(c.chart_of[8] == c.chart_of[10]);         /* the flat fan is one chart */
     CHECK_INT(c.topology.complex_edge_faces, 1);
     CHECK_INT(c.topology.flipped_faces, 1);
