@@ -245,10 +245,10 @@ static void print_report(const lmb_scene *s, const lmb_layout *l)
         lmb_uv_metrics um;
         mesh_stretch(lm, &um);
         chart_total += lm->chart_seconds;
-        printf("mesh '%s': %u triangles (%u zero-area), %u charts (%u planar, %u split), L2 stretch %.4f, "
+        printf("mesh '%s': %u triangles (%u zero-area), %u charts (%u planar, %u split, %u glued), L2 stretch %.4f, "
                "charting %.3f s\n",
                s->meshes[m].name, lm->soup.triangle_count, s->meshes[m].degenerate_count, lm->charts.chart_count,
-               lm->charts.planar_charts, lm->charts.splits, um.l2_stretch, lm->chart_seconds);
+               lm->charts.planar_charts, lm->charts.splits, lm->charts.glued, um.l2_stretch, lm->chart_seconds);
         print_topology(&lm->charts.topology);
     }
     printf("total: charting %.3f s, packing %.3f s, %u charts in %u atlas(es)\n", chart_total, l->pack_seconds,

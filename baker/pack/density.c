@@ -21,6 +21,56 @@ double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t
     return a;
 }
 
+/* World area of instance i's soup triangles (before charting), and its mesh's object area. */
+static void soup_areas(const lmb_scene *s, const lmb_layout *l, uint32_t i, double *world, double *object)
+{
+    const lmb_mesh_soup *sp = &l->meshes[s->instances[i].mesh].soup;
+    double q[9], o[9];
+    *world = *object = 0;
+    for (uint32_t f = 0; f < sp->triangle_count; f++) {
+        if (sp->skip && sp->skip[f])
+            continue;
+        lmb_layout_world_triangle(s, l, i, f, q);
+        for (int v = 0; v < 3; v++)
+            for (int d = 0; d < 3; d++)
+                o[3 * v + d] = sp->positions[3 * sp->indices[3 * f + v] + d];
+        *world += lmb_triangle_area(q);
+        *object += lmb_triangle_area(o);
+    }
+}
+
+void lmb_density_expected(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, double *per_mesh)
+{
+    double total = 0;
+    for (uint32_t m = 0; m < s->mesh_count; m++)
+        per_mesh[m] = 0;
+    double *world = malloc(sizeof(double) * s->instance_count + 1), *object = malloc(sizeof(double) * s->instance_count + 1);
+    if (!world || !object) {
+        free(world);
+        free(object);
+        return; /* no estimate: nothing is glued */
+    }
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        world[i] = object[i] = 0;
+        if (s->instances[i].lightmapped && l->meshes[s->instances[i].mesh].used) {
+            soup_areas(s, l, i, &world[i], &object[i]);
+            total += world[i];
+        }
+    }
+    double automatic = total > 0 ? sqrt((double)lmb_config_atlas_texels(cfg) / total) : 0;
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        if (!(world[i] > 0 && object[i] > 0))
+            continue;
+        double o = lmb_density_override_for(s, cfg, i);
+        double d = o > 0 ? o : cfg->texel_density > 0 ? cfg->texel_density : automatic;
+        double per_unit = d * sqrt(world[i] / object[i]);
+        uint32_t m = s->instances[i].mesh;
+        per_mesh[m] = per_unit > per_mesh[m] ? per_unit : per_mesh[m];
+    }
+    free(world);
+    free(object);
+}
+
 /* Per chart of instance i: its box sides in world units (chart box x world/uv scale) and, if
  * area is not NULL, its world area. */
 static int chart_boxes(const lmb_scene *s, const lmb_layout *l, uint32_t i, double *bw, double *bh, double *area)

@@ -37,6 +37,13 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
 /* The first density_overrides entry matching instance i's node or mesh name, or 0. */
 double lmb_density_override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t instance);
 
+/* Before charting: texels per object unit each mesh is expected to get, per_mesh[m] for
+ * m < s->mesh_count (0 for meshes no instance lightmaps): the most over its lightmapped
+ * instances of their density (an override, texel_density, or auto's sqrt(budget / world
+ * area), before any fit cap or floor) times their linear scale (sqrt of world over object
+ * area). Needs the soups. */
+void lmb_density_expected(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, double *per_mesh);
+
 /* World area of instance i's lightmapped triangles. */
 double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t instance);
 

@@ -225,11 +225,22 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
     lmb_unwrap_options opt;
     lmb_unwrap_options_default(&opt);
     for (uint32_t m = 0; m < s->mesh_count; m++) {
+        lmb_status st = l->meshes[m].used ? build_soup(s, m, &l->meshes[m].soup, err) : LMB_OK;
+        if (st != LMB_OK)
+            return st;
+    }
+    /* narrow charts are glued at the density each mesh is expected to get */
+    double *expected = calloc((size_t)s->mesh_count + 1, sizeof *expected);
+    if (!expected)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    lmb_density_expected(s, cfg, l, expected);
+    for (uint32_t m = 0; m < s->mesh_count; m++) {
         lmb_layout_mesh *lm = &l->meshes[m];
         if (!lm->used)
             continue;
         opt.name = s->meshes[m].name;
-        lmb_status st = build_soup(s, m, &lm->soup, err);
+        opt.glue_below = cfg->min_chart_texels > 0 && expected[m] > 0 ? cfg->min_chart_texels / expected[m] : 0;
+        lmb_status st = LMB_OK;
         double t0 = lmb_seconds();
         lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
                                lm->soup.skip};
@@ -238,12 +249,15 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
             st = lm->kept_uv1 ? lmb_charts_from_uv1(s, m, &lm->soup, &lm->charts, err)
                               : lmb_unwrap_mesh(&in, &opt, &lm->charts, err);
         lm->chart_seconds = lmb_seconds() - t0;
-        if (st != LMB_OK)
+        if (st != LMB_OK) {
+            free(expected);
             return st;
+        }
         done += s->meshes[m].triangle_count;
         if (progress)
             progress(user, "unwrap", done, total);
     }
+    free(expected);
     return LMB_OK;
 }
 

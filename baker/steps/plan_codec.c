@@ -81,6 +81,7 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
         put_array(&w, c->order, c->triangle_count, sizeof *c->order);
         put_u32(&w, c->planar_charts);
         put_u32(&w, c->splits);
+        put_u32(&w, c->glued);
         put(&w, &c->topology, sizeof c->topology); /* uint32_t fields only: no padding */
     }
     for (uint32_t i = 0; i < l->instance_count; i++) {
@@ -197,6 +198,7 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
         c->order = get_array(&r, c->triangle_count, sizeof *c->order, NULL);
         c->planar_charts = get_u32(&r);
         c->splits = get_u32(&r);
+        c->glued = get_u32(&r);
         get(&r, &c->topology, sizeof c->topology);
         /* indices must name vertices; chart offsets must stay inside `order` */
         for (uint64_t k = 0; s->indices && !r.failed && k < 3 * (uint64_t)s->triangle_count; k++)

@@ -17,6 +17,7 @@
 void lmb_unwrap_options_default(lmb_unwrap_options *o)
 {
     o->max_chart_angle = 30.0 * 3.14159265358979323846 / 180.0;
+    o->glue_below = 0;
     o->name = NULL;
 }
 
@@ -405,8 +406,32 @@ lmb_status lmb_unwrap_mesh(const lmb_unwrap_input *in, const lmb_unwrap_options 
         if (st == LMB_OK && !pool_add(&p, tris, len, out->chart_of, before, next, angle))
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "unwrap: out of memory");
     }
+    if (st == LMB_OK && opt->glue_below > 0) {
+        int ok;
+        out->glued = lmb_glue_narrow_charts(in, &t, out->chart_of, out->uv, p.nc, opt->glue_below, &ok);
+        p.used = 0; /* the pool again, from the glued labels (tris was the splits' scratch) */
+        p.nc = 0;
+        n = 0;
+        for (uint32_t f = 0; f < nt; f++)
+            if (out->chart_of[f] != LMB_NONE)
+                tris[n++] = f;
+        if (!ok || !pool_add(&p, tris, n, out->chart_of, 0, next, opt->max_chart_angle))
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "unwrap: out of memory");
+    }
     if (st == LMB_OK)
         st = finish(out, &p, nt, err);
+    if (st == LMB_OK && out->glued) { /* a chart glued across a crease is no longer a projection */
+        out->planar_charts = 0;
+        for (uint32_t c = 0; c < out->chart_count; c++) {
+            const double *n0 = t.normal + 3 * out->order[out->first[c]];
+            int planar = 1;
+            for (uint32_t i = out->first[c] + 1; i < out->first[c + 1] && planar; i++) {
+                const double *n1 = t.normal + 3 * out->order[i];
+                planar = n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] >= LMB_PLANAR_DOT;
+            }
+            out->planar_charts += planar;
+        }
+    }
     /* triangles left out keep UV 0 and chart LMB_NONE */
     free(tris);
     free(scratch);

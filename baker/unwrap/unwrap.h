@@ -7,6 +7,7 @@
  *   segment.c   greedy chart growth from seeds under a normal-cone and roundness cost
  *   flatten.c   planar projection where exact, else LSCM (Levy et al. 2002) solved with CHOLMOD
  *   unwrap.c    validity (no flips, no boundary self-intersection) and splitting until valid
+ *   glue.c      narrow charts glued onto a neighbour, unfolded across the crease
  */
 #ifndef LMBAKE_UNWRAP_H
 #define LMBAKE_UNWRAP_H
@@ -23,6 +24,9 @@ typedef struct lmb_unwrap_input {
 
 typedef struct lmb_unwrap_options {
     double max_chart_angle; /* radians: a chart's normals stay within this cone of its mean */
+    double glue_below;      /* object units: charts narrower than this are glued onto a neighbour
+                               (glue.c); 0 = none. The layout sets it from atlas.min_chart_texels
+                               and the density the mesh is expected to get. */
     const char *name;       /* the mesh, named in error messages; NULL: "mesh" */
 } lmb_unwrap_options;
 
@@ -50,6 +54,7 @@ typedef struct lmb_charts {
     uint32_t *order;      /* triangles sorted by chart */
     uint32_t planar_charts;   /* flattened by projection */
     uint32_t splits;          /* charts split because their flattening was invalid */
+    uint32_t glued;           /* narrow charts glued onto a neighbour (glue_below) */
     lmb_topology_counts topology;
 } lmb_charts;
 

@@ -62,4 +62,12 @@ lmb_status lmb_segment(const lmb_unwrap_input *in, const lmb_topology *t, const 
 lmb_status lmb_flatten(const lmb_unwrap_input *in, const lmb_topology *t, const uint32_t *tris, uint32_t n,
                        double *uv, int *planar, lmb_error *err);
 
+/* Glues every chart narrower than glue_below (object units, across its principal axis in
+ * UV) onto the neighbouring chart it shares the most edge length with, moved rigidly in UV,
+ * where nothing overlaps (glue.c). Charts are ids below chart_count in chart_of; a glued
+ * chart's triangles take its host's id and UVs in the host's frame. Returns the charts
+ * glued; *ok = 0 when out of memory (nothing is glued then). */
+uint32_t lmb_glue_narrow_charts(const lmb_unwrap_input *in, const lmb_topology *t, uint32_t *chart_of, double *uv,
+                                uint32_t chart_count, double glue_below, int *ok);
+
 #endif
