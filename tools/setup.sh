@@ -49,8 +49,9 @@ if ((${#missing[@]})); then
   rm -f "$log"
 fi
 
-# npm pieces (package.json): the Khronos glTF validator and ktx-parse (an independent KTX2 reader) for the tests
-if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ]; then
+# npm pieces (package.json): the Khronos glTF validator and ktx-parse (an independent KTX2 reader) for the
+# tests, three.js and playwright-core for the preview, xatlasjs for the unwrap benchmark
+if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ] || [ ! -d node_modules/xatlasjs ]; then
   echo "setup: installing npm packages (package.json)"
   npm install --no-audit --no-fund --silent >/dev/null 2>&1 || { echo "setup: npm install failed"; exit 1; }
 fi

@@ -8,6 +8,10 @@
 #include <string.h>
 
 #define FIT_AREA_SHARE 0.8
+/* An explicit density is refused before packing only past this share of the atlas: the boxes
+ * overstate what the packer needs (it interlocks non-rectangular footprints), so between the
+ * estimate and this the packer is asked, and names the instance if it cannot. */
+#define TRY_AREA_SHARE 1.3
 
 double lmb_instance_world_area(const lmb_scene *s, const lmb_layout *l, uint32_t i)
 {
@@ -111,7 +115,7 @@ static double footprint_area(const double *bw, const double *bh, uint32_t nc, do
     return area;
 }
 
-double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t i)
+static double fit_at_share(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t i, double share)
 {
     const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
     uint32_t nc = lm->charts.chart_count;
@@ -127,7 +131,7 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
     double border = 2.0 * (cfg->padding + 1) + 1 + 2 /* margin for rounding */, longest = 0;
     for (uint32_t k = 0; k < nc; k++)
         longest = fmax(longest, fmax(bw[k], bh[k]));
-    double atlas = FIT_AREA_SHARE * (double)cfg->max_atlas_size * cfg->max_atlas_size;
+    double atlas = share * (double)cfg->max_atlas_size * cfg->max_atlas_size;
     double d_side = longest > 0 ? (cfg->max_atlas_size - border) / longest : INFINITY;
     double result = d_side > 0 ? d_side : 0;
     if (isfinite(d_side) && footprint_area(bw, bh, nc, d_side, cfg->padding) > atlas) {
@@ -144,6 +148,11 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
     free(bw);
     free(bh);
     return result;
+}
+
+double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t i)
+{
+    return fit_at_share(s, l, cfg, i, FIT_AREA_SHARE);
 }
 
 typedef struct side_area {
@@ -300,8 +309,14 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
         if (o <= 0) /* an override is the artist's word for this instance: no floor */
             floor_d[k] = fmin(lmb_density_floor(s, l, cfg, i), fit[k]);
         if (d > 0) { /* explicit: it wins (raised to the floor), or it is refused now */
-            if (d > fit[k])
+            if (d > fit[k] && d > fit_at_share(s, l, cfg, i, TRY_AREA_SHARE))
                 st = explicit_too_high(s, cfg, i, d, fit[k], o > 0, err);
+            else if (d > fit[k])
+                lmb_info(log,
+                         "instance '%s' (mesh '%s'): texel_density %g is above the %.4g estimated to fit one %ux%u "
+                         "atlas; the packer decides",
+                         s->instances[i].name, s->meshes[s->instances[i].mesh].name, d, fit[k], cfg->max_atlas_size,
+                         cfg->max_atlas_size);
             if (floor_d[k] > d) {
                 d = floor_d[k];
                 rep->raised++;

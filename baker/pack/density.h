@@ -29,8 +29,10 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
 double lmb_density_floor(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t instance);
 
 /* Sets l->instances[list[k]].texel_density for the lightmapped instances list[0..n).
- * Explicit densities that are not expected to fit one atlas are LMB_ERR_INPUT naming the
- * instance and the density that would fit, before anything is packed. */
+ * Explicit densities far above what fits one atlas (their charts' boxes with padding over
+ * 130% of it, or the longest chart longer than its side) are LMB_ERR_INPUT naming the instance
+ * and the density estimated to fit, before anything is packed; nearer ones are left to the
+ * packer, which names the instance if it cannot place it. */
 lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
                               uint32_t n, const lmb_log *log, lmb_density_report *report, lmb_error *err);
 

@@ -149,10 +149,10 @@ static lmb_status pack_instances(const lmb_scene *s, const lmb_config *cfg, lmb_
         } else {
             st = lmb_error_set(err, LMB_ERR_INPUT,
                                "instance '%s' (mesh '%s') does not fit in one %ux%u atlas at %g texels per unit: "
-                               "lower texel_density (or a density_overrides entry), use texel_density: auto, or "
-                               "raise atlas.max_size",
+                               "lower texel_density (or a density_overrides entry; about %.4g is estimated to fit), "
+                               "use texel_density: auto, or raise atlas.max_size",
                                s->instances[i].name, s->meshes[s->instances[i].mesh].name, cfg->max_atlas_size,
-                               cfg->max_atlas_size, l->instances[i].texel_density);
+                               cfg->max_atlas_size, l->instances[i].texel_density, lmb_density_fit(s, l, cfg, i));
         }
     }
     if (st == LMB_OK) {

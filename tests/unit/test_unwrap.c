@@ -2,8 +2,8 @@
  * Unwrapper tests on the generated reference meshes and on degenerate / non-manifold
  * input: every charted triangle keeps its orientation, no chart overlaps itself when
  * rasterized (texel centres covered twice), each chart's UV area equals its 3D area,
- * L2 stretch <= 1.01 on the sphere and torus (issue 3's bound; planar charts exactly 1),
- * and the result is deterministic.
+ * L2 stretch <= 1.01 on the sphere and torus (planar charts exactly 1), the result is
+ * deterministic, and narrow charts glue onto their neighbours without stretch or overlap.
  */
 #include "check.h"
 
@@ -139,6 +139,50 @@ static void test_degenerate_and_nonmanifold(void)
     lmb_charts_free(&c);
 }
 
+/* A thin wall (7 x 4 x 0.3, a closed box): with glue_below 1 its top, bottom and ends (0.3
+ * wide) are glued onto the two big faces, unfolded across the creases: 2 charts instead of 6,
+ * every triangle keeps its orientation and its area (no stretch), and no chart overlaps
+ * itself. Gluing off: 6 charts. */
+static void test_glue_thin_wall(void)
+{
+    const float x1 = 7, y1 = 4, z1 = 0.3f;
+    const float pos[] = {0, 0, 0, x1, 0, 0, x1, y1, 0, 0, y1, 0, 0, 0, z1, x1, 0, z1, x1, y1, z1, 0, y1, z1};
+    const uint32_t quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+    uint32_t idx[36];
+    for (int q = 0; q < 6; q++) {
+        const uint32_t t[6] = {quads[q][0], quads[q][1], quads[q][2], quads[q][0], quads[q][2], quads[q][3]};
+        memcpy(idx + 6 * q, t, sizeof t);
+    }
+    lmb_unwrap_input in = {8, pos, 12, idx, NULL};
+    lmb_unwrap_options o;
+    lmb_charts c;
+    lmb_error err;
+    lmb_unwrap_options_default(&o);
+    CHECK_INT(lmb_unwrap_mesh(&in, &o, &c, &err), LMB_OK);
+    CHECK_INT(c.chart_count, 6);
+    CHECK_INT(c.glued, 0);
+    lmb_charts_free(&c);
+    o.glue_below = 1.0;
+    CHECK_INT(lmb_unwrap_mesh(&in, &o, &c, &err), LMB_OK);
+    CHECK_INT(c.chart_count, 2);
+    CHECK_INT(c.glued, 4);
+    double *p = soup_positions(pos, idx, 12);
+    for (uint32_t f = 0; p && f < 12; f++) {
+        const double *u = c.uv + 6 * f, *q = p + 9 * f;
+        double a2 = (u[2] - u[0]) * (u[5] - u[1]) - (u[4] - u[0]) * (u[3] - u[1]), e1[3], e2[3];
+        for (int d = 0; d < 3; d++) {
+            e1[d] = q[3 + d] - q[d];
+            e2[d] = q[6 + d] - q[d];
+        }
+        double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
+        CHECK(a2 > 0);                                                    /* orientation kept */
+        CHECK_NEAR(0.5 * a2, 0.5 * sqrt(cx * cx + cy * cy + cz * cz), 1e-9); /* area kept */
+    }
+    CHECK_INT(self_overlaps(&c, p, 16.0), 0);
+    free(p);
+    lmb_charts_free(&c);
+}
+
 int main(void)
 {
     gen_mesh g;
@@ -155,5 +199,6 @@ int main(void)
         gen_mesh_free(&g);
     }
     test_degenerate_and_nonmanifold();
+    test_glue_thin_wall();
     return check_failures();
 }
