@@ -144,13 +144,11 @@ static lmb_status denoise_range(void *user, uint64_t first, uint64_t last, lmb_b
         if (!j->dn[a] || lo >= hi)
             continue;
         size_t n = 3 * (size_t)(hi - lo);
-        float *o = malloc((n + 1) * sizeof *o);
+        float *o = lmb_buf_extend(out, n * sizeof *o, err); /* filtered straight into the step's bytes */
         if (!o)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for %zu texels", n / 3);
+            return LMB_ERR_INTERNAL;
         lmb_denoiser_level(j->dn[a], j->level, j->from[a], (uint32_t)(lo - j->first[a]), (uint32_t)(hi - j->first[a]),
                            o, j->threads);
-        st = lmb_buf_append(out, o, n * sizeof *o, err);
-        free(o);
     }
     return st;
 }

@@ -25,22 +25,40 @@ struct lmb_steps {
     double computed_s, waited_s, merged_s; /* worker mode: where its steps' time went */
 };
 
+/* Room for n more bytes: the capacity doubles, or grows to exactly what is asked when that is
+ * more (a step that appends a whole atlas at once gets no slack). */
+static lmb_status buf_reserve(lmb_buf *b, size_t n, lmb_error *err)
+{
+    if (b->size + n <= b->cap)
+        return LMB_OK;
+    size_t cap = b->cap ? 2 * b->cap : 4096;
+    if (cap < b->size + n)
+        cap = b->size + n;
+    uint8_t *d = realloc(b->data, cap);
+    if (!d)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory for %zu bytes of step results", cap);
+    b->data = d;
+    b->cap = cap;
+    return LMB_OK;
+}
+
 lmb_status lmb_buf_append(lmb_buf *b, const void *p, size_t n, lmb_error *err)
 {
-    if (b->size + n > b->cap) {
-        size_t cap = b->cap ? b->cap : 4096;
-        while (cap < b->size + n)
-            cap *= 2;
-        uint8_t *d = realloc(b->data, cap);
-        if (!d)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory for %zu bytes of step results", cap);
-        b->data = d;
-        b->cap = cap;
-    }
+    lmb_status st = buf_reserve(b, n, err);
+    if (st != LMB_OK)
+        return st;
     if (n)
         memcpy(b->data + b->size, p, n);
     b->size += n;
     return LMB_OK;
+}
+
+void *lmb_buf_extend(lmb_buf *b, size_t n, lmb_error *err)
+{
+    if (buf_reserve(b, n, err) != LMB_OK)
+        return NULL;
+    b->size += n;
+    return b->data + b->size - n;
 }
 
 int lmb_buf_take(lmb_buf *b, void *p, size_t n)

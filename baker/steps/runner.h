@@ -47,6 +47,9 @@ typedef struct lmb_buf {
 } lmb_buf;
 
 lmb_status lmb_buf_append(lmb_buf *b, const void *p, size_t n, lmb_error *err);
+/* Appends n bytes left for the caller to write (no copy through a buffer of its own); NULL
+ * when out of memory (err set). The pointer is valid until the next append. */
+void *lmb_buf_extend(lmb_buf *b, size_t n, lmb_error *err);
 /* Copies the next n bytes into p; 0 when fewer are left. */
 int lmb_buf_take(lmb_buf *b, void *p, size_t n);
 void lmb_buf_free(lmb_buf *b);
