@@ -33,38 +33,24 @@ typedef struct chart_list {
 
 /* Seam edges by welded end points (sorted), so a chart can be glued across a seam the
  * half-edge mesh made (a non-manifold edge: the inner faces of touching crates). */
-typedef struct seam_edge {
-    uint32_t lo, hi, face, k;
-} seam_edge;
-
 typedef struct seam_index {
-    seam_edge *e;
+    lmb_welded_edge *e;
     uint32_t n;
 } seam_index;
-
-static int cmp_seam(const void *a, const void *b)
-{
-    const seam_edge *x = a, *y = b;
-    if (x->lo != y->lo)
-        return x->lo < y->lo ? -1 : 1;
-    if (x->hi != y->hi)
-        return x->hi < y->hi ? -1 : 1;
-    return (x->face > y->face) - (x->face < y->face);
-}
 
 static int seam_index_build(const lmb_topology *t, const uint32_t *chart_of, uint32_t nt, seam_index *si)
 {
     si->n = 0;
-    si->e = malloc(sizeof(seam_edge) * (3 * (size_t)nt + 1));
+    si->e = malloc(sizeof(lmb_welded_edge) * (3 * (size_t)nt + 1));
     if (!si->e)
         return 0;
     for (uint32_t f = 0; f < nt; f++)
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t a = t->weld[3 * f + k], b = t->weld[3 * f + (k + 1) % 3];
             if (chart_of[f] != LMB_NONE && t->neighbor[3 * f + k] == LMB_NONE && a != b)
-                si->e[si->n++] = (seam_edge){a < b ? a : b, a < b ? b : a, f, k};
+                si->e[si->n++] = (lmb_welded_edge){a < b ? a : b, a < b ? b : a, f, k};
         }
-    qsort(si->e, si->n, sizeof *si->e, cmp_seam);
+    qsort(si->e, si->n, sizeof *si->e, lmb_cmp_welded_edge);
     return 1;
 }
 
@@ -74,7 +60,7 @@ static uint32_t seam_first(const seam_index *si, uint32_t a, uint32_t b)
     uint32_t lo_id = a < b ? a : b, hi_id = a < b ? b : a, lo = 0, hi = si->n;
     while (lo < hi) {
         uint32_t mid = (lo + hi) / 2;
-        const seam_edge *m = &si->e[mid];
+        const lmb_welded_edge *m = &si->e[mid];
         if (m->lo < lo_id || (m->lo == lo_id && m->hi < hi_id))
             lo = mid + 1;
         else
@@ -94,7 +80,7 @@ static uint32_t across_next(const lmb_topology *t, const seam_index *si, uint32_
     if (*it == 0)
         *it = seam_first(si, a, b) + 1; /* stored one past, so 0 means "not started" */
     while (*it - 1 < si->n) {
-        const seam_edge *e = &si->e[*it - 1];
+        const lmb_welded_edge *e = &si->e[*it - 1];
         if (e->lo != (a < b ? a : b) || e->hi != (a < b ? b : a))
             break;
         (*it)++;
@@ -150,21 +136,10 @@ static double chart_width(const chart_list *cl, uint32_t c, const double *uv)
     return hi - lo;
 }
 
-static double orient(const double *a, const double *b, const double *c)
-{
-    return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
-}
-
-static int crosses(const double *p, const double *q, const double *r, const double *s)
-{
-    double d1 = orient(p, q, r), d2 = orient(p, q, s), d3 = orient(r, s, p), d4 = orient(r, s, q);
-    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
-}
-
 /* Point p strictly inside triangle t (counter-clockwise UV). */
 static int inside(const double *t, const double *p)
 {
-    return orient(t, t + 2, p) > 0 && orient(t + 2, t + 4, p) > 0 && orient(t + 4, t, p) > 0;
+    return lmb_uv_orient(t, t + 2, p) > 0 && lmb_uv_orient(t + 2, t + 4, p) > 0 && lmb_uv_orient(t + 4, t, p) > 0;
 }
 
 static void tri_box(const double *t, double box[4])
@@ -206,7 +181,7 @@ static int overlaps(const chart_list *cl, uint32_t c, uint32_t h, const double *
                 return 1;
             for (int a = 0; a < 3; a++)
                 for (int b = 0; b < 3; b++)
-                    if (crosses(p + 2 * a, p + 2 * ((a + 1) % 3), q + 2 * b, q + 2 * ((b + 1) % 3)))
+                    if (lmb_uv_crosses(p + 2 * a, p + 2 * ((a + 1) % 3), q + 2 * b, q + 2 * ((b + 1) % 3)))
                         return 1;
         }
     }

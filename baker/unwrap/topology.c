@@ -58,27 +58,13 @@ static void geometry(const lmb_unwrap_input *in, uint32_t f, lmb_topology *t)
         t->normal[3 * f + i] = len > 0 ? n[i] / len : 0.0;
 }
 
-typedef struct wedge {
-    uint32_t lo, hi, face, k;
-} wedge;
-
-static int cmp_wedge(const void *a, const void *b)
-{
-    const wedge *x = a, *y = b;
-    if (x->lo != y->lo)
-        return x->lo < y->lo ? -1 : 1;
-    if (x->hi != y->hi)
-        return x->hi < y->hi ? -1 : 1;
-    return (x->face > y->face) - (x->face < y->face);
-}
-
 /* t->link: for each seam corner edge, the single other triangle on the same welded edge
  * (sorted edge list) with the same normal that runs the edge the other way (so it lies on
  * the far side of the edge, not over the first); none if there are two or more
  * (overlapping coplanar copies: which to join would be a guess) on either side. */
 static int coplanar_links(lmb_topology *t, uint32_t nt, const uint8_t *skip)
 {
-    wedge *e = malloc(((size_t)nt * 3 + 1) * sizeof *e);
+    lmb_welded_edge *e = malloc(((size_t)nt * 3 + 1) * sizeof *e);
     if (!e)
         return 0;
     uint32_t ne = 0;
@@ -87,9 +73,9 @@ static int coplanar_links(lmb_topology *t, uint32_t nt, const uint8_t *skip)
             t->link[3 * f + k] = LMB_NONE;
             uint32_t a = t->weld[3 * f + k], b = t->weld[3 * f + (k + 1) % 3];
             if (!skip[f] && t->neighbor[3 * f + k] == LMB_NONE && a != b)
-                e[ne++] = (wedge){a < b ? a : b, a < b ? b : a, f, k};
+                e[ne++] = (lmb_welded_edge){a < b ? a : b, a < b ? b : a, f, k};
         }
-    qsort(e, ne, sizeof *e, cmp_wedge);
+    qsort(e, ne, sizeof *e, lmb_cmp_welded_edge);
     for (uint32_t i = 0, j; i < ne; i = j) {
         for (j = i + 1; j < ne && e[j].lo == e[i].lo && e[j].hi == e[i].hi;)
             j++;

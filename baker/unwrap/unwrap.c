@@ -30,18 +30,6 @@ void lmb_charts_free(lmb_charts *c)
     memset(c, 0, sizeof *c);
 }
 
-static double orient(const double *a, const double *b, const double *c)
-{
-    return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
-}
-
-/* Proper crossing of segments pq and rs (touching at an end point does not count). */
-static int crosses(const double *p, const double *q, const double *r, const double *s)
-{
-    double d1 = orient(p, q, r), d2 = orient(p, q, s), d3 = orient(r, s, p), d4 = orient(r, s, q);
-    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
-}
-
 typedef struct bedge {
     const double *a, *b;
     uint32_t wa, wb; /* end points' vertex ids: mesh ids (chart_valid), welded ids (has_hole) */
@@ -110,7 +98,7 @@ static int boundary_crosses(const bedge *e, uint32_t ne)
                     const bedge *p = &e[list[i]], *q = &e[list[j]];
                     if (p->wa == q->wa || p->wa == q->wb || p->wb == q->wa || p->wb == q->wb)
                         continue;
-                    hit = crosses(p->a, p->b, q->a, q->b);
+                    hit = lmb_uv_crosses(p->a, p->b, q->a, q->b);
                 }
     }
     free(count);
@@ -127,7 +115,7 @@ static int chart_valid(const lmb_topology *t, const uint32_t *tris, uint32_t n,
     uint32_t ne = 0;
     for (uint32_t i = 0; i < n; i++) {
         const double *p = uv + 6 * tris[i];
-        if (!(orient(p, p + 2, p + 4) > 0))
+        if (!(lmb_uv_orient(p, p + 2, p + 4) > 0))
             return 0;
         for (int k = 0; k < 3; k++) {
             if (edge_inside(t, tris[i], k, chart_of))

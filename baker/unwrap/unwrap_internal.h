@@ -26,6 +26,37 @@ static inline uint32_t lmb_lower_bound(const uint32_t *ids, uint32_t n, uint32_t
     return lo;
 }
 
+/* Orientation of triangle abc in UV (twice its signed area), and whether segments pq and rs
+ * cross properly (touching at an end point does not count). */
+static inline double lmb_uv_orient(const double *a, const double *b, const double *c)
+{
+    return (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+}
+
+static inline int lmb_uv_crosses(const double *p, const double *q, const double *r, const double *s)
+{
+    double d1 = lmb_uv_orient(p, q, r), d2 = lmb_uv_orient(p, q, s), d3 = lmb_uv_orient(r, s, p),
+           d4 = lmb_uv_orient(r, s, q);
+    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+/* Corner k's edge of triangle `face` by its welded end points (lo < hi). Sorted with
+ * lmb_cmp_welded_edge, the triangles on one welded edge are neighbours in the list
+ * (topology.c's coplanar links, glue.c's seams). */
+typedef struct lmb_welded_edge {
+    uint32_t lo, hi, face, k;
+} lmb_welded_edge;
+
+static inline int lmb_cmp_welded_edge(const void *a, const void *b)
+{
+    const lmb_welded_edge *x = a, *y = b;
+    if (x->lo != y->lo)
+        return x->lo < y->lo ? -1 : 1;
+    if (x->hi != y->hi)
+        return x->hi < y->hi ? -1 : 1;
+    return (x->face > y->face) - (x->face < y->face);
+}
+
 /* Welded topology of one mesh: vertices merged by exact position into a half-edge mesh
  * (OpenMesh; a triangle it refuses gets duplicated vertices), and for each triangle corner
  * k its mesh vertex and the triangle across edge (k, k+1), or LMB_NONE at a boundary, a
