@@ -197,87 +197,126 @@ static int corner_of(const lmb_topology *t, uint32_t g, uint32_t w)
     return -1;
 }
 
-/* Tries to glue chart c onto a neighbour; returns the host, or LMB_NONE. */
-static uint32_t glue_one(const lmb_topology *t, const seam_index *si, const lmb_unwrap_input *in, chart_list *cl,
-                         uint32_t *chart_of, double *uv, uint32_t c, double *moved, uint32_t *hosts, double *shared)
+/* Scratch for one chart's candidate hosts. */
+typedef struct candidates {
+    uint32_t n, host[64];
+    double shared[64]; /* 3D edge length shared with each host */
+} candidates;
+
+/* The charts across c's edges, with the edge length each shares with c. */
+static void find_hosts(const lmb_topology *t, const seam_index *si, const lmb_unwrap_input *in,
+                       const chart_list *cl, const uint32_t *chart_of, uint32_t c, candidates *h)
 {
-    /* candidate hosts with the 3D edge length shared with each (small linear list) */
-    uint32_t nh = 0;
+    h->n = 0;
     for (uint32_t f = cl->head[c]; f != LMB_NONE; f = cl->next[f])
         for (int k = 0; k < 3; k++)
-            for (uint32_t it = 0, g; it != UINT32_MAX && (g = across_next(t, si, f, k, &it)) != LMB_NONE;) {
-            if (chart_of[g] == c || chart_of[g] == LMB_NONE)
-                continue;
-            const float *a = in->positions + 3 * in->indices[3 * f + k],
-                        *b = in->positions + 3 * in->indices[3 * f + (k + 1) % 3];
-            double len = sqrt(((double)a[0] - b[0]) * ((double)a[0] - b[0]) + ((double)a[1] - b[1]) * ((double)a[1] - b[1]) +
-                              ((double)a[2] - b[2]) * ((double)a[2] - b[2]));
-            uint32_t h = chart_of[g], j = 0;
-            while (j < nh && hosts[j] != h)
-                j++;
-            if (j == nh) {
-                if (nh == 64)
-                    continue; /* enough candidates */
-                hosts[nh] = h;
-                shared[nh++] = 0;
-            }
-            shared[j] += len;
-        }
-    /* best first: most shared length, then lower id */
-    while (nh > 0) {
-        uint32_t best = 0;
-        for (uint32_t j = 1; j < nh; j++)
-            if (shared[j] > shared[best] || (shared[j] == shared[best] && hosts[j] < hosts[best]))
-                best = j;
-        uint32_t h = hosts[best];
-        hosts[best] = hosts[--nh];
-        shared[best] = shared[nh];
-        /* the first shared edge (in member order) anchors the move */
-        for (uint32_t f = cl->head[c]; f != LMB_NONE; f = cl->next[f])
-            for (int k = 0; k < 3; k++)
-                for (uint32_t it = 0, g; it != UINT32_MAX && (g = across_next(t, si, f, k, &it)) != LMB_NONE;) {
-                if (chart_of[g] != h)
+            for (uint32_t it = 0, g; (g = across_next(t, si, f, k, &it)) != LMB_NONE;) {
+                if (chart_of[g] == c || chart_of[g] == LMB_NONE)
                     continue;
-                int k0 = k, k1 = (k0 + 1) % 3;
-                int g0 = corner_of(t, g, t->weld[3 * f + k0]), g1 = corner_of(t, g, t->weld[3 * f + k1]);
-                /* g must run the edge the other way (from f's k1 to f's k0): then c lands across it */
-                if (g0 < 0 || g1 < 0 || (g1 + 1) % 3 != g0)
+                const float *a = in->positions + 3 * in->indices[3 * f + k],
+                            *b = in->positions + 3 * in->indices[3 * f + (k + 1) % 3];
+                double d[3] = {(double)a[0] - b[0], (double)a[1] - b[1], (double)a[2] - b[2]};
+                uint32_t j = 0;
+                while (j < h->n && h->host[j] != chart_of[g])
+                    j++;
+                if (j == h->n) {
+                    if (h->n == 64)
+                        continue; /* enough candidates */
+                    h->host[h->n] = chart_of[g];
+                    h->shared[h->n++] = 0;
+                }
+                h->shared[j] += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            }
+}
+
+/* The first edge of c (in member order) that host h's triangle g runs the other way, with
+ * copies of equal length (within 10%): its corners in f (k0 -> k1) and g (g0, g1). */
+static int find_anchor(const lmb_topology *t, const seam_index *si, const chart_list *cl, const uint32_t *chart_of,
+                       const double *uv, uint32_t c, uint32_t h, uint32_t *f_out, uint32_t *g_out, int corners[4])
+{
+    for (uint32_t f = cl->head[c]; f != LMB_NONE; f = cl->next[f])
+        for (int k0 = 0; k0 < 3; k0++)
+            for (uint32_t it = 0, g; (g = across_next(t, si, f, k0, &it)) != LMB_NONE;) {
+                int k1 = (k0 + 1) % 3;
+                int g0 = chart_of[g] == h ? corner_of(t, g, t->weld[3 * f + k0]) : -1,
+                    g1 = chart_of[g] == h ? corner_of(t, g, t->weld[3 * f + k1]) : -1;
+                if (g0 < 0 || g1 < 0 || (g1 + 1) % 3 != g0) /* g must run it from f's k1 to f's k0 */
                     continue;
                 const double *p0 = uv + 6 * f + 2 * k0, *p1 = uv + 6 * f + 2 * k1;
                 const double *q0 = uv + 6 * g + 2 * g0, *q1 = uv + 6 * g + 2 * g1;
-                double dp[2] = {p1[0] - p0[0], p1[1] - p0[1]}, dq[2] = {q1[0] - q0[0], q1[1] - q0[1]};
-                double lp = dp[0] * dp[0] + dp[1] * dp[1], lq = dq[0] * dq[0] + dq[1] * dq[1];
+                double lp = (p1[0] - p0[0]) * (p1[0] - p0[0]) + (p1[1] - p0[1]) * (p1[1] - p0[1]),
+                       lq = (q1[0] - q0[0]) * (q1[0] - q0[0]) + (q1[1] - q0[1]) * (q1[1] - q0[1]);
                 if (!(lp > 0) || !(lq > 0) || lq < 0.81 * lp || lq > 1.21 * lp)
                     continue;
-                /* rotation taking dp's direction to dq's; unit scale (both flattenings are
-                 * isometric), so the edge's mid-points meet */
-                double s = sqrt(lp * lq), cs = (dp[0] * dq[0] + dp[1] * dq[1]) / s,
-                       sn = (dp[0] * dq[1] - dp[1] * dq[0]) / s;
-                double mp[2] = {0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])},
-                       mq[2] = {0.5 * (q0[0] + q1[0]), 0.5 * (q0[1] + q1[1])};
-                uint32_t i = 0;
-                for (uint32_t m = cl->head[c]; m != LMB_NONE; m = cl->next[m], i++)
-                    for (int v = 0; v < 3; v++) {
-                        double x = uv[6 * m + 2 * v] - mp[0], y = uv[6 * m + 2 * v + 1] - mp[1];
-                        moved[6 * i + 2 * v] = mq[0] + cs * x - sn * y;
-                        moved[6 * i + 2 * v + 1] = mq[1] + sn * x + cs * y;
-                    }
-                if (overlaps(cl, c, h, uv, moved))
-                    goto next_host; /* the anchor fixes the move: another edge would give the same */
-                i = 0;
-                for (uint32_t m = cl->head[c]; m != LMB_NONE; m = cl->next[m], i++) {
-                    memcpy(uv + 6 * m, moved + 6 * i, 6 * sizeof *uv);
-                    chart_of[m] = h;
-                }
-                /* append c's list to h's */
-                cl->next[cl->tail[h]] = cl->head[c];
-                cl->tail[h] = cl->tail[c];
-                cl->count[h] += cl->count[c];
-                cl->head[c] = cl->tail[c] = LMB_NONE;
-                cl->count[c] = 0;
-                return h;
+                *f_out = f;
+                *g_out = g;
+                corners[0] = k0, corners[1] = k1, corners[2] = g0, corners[3] = g1;
+                return 1;
             }
-    next_host:;
+    return 0;
+}
+
+/* c's UVs moved rigidly so that edge (p0, p1) of triangle f lands on (q1, q0) of g: a
+ * rotation taking p0 -> p1 to q0 -> q1, and the edges' mid-points made to meet (both
+ * flattenings are isometric: no scale). moved: 6 per member, in list order. */
+static void move_chart(const chart_list *cl, uint32_t c, const double *uv, uint32_t f, uint32_t g,
+                       const int corners[4], double *moved)
+{
+    const double *p0 = uv + 6 * f + 2 * corners[0], *p1 = uv + 6 * f + 2 * corners[1];
+    const double *q0 = uv + 6 * g + 2 * corners[2], *q1 = uv + 6 * g + 2 * corners[3];
+    double dp[2] = {p1[0] - p0[0], p1[1] - p0[1]}, dq[2] = {q1[0] - q0[0], q1[1] - q0[1]};
+    double s = sqrt((dp[0] * dp[0] + dp[1] * dp[1]) * (dq[0] * dq[0] + dq[1] * dq[1]));
+    double cs = (dp[0] * dq[0] + dp[1] * dq[1]) / s, sn = (dp[0] * dq[1] - dp[1] * dq[0]) / s;
+    double mp[2] = {0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])}, mq[2] = {0.5 * (q0[0] + q1[0]), 0.5 * (q0[1] + q1[1])};
+    uint32_t i = 0;
+    for (uint32_t m = cl->head[c]; m != LMB_NONE; m = cl->next[m], i++)
+        for (int v = 0; v < 3; v++) {
+            double x = uv[6 * m + 2 * v] - mp[0], y = uv[6 * m + 2 * v + 1] - mp[1];
+            moved[6 * i + 2 * v] = mq[0] + cs * x - sn * y;
+            moved[6 * i + 2 * v + 1] = mq[1] + sn * x + cs * y;
+        }
+}
+
+/* c becomes part of h: its moved UVs, h's id, its members appended to h's list. */
+static void attach(chart_list *cl, uint32_t *chart_of, double *uv, uint32_t c, uint32_t h, const double *moved)
+{
+    uint32_t i = 0;
+    for (uint32_t m = cl->head[c]; m != LMB_NONE; m = cl->next[m], i++) {
+        memcpy(uv + 6 * m, moved + 6 * i, 6 * sizeof *uv);
+        chart_of[m] = h;
+    }
+    cl->next[cl->tail[h]] = cl->head[c];
+    cl->tail[h] = cl->tail[c];
+    cl->count[h] += cl->count[c];
+    cl->head[c] = cl->tail[c] = LMB_NONE;
+    cl->count[c] = 0;
+}
+
+/* Tries to glue chart c onto a neighbour, the one sharing the most edge length first (ties:
+ * lower id); the anchor edge fixes the move, so a host where it overlaps is passed over.
+ * Returns the host, or LMB_NONE. */
+static uint32_t glue_one(const lmb_topology *t, const seam_index *si, const lmb_unwrap_input *in, chart_list *cl,
+                         uint32_t *chart_of, double *uv, uint32_t c, double *moved, candidates *hosts)
+{
+    find_hosts(t, si, in, cl, chart_of, c, hosts);
+    while (hosts->n > 0) {
+        uint32_t best = 0;
+        for (uint32_t j = 1; j < hosts->n; j++)
+            if (hosts->shared[j] > hosts->shared[best] ||
+                (hosts->shared[j] == hosts->shared[best] && hosts->host[j] < hosts->host[best]))
+                best = j;
+        uint32_t h = hosts->host[best], f, g;
+        hosts->n--;
+        hosts->host[best] = hosts->host[hosts->n];
+        hosts->shared[best] = hosts->shared[hosts->n];
+        int corners[4];
+        if (!find_anchor(t, si, cl, chart_of, uv, c, h, &f, &g, corners))
+            continue;
+        move_chart(cl, c, uv, f, g, corners, moved);
+        if (overlaps(cl, c, h, uv, moved))
+            continue;
+        attach(cl, chart_of, uv, c, h, moved);
+        return h;
     }
     return LMB_NONE;
 }
@@ -292,10 +331,10 @@ uint32_t lmb_glue_narrow_charts(const lmb_unwrap_input *in, const lmb_topology *
     chart_list cl = {malloc(sizeof(uint32_t) * chart_count), malloc(sizeof(uint32_t) * chart_count),
                      malloc(sizeof(uint32_t) * ((size_t)nt + 1)), calloc(chart_count, sizeof(uint32_t))};
     narrow *order = malloc(sizeof(narrow) * chart_count);
-    uint32_t *hosts = malloc(64 * sizeof *hosts);
-    double *shared = malloc(64 * sizeof *shared), *moved = NULL;
+    candidates *hosts = malloc(sizeof *hosts);
+    double *moved = NULL;
     seam_index si = {NULL, 0};
-    if (!seam_index_build(t, chart_of, nt, &si) || !cl.head || !cl.tail || !cl.next || !cl.count || !order || !hosts || !shared) {
+    if (!seam_index_build(t, chart_of, nt, &si) || !cl.head || !cl.tail || !cl.next || !cl.count || !order || !hosts) {
         *ok = 0;
         goto done;
     }
@@ -331,7 +370,7 @@ uint32_t lmb_glue_narrow_charts(const lmb_unwrap_input *in, const lmb_topology *
             continue; /* glued into another already */
         if (chart_width(&cl, c, uv) >= glue_below)
             continue; /* charts glued onto it made it wide enough */
-        glued += glue_one(t, &si, in, &cl, chart_of, uv, c, moved, hosts, shared) != LMB_NONE;
+        glued += glue_one(t, &si, in, &cl, chart_of, uv, c, moved, hosts) != LMB_NONE;
     }
 done:
     free(si.e);
@@ -341,7 +380,6 @@ done:
     free(cl.count);
     free(order);
     free(hosts);
-    free(shared);
     free(moved);
     return glued;
 }
