@@ -127,7 +127,7 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
 typedef struct denoise_job {
     uint32_t atlases;
     lmb_denoiser **dn;  /* per atlas; NULL: not filtered */
-    float **from;       /* per atlas: the previous level's light */
+    float **from;       /* per atlas: the previous level's light (the light being filtered) */
     uint64_t *first;    /* per atlas (+1): its first item */
     uint32_t level;
     int threads;
@@ -166,8 +166,7 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
     double most = 0;
     denoise_job j = {n, calloc((size_t)n + 1, sizeof(lmb_denoiser *)), calloc((size_t)n + 1, sizeof(float *)),
                      calloc((size_t)n + 2, sizeof(uint64_t)), 0, (int)cfg->threads};
-    float **work = calloc((size_t)n + 1, sizeof *work); /* per atlas: the other buffer (owned) */
-    lmb_status st = j.dn && j.from && j.first && work ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory");
+    lmb_status st = j.dn && j.from && j.first ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory");
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
         atlas_work *w = &env->w[a];
         double level = noise ? *noise : LMB_DENOISE_TEXEL_SHARE * w->gather_noise;
@@ -179,9 +178,6 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
                                    (int)cfg->threads};
         st = lmb_denoiser_create(&w->t, &opt, &j.dn[a], err);
         j.from[a] = *(float **)(void *)((char *)w + field);
-        work[a] = st == LMB_OK ? malloc((3 * (size_t)w->t.count + 1) * sizeof *work[a]) : NULL;
-        if (st == LMB_OK && !work[a])
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for atlas %u", a);
         j.first[a + 1] += w->t.count;
         if (st == LMB_OK)
             lmb_denoise_measure(&w->t, j.from[a], &ds.before, &ds.texels);
@@ -197,34 +193,20 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
         if (st == LMB_OK && bytes.size != 3 * sizeof(float) * j.first[n])
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: step '%s' gave %zu bytes for %llu texels", name,
                                bytes.size, (unsigned long long)j.first[n]);
-        for (uint32_t a = 0; a < n && st == LMB_OK; a++) { /* levels alternate between the light and work */
-            if (!j.dn[a])
-                continue;
-            float *light = *(float **)(void *)((char *)&env->w[a] + field);
-            float *next = j.from[a] == light ? work[a] : light;
-            memcpy(next, bytes.data + 3 * sizeof(float) * j.first[a], 3 * sizeof(float) * env->w[a].t.count);
-            j.from[a] = next;
-        }
+        /* the level is whole in the step's bytes: the next level reads it from the light itself */
+        for (uint32_t a = 0; a < n && st == LMB_OK; a++)
+            if (j.dn[a])
+                memcpy(j.from[a], bytes.data + 3 * sizeof(float) * j.first[a], 3 * sizeof(float) * env->w[a].t.count);
     }
     lmb_buf_free(&bytes);
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        float *light = *(float **)(void *)((char *)&env->w[a] + field);
-        if (!j.dn[a])
-            continue;
-        if (j.from[a] != light) /* an odd number of levels ends in work */
-            memcpy(light, j.from[a], 3 * sizeof(float) * env->w[a].t.count);
-        lmb_denoise_measure(&env->w[a].t, light, &ds.after, NULL);
-    }
-    for (uint32_t a = 0; a < n; a++) {
-        if (j.dn)
-            lmb_denoiser_free(j.dn[a]);
-        if (work)
-            free(work[a]);
-    }
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++)
+        if (j.dn[a])
+            lmb_denoise_measure(&env->w[a].t, j.from[a], &ds.after, NULL);
+    for (uint32_t a = 0; j.dn && a < n; a++)
+        lmb_denoiser_free(j.dn[a]);
     free(j.dn);
     free(j.from);
     free(j.first);
-    free(work);
     env->stats->denoised_texels += ds.texels;
     if (st == LMB_OK && ds.texels)
         lmb_info(env->log, "denoise: %s of %llu texels filtered at %.2f%% noise (%u levels, strength %g); its mean "
@@ -300,18 +282,26 @@ static lmb_status texel_step(const pass_env *env, const char *name, uint32_t dir
         texels += env->w[a].t.count;
     double rays = (double)texels * (direction_rays ? direction_rays : env->job->estimator.rays);
     lmb_step_desc d = {name, tp.first[n], cost, rays, texel_pass_range, &tp};
-    lmb_buf bytes = {0};
-    uint64_t counters[LMB_STEP_COUNTERS];
-    lmb_status st = lmb_steps_run(env->job->steps, &d, &bytes, counters, err);
-    gs->rays += counters[0];
-    gs->texels += counters[1];
-    gs->adapted += counters[2];
+    uint64_t counters[LMB_STEP_COUNTERS], *floats = calloc((size_t)n + 1, sizeof *floats);
+    float **dst = calloc((size_t)n + 1, sizeof *dst);
+    lmb_status st = floats && dst ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        float *dst = *(float **)(void *)((char *)&env->w[a] + field);
-        if (!lmb_buf_take(&bytes, dst, 3 * sizeof *dst * env->w[a].t.count))
-            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels for atlas %u", name, a);
+        dst[a] = *(float **)(void *)((char *)&env->w[a] + field);
+        floats[a] = 3 * (uint64_t)env->w[a].t.count;
     }
-    lmb_buf_free(&bytes);
+    lmb_float_sink sink = {n, dst, floats, 0, 0};
+    if (st == LMB_OK) /* a local bake fills the arrays chunk by chunk, never holding the step's bytes whole */
+        st = lmb_steps_run_streamed(env->job->steps, &d, tp.per_atlas ? 1 : LMB_STEP_STREAM_ITEMS, lmb_take_floats,
+                                    &sink, counters, err);
+    if (st == LMB_OK) {
+        gs->rays += counters[0];
+        gs->texels += counters[1];
+        gs->adapted += counters[2];
+        if (!lmb_float_sink_full(&sink))
+            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", name);
+    }
+    free(floats);
+    free(dst);
     free(tp.first);
     free(cost);
     return st;
@@ -369,20 +359,32 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
     for (uint32_t a = 0; add_direct && through_cache && a < cache->atlas_count; a++)
         if (env->w[a].gather_noise > stats->indirect_noise)
             stats->indirect_noise = env->w[a].gather_noise;
+    if (add_direct && env->shared) /* the final gather: no later pass reads the records */
+        lmb_ic_records_free(env->shared);
+    if (add_direct && store) /* nothing gathers until the store: the filter and refinement get its room */
+        lmb_cache_release(cache);
     if (st == LMB_OK && add_direct && through_cache && env->cfg->denoise_indirect && !job->reference)
         st = denoise_light(env, offsetof(atlas_work, result), NULL, 0, env->cfg->denoise_levels,
                            "the final gather's light (a quarter of its records' median noise)", err);
     if (st == LMB_OK && add_direct && !job->reference) /* the final gather: the light shown is known */
         st = refine_direct(env, 0, err);
-    /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting) */
-    for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++)
+    /* the lightmap's direct light: every light's but the `indirect` ones' (mixed lighting);
+     * nothing reads direct light after this */
+    for (uint32_t a = 0; add_direct && a < cache->atlas_count && st == LMB_OK; a++) {
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
             float v = w[a].result[k] + w[a].direct[k] - (w[a].deferred ? w[a].deferred[k] : 0.0f);
             w[a].result[k] = v > 0 ? v : 0.0f;
         }
+        free(w[a].direct);
+        w[a].direct = NULL;
+    }
     if (st == LMB_OK && add_direct && !job->reference && env->cfg->denoise_direct && stats->direct_noise_median > 0)
         st = denoise_light(env, offsetof(atlas_work, result), &stats->direct_noise_median, 1, LMB_DENOISE_DIRECT_LEVELS,
                            "the light with its direct part (each texel's direct light's own variance)", err);
+    for (uint32_t a = 0; add_direct && a < cache->atlas_count; a++) { /* read by the refinement and filter only */
+        free(w[a].variance);
+        w[a].variance = NULL;
+    }
     if (st == LMB_OK && store)
         st = store_pass(w, cache, err);
     stats->rays += gs->rays;

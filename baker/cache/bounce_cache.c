@@ -64,8 +64,20 @@ static lmb_status scatter(float *img, uint8_t *st, uint32_t w, uint32_t h, const
     return lmb_dilate(img, st, w, h, err);
 }
 
+void lmb_cache_release(lmb_cache *c)
+{
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        free(c->irradiance[a]);
+        c->irradiance[a] = NULL;
+    }
+}
+
 lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err)
 {
+    if (!c->irradiance[a])
+        c->irradiance[a] = malloc((3 * (size_t)c->layout->width[a] * c->layout->height[a] + 1) * sizeof **c->irradiance);
+    if (!c->irradiance[a])
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u", a);
     return scatter(c->irradiance[a], c->state[a], c->layout->width[a], c->layout->height[a], t, e, err);
 }
 

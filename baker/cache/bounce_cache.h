@@ -30,7 +30,7 @@ typedef struct lmb_cache {
     const lmb_rt *rt;             /* borrowed */
     const lmb_textures *textures; /* borrowed, may be NULL */
     uint32_t atlas_count;
-    float **irradiance; /* owned: per atlas width x height x 3, dilated */
+    float **irradiance; /* owned: per atlas width x height x 3, dilated (NULL after lmb_cache_release) */
     uint8_t **state;    /* owned: per atlas width x height LMB_TEXEL_* */
     float **direction;  /* owned, NULL until lmb_cache_store_direction: per atlas width x height x 3,
                            the light's mean direction (directional lightmaps), dilated */
@@ -51,6 +51,11 @@ void lmb_cache_free(lmb_cache *c);
 
 /* Atlas a's image := e (3 floats per listed texel of t, the texels of atlas a), dilated. */
 lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err);
+
+/* Frees every atlas's irradiance image while nothing gathers (between a pass's gather and its
+ * store, when the light is filtered and refined): no lmb_cache_lookup until the next
+ * lmb_cache_store of each atlas, which allocates the image again. */
+void lmb_cache_release(lmb_cache *c);
 
 /* Atlas a's direction image := d (3 floats per listed texel of t), dilated as the irradiance. */
 lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *d, lmb_error *err);

@@ -301,13 +301,18 @@ static lmb_status interpolate_all(const pass_ctx *c, float *const *out, lmb_erro
     /* rays: a lookup visits tens of records; counted as 8 rays per texel for farm.min_step_rays */
     lmb_step_desc d = {name, is.first[c->atlas_count], NULL, 8.0 * (double)is.first[c->atlas_count],
                        interpolate_range, &is};
-    lmb_buf bytes = {0};
-    uint64_t counters[LMB_STEP_COUNTERS];
-    lmb_status st = lmb_steps_run(c->job->steps, &d, &bytes, counters, err);
-    for (uint32_t a = 0; a < c->atlas_count && st == LMB_OK; a++)
-        if (!lmb_buf_take(&bytes, out[a], 3 * sizeof(float) * c->t[a]->count))
-            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", name);
-    lmb_buf_free(&bytes);
+    uint64_t counters[LMB_STEP_COUNTERS], *floats = calloc((size_t)c->atlas_count + 1, sizeof *floats);
+    if (!floats) {
+        free(is.first);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    }
+    for (uint32_t a = 0; a < c->atlas_count; a++)
+        floats[a] = 3 * (uint64_t)c->t[a]->count;
+    lmb_float_sink sink = {c->atlas_count, out, floats, 0, 0};
+    lmb_status st = lmb_steps_run_streamed(c->job->steps, &d, LMB_STEP_STREAM_ITEMS, lmb_take_floats, &sink, counters, err);
+    if (st == LMB_OK && !lmb_float_sink_full(&sink))
+        st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", name);
+    free(floats);
     free(is.first);
     return st;
 }

@@ -93,7 +93,6 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
     return st;
 }
 
-/* Appends the next band of `in` to out (exact growth, as lmb_texels_append). */
 /* Grows *arr to hold `total` texels of `per` floats; 0 when out of memory. */
 static int grow_floats(float **arr, size_t total, size_t per)
 {
@@ -103,6 +102,7 @@ static int grow_floats(float **arr, size_t total, size_t per)
     return p != NULL;
 }
 
+/* Appends the next band of `in` to out (exact growth, as lmb_texels_append). */
 static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out, const band_ctx *c, lmb_error *err)
 {
     int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
@@ -164,6 +164,22 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     return st;
 }
 
+/* The step's bytes as they come (lmb_steps_run_streamed): every band in them appended to out. */
+typedef struct bands_taken {
+    lmb_direct_atlas *out;
+    const band_ctx *c;
+    uint64_t bands;
+} bands_taken;
+
+static lmb_status take_bands(void *user, lmb_buf *bytes, lmb_error *err)
+{
+    bands_taken *bt = user;
+    lmb_status st = LMB_OK;
+    for (; bytes->read < bytes->size && st == LMB_OK; bt->bands++)
+        st = take_band(bytes, bt->c->cfg->directional, bt->out, bt->c, err);
+    return st;
+}
+
 /* Each band's estimated cost: the atlas area its rows hold under the instances' triangles
  * (each triangle's area spread evenly over the rows it spans; covered texels cast the rays),
  * plus a little per texel (an empty texel is still visited). Packing leaves whole rows nearly
@@ -217,13 +233,14 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     /* rays: sub-samples x shadow rays, over the atlas's area (an upper bound: not every texel is used) */
     lmb_step_desc d = {name, bands, cost, (double)c.width * c.height * cfg->texel_samples * cfg->direct_samples,
                        compute_bands, &c};
-    lmb_buf bytes = {0};
     uint64_t counters[LMB_STEP_COUNTERS];
-    lmb_status st = lmb_steps_run(steps, &d, &bytes, counters, err);
+    bands_taken taken = {out, &c, 0};
+    lmb_status st = lmb_steps_run_streamed(steps, &d, 1, take_bands, &taken, counters, err);
     *rays += counters[0];
     out->rays = counters[0];
-    for (uint64_t b = 0; b < bands && st == LMB_OK; b++)
-        st = take_band(&bytes, cfg->directional, out, &c, err);
+    if (st == LMB_OK && taken.bands != bands)
+        st = lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: %llu of %llu bands", a,
+                           (unsigned long long)taken.bands, (unsigned long long)bands);
     if (st == LMB_OK && !out->t.texel) { /* an atlas without texels: empty arrays, not NULL */
         lmb_texels empty;
         memset(&empty, 0, sizeof empty);
@@ -245,6 +262,5 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     if (st == LMB_OK && (!out->direct || !out->variance || (cfg->directional && !out->direction)))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
     free(cost);
-    lmb_buf_free(&bytes);
     return st;
 }

@@ -8,29 +8,38 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* What the filter reads of a valid listed texel: where it is and how it faces. */
+/* What the filter reads of a valid listed texel: where it is and how it faces (its size and
+ * instance it reads from the texels). */
 typedef struct texel_guide {
     float p[3], n[3];
-    float size;        /* world units per texel */
-    uint32_t instance;
 } texel_guide;
+
+/* The instance texel i lies on (its gather point's, lmb_texels_point's point 0). */
+static uint32_t instance_of(const lmb_texels *t, uint32_t i)
+{
+    size_t at = (size_t)i * t->samples;
+    return t->refs ? t->refs[at].instance : t->points[at].instance;
+}
 
 #define NOT_LISTED UINT32_MAX
 #define LIGHT_CUT 16.0f /* the light term's cut-off, in its scale (exp(-16) = 1e-7) */
 
 static const float B3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
 
-/* The surface part of w(p, q) (denoise.h) for texels `atlas_distance` texels apart; 0 when q
- * is on another surface. */
-static float surface_weight(const texel_guide *gp, const texel_guide *gq, float atlas_distance, float step)
+/* The surface part of w(p, q) (denoise.h) for texels `atlas_distance` texels apart, p of
+ * `size` world units; 0 when q is on another surface. */
+static float surface_weight(const lmb_texels *t, uint32_t p, uint32_t q, const texel_guide *g, float atlas_distance,
+                            float step)
 {
-    if (gp->instance != gq->instance)
+    if (instance_of(t, p) != instance_of(t, q))
         return 0;
+    const texel_guide *gp = &g[p], *gq = &g[q];
+    float size = t->texel_size[p];
     float d[3] = {gq->p[0] - gp->p[0], gq->p[1] - gp->p[1], gq->p[2] - gp->p[2]};
-    float far = 2.0f * (atlas_distance + 1.0f) * gp->size;
+    float far = 2.0f * (atlas_distance + 1.0f) * size;
     if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > far * far)
         return 0;
-    float plane = fabsf(d[0] * gp->n[0] + d[1] * gp->n[1] + d[2] * gp->n[2]) / (gp->size * step);
+    float plane = fabsf(d[0] * gp->n[0] + d[1] * gp->n[1] + d[2] * gp->n[2]) / (size * step);
     float cosine = gp->n[0] * gq->n[0] + gp->n[1] * gq->n[1] + gp->n[2] * gq->n[2];
     if (cosine <= 0)
         return 0;
@@ -91,7 +100,7 @@ static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel
                 float w = B3[kx] * B3[ky];
                 if (j != i) {
                     float dx = (float)(kx - 2) * step, dy = (float)(ky - 2) * step;
-                    w *= surface_weight(&g[i], &g[j], sqrtf(dx * dx + dy * dy), (float)step);
+                    w *= surface_weight(t, i, j, g, sqrtf(dx * dx + dy * dy), (float)step);
                     float lq = (float)lmb_luminance_f(cq);
                     float scale = variance ? (float)light_scale * sqrtf(variance[i] + variance[j])
                                            : (float)(light_scale * 0.5 * (lp + lq));
@@ -118,8 +127,8 @@ static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel
 /* Each valid texel's variance averaged over the valid texels of its 3 x 3 neighbourhood on
  * the same instance (SVGF's prefilter, Schied et al. 2017 sec. 4.3): a variance estimated
  * from a texel's two rounds alone is itself noisy, and 0 by chance would pin the texel. */
-static void smooth_variance(const lmb_texels *t, const uint32_t *listed, const texel_guide *g, const float *variance,
-                            float *out, int threads)
+static void smooth_variance(const lmb_texels *t, const uint32_t *listed, const float *variance, float *out,
+                            int threads)
 {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
     for (uint32_t i = 0; i < t->count; i++) {
@@ -134,7 +143,7 @@ static void smooth_variance(const lmb_texels *t, const uint32_t *listed, const t
                 if (xx < 0 || yy < 0 || xx >= (long)t->width || yy >= (long)t->height)
                     continue;
                 uint32_t j = listed[(size_t)yy * t->width + (size_t)xx];
-                if (j != NOT_LISTED && t->valid[j] && g[j].instance == g[i].instance) {
+                if (j != NOT_LISTED && t->valid[j] && instance_of(t, j) == instance_of(t, i)) {
                     sum += variance[j];
                     n++;
                 }
@@ -198,11 +207,9 @@ lmb_status lmb_denoiser_create(const lmb_texels *t, const lmb_denoise_options *o
             g[i].p[k] = (float)gp.p[k];
             g[i].n[k] = gp.n[k];
         }
-        g[i].size = t->texel_size[i];
-        g[i].instance = gp.instance;
     }
     if (d->variance)
-        smooth_variance(t, d->listed, g, opt->variance, d->variance, threads);
+        smooth_variance(t, d->listed, opt->variance, d->variance, threads);
     *out = d;
     return LMB_OK;
 }

@@ -316,6 +316,70 @@ lmb_status lmb_steps_run(lmb_steps *s, const lmb_step_desc *d, lmb_buf *out, uin
     return read_state(s, d, step, out, counters, err);
 }
 
+lmb_status lmb_steps_run_streamed(lmb_steps *s, const lmb_step_desc *d, uint64_t chunk, lmb_step_take_fn take,
+                                  void *take_user, uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    lmb_buf bytes = {0};
+    lmb_status st = LMB_OK;
+    int below = d->rays < s->min_rays;
+    int here = below || s->mode == LMB_STEPS_LOCAL || (s->mode == LMB_STEPS_SHARD && s->next > s->step);
+    if (!d->items || !here) { /* read (or, at a shard's own step, computed and written): all at once */
+        st = lmb_steps_run(s, d, &bytes, counters, err);
+        if (st == LMB_OK && d->items)
+            st = take(take_user, &bytes, err);
+        lmb_buf_free(&bytes);
+        return st;
+    }
+    memset(counters, 0, LMB_STEP_COUNTERS * sizeof *counters);
+    if (!below)
+        s->next++; /* numbered as lmb_steps_run numbers it */
+    chunk = chunk ? chunk : d->items;
+    for (uint64_t first = 0; first < d->items && st == LMB_OK; first += chunk) {
+        uint64_t last = d->items - first > chunk ? first + chunk : d->items;
+        bytes.size = bytes.read = 0;
+        st = d->fn(d->user, first, last, &bytes, counters, err);
+        if (st == LMB_OK)
+            st = take(take_user, &bytes, err);
+        if (st == LMB_OK && bytes.read != bytes.size)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "step '%s': %zu bytes of items %llu..%llu left unread", d->name,
+                               bytes.size - bytes.read, (unsigned long long)first, (unsigned long long)last);
+    }
+    lmb_buf_free(&bytes);
+    return st;
+}
+
+/* Moves past arrays that are full (or hold nothing). */
+static void sink_skip_full(lmb_float_sink *k)
+{
+    while (k->at < k->arrays && k->filled == k->floats[k->at]) {
+        k->at++;
+        k->filled = 0;
+    }
+}
+
+lmb_status lmb_take_floats(void *sink, lmb_buf *bytes, lmb_error *err)
+{
+    lmb_float_sink *k = sink;
+    if ((bytes->size - bytes->read) % sizeof(float))
+        return lmb_error_set(err, LMB_ERR_INPUT, "step results: %zu bytes are not whole floats", bytes->size - bytes->read);
+    for (sink_skip_full(k); bytes->read < bytes->size; sink_skip_full(k)) {
+        if (k->at == k->arrays)
+            return lmb_error_set(err, LMB_ERR_INPUT, "step results: %zu bytes more than the texels hold",
+                                 bytes->size - bytes->read);
+        uint64_t have = (bytes->size - bytes->read) / sizeof(float), need = k->floats[k->at] - k->filled;
+        uint64_t n = have < need ? have : need;
+        lmb_buf_take(bytes, k->dst[k->at] + k->filled, n * sizeof(float));
+        k->filled += n;
+    }
+    return LMB_OK;
+}
+
+int lmb_float_sink_full(lmb_float_sink *k)
+{
+    sink_skip_full(k);
+    return k->at == k->arrays;
+}
+
 lmb_status lmb_steps_write_end(lmb_steps *s, lmb_error *err)
 {
     char path[4400];

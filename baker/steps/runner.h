@@ -97,6 +97,34 @@ lmb_status lmb_steps_worker_end(lmb_steps *s, lmb_error *err);
 lmb_status lmb_steps_run(lmb_steps *s, const lmb_step_desc *d, lmb_buf *out, uint64_t counters[LMB_STEP_COUNTERS],
                          lmb_error *err);
 
+/* Takes a step's bytes as they come; must read all it is given (bytes->read == bytes->size). */
+typedef lmb_status (*lmb_step_take_fn)(void *user, lmb_buf *bytes, lmb_error *err);
+
+/* Items per chunk for a streamed step of texels: its bytes in a local bake are this many texels'. */
+#define LMB_STEP_STREAM_ITEMS 65536
+
+/* lmb_steps_run, with the bytes handed to take in item order: where the step runs in this
+ * process over all its items (a local bake, or a step under the runner's minimum), `chunk`
+ * items at a time, so the whole step's bytes never exist at once (the texel arrays they fill
+ * are all the step costs); elsewhere (a farm's merged state) all at once. The bytes are the
+ * same either way: items are independent. */
+lmb_status lmb_steps_run_streamed(lmb_steps *s, const lmb_step_desc *d, uint64_t chunk, lmb_step_take_fn take,
+                                  void *take_user, uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err);
+
+/* The take function of the common step whose bytes are floats filling arrays one after the
+ * other (an atlas's texels, then the next atlas's): dst[k] receives floats[k] floats. */
+typedef struct lmb_float_sink {
+    uint32_t arrays;
+    float *const *dst;
+    const uint64_t *floats;
+    uint32_t at;     /* the array being filled, and how much of it is */
+    uint64_t filled;
+} lmb_float_sink;
+
+lmb_status lmb_take_floats(void *sink, lmb_buf *bytes, lmb_error *err);
+/* Whether every array is full (the step gave all it should). */
+int lmb_float_sink_full(lmb_float_sink *sink);
+
 /* Steps run or read so far. */
 uint32_t lmb_steps_count(const lmb_steps *s);
 
