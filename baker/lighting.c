@@ -123,14 +123,20 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
 }
 
 /* The denoiser's passes as steps (steps/runner.h): a step per level over the listed texels of
- * every atlas it filters, in atlas order; each reads the previous level's light of every texel. */
+ * every atlas it filters, in atlas order; each reads the previous level's light of every texel.
+ * A level's results are written back into the light as soon as no texel still to be filtered
+ * reads them (lmb_denoiser_reach rows on), so a local bake holds a few rows of them, not a
+ * second copy of the light; the output is the same as writing them back at the level's end. */
 typedef struct denoise_job {
     uint32_t atlases;
     lmb_denoiser **dn;  /* per atlas; NULL: not filtered */
-    float **from;       /* per atlas: the previous level's light (the light being filtered) */
+    float **from;       /* per atlas: the light being filtered, the previous level's result */
+    const atlas_work *w;
     uint64_t *first;    /* per atlas (+1): its first item */
     uint32_t level;
     int threads;
+    lmb_buf pending;    /* results of items [written, taken) not written back yet */
+    uint64_t written, taken;
 } denoise_job;
 
 static lmb_status denoise_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
@@ -147,9 +153,64 @@ static lmb_status denoise_range(void *user, uint64_t first, uint64_t last, lmb_b
         float *o = lmb_buf_extend(out, n * sizeof *o, err); /* filtered straight into the step's bytes */
         if (!o)
             return LMB_ERR_INTERNAL;
-        lmb_denoiser_level(j->dn[a], j->level, j->from[a], (uint32_t)(lo - j->first[a]), (uint32_t)(hi - j->first[a]),
-                           o, j->threads);
+        st = lmb_denoiser_level(j->dn[a], j->level, j->from[a], (uint32_t)(lo - j->first[a]),
+                                (uint32_t)(hi - j->first[a]), o, j->threads, err);
     }
+    return st;
+}
+
+/* Item k's atlas (j->first is ascending). */
+static uint32_t item_atlas(const denoise_job *j, uint64_t k)
+{
+    uint32_t a = 0;
+    while (a + 1 < j->atlases && j->first[a + 1] <= k)
+        a++;
+    return a;
+}
+
+/* Whether item k's result may be written back while items from `next` on are still to be
+ * filtered: another atlas's, or rows beyond the taps' reach. */
+static int may_write_back(const denoise_job *j, uint64_t k, uint64_t next)
+{
+    if (next >= j->first[j->atlases])
+        return 1;
+    uint32_t a = item_atlas(j, k), b = item_atlas(j, next);
+    if (a != b)
+        return 1;
+    const lmb_texels *t = &j->w[a].t;
+    if (!lmb_denoiser_in_order(j->dn[a]))
+        return 0;
+    uint32_t row = t->texel[k - j->first[a]] / t->width, next_row = t->texel[next - j->first[a]] / t->width;
+    return (uint64_t)row + lmb_denoiser_reach(j->level) < next_row;
+}
+
+/* The level's results as they come (lmb_steps_run_streamed): kept, and written back as far as
+ * may_write_back allows. */
+static lmb_status denoise_take(void *user, lmb_buf *bytes, lmb_error *err)
+{
+    denoise_job *j = user;
+    size_t n = bytes->size - bytes->read;
+    if (n % (3 * sizeof(float)))
+        return lmb_error_set(err, LMB_ERR_INPUT, "denoise: %zu bytes are not whole texels", n);
+    lmb_status st = lmb_buf_append(&j->pending, bytes->data + bytes->read, n, err);
+    bytes->read = bytes->size;
+    j->taken += n / (3 * sizeof(float));
+    if (j->taken > j->first[j->atlases])
+        return lmb_error_set(err, LMB_ERR_INPUT, "denoise: the step gave more texels than it has");
+    uint64_t done = j->written;
+    while (st == LMB_OK && done < j->taken && may_write_back(j, done, j->taken))
+        done++;
+    for (uint64_t k = j->written; k < done;) { /* atlas by atlas */
+        uint32_t a = item_atlas(j, k);
+        uint64_t end = done < j->first[a + 1] ? done : j->first[a + 1];
+        memcpy(j->from[a] + 3 * (k - j->first[a]), j->pending.data + 3 * sizeof(float) * (k - j->written),
+               3 * sizeof(float) * (end - k));
+        k = end;
+    }
+    size_t used = 3 * sizeof(float) * (done - j->written);
+    memmove(j->pending.data, j->pending.data + used, j->pending.size - used);
+    j->pending.size -= used;
+    j->written = done;
     return st;
 }
 
@@ -164,8 +225,8 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
     uint32_t n = env->cache->atlas_count;
     lmb_denoise_stats ds = {0};
     double most = 0;
-    denoise_job j = {n, calloc((size_t)n + 1, sizeof(lmb_denoiser *)), calloc((size_t)n + 1, sizeof(float *)),
-                     calloc((size_t)n + 2, sizeof(uint64_t)), 0, (int)cfg->threads};
+    denoise_job j = {n, calloc((size_t)n + 1, sizeof(lmb_denoiser *)), calloc((size_t)n + 1, sizeof(float *)), env->w,
+                     calloc((size_t)n + 2, sizeof(uint64_t)), 0, (int)cfg->threads, {0}, 0, 0};
     lmb_status st = j.dn && j.from && j.first ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory");
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
         atlas_work *w = &env->w[a];
@@ -182,23 +243,19 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
         if (st == LMB_OK)
             lmb_denoise_measure(&w->t, j.from[a], &ds.before, &ds.texels);
     }
-    lmb_buf bytes = {0};
     for (uint32_t level = 0; level < levels && st == LMB_OK && j.first[n] > 0; level++) {
         char name[96];
         snprintf(name, sizeof name, "denoise %s, level %u", own_variance ? "all light" : "gathered light", level + 1);
         j.level = level;
+        j.written = j.taken = 0;
         lmb_step_desc d = {name, j.first[n], NULL, LMB_DENOISE_RAYS_PER_TEXEL * (double)j.first[n], denoise_range, &j};
         uint64_t counters[LMB_STEP_COUNTERS];
-        st = lmb_steps_run(env->job->steps, &d, &bytes, counters, err);
-        if (st == LMB_OK && bytes.size != 3 * sizeof(float) * j.first[n])
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: step '%s' gave %zu bytes for %llu texels", name,
-                               bytes.size, (unsigned long long)j.first[n]);
-        /* the level is whole in the step's bytes: the next level reads it from the light itself */
-        for (uint32_t a = 0; a < n && st == LMB_OK; a++)
-            if (j.dn[a])
-                memcpy(j.from[a], bytes.data + 3 * sizeof(float) * j.first[a], 3 * sizeof(float) * env->w[a].t.count);
+        st = lmb_steps_run_streamed(env->job->steps, &d, LMB_STEP_STREAM_ITEMS, denoise_take, &j, counters, err);
+        if (st == LMB_OK && j.written != j.first[n])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: step '%s' gave %llu of %llu texels", name,
+                               (unsigned long long)j.taken, (unsigned long long)j.first[n]);
     }
-    lmb_buf_free(&bytes);
+    lmb_buf_free(&j.pending);
     for (uint32_t a = 0; a < n && st == LMB_OK; a++)
         if (j.dn[a])
             lmb_denoise_measure(&env->w[a].t, j.from[a], &ds.after, NULL);

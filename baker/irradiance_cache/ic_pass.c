@@ -361,6 +361,23 @@ static lmb_status records_noise(const lmb_ic_records *s, uint32_t atlas_count, d
     return LMB_OK;
 }
 
+/* Frees what only the record gathers read: the records' guide mixtures and the levels' tested
+ * reaches (idempotent). */
+static void free_gather_state(pass_ctx *c)
+{
+    free(c->mix);
+    free(c->has_mix);
+    c->mix = NULL;
+    c->has_mix = NULL;
+    c->mix_cap = 0;
+    for (uint32_t l = 0; c->tested_reach && l < c->levels; l++)
+        free(c->tested_reach[l]);
+    free(c->tested_reach);
+    free(c->tested_count);
+    c->tested_reach = NULL;
+    c->tested_count = NULL;
+}
+
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
                               lmb_ic_records *shared, lmb_gather_stats *stats, lmb_error *err)
@@ -427,6 +444,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     }
     if (st == LMB_OK)
         st = fit_gradients(&c, err);
+    free_gather_state(&c); /* the interpolation reads records only: their guides and tests go first */
     if (st == LMB_OK)
         st = interpolate_all(&c, out, err);
     if (st == LMB_OK) {
@@ -447,12 +465,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);
-    free(c.mix);
-    free(c.has_mix);
-    for (uint32_t l = 0; c.tested_reach && l < c.levels; l++)
-        free(c.tested_reach[l]);
-    free(c.tested_reach);
-    free(c.tested_count);
+    free_gather_state(&c);
     if (shared && st == LMB_OK) { /* handed to the next pass */
         lmb_ic_records_free(shared);
         *shared = c.records;

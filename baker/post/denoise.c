@@ -26,14 +26,14 @@ static uint32_t instance_of(const lmb_texels *t, uint32_t i)
 
 static const float B3[5] = {1.0f / 16, 4.0f / 16, 6.0f / 16, 4.0f / 16, 1.0f / 16};
 
-/* The surface part of w(p, q) (denoise.h) for texels `atlas_distance` texels apart, p of
- * `size` world units; 0 when q is on another surface. */
-static float surface_weight(const lmb_texels *t, uint32_t p, uint32_t q, const texel_guide *g, float atlas_distance,
-                            float step)
+/* The surface part of w(p, q) (denoise.h) for texels `atlas_distance` texels apart (g: the
+ * guides of listed texels from g0 on); 0 when q is on another surface. */
+static float surface_weight(const lmb_texels *t, uint32_t p, uint32_t q, const texel_guide *g, uint32_t g0,
+                            float atlas_distance, float step)
 {
     if (instance_of(t, p) != instance_of(t, q))
         return 0;
-    const texel_guide *gp = &g[p], *gq = &g[q];
+    const texel_guide *gp = &g[p - g0], *gq = &g[q - g0];
     float size = t->texel_size[p];
     float d[3] = {gq->p[0] - gp->p[0], gq->p[1] - gp->p[1], gq->p[2] - gp->p[2]};
     float far = 2.0f * (atlas_distance + 1.0f) * size;
@@ -67,9 +67,9 @@ static void plane_fit(const double m[6], double r[3][3], const float lo[3], cons
 
 /* One a-trous pass with taps `step` texels apart over listed texels [first, last): out (3
  * floats per texel of the range) from in (every listed texel's). */
-static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel_guide *g, const float *in, float *out,
-                        uint32_t first, uint32_t last, uint32_t step, double light_scale, const float *variance,
-                        int threads)
+static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel_guide *g, uint32_t g0, const float *in,
+                        float *out, uint32_t first, uint32_t last, uint32_t step, double light_scale,
+                        const float *variance, int threads)
 {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 256)
     for (uint32_t i = first; i < last; i++) {
@@ -100,7 +100,7 @@ static void atrous_pass(const lmb_texels *t, const uint32_t *listed, const texel
                 float w = B3[kx] * B3[ky];
                 if (j != i) {
                     float dx = (float)(kx - 2) * step, dy = (float)(ky - 2) * step;
-                    w *= surface_weight(t, i, j, g, sqrtf(dx * dx + dy * dy), (float)step);
+                    w *= surface_weight(t, i, j, g, g0, sqrtf(dx * dx + dy * dy), (float)step);
                     float lq = (float)lmb_luminance_f(cq);
                     float scale = variance ? (float)light_scale * sqrtf(variance[i] + variance[j])
                                            : (float)(light_scale * 0.5 * (lp + lq));
@@ -155,10 +155,10 @@ static void smooth_variance(const lmb_texels *t, const uint32_t *listed, const f
 struct lmb_denoiser {
     const lmb_texels *t;
     uint32_t *listed;   /* atlas texel -> listed index, or NOT_LISTED */
-    texel_guide *g;
     float *variance;    /* smoothed, or NULL */
     double light_scale;
     uint32_t levels;
+    int rows_sorted;    /* listed texels in atlas order: a range's guides are its rows' and its taps' */
 };
 
 void lmb_denoiser_free(lmb_denoiser *d)
@@ -166,7 +166,6 @@ void lmb_denoiser_free(lmb_denoiser *d)
     if (!d)
         return;
     free(d->listed);
-    free(d->g);
     free(d->variance);
     free(d);
 }
@@ -184,41 +183,79 @@ lmb_status lmb_denoiser_create(const lmb_texels *t, const lmb_denoise_options *o
         d->levels = opt->levels;
         d->light_scale = opt->variance ? opt->sigma_light : opt->sigma_light * opt->noise;
         d->listed = malloc((n + 1) * sizeof *d->listed);
-        d->g = malloc(((size_t)t->count + 1) * sizeof *d->g);
         d->variance = opt->variance ? malloc(((size_t)t->count + 1) * sizeof *d->variance) : NULL;
     }
-    if (!d || !d->listed || !d->g || (opt->variance && !d->variance)) {
+    if (!d || !d->listed || (opt->variance && !d->variance)) {
         lmb_denoiser_free(d);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for a %ux%u atlas", t->width, t->height);
     }
     for (size_t k = 0; k < n; k++)
         d->listed[k] = NOT_LISTED;
-    int threads = opt->threads > 0 ? opt->threads : omp_get_max_threads();
-    texel_guide *g = d->g;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
+    d->rows_sorted = 1;
     for (uint32_t i = 0; i < t->count; i++) {
         d->listed[t->texel[i]] = i;
-        memset(&g[i], 0, sizeof g[i]);
-        if (!t->valid[i])
-            continue;
-        lmb_gather_point gp;
-        lmb_texels_point(t, i, 0, &gp);
-        for (int k = 0; k < 3; k++) {
-            g[i].p[k] = (float)gp.p[k];
-            g[i].n[k] = gp.n[k];
-        }
+        d->rows_sorted &= i == 0 || t->texel[i] > t->texel[i - 1];
     }
+    int threads = opt->threads > 0 ? opt->threads : omp_get_max_threads();
     if (d->variance)
         smooth_variance(t, d->listed, opt->variance, d->variance, threads);
     *out = d;
     return LMB_OK;
 }
 
-void lmb_denoiser_level(const lmb_denoiser *d, uint32_t level, const float *in, uint32_t first, uint32_t last,
-                        float *out, int threads)
+int lmb_denoiser_in_order(const lmb_denoiser *d)
 {
-    atrous_pass(d->t, d->listed, d->g, in, out, first, last, 1u << level, d->light_scale, d->variance,
-                threads > 0 ? threads : omp_get_max_threads());
+    return d->rows_sorted;
+}
+
+/* The first listed texel at or after atlas texel `texel` (t->texel ascending). */
+static uint32_t listed_from(const lmb_texels *t, uint64_t texel)
+{
+    uint32_t lo = 0, hi = t->count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (t->texel[mid] < texel)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+lmb_status lmb_denoiser_level(const lmb_denoiser *d, uint32_t level, const float *in, uint32_t first, uint32_t last,
+                              float *out, int threads, lmb_error *err)
+{
+    const lmb_texels *t = d->t;
+    if (first >= last)
+        return LMB_OK;
+    threads = threads > 0 ? threads : omp_get_max_threads();
+    /* the guides of the range's rows and of every row its taps reach (2 x 2^level rows each way):
+     * built for the pass and dropped, so no pass holds an atlas's guides whole */
+    uint32_t g0 = 0, g1 = t->count;
+    if (d->rows_sorted) {
+        uint64_t reach = lmb_denoiser_reach(level), y0 = t->texel[first] / t->width, y1 = t->texel[last - 1] / t->width + 1;
+        g0 = listed_from(t, (y0 > reach ? y0 - reach : 0) * t->width);
+        g1 = listed_from(t, (y1 + reach) * (uint64_t)t->width);
+    }
+    texel_guide *g = malloc(((size_t)(g1 - g0) + 1) * sizeof *g);
+    if (!g)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory for the guides of %u texels", g1 - g0);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1024)
+    for (uint32_t i = g0; i < g1; i++) {
+        texel_guide *gi = &g[i - g0];
+        memset(gi, 0, sizeof *gi);
+        if (!t->valid[i])
+            continue;
+        lmb_gather_point gp;
+        lmb_texels_point(t, i, 0, &gp);
+        for (int k = 0; k < 3; k++) {
+            gi->p[k] = (float)gp.p[k];
+            gi->n[k] = gp.n[k];
+        }
+    }
+    atrous_pass(t, d->listed, g, g0, in, out, first, last, 1u << level, d->light_scale, d->variance, threads);
+    free(g);
+    return LMB_OK;
 }
 
 void lmb_denoise_measure(const lmb_texels *t, const float *rgb, double *sum, uint64_t *texels)
@@ -248,7 +285,12 @@ lmb_status lmb_denoise_atlas(const lmb_texels *t, float *rgb, const lmb_denoise_
     /* passes alternate between rgb and work; an odd count ends in work and is copied back */
     float *from = rgb, *to = work;
     for (uint32_t level = 0; level < opt->levels; level++) {
-        lmb_denoiser_level(d, level, from, 0, t->count, to, opt->threads);
+        lmb_status st = lmb_denoiser_level(d, level, from, 0, t->count, to, opt->threads, err);
+        if (st != LMB_OK) {
+            free(work);
+            lmb_denoiser_free(d);
+            return st;
+        }
         float *swap = from;
         from = to;
         to = swap;

@@ -64,8 +64,8 @@ typedef struct lmb_denoise_stats {
     double before, after; /* their luminance, summed, before and after */
 } lmb_denoise_stats;
 
-/* One atlas's guides for the filter (where each texel is and how it faces, the atlas-to-texel
- * map, the smoothed variances): built once, then each pass can run over any range of texels,
+/* One atlas's filter state (the atlas-to-texel map, the smoothed variances; where each texel is
+ * and how it faces is built per range): made once, then each pass can run over any range of texels,
  * so the passes can be steps of the bake (lighting.c). Owned: lmb_denoiser_free. t and
  * opt->variance must outlive it. */
 typedef struct lmb_denoiser lmb_denoiser;
@@ -75,9 +75,22 @@ lmb_status lmb_denoiser_create(const lmb_texels *t, const lmb_denoise_options *o
 void lmb_denoiser_free(lmb_denoiser *d);
 
 /* Pass `level` (taps 2^level texels apart) over listed texels [first, last): out gets 3 floats
- * per texel of the range, from in (3 floats per listed texel: the previous pass's result). */
-void lmb_denoiser_level(const lmb_denoiser *d, uint32_t level, const float *in, uint32_t first, uint32_t last,
-                        float *out, int threads);
+ * per texel of the range, from in (3 floats per listed texel: the previous pass's result).
+ * Reads in only within lmb_denoiser_reach(level) atlas rows of the range's rows, so a caller
+ * going through the texels in order may write a texel's result back into in once the ranges
+ * still to come start more than that many rows past it. */
+lmb_status lmb_denoiser_level(const lmb_denoiser *d, uint32_t level, const float *in, uint32_t first, uint32_t last,
+                              float *out, int threads, lmb_error *err);
+
+/* Whether the listed texels are in atlas order (as the lights stage lists them); when not,
+ * results may be written back only once a pass is done. */
+int lmb_denoiser_in_order(const lmb_denoiser *d);
+
+/* How many atlas rows pass `level`'s taps reach either way. */
+static inline uint32_t lmb_denoiser_reach(uint32_t level)
+{
+    return 2u << level;
+}
 
 /* Adds the valid texels' luminance to *sum (and their count to *texels unless NULL). */
 void lmb_denoise_measure(const lmb_texels *t, const float *rgb, double *sum, uint64_t *texels);
