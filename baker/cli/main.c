@@ -8,6 +8,9 @@
 
 #include <stdio.h>
 #include <string.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 static const char usage[] =
     "usage: lmbake <command> [options]\n"
@@ -37,6 +40,13 @@ static const char usage[] =
 
 int main(int argc, char **argv)
 {
+#ifdef __GLIBC__
+    /* Buffers of 128 KB and more are mapped and unmapped on their own. Left to itself, glibc
+     * raises this threshold after the first large free, so later large transients (a band, a
+     * chunk of a step, a filter's rows) come from the heap, where freeing them does not give
+     * the memory back: about 30 MB more at the peak of a 2M-texel bake. */
+    mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+#endif
     if (argc < 2) {
         fputs(usage, stderr);
         return LMB_ERR_USAGE;

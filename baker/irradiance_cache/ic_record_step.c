@@ -220,6 +220,48 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
     return st;
 }
 
+/* Where a step's records go as they come (lmb_steps_run_streamed): each item's flag (when
+ * candidates), record and mixture, into rec (new records) or over the records at slots. */
+typedef struct records_taken {
+    pass_ctx *c;
+    const uint32_t *slots;
+    int candidates;
+    lmb_ic_record *rec;
+    uint64_t items, made; /* items read, records made */
+} records_taken;
+
+static lmb_status take_records(void *user, lmb_buf *bytes, lmb_error *err)
+{
+    records_taken *rt = user;
+    pass_ctx *c = rt->c;
+    for (; bytes->read < bytes->size; rt->items++) {
+        uint8_t flag = 1;
+        if (rt->candidates && !lmb_buf_take(bytes, &flag, 1))
+            flag = 2;
+        if (!flag)
+            continue;
+        uint32_t slot = rt->slots ? rt->slots[rt->items] : c->records.count + (uint32_t)rt->made;
+        lmb_ic_record fresh;
+        lmb_mixture mix;
+        if (flag == 2 || !take_record(bytes, &fresh) || (c->guided && !take_mixture(bytes, &mix)))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: a truncated record in step results", c->job->stage);
+        if (c->guided)
+            c->mix[slot] = mix; /* not read before has_mix is set, when the whole group is in */
+        if (rt->slots) {
+            memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
+            memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
+        } else {
+            rt->rec[rt->made] = fresh;
+        }
+        rt->made++;
+    }
+    return LMB_OK;
+}
+
+/* Items per chunk of a records step in a local bake: a chunk's records and mixtures are at most
+ * 4096 x 640 bytes. */
+#define RECORD_CHUNK 4096
+
 lmb_status lmb_ic_gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, int candidates,
                                  lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
                                  lmb_gather_stats *stats, lmb_error *err)
@@ -231,45 +273,23 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const texel_at *at, uint64_t m, co
     snprintf(name, sizeof name, "%s: %s %u", c->stage, slots ? "records gathered again, group" : "records placed, level",
              slots ? c->regather_group : c->group);
     lmb_step_desc d = {name, m, NULL, (double)m * c->job->estimator.rays, gather_records_range, &rs};
-    lmb_buf bytes = {0};
     uint64_t counters[LMB_STEP_COUNTERS];
-    lmb_status st = lmb_steps_run(c->job->steps, &d, &bytes, counters, err);
+    records_taken rt = {c, slots, candidates, rec, 0, 0};
+    /* records gathered again overwrite records their own group reads: taken once all are gathered */
+    lmb_status st = lmb_steps_run_streamed(c->job->steps, &d, slots ? 0 : RECORD_CHUNK, take_records, &rt, counters, err);
     stats->rays += counters[0];
     stats->texels += counters[1];
     stats->adapted += counters[2];
     stats->extended += counters[3];
     stats->capped += counters[4];
-    uint64_t n = 0; /* records made */
-    for (uint64_t k = 0; k < m && st == LMB_OK; k++) {
-        uint8_t flag = 1;
-        if (candidates && !lmb_buf_take(&bytes, &flag, 1))
-            flag = 2;
-        if (!flag)
-            continue;
-        uint32_t slot = slots ? slots[k] : c->records.count + (uint32_t)n;
-        lmb_ic_record fresh;
-        lmb_mixture mix;
-        if (flag == 2 || !take_record(&bytes, &fresh) || (c->guided && !take_mixture(&bytes, &mix))) {
-            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step '%s' holds fewer records than %llu", c->job->stage, name,
-                               (unsigned long long)m);
-            break;
-        }
-        if (c->guided)
-            c->mix[slot] = mix;
-        if (slots) {
-            memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
-            memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);
-        } else {
-            rec[n] = fresh;
-        }
-        n++;
-    }
-    lmb_buf_free(&bytes);
+    if (st == LMB_OK && rt.items != m)
+        st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step '%s' holds %llu of %llu records", c->job->stage, name,
+                           (unsigned long long)rt.items, (unsigned long long)m);
     if (made)
-        *made = n;
+        *made = rt.made;
     if (st != LMB_OK)
         return st;
-    for (uint64_t k = 0; c->guided && k < n; k++) /* the group is in: later groups may be guided by it */
+    for (uint64_t k = 0; c->guided && k < rt.made; k++) /* the group is in: later groups may be guided by it */
         c->has_mix[slots ? slots[k] : c->records.count + (uint32_t)k] = 1;
     return LMB_OK;
 }
