@@ -1,12 +1,12 @@
 /* The lighting passes over all atlases (see lighting.h). */
-#include "lighting.h"
+#include "lighting_internal.h"
 
 #include "steps/runner.h"
 #include "gather/gather.h"
 #include "lights/direct_refine.h"
 #include "lights/direct_step.h"
 #include "irradiance_cache/ic_pass.h"
-#include "post/denoise.h"
+#include "post/denoise_steps.h"
 #include "post/rim.h"
 #include "util/clock.h"
 #include "util/lmb_math.h"
@@ -16,19 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct atlas_work {
-    lmb_texels t;
-    float *direct;   /* 3 per listed texel */
-    float *result;   /* 3 per listed texel: the pass being computed */
-    float *direct_dir; /* output.directional: 3 per listed texel, direct light's direction sum */
-    float *indirect_dir; /* output.directional: 3 per listed texel, the indirect part, then the direction */
-    float *deferred; /* mixed lighting: 3 per listed texel, the `indirect` lights' part of direct; else NULL */
-    float *shadowmask; /* output.shadowmask: 4 per listed texel; else NULL */
-    float *variance; /* per listed texel: variance of a round of its sampled direct light (direct_refine.h) */
-    uint64_t direct_rays; /* what the direct step traced for this atlas */
-    double gather_noise;  /* the last cached gather's records: median relative standard error (ic_pass.h) */
-} atlas_work;
 
 static void work_free(atlas_work *w, uint32_t n)
 {
@@ -46,7 +33,7 @@ static void work_free(atlas_work *w, uint32_t n)
 }
 
 /* The cache := every atlas's result (dilated). */
-static lmb_status store_pass(atlas_work *w, lmb_cache *cache, lmb_error *err)
+lmb_status lmb_lighting_store(atlas_work *w, lmb_cache *cache, lmb_error *err)
 {
     lmb_status st = LMB_OK;
     for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
@@ -72,17 +59,6 @@ static lmb_status store_indirect(atlas_work *w, lmb_cache *cache, int passes_ran
     return st;
 }
 
-/* What the passes share. */
-typedef struct pass_env {
-    const lmb_config *cfg;
-    const lmb_log *log;
-    lmb_gather_job *job;
-    atlas_work *w;
-    lmb_cache *cache;
-    lmb_bake_stats *stats;
-    lmb_ic_points *points; /* set during the final gather only: where its records go */
-    lmb_ic_records *shared; /* irradiance_cache.records: shared: the records passed on; else NULL */
-} pass_env;
 
 /* The pass's gather through the irradiance cache, every atlas at once (records are shared
  * across atlases), with one report line per atlas. */
@@ -122,102 +98,10 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     return st;
 }
 
-/* The denoiser's passes as steps (steps/runner.h): a step per level over the listed texels of
- * every atlas it filters, in atlas order; each reads the previous level's light of every texel.
- * A level's results are written back into the light as soon as no texel still to be filtered
- * reads them (lmb_denoiser_reach rows on), so a local bake holds a few rows of them, not a
- * second copy of the light; the output is the same as writing them back at the level's end. */
-typedef struct denoise_job {
-    uint32_t atlases;
-    lmb_denoiser **dn;  /* per atlas; NULL: not filtered */
-    float **from;       /* per atlas: the light being filtered, the previous level's result */
-    const atlas_work *w;
-    uint64_t *first;    /* per atlas (+1): its first item */
-    uint32_t level;
-    int threads;
-    lmb_buf pending;    /* results of items [written, taken) not written back yet */
-    uint64_t written, taken;
-} denoise_job;
-
-static lmb_status denoise_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
-                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
-{
-    (void)counters;
-    const denoise_job *j = user;
-    lmb_status st = LMB_OK;
-    for (uint32_t a = 0; a < j->atlases && st == LMB_OK; a++) {
-        uint64_t lo = first > j->first[a] ? first : j->first[a], hi = last < j->first[a + 1] ? last : j->first[a + 1];
-        if (!j->dn[a] || lo >= hi)
-            continue;
-        size_t n = 3 * (size_t)(hi - lo);
-        float *o = lmb_buf_extend(out, n * sizeof *o, err); /* filtered straight into the step's bytes */
-        if (!o)
-            return LMB_ERR_INTERNAL;
-        st = lmb_denoiser_level(j->dn[a], j->level, j->from[a], (uint32_t)(lo - j->first[a]),
-                                (uint32_t)(hi - j->first[a]), o, j->threads, err);
-    }
-    return st;
-}
-
-/* Item k's atlas (j->first is ascending). */
-static uint32_t item_atlas(const denoise_job *j, uint64_t k)
-{
-    uint32_t a = 0;
-    while (a + 1 < j->atlases && j->first[a + 1] <= k)
-        a++;
-    return a;
-}
-
-/* Whether item k's result may be written back while items from `next` on are still to be
- * filtered: another atlas's, or rows beyond the taps' reach. */
-static int may_write_back(const denoise_job *j, uint64_t k, uint64_t next)
-{
-    if (next >= j->first[j->atlases])
-        return 1;
-    uint32_t a = item_atlas(j, k), b = item_atlas(j, next);
-    if (a != b)
-        return 1;
-    const lmb_texels *t = &j->w[a].t;
-    if (!lmb_denoiser_in_order(j->dn[a]))
-        return 0;
-    uint32_t row = t->texel[k - j->first[a]] / t->width, next_row = t->texel[next - j->first[a]] / t->width;
-    return (uint64_t)row + lmb_denoiser_reach(j->level) < next_row;
-}
-
-/* The level's results as they come (lmb_steps_run_streamed): kept, and written back as far as
- * may_write_back allows. */
-static lmb_status denoise_take(void *user, lmb_buf *bytes, lmb_error *err)
-{
-    denoise_job *j = user;
-    size_t n = bytes->size - bytes->read;
-    if (n % (3 * sizeof(float)))
-        return lmb_error_set(err, LMB_ERR_INPUT, "denoise: %zu bytes are not whole texels", n);
-    lmb_status st = lmb_buf_append(&j->pending, bytes->data + bytes->read, n, err);
-    bytes->read = bytes->size;
-    j->taken += n / (3 * sizeof(float));
-    if (j->taken > j->first[j->atlases])
-        return lmb_error_set(err, LMB_ERR_INPUT, "denoise: the step gave more texels than it has");
-    uint64_t done = j->written;
-    while (st == LMB_OK && done < j->taken && may_write_back(j, done, j->taken))
-        done++;
-    for (uint64_t k = j->written; k < done;) { /* atlas by atlas */
-        uint32_t a = item_atlas(j, k);
-        uint64_t end = done < j->first[a + 1] ? done : j->first[a + 1];
-        memcpy(j->from[a] + 3 * (k - j->first[a]), j->pending.data + 3 * sizeof(float) * (k - j->written),
-               3 * sizeof(float) * (end - k));
-        k = end;
-    }
-    size_t used = 3 * sizeof(float) * (done - j->written);
-    memmove(j->pending.data, j->pending.data + used, j->pending.size - used);
-    j->pending.size -= used;
-    j->written = done;
-    return st;
-}
-
 /* Every atlas's `field` (3 floats per listed texel) through the edge-aware filter
- * (post/denoise.h) at the relative noise `noise` (atlas by atlas when NULL: each atlas's
- * records' gather_noise) with `levels` passes, each a step of the bake; `what` names the
- * light in the log line. */
+ * (post/denoise_steps.h) at the relative noise `noise` (atlas by atlas when NULL: each atlas's
+ * records' gather_noise) or, with own_variance, each texel's variance, with `levels` passes;
+ * `what` names the light in the log line. */
 static lmb_status denoise_light(const pass_env *env, size_t field, const double *noise, int own_variance,
                                 uint32_t levels, const char *what, lmb_error *err)
 {
@@ -225,45 +109,20 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
     uint32_t n = env->cache->atlas_count;
     lmb_denoise_stats ds = {0};
     double most = 0;
-    denoise_job j = {n, calloc((size_t)n + 1, sizeof(lmb_denoiser *)), calloc((size_t)n + 1, sizeof(float *)), env->w,
-                     calloc((size_t)n + 2, sizeof(uint64_t)), 0, (int)cfg->threads, {0}, 0, 0};
-    lmb_status st = j.dn && j.from && j.first ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory");
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+    lmb_denoise_part *atlases = calloc((size_t)n + 1, sizeof *atlases);
+    if (!atlases)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: out of memory");
+    for (uint32_t a = 0; a < n; a++) {
         atlas_work *w = &env->w[a];
         double level = noise ? *noise : LMB_DENOISE_TEXEL_SHARE * w->gather_noise;
-        j.first[a + 1] = j.first[a];
-        if (!(level > 0) || (own_variance && !w->variance))
-            continue;
-        most = level > most ? level : most;
-        lmb_denoise_options opt = {levels, level, own_variance ? w->variance : NULL, cfg->denoise_strength,
-                                   (int)cfg->threads};
-        st = lmb_denoiser_create(&w->t, &opt, &j.dn[a], err);
-        j.from[a] = *(float **)(void *)((char *)w + field);
-        j.first[a + 1] += w->t.count;
-        if (st == LMB_OK)
-            lmb_denoise_measure(&w->t, j.from[a], &ds.before, &ds.texels);
+        int filtered = level > 0 && (!own_variance || w->variance);
+        atlases[a] = (lmb_denoise_part){&w->t, *(float **)(void *)((char *)w + field),
+                                         filtered && own_variance ? w->variance : NULL, filtered ? level : 0};
+        most = filtered && level > most ? level : most;
     }
-    for (uint32_t level = 0; level < levels && st == LMB_OK && j.first[n] > 0; level++) {
-        char name[96];
-        snprintf(name, sizeof name, "denoise %s, level %u", own_variance ? "all light" : "gathered light", level + 1);
-        j.level = level;
-        j.written = j.taken = 0;
-        lmb_step_desc d = {name, j.first[n], NULL, LMB_DENOISE_RAYS_PER_TEXEL * (double)j.first[n], denoise_range, &j};
-        uint64_t counters[LMB_STEP_COUNTERS];
-        st = lmb_steps_run_streamed(env->job->steps, &d, LMB_STEP_STREAM_ITEMS, denoise_take, &j, counters, err);
-        if (st == LMB_OK && j.written != j.first[n])
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "denoise: step '%s' gave %llu of %llu texels", name,
-                               (unsigned long long)j.taken, (unsigned long long)j.first[n]);
-    }
-    lmb_buf_free(&j.pending);
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++)
-        if (j.dn[a])
-            lmb_denoise_measure(&env->w[a].t, j.from[a], &ds.after, NULL);
-    for (uint32_t a = 0; j.dn && a < n; a++)
-        lmb_denoiser_free(j.dn[a]);
-    free(j.dn);
-    free(j.from);
-    free(j.first);
+    lmb_denoise_run run = {levels, cfg->denoise_strength, (int)cfg->threads, own_variance ? "all light" : "gathered light"};
+    lmb_status st = lmb_denoise_steps(env->job->steps, atlases, n, &run, &ds, err);
+    free(atlases);
     env->stats->denoised_texels += ds.texels;
     if (st == LMB_OK && ds.texels)
         lmb_info(env->log, "denoise: %s of %llu texels filtered at %.2f%% noise (%u levels, strength %g); its mean "
@@ -400,7 +259,7 @@ static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_
 /* One gather pass over every atlas: result = gather(cache) (+ direct with add_direct), then
  * (store) the cache := result. The gather runs at every texel, or at irradiance-cache records
  * (irradiance_cache.error > 0). */
-static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add_direct, int store, lmb_error *err)
+lmb_status lmb_lighting_gather(const pass_env *env, lmb_gather_stats *gs, int add_direct, int store, lmb_error *err)
 {
     lmb_gather_job *job = env->job;
     atlas_work *w = env->w;
@@ -443,148 +302,8 @@ static lmb_status gather_pass(const pass_env *env, lmb_gather_stats *gs, int add
         w[a].variance = NULL;
     }
     if (st == LMB_OK && store)
-        st = store_pass(w, cache, err);
+        st = lmb_lighting_store(w, cache, err);
     stats->rays += gs->rays;
-    return st;
-}
-
-/* Rays per texel of bounce pass b: higher orders carry less light and reach the texel through
- * more gathers (their noise averages out), so they may use fewer (samples.bounce_high). */
-static uint32_t pass_rays(const lmb_config *cfg, uint32_t b)
-{
-    return b >= 3 && cfg->bounce_rays_high ? cfg->bounce_rays_high : cfg->bounce_rays;
-}
-
-/* Mean of each channel over the valid texels of every atlas (field: direct or result). */
-static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3])
-{
-    double sum[3] = {0, 0, 0};
-    uint64_t count = 0;
-    for (uint32_t a = 0; a < n; a++) {
-        const float *e = *(float *const *)(const void *)((const char *)&w[a] + field);
-        for (uint32_t i = 0; i < w[a].t.count; i++)
-            if (w[a].t.valid[i]) {
-                count++;
-                for (int c = 0; c < 3; c++)
-                    sum[c] += e[3 * (size_t)i + c];
-            }
-    }
-    for (int c = 0; c < 3; c++)
-        out[c] = count ? sum[c] / (double)count : 0;
-}
-
-/*
- * The bounce passes before the final gather (docs/lighting.md "Bounces"). Each pass gathers
- * the light the previous pass added, not all the light so far:
- *   D_0 = E_direct,  D_b = K D_{b-1},  E_b = D_0 + D_1 + ... + D_b,
- * with K one cosine gather (per texel or through the irradiance cache). The sum is the same
- * Neumann series as gathering E_{b-1} again (E_b = E_direct + K E_{b-1}), but each pass's noise
- * is now proportional to what that pass adds: gathering E_{b-1} again re-gathers the direct
- * light's hot spots in every pass, and their noise (a few % of the light with a point light
- * near a ceiling) swamped the later passes' small increments and the ratio that bounces: auto
- * reads from them.
- *
- * bounces: k runs k - 1 passes. bounces: auto runs passes until what they add settles into
- * a geometric series: the ratio r = D_b / D_{b-1} (per channel: the mean albedo seen, weighted
- * by where light goes) agrees with the previous pass's, and the tail the passes leave out,
- * T = D_b r / (1 - r) beyond E_b, is below bounces_auto.tail of the total; or a pass adds under
- * 0.1% of the light; or bounces_auto.max. The tail is then added texel by texel,
- * T_x = D_b,x r / (1 - r), so the final gather reads converged light: a closed room of albedo
- * rho gets pi Le / (1 - rho), not the series cut after b + 1 terms. (At rho = 0.8 a 1% tail
- * takes ~20 passes; the ratio settles after 3-4 and the extrapolation is exact for a furnace.)
- * On return w[].result holds E_b (+ tail) and so does the cache.
- */
-static lmb_status bounce_passes(const pass_env *env, uint32_t *passes, lmb_error *err)
-{
-    const lmb_config *cfg = env->cfg;
-    lmb_gather_job *job = env->job;
-    atlas_work *w = env->w;
-    lmb_cache *cache = env->cache;
-    lmb_bake_stats *stats = env->stats;
-    uint32_t n = cache->atlas_count;
-    int automatic = cfg->bounces == LMB_AUTO;
-    uint32_t max_passes = automatic ? cfg->bounces_max - 1 : cfg->bounces - 1;
-    double direct[3], total[3], added[3], last[3] = {0, 0, 0}, ratio[3] = {0, 0, 0}, prev_ratio = -1;
-    float **sum = calloc((size_t)n + 1, sizeof *sum);
-    lmb_status st = sum ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        sum[a] = malloc((3 * (size_t)w[a].t.count + 1) * sizeof **sum);
-        if (!sum[a])
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-        else
-            memcpy(sum[a], w[a].direct, 3 * (size_t)w[a].t.count * sizeof **sum);
-    }
-    mean_rgb(w, n, offsetof(atlas_work, direct), direct);
-    memcpy(total, direct, sizeof total);
-    stats->bounce_energy[0] = lmb_luminance(direct);
-    char stage[64];
-    uint32_t done = 0;
-    double tail_factor[3] = {0, 0, 0};
-    for (uint32_t b = 1; b <= max_passes && st == LMB_OK; b++) {
-        lmb_gather_stats gs = {0};
-        lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
-        job->estimator = e;
-        job->pass = b;
-        if (automatic)
-            snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
-        else
-            snprintf(stage, sizeof stage, "bounce %u/%u", b, cfg->bounces);
-        job->stage = stage;
-        st = gather_pass(env, &gs, 0, 0, err); /* result := D_b, gathered from D_{b-1} in the cache */
-        if (st != LMB_OK)
-            break;
-        done = b;
-        mean_rgb(w, n, offsetof(atlas_work, result), added);
-        for (uint32_t a = 0; a < n; a++)
-            for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++)
-                sum[a][k] += w[a].result[k];
-        for (int c = 0; c < 3; c++) {
-            total[c] += added[c];
-            ratio[c] = last[c] > 0 ? added[c] / last[c] : 0;
-            ratio[c] = ratio[c] < 0 ? 0 : ratio[c] > 0.98 ? 0.98 : ratio[c];
-            last[c] = added[c];
-        }
-        if (b < LMB_MAX_REPORTED_BOUNCES)
-            stats->bounce_energy[b] = lmb_luminance(added);
-        int last_pass = b == max_passes;
-        if (automatic) {
-            double r = lmb_luminance(ratio), tail[3];
-            for (int c = 0; c < 3; c++)
-                tail[c] = added[c] * ratio[c] / (1 - ratio[c]);
-            double all = lmb_luminance(total) + lmb_luminance(tail);
-            double tail_share = all > 0 ? lmb_luminance(tail) / all : 0;
-            int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
-            /* a pass that adds under 0.1% of the light leaves a tail below the passes' noise */
-            int small = lmb_luminance(added) <= 1e-3 * lmb_luminance(total);
-            int converged = small || (settled && tail_share < cfg->bounces_tail);
-            stats->bounce_stop = small ? LMB_BOUNCES_SMALL_PASS : converged ? LMB_BOUNCES_TAIL : LMB_BOUNCES_MAX;
-            stats->tail_share = b >= 2 ? tail_share : 0;
-            stats->bounce_ratio = b >= 2 ? r : 0;
-            prev_ratio = b >= 2 ? r : -1;
-            last_pass |= converged;
-            if (last_pass && b >= 2 && lmb_luminance(added) > 0)
-                for (int c = 0; c < 3; c++)
-                    tail_factor[c] = ratio[c] / (1 - ratio[c]);
-            else if (last_pass)
-                stats->tail_share = 0; /* nothing left to extrapolate */
-            stats->tail_added = tail_factor[0] > 0 || tail_factor[1] > 0 || tail_factor[2] > 0;
-        }
-        if (last_pass)
-            break;
-        st = store_pass(w, cache, err); /* the cache := D_b, what the next pass gathers */
-    }
-    /* result := E_b + the tail D_b r / (1 - r); the cache := result */
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++)
-        for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
-            double v = sum[a][k] + (done ? w[a].result[k] * tail_factor[k % 3] : 0);
-            w[a].result[k] = (float)(v > 0 ? v : 0);
-        }
-    if (st == LMB_OK)
-        st = store_pass(w, cache, err);
-    for (uint32_t a = 0; sum && a < n; a++)
-        free(sum[a]);
-    free(sum);
-    *passes = done;
     return st;
 }
 
@@ -701,7 +420,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     /* bounce passes: classic gathering with few rays, a fixed number or until converged */
     uint32_t passes = 0;
     if (st == LMB_OK && !dark && !cfg->reference && (cfg->bounces == LMB_AUTO || cfg->bounces > 1))
-        st = bounce_passes(&env, &passes, err);
+        st = lmb_lighting_bounces(&env, &passes, err);
     uint32_t bounces = dark ? 0 : cfg->bounces == LMB_AUTO ? (cfg->reference ? cfg->bounces_max : passes + 1) : cfg->bounces;
     stats->bounces = bounces;
     /* the final gather, or the reference */
@@ -732,7 +451,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         double t0 = lmb_seconds();
         env.points = records;
         if (st == LMB_OK)
-            st = gather_pass(&env, &gs, 1, 1, err);
+            st = lmb_lighting_gather(&env, &gs, 1, 1, err);
         env.points = NULL;
         stats->gather_records = gs.records;
         stats->gather_seconds = lmb_seconds() - t0;

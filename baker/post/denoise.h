@@ -1,6 +1,7 @@
 /*
  * The denoiser: an edge-aware a-trous filter of one atlas's light, in lightmap space: the final
- * gather's light, then all of it with the direct light's own variances (lighting.c).
+ * gather's light, then all of it with the direct light's own variances (lighting.c, through
+ * denoise_steps.h).
  *
  * The final gather's noise sits in the irradiance cache's records: each record's error is
  * copied to every texel it serves, so it is correlated over a record's reach (4 to 8 texels)
@@ -66,7 +67,7 @@ typedef struct lmb_denoise_stats {
 
 /* One atlas's filter state (the atlas-to-texel map, the smoothed variances; where each texel is
  * and how it faces is built per range): made once, then each pass can run over any range of texels,
- * so the passes can be steps of the bake (lighting.c). Owned: lmb_denoiser_free. t and
+ * so the passes can be steps of the bake (denoise_steps.h). Owned: lmb_denoiser_free. t and
  * opt->variance must outlive it. */
 typedef struct lmb_denoiser lmb_denoiser;
 
