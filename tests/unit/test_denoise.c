@@ -9,11 +9,16 @@
  *   - a hard shadow edge (light 1 | 0) with 2% white noise and per-texel variances: the dark
  *     side stays exactly 0 and the lit side's texels at the edge keep their mean within 2%;
  *   - the wall's light (10x the floor's) does not leak onto the floor beside it, or back;
- *   - 1 and 2 threads give the same bytes.
+ *   - 1 and 2 threads give the same bytes;
+ *   - as steps of a local bake (denoise_steps.h: ranges of 64k texels, each level written back
+ *     while later ranges are filtered) over a 420 x 400 atlas with gaps and the 64 x 48 one, the
+ *     light is the same bytes as each atlas filtered whole (lmb_denoise_atlas), both with a
+ *     noise level and with per-texel variances.
  */
 #include "check.h"
 
 #include "post/denoise.h"
+#include "post/denoise_steps.h"
 #include "util/rng.h"
 
 #include <stdlib.h>
@@ -171,6 +176,91 @@ static void test_no_leak_across_surfaces(void)
     CHECK_NEAR(wall_least, 10.0, 1e-5);
 }
 
+/* A 420 x 400 floor (1 cm texels) whose listed texels skip a pattern of atlas texels, with
+ * ripples and 5% noise: more texels than a range of a streamed step, so a level is written
+ * back while later ranges are filtered. Owned arrays: free_big. */
+#define BW 420
+#define BH 400
+typedef struct big {
+    lmb_texels t;
+    float *rgb, *var;
+} big;
+
+static void make_big(big *b)
+{
+    memset(b, 0, sizeof *b);
+    uint32_t n = 0;
+    b->t.texel = malloc(sizeof(uint32_t) * BW * BH);
+    b->t.valid = malloc(BW * BH);
+    b->t.texel_size = malloc(sizeof(float) * BW * BH);
+    b->t.points = calloc(BW * BH, sizeof(lmb_gather_point));
+    b->rgb = malloc(3 * sizeof(float) * BW * BH);
+    b->var = malloc(sizeof(float) * BW * BH);
+    for (uint32_t y = 0; y < BH; y++)
+        for (uint32_t x = 0; x < BW; x++) {
+            if ((x * 7 + y * 3) % 11 == 0)
+                continue; /* not listed */
+            lmb_rng r = lmb_rng_make(9, x, y);
+            b->t.texel[n] = y * BW + x;
+            b->t.valid[n] = (x + y) % 17 != 0;
+            b->t.texel_size[n] = 0.01f;
+            lmb_gather_point *p = &b->t.points[n];
+            p->p[0] = 0.01 * x, p->p[1] = 0.01 * y;
+            p->n[2] = p->ng[2] = 1;
+            p->instance = x < BW / 2 ? 0 : 1;
+            set_grey(b->rgb, n, (float)((1 + 0.3 * sin(0.37 * x) * cos(0.23 * y)) * (1 + 0.1 * (lmb_rng_next(&r) - 0.5))));
+            b->var[n] = 0.03f * 0.03f;
+            n++;
+        }
+    b->t.width = BW, b->t.height = BH, b->t.samples = 1, b->t.count = n;
+}
+
+static void free_big(big *b)
+{
+    free(b->t.texel);
+    free(b->t.valid);
+    free(b->t.texel_size);
+    free(b->t.points);
+    free(b->rgb);
+    free(b->var);
+}
+
+static void test_steps_match_whole(int with_variance)
+{
+    big b;
+    make_big(&b);
+    static atlas a;
+    make_atlas(&a);
+    static float small[3 * W * H], small_whole[3 * W * H];
+    for (uint32_t i = 0; i < W * H; i++)
+        set_grey(small, i, blotch(i % W, i / W, 0.05));
+    memcpy(small_whole, small, sizeof small);
+    size_t bytes = 3 * sizeof(float) * b.t.count;
+    float *whole = malloc(bytes);
+    memcpy(whole, b.rgb, bytes);
+    lmb_error err = {0};
+    lmb_denoise_stats st = {0}, st_whole = {0};
+    lmb_denoise_options opt = {3, 0.05, with_variance ? b.var : NULL, 2, 2};
+    CHECK_INT(lmb_denoise_atlas(&b.t, whole, &opt, &st_whole, &err), LMB_OK);
+    lmb_denoise_options opt_small = {3, 0.05, NULL, 2, 2};
+    CHECK_INT(lmb_denoise_atlas(&a.t, small_whole, &opt_small, &st_whole, &err), LMB_OK);
+
+    lmb_steps *steps;
+    CHECK_INT(lmb_steps_create(LMB_STEPS_LOCAL, NULL, NULL, 0, 0, 1, 0.0, NULL, &steps, &err), LMB_OK);
+    lmb_denoise_part parts[2] = {{&b.t, b.rgb, with_variance ? b.var : NULL, 0.05}, {&a.t, small, NULL, 0.05}};
+    lmb_denoise_run run = {3, 2, 2, "test light"};
+    CHECK_INT(lmb_denoise_steps(steps, parts, 2, &run, &st, &err), LMB_OK);
+    CHECK_INT(lmb_steps_count(steps), 3);
+    CHECK(b.t.count > 2 * LMB_STEP_STREAM_ITEMS);
+    CHECK(memcmp(whole, b.rgb, bytes) == 0);
+    CHECK(memcmp(small_whole, small, sizeof small) == 0);
+    CHECK_INT(st.texels, st_whole.texels);
+    CHECK(memcmp(whole, b.rgb, bytes) != 0 || st.before != st.after); /* it did filter */
+    lmb_steps_free(steps);
+    free(whole);
+    free_big(&b);
+}
+
 int main(void)
 {
     test_ramp_kept();
@@ -180,5 +270,7 @@ int main(void)
     test_shadow_edge(2, two);
     CHECK(memcmp(one, two, sizeof one) == 0);
     test_no_leak_across_surfaces();
+    test_steps_match_whole(0);
+    test_steps_match_whole(1);
     return check_failures();
 }

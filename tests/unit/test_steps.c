@@ -5,7 +5,10 @@
  * shard's cost is within 1.5% of a quarter of the total (chunks cut by cost, not by count); the merged
  * state reads back (finish mode) as the items in order with the counters summed; a shard run
  * twice writes the same bytes; a step under min_rays runs in every process and is no farm step;
- * a merge over a missing part or a part of another config is refused, naming it.
+ * a merge over a missing part or a part of another config is refused, naming it. Streamed
+ * (lmb_steps_run_streamed): a local step is computed 64 items at a time and taken in order,
+ * the same bytes and counters as whole; in finish mode it is read and taken at once; the float
+ * sink fills arrays of 4, 0 and 6 floats across chunk borders and refuses a float too many.
  * usage: test_steps WORKDIR
  */
 #define _GNU_SOURCE
@@ -50,6 +53,83 @@ static lmb_status compute(void *user, uint64_t first, uint64_t last, lmb_buf *ou
         counters[1] += i;
     }
     return LMB_OK;
+}
+
+/* A take function: appends what it is given to a buffer and counts its calls. */
+typedef struct collected {
+    lmb_buf all;
+    uint32_t calls;
+} collected;
+
+static lmb_status collect(void *user, lmb_buf *bytes, lmb_error *err)
+{
+    collected *c = user;
+    c->calls++;
+    lmb_status st = lmb_buf_append(&c->all, bytes->data + bytes->read, bytes->size - bytes->read, err);
+    bytes->read = bytes->size;
+    return st;
+}
+
+/* Local streaming and the float sink. */
+static void test_streamed(void)
+{
+    lmb_error err;
+    lmb_steps *s;
+    CHECK_INT(lmb_steps_create(LMB_STEPS_LOCAL, NULL, NULL, 0, 0, 1, 100.0, NULL, &s, &err), LMB_OK);
+    fake f = {0, 0, 0, 0, 0, NULL, NULL};
+    lmb_step_desc d = {"streamed", ITEMS, NULL, 1e9, compute, &f};
+    collected c = {{0}, 0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    CHECK_INT(lmb_steps_run_streamed(s, &d, 64, collect, &c, counters, &err), LMB_OK);
+    CHECK_INT(c.calls, (ITEMS + 63) / 64);
+    CHECK_INT(f.calls, (ITEMS + 63) / 64);
+    CHECK_INT(lmb_steps_count(s), 1);
+    CHECK_INT(c.all.size, 4 * ITEMS);
+    int in_order = 1;
+    for (uint32_t i = 0; i < ITEMS && c.all.size == 4 * ITEMS; i++) {
+        uint32_t v;
+        memcpy(&v, c.all.data + 4 * i, 4);
+        in_order &= v == i;
+    }
+    CHECK(in_order);
+    CHECK_INT(counters[0], ITEMS);
+    CHECK_INT(counters[1], ITEMS * (ITEMS - 1) / 2);
+    lmb_buf_free(&c.all);
+
+    /* floats: items 0..9 as floats into arrays of 4, 0 and 6, three items a chunk */
+    float a[4], b[1], e[6];
+    float *dst[3] = {a, b, e};
+    uint64_t floats[3] = {4, 0, 6};
+    lmb_float_sink sink = {3, dst, floats, 0, 0};
+    lmb_buf chunk = {0};
+    int filled = 1;
+    for (uint32_t i = 0; i < 10; i += 3) {
+        chunk.size = chunk.read = 0;
+        for (uint32_t k = i; k < i + 3 && k < 10; k++) {
+            float v = (float)k;
+            lmb_buf_append(&chunk, &v, 4, &err);
+        }
+        CHECK_INT(lmb_take_floats(&sink, &chunk, &err), LMB_OK);
+        CHECK_INT(chunk.read, chunk.size);
+    }
+    CHECK(lmb_float_sink_full(&sink));
+    for (int k = 0; k < 4; k++)
+        filled &= a[k] == (float)k;
+    for (int k = 0; k < 6; k++)
+        filled &= e[k] == (float)(4 + k);
+    CHECK(filled);
+    chunk.size = chunk.read = 0;
+    float extra = 1;
+    lmb_buf_append(&chunk, &extra, 4, &err);
+    CHECK_INT(lmb_take_floats(&sink, &chunk, &err), LMB_ERR_INPUT);
+    CHECK(strstr(err.message, "more than the texels hold") != NULL);
+    lmb_float_sink short_sink = {3, dst, floats, 0, 0};
+    chunk.size = chunk.read = 0;
+    lmb_buf_append(&chunk, &extra, 4, &err);
+    CHECK_INT(lmb_take_floats(&short_sink, &chunk, &err), LMB_OK);
+    CHECK(!lmb_float_sink_full(&short_sink));
+    lmb_buf_free(&chunk);
+    lmb_steps_free(s);
 }
 
 static lmb_part_identity identity(const char *config_text)
@@ -207,6 +287,15 @@ int main(int argc, char **argv)
         CHECK(in_order);
         CHECK_INT(counters[0], ITEMS);
         CHECK_INT(counters[1], ITEMS * (ITEMS - 1) / 2);
+        lmb_steps_free(s);
+        /* streamed in finish mode: read, and taken at once */
+        CHECK_INT(lmb_steps_create(LMB_STEPS_FINISH, farm, &id, 0, 0, 1, 100.0, NULL, &s, &err), LMB_OK);
+        collected c = {{0}, 0};
+        CHECK_INT(lmb_steps_run_streamed(s, &d, 64, collect, &c, counters, &err), LMB_OK);
+        CHECK_INT(f.calls, 0);
+        CHECK_INT(c.calls, 1);
+        CHECK(c.all.size == out.size && memcmp(c.all.data, out.data, out.size) == 0);
+        lmb_buf_free(&c.all);
         /* the next step is not merged: refused, named */
         lmb_step_desc d2 = {"next", 5, NULL, 1e9, compute, &f};
         CHECK_INT(lmb_steps_run(s, &d2, &out, counters, &err), LMB_ERR_INPUT);
@@ -216,6 +305,7 @@ int main(int argc, char **argv)
     }
     lmb_part_identity_free(&id);
     lmb_part_identity_free(&id_other);
+    test_streamed();
     printf("%s\n", check_failed_count ? "FAILED" : "ok");
     return check_failed_count != 0;
 }
