@@ -24,7 +24,6 @@ static void work_free(atlas_work *w, uint32_t n)
         free(w[a].direct);
         free(w[a].result);
         free(w[a].direct_dir);
-        free(w[a].indirect_dir);
         free(w[a].deferred);
         free(w[a].shadowmask);
         free(w[a].variance);
@@ -175,10 +174,10 @@ static lmb_status texel_pass_range(void *user, uint64_t first, uint64_t last, lm
     return st;
 }
 
-/* Runs the pass as one step; each atlas's 3 floats per texel go to the float array at `field`
- * of its atlas_work (result or a direction array). */
-static lmb_status texel_step(const pass_env *env, const char *name, uint32_t direction_rays, size_t field,
-                             lmb_gather_stats *gs, lmb_error *err)
+/* Runs the pass as one step; its texels' 3 floats each go to take, in atlas order (a local
+ * bake hands them over chunk by chunk, never holding the step's bytes whole). */
+static lmb_status texel_step(const pass_env *env, const char *name, uint32_t direction_rays, lmb_step_take_fn take,
+                             void *take_user, lmb_gather_stats *gs, lmb_error *err)
 {
     uint32_t n = env->cache->atlas_count;
     texel_pass tp = {env, direction_rays, calloc((size_t)n + 2, sizeof(uint64_t)), 0};
@@ -198,28 +197,37 @@ static lmb_status texel_step(const pass_env *env, const char *name, uint32_t dir
         texels += env->w[a].t.count;
     double rays = (double)texels * (direction_rays ? direction_rays : env->job->estimator.rays);
     lmb_step_desc d = {name, tp.first[n], cost, rays, texel_pass_range, &tp};
-    uint64_t counters[LMB_STEP_COUNTERS], *floats = calloc((size_t)n + 1, sizeof *floats);
-    float **dst = calloc((size_t)n + 1, sizeof *dst);
-    lmb_status st = floats && dst ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
-    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
-        dst[a] = *(float **)(void *)((char *)&env->w[a] + field);
-        floats[a] = 3 * (uint64_t)env->w[a].t.count;
-    }
-    lmb_float_sink sink = {n, dst, floats, 0, 0};
-    if (st == LMB_OK) /* a local bake fills the arrays chunk by chunk, never holding the step's bytes whole */
-        st = lmb_steps_run_streamed(env->job->steps, &d, tp.per_atlas ? 1 : LMB_STEP_STREAM_ITEMS, lmb_take_floats,
-                                    &sink, counters, err);
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run_streamed(env->job->steps, &d, tp.per_atlas ? 1 : LMB_STEP_STREAM_ITEMS, take,
+                                           take_user, counters, err);
     if (st == LMB_OK) {
         gs->rays += counters[0];
         gs->texels += counters[1];
         gs->adapted += counters[2];
-        if (!lmb_float_sink_full(&sink))
-            st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", name);
     }
-    free(floats);
-    free(dst);
     free(tp.first);
     free(cost);
+    return st;
+}
+
+/* The gather at every texel as one step, into every atlas's result. */
+static lmb_status gather_step(const pass_env *env, lmb_gather_stats *gs, lmb_error *err)
+{
+    uint32_t n = env->cache->atlas_count;
+    uint64_t *floats = calloc((size_t)n + 1, sizeof *floats);
+    float **dst = calloc((size_t)n + 1, sizeof *dst);
+    lmb_status st = floats && dst ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
+        dst[a] = env->w[a].result;
+        floats[a] = 3 * (uint64_t)env->w[a].t.count;
+    }
+    lmb_float_sink sink = {n, dst, floats, 0, 0};
+    if (st == LMB_OK)
+        st = texel_step(env, env->job->stage, 0, lmb_take_floats, &sink, gs, err);
+    if (st == LMB_OK && !lmb_float_sink_full(&sink))
+        st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", env->job->stage);
+    free(floats);
+    free(dst);
     return st;
 }
 
@@ -271,7 +279,7 @@ lmb_status lmb_lighting_gather(const pass_env *env, lmb_gather_stats *gs, int ad
     if (through_cache)
         st = cached_gather(env, gs, err);
     else
-        st = texel_step(env, job->stage, 0, offsetof(atlas_work, result), gs, err);
+        st = gather_step(env, gs, err);
     for (uint32_t a = 0; add_direct && through_cache && a < cache->atlas_count; a++)
         if (env->w[a].gather_noise > stats->indirect_noise)
             stats->indirect_noise = env->w[a].gather_noise;
@@ -314,7 +322,56 @@ lmb_status lmb_lighting_gather(const pass_env *env, lmb_gather_stats *gs, int ad
  * v_direct from the lights stage (exact per light), v_indirect from samples.directional cosine
  * rays reading the finished cache (lmb_gather_directions). |D| <= 1: 1 when all light comes
  * from one direction, 2/3 under a uniform sky. Noise can push |D| past 1: it is clamped.
+ * Here: texel i of atlas a, direct_dir := D from v_direct (direct_dir) and v_indirect (ind).
  */
+static void finish_direction(const pass_env *env, uint32_t a, uint32_t i, const float ind[3])
+{
+    atlas_work *w = &env->w[a];
+    const float *e = (env->stats->bounces ? w->result : w->direct) + 3 * (size_t)i;
+    float *d = w->direct_dir + 3 * (size_t)i;
+    double lum = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2], v[3], len = 0;
+    for (int k = 0; k < 3; k++) {
+        v[k] = (double)ind[k] + (double)d[k];
+        v[k] = lum > 0 ? v[k] / lum : 0;
+        len += v[k] * v[k];
+    }
+    len = sqrt(len);
+    for (int k = 0; k < 3; k++)
+        d[k] = (float)(len > 1 ? v[k] / len : v[k]);
+}
+
+/* The directions step's texels as they come (lmb_steps_run_streamed), each finished at once:
+ * no array of the indirect parts is kept. */
+typedef struct directions_taken {
+    const pass_env *env;
+    uint32_t atlas, texel; /* the next texel */
+} directions_taken;
+
+/* Moves past atlases whose texels are all finished; 0 when none is left. */
+static int directions_next(directions_taken *k)
+{
+    while (k->atlas < k->env->cache->atlas_count && k->texel == k->env->w[k->atlas].t.count) {
+        k->atlas++;
+        k->texel = 0;
+    }
+    return k->atlas < k->env->cache->atlas_count;
+}
+
+static lmb_status directions_take(void *user, lmb_buf *bytes, lmb_error *err)
+{
+    directions_taken *k = user;
+    if ((bytes->size - bytes->read) % (3 * sizeof(float)))
+        return lmb_error_set(err, LMB_ERR_INPUT, "directions: %zu bytes are not whole texels", bytes->size - bytes->read);
+    while (bytes->read < bytes->size) {
+        if (!directions_next(k))
+            return lmb_error_set(err, LMB_ERR_INPUT, "directions: the step holds more texels than the atlases");
+        float ind[3];
+        lmb_buf_take(bytes, ind, sizeof ind);
+        finish_direction(k->env, k->atlas, k->texel++, ind);
+    }
+    return LMB_OK;
+}
+
 static lmb_status light_directions(const pass_env *env, lmb_error *err)
 {
     const lmb_config *cfg = env->cfg;
@@ -326,32 +383,21 @@ static lmb_status light_directions(const pass_env *env, lmb_error *err)
     job->pass = 2000;
     job->direct_at_hits = 0; /* the cache holds all the light now */
     job->stage = "directions";
-    for (uint32_t a = 0; a < cache->atlas_count; a++) {
-        w[a].indirect_dir = calloc(3 * (size_t)w[a].t.count + 1, sizeof *w[a].indirect_dir);
-        if (!w[a].indirect_dir)
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u's directions", a);
-    }
     lmb_gather_stats gs = {0};
-    if (!stats->no_light && stats->bounces > 0) /* bounces: 0 has no indirect light to point to */
-        st = texel_step(env, "directions", cfg->directional_rays, offsetof(atlas_work, indirect_dir), &gs, err);
-    stats->rays += gs.rays;
-    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
-        const lmb_texels *t = &w[a].t;
-        float *d = w[a].indirect_dir;
-        for (uint32_t i = 0; i < t->count; i++) {
-            const float *e = (stats->bounces ? w[a].result : w[a].direct) + 3 * (size_t)i;
-            double lum = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2], v[3], len = 0;
-            for (int k = 0; k < 3; k++) {
-                v[k] = (double)d[3 * (size_t)i + k] + (double)w[a].direct_dir[3 * (size_t)i + k];
-                v[k] = lum > 0 ? v[k] / lum : 0;
-                len += v[k] * v[k];
-            }
-            len = sqrt(len);
-            for (int k = 0; k < 3; k++)
-                d[3 * (size_t)i + k] = (float)(len > 1 ? v[k] / len : v[k]);
-        }
-        st = lmb_cache_store_direction(cache, a, t, d, err);
+    directions_taken taken = {env, 0, 0};
+    if (!stats->no_light && stats->bounces > 0) { /* bounces: 0 has no indirect light to point to */
+        st = texel_step(env, "directions", cfg->directional_rays, directions_take, &taken, &gs, err);
+        if (st == LMB_OK && directions_next(&taken))
+            st = lmb_error_set(err, LMB_ERR_INPUT, "directions: step holds too few texels");
+    } else {
+        const float none[3] = {0, 0, 0};
+        for (uint32_t a = 0; a < cache->atlas_count; a++)
+            for (uint32_t i = 0; i < w[a].t.count; i++)
+                finish_direction(env, a, i, none);
     }
+    stats->rays += gs.rays;
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
+        st = lmb_cache_store_direction(cache, a, &w[a].t, w[a].direct_dir, err);
     return st;
 }
 

@@ -13,8 +13,8 @@ typedef struct atlas_work {
     lmb_texels t;
     float *direct;   /* 3 per listed texel */
     float *result;   /* 3 per listed texel: the pass being computed */
-    float *direct_dir; /* output.directional: 3 per listed texel, direct light's direction sum */
-    float *indirect_dir; /* output.directional: 3 per listed texel, the indirect part, then the direction */
+    float *direct_dir; /* output.directional: 3 per listed texel, direct light's direction sum, then
+                          (light_directions) the light's mean direction */
     float *deferred; /* mixed lighting: 3 per listed texel, the `indirect` lights' part of direct; else NULL */
     float *shadowmask; /* output.shadowmask: 4 per listed texel; else NULL */
     float *variance; /* per listed texel: variance of a round of its sampled direct light (direct_refine.h) */
