@@ -243,15 +243,20 @@ static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_
     lmb_status st = LMB_OK;
     for (uint32_t a = 0; a < env->cache->atlas_count && st == LMB_OK; a++) {
         atlas_work *w = &env->w[a];
-        size_t n = 3 * (size_t)w->t.count;
-        float *shown = malloc((n + 1) * sizeof *shown);
+        double *shown = malloc(((size_t)w->t.count + 1) * sizeof *shown); /* its luminance: all that is read */
         if (!shown) {
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
             break;
         }
-        for (size_t k = 0; k < n; k++) {
-            float v = result_has_direct ? w->result[k] : w->result[k] + w->direct[k] - (w->deferred ? w->deferred[k] : 0.0f);
-            shown[k] = v > 0 ? v : 0.0f;
+        for (uint32_t i = 0; i < w->t.count; i++) {
+            float rgb[3];
+            for (int c = 0; c < 3; c++) {
+                size_t k = 3 * (size_t)i + c;
+                float v = result_has_direct ? w->result[k]
+                                            : w->result[k] + w->direct[k] - (w->deferred ? w->deferred[k] : 0.0f);
+                rgb[c] = v > 0 ? v : 0.0f;
+            }
+            shown[i] = lmb_luminance_f(rgb);
         }
         lmb_direct_atlas da = {w->t, w->direct, w->direct_dir, w->deferred, NULL, w->variance, w->direct_rays};
         st = lmb_direct_refine_step(env->job->steps, cfg, env->job->direct, env->cache->scene, env->cache->layout, a,

@@ -204,9 +204,33 @@ static void set_targets(lmb_mixture *out, const uint32_t *index, const float *w,
     }
 }
 
+void lmb_mixture_keep(const lmb_mixture *m, lmb_mixture_kept *out)
+{
+    memset(out, 0, sizeof *out);
+    out->count = m->count;
+    out->diffuse = m->diffuse;
+    memcpy(out->aimed, m->aimed, sizeof out->aimed);
+    memcpy(out->lobe, m->lobe, sizeof out->lobe);
+    memcpy(out->weight, m->weight, sizeof out->weight);
+    memcpy(out->target, m->target, sizeof out->target);
+}
+
 void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double to[3], lmb_mixture *out)
 {
-    *out = *m;
+    lmb_mixture_kept kept;
+    lmb_mixture_keep(m, &kept);
+    lmb_mixture_reaim_kept(&kept, from, to, out);
+}
+
+void lmb_mixture_reaim_kept(const lmb_mixture_kept *m, const double from[3], const double to[3], lmb_mixture *out)
+{
+    memset(out, 0, sizeof *out);
+    out->count = m->count;
+    out->diffuse = m->diffuse;
+    memcpy(out->aimed, m->aimed, sizeof out->aimed);
+    memcpy(out->lobe, m->lobe, sizeof out->lobe);
+    memcpy(out->weight, m->weight, sizeof out->weight);
+    memcpy(out->target, m->target, sizeof out->target);
     for (uint32_t k = 0; k < m->count; k++) {
         if (m->aimed[k]) {
             double v[3];

@@ -42,9 +42,24 @@ static inline int lmb_mixture_learned(const lmb_mixture *m)
     return m->count > 0 || m->diffuse > 0;
 }
 
+/* A mixture as kept between its fit and its re-aiming: without the frames, which
+ * lmb_mixture_reaim sets again (224 bytes instead of 368: the irradiance cache keeps one per
+ * record). */
+typedef struct lmb_mixture_kept {
+    uint32_t count;
+    int aimed[LMB_MIXTURE_MAX_LOBES];
+    double diffuse;
+    lmb_lobe lobe[LMB_MIXTURE_MAX_LOBES];
+    double weight[LMB_MIXTURE_MAX_LOBES];
+    double target[LMB_MIXTURE_MAX_LOBES][3];
+} lmb_mixture_kept;
+
+void lmb_mixture_keep(const lmb_mixture *m, lmb_mixture_kept *out);
+
 /* The mixture fitted at `from` as seen from `to`: every aimed lobe turned towards its target
  * (parallax), exponents and shares kept; frames set. */
 void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double to[3], lmb_mixture *out);
+void lmb_mixture_reaim_kept(const lmb_mixture_kept *m, const double from[3], const double to[3], lmb_mixture *out);
 
 /* Per-thread memory of the fit. */
 typedef struct lmb_mixture_scratch {

@@ -34,7 +34,7 @@ typedef struct pass_ctx {
      * guided only by records of earlier groups (deterministic at any thread count) */
     int guided;
     uint32_t lobes;
-    lmb_mixture *mix;
+    lmb_mixture_kept *mix;
     uint8_t *has_mix;
     uint32_t mix_cap;
     /* placement rounds after the first (ic_pass.c, uncovered_again): per level, the reach of

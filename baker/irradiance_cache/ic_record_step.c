@@ -18,7 +18,7 @@ static int reserve_mix(pass_ctx *c, uint32_t n)
     uint32_t cap = c->mix_cap ? c->mix_cap : 1024;
     while (cap < n)
         cap = cap > UINT32_MAX / 2 ? n : cap * 2;
-    lmb_mixture *m = realloc(c->mix, (size_t)cap * sizeof *m);
+    lmb_mixture_kept *m = realloc(c->mix, (size_t)cap * sizeof *m);
     if (m)
         c->mix = m;
     uint8_t *h = realloc(c->has_mix, cap);
@@ -173,7 +173,7 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                     lmb_ic_texel_point(c, x, p, n);
                     int64_t j = lmb_ic_records_nearest(&c->records, p, n, LMB_GUIDE_SAME_SURFACE_COS, c->has_mix);
                     if (j >= 0) {
-                        lmb_mixture_reaim(&c->mix[j], c->records.rec[j].p, p, &guide);
+                        lmb_mixture_reaim_kept(&c->mix[j], c->records.rec[j].p, p, &guide);
                         by = &guide;
                     }
                 }
@@ -246,7 +246,7 @@ static lmb_status take_records(void *user, lmb_buf *bytes, lmb_error *err)
         if (flag == 2 || !take_record(bytes, &fresh) || (c->guided && !take_mixture(bytes, &mix)))
             return lmb_error_set(err, LMB_ERR_INPUT, "%s: a truncated record in step results", c->job->stage);
         if (c->guided)
-            c->mix[slot] = mix; /* not read before has_mix is set, when the whole group is in */
+            lmb_mixture_keep(&mix, &c->mix[slot]); /* not read before has_mix is set, when the whole group is in */
         if (rt->slots) {
             memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
             memcpy(c->records.rec[slot].grad_r, fresh.grad_r, sizeof fresh.grad_r);

@@ -50,7 +50,7 @@ static uint32_t rounds_needed(const lmb_config *cfg, double k, double variance, 
  * (its relative error looks large) nor one that drew high left high: deciding from its own
  * estimate alone biased a sun map's mean 1% high. Returns 0 when out of memory. */
 #define NEIGHBOURS 2
-static int neighbourhood_means(const lmb_direct_atlas *da, const float *shown, uint32_t width, uint32_t height,
+static int neighbourhood_means(const lmb_direct_atlas *da, const double *shown, uint32_t width, uint32_t height,
                                float *mean_var, float *mean_lum)
 {
     int32_t *at = malloc(((size_t)width * height + 1) * sizeof *at);
@@ -71,7 +71,7 @@ static int neighbourhood_means(const lmb_direct_atlas *da, const float *shown, u
                     continue;
                 int32_t j = at[yy * width + xx];
                 v += da->variance[j];
-                l += lmb_luminance_f(&shown[3 * (size_t)j]);
+                l += shown[j];
                 n++;
             }
         mean_var[i] = n ? (float)(v / n) : 0.0f;
@@ -193,7 +193,7 @@ static lmb_status take_refined(lmb_buf *in, uint64_t bands, lmb_direct_atlas *da
 }
 
 lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
-                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const float *shown,
+                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const double *shown,
                                   lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
                                   uint64_t *estimate_count, lmb_error *err)
 {
@@ -283,7 +283,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     }
     /* what the texels reached, measured again where they were refined */
     for (uint32_t i = 0; st == LMB_OK && i < count; i++) {
-        double v = da->variance[i], lum = lmb_luminance_f(&shown[3 * (size_t)i]);
+        double v = da->variance[i], lum = shown[i];
         if (da->t.valid[i] && v > 0)
             (*estimates)[(*estimate_count)++] = lum > 0 ? (float)(sqrt(v / (rounds[i] ? rounds[i] : 2)) / lum) : 0.0f;
         da->variance[i] = (float)(v / (rounds[i] ? rounds[i] : 2)); /* now the estimate's own (denoise.h) */

@@ -24,12 +24,12 @@ typedef struct lmb_direct_noise {
 } lmb_direct_noise;
 
 /* Refines atlas a's direct light in place (da: its texels, direct, direction, deferred and
- * variance arrays). shown: 3 floats per listed texel, the lightmap's light (indirect + direct
- * - deferred) before refining. With samples.adaptive off nothing is refined, only measured.
+ * variance arrays). shown: per listed texel the luminance of the lightmap's light (indirect +
+ * direct - deferred) before refining. With samples.adaptive off nothing is refined, only measured.
  * Adds to *rays and to noise (median and p95 are set by lmb_direct_noise_finish). Afterwards
  * da->variance holds each texel's estimate's variance (a round's over its rounds), not a round's. */
 lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
-                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const float *shown,
+                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const double *shown,
                                   lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
                                   uint64_t *estimate_count, lmb_error *err);
 
