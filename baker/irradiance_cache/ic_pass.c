@@ -20,6 +20,19 @@
 
 
 
+texel_at lmb_ic_texel_at(const pass_ctx *c, uint32_t id)
+{
+    uint32_t lo = 0, hi = c->atlas_count; /* the last atlas whose first id is <= id */
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (c->first_id[mid] <= id)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return (texel_at){lo, id - c->first_id[lo]};
+}
+
 void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
 {
     lmb_shading_point sp;
@@ -44,7 +57,7 @@ void lmb_ic_report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total)
 }
 
 /* Valid texels on this level's grid that are not records yet, in (atlas, texel) order. */
-static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, texel_at **out, uint64_t *count, lmb_error *err)
+static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, uint32_t **out, uint64_t *count, lmb_error *err)
 {
     uint64_t n = 0;
     for (int pass = 0; pass < 2; pass++) {
@@ -56,7 +69,7 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, texel_at
                 if (!t->valid[i] || c->is_record[a][i] || x % spacing || y % spacing)
                     continue;
                 if (pass)
-                    (*out)[n] = (texel_at){a, i};
+                    (*out)[n] = c->first_id[a] + i;
                 n++;
             }
         }
@@ -76,7 +89,7 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, texel_at
 static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
 {
     uint32_t m = c->records.count, groups = 0;
-    texel_at *at = malloc(((size_t)m + 1) * sizeof *at);
+    uint32_t *at = malloc(((size_t)m + 1) * sizeof *at);
     uint32_t *slots = malloc(((size_t)m + 1) * sizeof *slots);
     if (!at || !slots) {
         free(at);
@@ -97,7 +110,7 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
         for (uint32_t k = 0; k < m; k++)
             if (!c->guided || c->records.rec[k].group == g) {
                 slots[n] = k;
-                at[n++] = (texel_at){c->records.rec[k].atlas, c->records.rec[k].texel};
+                at[n++] = lmb_ic_texel_id(c, (texel_at){c->records.rec[k].atlas, c->records.rec[k].texel});
             }
         c->regather_group = g;
         if (n)
@@ -119,7 +132,7 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
  * few thousand of a million on level-single-10, so the test runs here, in every process of a
  * farm, and the level's step holds only the gathers.
  */
-static lmb_status uncovered_again(pass_ctx *c, uint32_t slot, texel_at *cand, uint64_t *n, lmb_error *err)
+static lmb_status uncovered_again(pass_ctx *c, uint32_t slot, uint32_t *cand, uint64_t *n, lmb_error *err)
 {
     const double *then = c->tested_reach[slot];
     lmb_ic_records shrunk;
@@ -144,7 +157,7 @@ static lmb_status uncovered_again(pass_ctx *c, uint32_t slot, texel_at *cand, ui
 #pragma omp parallel for num_threads(c->threads) schedule(dynamic, 4096)
         for (uint64_t k = 0; k < count; k++) {
             double p[3], nn[3];
-            lmb_ic_texel_point(c, cand[k], p, nn);
+            lmb_ic_texel_point(c, lmb_ic_texel_at(c, cand[k]), p, nn);
             keep[k] = lmb_ic_interpolate(&shrunk, p, nn, NULL) > 0 &&
                       lmb_ic_interpolate(&c->records, p, nn, NULL) < LMB_IC_COVERED;
         }
@@ -180,7 +193,7 @@ static lmb_status note_tested(pass_ctx *c, uint32_t slot, lmb_error *err)
 static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint32_t round, int clamp,
                               uint64_t *placed, lmb_gather_stats *stats, lmb_error *err)
 {
-    texel_at *cand = NULL;
+    uint32_t *cand = NULL;
     uint64_t n = 0;
     lmb_status st = level_candidates(c, spacing, &cand, &n, err);
     if (st == LMB_OK && round > 0)
@@ -403,9 +416,14 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     }
     lmb_status st = LMB_OK;
     c.is_record = calloc((size_t)atlas_count + 1, sizeof *c.is_record);
-    if (!c.is_record)
+    c.first_id = calloc((size_t)atlas_count + 1, sizeof *c.first_id);
+    if (!c.is_record || !c.first_id)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
     for (uint32_t a = 0; a < atlas_count && st == LMB_OK; a++) {
+        if ((uint64_t)c.first_id[a] + t[a]->count > UINT32_MAX - 1)
+            st = lmb_error_set(err, LMB_ERR_INPUT, "irradiance cache: more than 4 billion texels in all atlases");
+        else
+            c.first_id[a + 1] = c.first_id[a] + t[a]->count;
         c.is_record[a] = calloc((size_t)t[a]->count + 1, 1);
         if (!c.is_record[a])
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
@@ -465,6 +483,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);
+    free(c.first_id);
     free_gather_state(&c);
     if (shared && st == LMB_OK) { /* handed to the next pass */
         lmb_ic_records_free(shared);

@@ -11,7 +11,8 @@
 #include "irradiance_cache/ic_pass.h"
 #include "irradiance_cache/records.h"
 
-/* A listed texel of some atlas. */
+/* A listed texel of some atlas. Lists of them (a level's candidates) hold its id instead, the
+ * texels of the atlases before it plus its index: 4 bytes, not 8 (lmb_ic_texel_at). */
 typedef struct texel_at {
     uint32_t atlas, index;
 } texel_at;
@@ -21,6 +22,7 @@ typedef struct pass_ctx {
     const lmb_ic_options *opt;
     uint32_t atlas_count;
     const lmb_texels *const *t;
+    uint32_t *first_id;           /* per atlas (+1): the id of its first texel */
     uint8_t **is_record;          /* per atlas, per listed texel */
     lmb_ic_records records;
     int threads;
@@ -43,6 +45,13 @@ typedef struct pass_ctx {
     uint32_t *tested_count;
 } pass_ctx;
 
+/* The texel of an id, and the id of a texel. */
+texel_at lmb_ic_texel_at(const pass_ctx *c, uint32_t id);
+static inline uint32_t lmb_ic_texel_id(const pass_ctx *c, texel_at x)
+{
+    return c->first_id[x.atlas] + x.index;
+}
+
 /* The world position and shading normal a texel gathers at. */
 void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3]);
 
@@ -50,7 +59,7 @@ void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3])
 void lmb_ic_report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total);
 
 /*
- * Gathers at the m texels at[] (one step of the bake). slots == NULL: new records, appended
+ * Gathers at the m texels of ids at[] (one step of the bake). slots == NULL: new records, appended
  * to rec[] (*made of them; NULL made: every texel makes one); with `candidates`, a texel the
  * records so far cover makes none (level placement: the test runs in the step, beside the
  * gathers). slots != NULL: records placed by an earlier pass (`irradiance_cache.records:
@@ -58,7 +67,7 @@ void lmb_ic_report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total);
  * keeping position and reach. Guided: each gathers by the nearest record of an earlier group
  * on the same surface (its mixture re-aimed), or learns one.
  */
-lmb_status lmb_ic_gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, int candidates,
+lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, const uint32_t *slots, int candidates,
                                  lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
                                  lmb_gather_stats *stats, lmb_error *err);
 

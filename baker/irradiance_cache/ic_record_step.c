@@ -126,7 +126,7 @@ static int take_mixture(lmb_buf *in, lmb_mixture *m)
 /* A gather_records call as a step: its items are the texels at[]. */
 typedef struct records_step {
     pass_ctx *c;
-    const texel_at *at;
+    const uint32_t *at;           /* texel ids */
     const uint32_t *slots;
     int candidates;              /* at[] are a level's candidates: each is first tested for coverage
                                     by the records so far, and gathered only when uncovered */
@@ -160,7 +160,7 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
             for (uint64_t k = start; k < end; k++) {
                 lmb_mixture guide;
                 const lmb_mixture *by = NULL;
-                const texel_at x = rs->at[k];
+                const texel_at x = lmb_ic_texel_at(c, rs->at[k]);
                 if (rs->candidates) {
                     double p[3], nn[3];
                     lmb_ic_texel_point(c, x, p, nn);
@@ -262,7 +262,7 @@ static lmb_status take_records(void *user, lmb_buf *bytes, lmb_error *err)
  * 4096 x 640 bytes. */
 #define RECORD_CHUNK 4096
 
-lmb_status lmb_ic_gather_records(pass_ctx *c, const texel_at *at, uint64_t m, const uint32_t *slots, int candidates,
+lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, const uint32_t *slots, int candidates,
                                  lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
                                  lmb_gather_stats *stats, lmb_error *err)
 {
