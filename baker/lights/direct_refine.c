@@ -24,6 +24,7 @@ typedef struct refine_ctx {
     const lmb_direct_atlas *da;
     const uint32_t *rounds;  /* per listed texel: 0 (kept) or its rounds */
     uint32_t *first;         /* per band (+1): its first listed texel */
+    lmb_instance_rows instance_rows; /* which instances a band visits */
 } refine_ctx;
 
 /* The rounds texel i needs: its standard error after R rounds is sqrt(variance / R); R is the
@@ -129,7 +130,8 @@ static lmb_status refine_bands(void *user, uint64_t first, uint64_t last, lmb_bu
         }
         uint32_t y0 = (uint32_t)b * c->rows, y1 = y0 + c->rows < c->height ? y0 + c->rows : c->height;
         lmb_texels band;
-        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &band, err);
+        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &c->instance_rows,
+                                   &band, err);
         if (st != LMB_OK)
             break;
         size_t n = band.count;
@@ -267,19 +269,22 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     }
     lmb_status st = LMB_OK;
     if (noise->refined) {
-        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first};
+        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first, {NULL, NULL}};
+        st = lmb_instance_rows_make(scene, layout, a, &c.instance_rows, err);
         char name[64];
         snprintf(name, sizeof name, "direct, atlas %u: more samples", a);
         lmb_step_desc d = {name, bands, cost, step_rays, refine_bands, &c};
         lmb_buf bytes = {0};
         uint64_t counters[LMB_STEP_COUNTERS];
-        st = lmb_steps_run(steps, &d, &bytes, counters, err);
+        if (st == LMB_OK)
+            st = lmb_steps_run(steps, &d, &bytes, counters, err);
         if (st == LMB_OK) {
             *rays += counters[0];
             noise->samples += counters[1];
             st = take_refined(&bytes, bands, da, a, err);
         }
         lmb_buf_free(&bytes);
+        lmb_instance_rows_free(&c.instance_rows);
     }
     /* what the texels reached, measured again where they were refined */
     for (uint32_t i = 0; st == LMB_OK && i < count; i++) {

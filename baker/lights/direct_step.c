@@ -16,6 +16,7 @@ typedef struct band_ctx {
     lmb_progress_fn progress;
     void *progress_user;
     uint64_t row0, band_rows;            /* the band being computed, for progress */
+    lmb_instance_rows instance_rows;     /* which instances a band visits */
 } band_ctx;
 
 /* In atlas texels: the band's rows before it, plus its share of its own rows. */
@@ -65,7 +66,8 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
     for (uint64_t b = first; b < last && st == LMB_OK; b++) {
         uint32_t y0 = (uint32_t)b * c->rows, y1 = y0 + c->rows < c->height ? y0 + c->rows : c->height;
         lmb_texels band;
-        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &band, err);
+        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &c->instance_rows,
+                                   &band, err);
         if (st != LMB_OK)
             break;
         float *e = calloc(3 * (size_t)band.count + 1, sizeof *e);
@@ -219,7 +221,8 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
                                  void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
-    band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user, 0, 0};
+    band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user, 0, 0,
+                  {NULL, NULL}};
     c.rows = c.width ? (LMB_DIRECT_BAND_TEXELS + c.width - 1) / c.width : c.height;
     if (!c.rows)
         c.rows = 1;
@@ -227,6 +230,11 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     double *cost = malloc((bands + 1) * sizeof *cost);
     if (!cost)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+    lmb_status st = lmb_instance_rows_make(scene, layout, a, &c.instance_rows, err);
+    if (st != LMB_OK) {
+        free(cost);
+        return st;
+    }
     band_costs(layout, a, c.width, c.height, c.rows, bands, cost);
     char name[64];
     snprintf(name, sizeof name, "direct, atlas %u", a);
@@ -235,7 +243,7 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
                        compute_bands, &c};
     uint64_t counters[LMB_STEP_COUNTERS];
     bands_taken taken = {out, &c, 0};
-    lmb_status st = lmb_steps_run_streamed(steps, &d, 1, take_bands, &taken, counters, err);
+    st = lmb_steps_run_streamed(steps, &d, 1, take_bands, &taken, counters, err);
     *rays += counters[0];
     out->rays = counters[0];
     if (st == LMB_OK && taken.bands != bands)
@@ -262,5 +270,6 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     if (st == LMB_OK && (!out->direct || !out->variance || (cfg->directional && !out->direction)))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
     free(cost);
+    lmb_instance_rows_free(&c.instance_rows);
     return st;
 }

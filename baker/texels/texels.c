@@ -124,24 +124,67 @@ static double closest_on_triangle(const double *uv, const double p[2], double *b
     return bestd;
 }
 
-/* Sub-samples of rows [y0, y1) only: b holds (y1 - y0) rows. */
-static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, uint32_t samples, uint32_t y0_band,
-                      uint32_t y1_band, best *b)
+/* The rows triangle uv (3 atlas points) reaches: its texels' and their neighbours'. */
+static void triangle_rows(const double *uv, long *y0, long *y1)
 {
-    uint32_t w = l->width[atlas];
+    *y0 = (long)floor(fmin(uv[1], fmin(uv[3], uv[5]))) - 1;
+    *y1 = (long)floor(fmax(uv[1], fmax(uv[3], uv[5]))) + 1;
+}
+
+lmb_status lmb_instance_rows_make(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, lmb_instance_rows *out,
+                                  lmb_error *err)
+{
+    out->lo = malloc(((size_t)l->instance_count + 1) * sizeof *out->lo);
+    out->hi = malloc(((size_t)l->instance_count + 1) * sizeof *out->hi);
+    if (!out->lo || !out->hi) {
+        lmb_instance_rows_free(out);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u instances", l->instance_count);
+    }
     for (uint32_t i = 0; i < l->instance_count; i++) {
         const lmb_layout_instance *li = &l->instances[i];
+        out->lo[i] = INT64_MAX;
+        out->hi[i] = INT64_MIN;
         if (!li->lightmapped || li->atlas != atlas)
             continue;
         const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
         for (uint32_t f = 0; f < c->triangle_count; f++) {
             if (c->chart_of[f] == UINT32_MAX)
                 continue;
+            long y0, y1;
+            triangle_rows(li->uv1 + 6 * f, &y0, &y1);
+            out->lo[i] = y0 < out->lo[i] ? y0 : out->lo[i];
+            out->hi[i] = y1 > out->hi[i] ? y1 : out->hi[i];
+        }
+    }
+    return LMB_OK;
+}
+
+void lmb_instance_rows_free(lmb_instance_rows *r)
+{
+    free(r->lo);
+    free(r->hi);
+    r->lo = r->hi = NULL;
+}
+
+/* Sub-samples of rows [y0, y1) only: b holds (y1 - y0) rows. */
+static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, uint32_t samples, uint32_t y0_band,
+                      uint32_t y1_band, const lmb_instance_rows *rows, best *b)
+{
+    uint32_t w = l->width[atlas];
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        const lmb_layout_instance *li = &l->instances[i];
+        if (!li->lightmapped || li->atlas != atlas)
+            continue;
+        if (rows && (rows->hi[i] < (int64_t)y0_band || rows->lo[i] >= (int64_t)y1_band))
+            continue; /* none of its triangles reaches the band */
+        const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
+        for (uint32_t f = 0; f < c->triangle_count; f++) {
+            if (c->chart_of[f] == UINT32_MAX)
+                continue;
             const double *uv = li->uv1 + 6 * f;
-            double lo[2] = {fmin(uv[0], fmin(uv[2], uv[4])), fmin(uv[1], fmin(uv[3], uv[5]))};
-            double hi[2] = {fmax(uv[0], fmax(uv[2], uv[4])), fmax(uv[1], fmax(uv[3], uv[5]))};
-            long x0 = (long)floor(lo[0]) - 1, x1 = (long)floor(hi[0]) + 1, y0 = (long)floor(lo[1]) - 1,
-                 y1 = (long)floor(hi[1]) + 1;
+            long x0 = (long)floor(fmin(uv[0], fmin(uv[2], uv[4]))) - 1,
+                 x1 = (long)floor(fmax(uv[0], fmax(uv[2], uv[4]))) + 1, y0, y1;
+            triangle_rows(uv, &y0, &y1);
             x0 = x0 < 0 ? 0 : x0;
             y0 = y0 < (long)y0_band ? (long)y0_band : y0;
             x1 = x1 >= (long)w ? (long)w - 1 : x1;
@@ -260,11 +303,12 @@ void lmb_texels_point(const lmb_texels *t, uint32_t i, uint32_t k, lmb_gather_po
 lmb_status lmb_texels_build(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t samples, lmb_texels *out,
                             lmb_error *err)
 {
-    return lmb_texels_build_rows(s, l, atlas, samples, 0, l->height[atlas], out, err);
+    return lmb_texels_build_rows(s, l, atlas, samples, 0, l->height[atlas], NULL, out, err);
 }
 
 lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t samples,
-                                 uint32_t y0, uint32_t y1, lmb_texels *out, lmb_error *err)
+                                 uint32_t y0, uint32_t y1, const lmb_instance_rows *rows, lmb_texels *out,
+                                 lmb_error *err)
 {
     memset(out, 0, sizeof *out);
     uint32_t w = l->width[atlas], h = y1 - y0;
@@ -274,7 +318,7 @@ lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for a %ux%u atlas", w, h);
     for (size_t i = 0; i < n; i++)
         b[i].dist = FLT_MAX;
-    rasterize(l, s, atlas, samples, y0, y1, b);
+    rasterize(l, s, atlas, samples, y0, y1, rows, b);
     out->width = w;
     out->height = l->height[atlas];
     out->samples = samples;

@@ -50,11 +50,25 @@ typedef struct lmb_texels {
 lmb_status lmb_texels_build(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, uint32_t samples,
                             lmb_texels *out, lmb_error *err);
 
+/* Each instance's reach in atlas rows (its triangles' texels and their neighbours), so that a
+ * band of rows visits only the instances that cross it: a level of many small instances (the
+ * copies of an instancing node) is banded in time that grows with the band, not with the level.
+ * Owned: lmb_instance_rows_free. */
+typedef struct lmb_instance_rows {
+    int64_t *lo, *hi; /* per instance; lo > hi: no row (not in the atlas) */
+} lmb_instance_rows;
+
+lmb_status lmb_instance_rows_make(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, lmb_instance_rows *out,
+                                  lmb_error *err);
+void lmb_instance_rows_free(lmb_instance_rows *r);
+
 /* The same for atlas rows [y0, y1) only (texel indices stay y * width + x of the atlas):
  * the lights stage builds an atlas band by band so that sub-sampled points for the whole
- * atlas never exist at once. */
+ * atlas never exist at once. rows: the atlas's lmb_instance_rows, or NULL (every instance is
+ * visited). */
 lmb_status lmb_texels_build_rows(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, uint32_t samples,
-                                 uint32_t y0, uint32_t y1, lmb_texels *out, lmb_error *err);
+                                 uint32_t y0, uint32_t y1, const lmb_instance_rows *rows, lmb_texels *out,
+                                 lmb_error *err);
 
 /* Appends band's texels to dst keeping one point each, the one indirect light is gathered
  * at (band->gather_at, set by the lights stage), as a 16-byte reference: dst then has
