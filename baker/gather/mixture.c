@@ -5,6 +5,7 @@
 #include "util/fast_pow.h"
 
 #include <stdlib.h>
+#include <stddef.h>
 #include <string.h>
 
 #define EM_STEPS 8      /* a mixture learned for the neighbours */
@@ -204,15 +205,33 @@ static void set_targets(lmb_mixture *out, const uint32_t *index, const float *w,
     }
 }
 
+/* The fields a kept mixture holds: where each lies in lmb_mixture and in lmb_mixture_kept. */
+static const struct {
+    size_t full, kept, size;
+} KEPT_FIELDS[] = {
+    {offsetof(lmb_mixture, count), offsetof(lmb_mixture_kept, count), sizeof(uint32_t)},
+    {offsetof(lmb_mixture, diffuse), offsetof(lmb_mixture_kept, diffuse), sizeof(double)},
+    {offsetof(lmb_mixture, aimed), offsetof(lmb_mixture_kept, aimed), sizeof(int) * LMB_MIXTURE_MAX_LOBES},
+    {offsetof(lmb_mixture, lobe), offsetof(lmb_mixture_kept, lobe), sizeof(lmb_lobe) * LMB_MIXTURE_MAX_LOBES},
+    {offsetof(lmb_mixture, weight), offsetof(lmb_mixture_kept, weight), sizeof(double) * LMB_MIXTURE_MAX_LOBES},
+    {offsetof(lmb_mixture, target), offsetof(lmb_mixture_kept, target), 3 * sizeof(double) * LMB_MIXTURE_MAX_LOBES},
+};
+
+/* Copies the kept fields from src to dst, one a mixture and the other a kept one (to_kept:
+ * dst is the kept one, of dst_size bytes); the rest of dst is zeroed. */
+static void copy_kept_fields(void *dst, size_t dst_size, const void *src, int to_kept)
+{
+    memset(dst, 0, dst_size);
+    for (size_t f = 0; f < sizeof KEPT_FIELDS / sizeof KEPT_FIELDS[0]; f++) {
+        size_t at_full = KEPT_FIELDS[f].full, at_kept = KEPT_FIELDS[f].kept;
+        memcpy((char *)dst + (to_kept ? at_kept : at_full), (const char *)src + (to_kept ? at_full : at_kept),
+               KEPT_FIELDS[f].size);
+    }
+}
+
 void lmb_mixture_keep(const lmb_mixture *m, lmb_mixture_kept *out)
 {
-    memset(out, 0, sizeof *out);
-    out->count = m->count;
-    out->diffuse = m->diffuse;
-    memcpy(out->aimed, m->aimed, sizeof out->aimed);
-    memcpy(out->lobe, m->lobe, sizeof out->lobe);
-    memcpy(out->weight, m->weight, sizeof out->weight);
-    memcpy(out->target, m->target, sizeof out->target);
+    copy_kept_fields(out, sizeof *out, m, 1);
 }
 
 void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double to[3], lmb_mixture *out)
@@ -224,13 +243,7 @@ void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double 
 
 void lmb_mixture_reaim_kept(const lmb_mixture_kept *m, const double from[3], const double to[3], lmb_mixture *out)
 {
-    memset(out, 0, sizeof *out);
-    out->count = m->count;
-    out->diffuse = m->diffuse;
-    memcpy(out->aimed, m->aimed, sizeof out->aimed);
-    memcpy(out->lobe, m->lobe, sizeof out->lobe);
-    memcpy(out->weight, m->weight, sizeof out->weight);
-    memcpy(out->target, m->target, sizeof out->target);
+    copy_kept_fields(out, sizeof *out, m, 0);
     for (uint32_t k = 0; k < m->count; k++) {
         if (m->aimed[k]) {
             double v[3];
