@@ -273,24 +273,31 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
 /* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
  * neighbours, then seams stitched. */
 static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
-                               lmb_cache *cache, lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
+                               lmb_cache *cache, lmb_progress_fn progress, void *user, lmb_bake_stats *stats,
+                               const lmb_log *log, lmb_error *err)
 {
     lmb_status st = LMB_OK;
     if (st == LMB_OK && cfg->firefly_spread && !cfg->reference) {
         lmb_firefly_stats fs = {0, 0, 0};
         for (uint32_t a = 0; st == LMB_OK && a < l->atlas_count; a++) {
+            if (progress)
+                progress(user, "fireflies", a, l->atlas_count);
             uint64_t before = fs.texels, last = ~0ull;
             /* a spike shared with its neighbours may leave them above the bound: again, a few times */
             for (int pass = 0; pass < LMB_FIREFLY_PASSES && st == LMB_OK && fs.texels != last; pass++) {
                 last = fs.texels;
                 double total = fs.total;
-                st = lmb_fireflies_spread(cache->irradiance[a], cache->state[a], l->width[a], l->height[a], &fs, err);
+                st = lmb_fireflies_spread(cache->irradiance[a], cache->state[a], l->width[a], l->height[a],
+                                          (int)cfg->threads, &fs, err);
                 if (pass)
                     fs.total = total; /* the atlas's light counts once */
             }
             if (st == LMB_OK && fs.texels > before) /* padding follows the texels it was dilated from */
-                st = lmb_dilate(cache->irradiance[a], cache->state[a], l->width[a], l->height[a], err);
+                st = lmb_dilate(cache->irradiance[a], cache->state[a], l->width[a], l->height[a], (int)cfg->threads,
+                                err);
         }
+        if (progress && st == LMB_OK)
+            progress(user, "fireflies", l->atlas_count, l->atlas_count);
         stats->firefly_texels = fs.texels;
         stats->firefly_moved = fs.total > 0 ? fs.moved / fs.total : 0;
         if (st == LMB_OK && fs.texels)
@@ -300,7 +307,12 @@ static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const 
     }
     if (st == LMB_OK && cfg->seam_stitch) {
         lmb_seam_report sr;
-        st = lmb_seams_stitch(s, l, rt, cache->irradiance, (const uint8_t *const *)cache->state, &sr, err);
+        if (progress)
+            progress(user, "seams", 0, 1);
+        st = lmb_seams_stitch(s, l, rt, cache->irradiance, (const uint8_t *const *)cache->state, (int)cfg->threads, &sr,
+                              err);
+        if (progress && st == LMB_OK)
+            progress(user, "seams", 1, 1);
         stats->seam_edges = sr.edges;
         stats->seam_jump_before = sr.jump_before;
         stats->seam_jump_after = sr.jump_after;
@@ -384,6 +396,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_direct_create(s, cfg, &rt, em, sky, &direct, err);
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
+    cache.threads = cfg->threads;
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
                                                                                                    : LMB_STEPS_LOCAL;
     lmb_steps_worker sw = {run->shards, run->worker, run->workers, run->wait_timeout};
@@ -416,12 +429,14 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     }
     run->steps = lmb_steps_count(steps);
     if (st == LMB_OK)
-        st = post_process(s, cfg, &l, &rt, &cache, stats, log, err);
+        st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
     lmb_atlas_output *outputs = calloc((size_t)l.atlas_count + 1, sizeof *outputs);
     if (st == LMB_OK && !outputs)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "output: out of memory");
     uint64_t clamped = 0;
     for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
+        if (progress)
+            progress(user, "images", a, l.atlas_count);
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
                                     l.height[a], &outputs[a], err);
         clamped += outputs[a].rgbm_clamped;
@@ -429,6 +444,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
             lmb_warn(log, "atlas %u: %llu texels brighter than RGBM's range %g were clamped (output.rgbm_range; auto "
                      "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
     }
+    if (progress && st == LMB_OK)
+        progress(user, "images", l.atlas_count, l.atlas_count);
     stats->rgbm_clamped = clamped;
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
@@ -440,6 +457,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     stats->density_auto = l.density.automatic;
     stats->density_capped = l.density.capped;
     stats->density_raised = l.density.raised;
+    if (st == LMB_OK && progress)
+        progress(user, "glTF", 0, 1);
     if (st == LMB_OK) {
         copy_textures(s, &od, log);
         st = write_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
@@ -450,6 +469,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_output_dir_commit(&od, err);
     else
         lmb_output_dir_abort(&od);
+    if (st == LMB_OK && progress)
+        progress(user, "glTF", 1, 1);
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
 done:

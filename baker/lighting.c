@@ -120,7 +120,12 @@ static lmb_status denoise_light(const pass_env *env, size_t field, const double 
         most = filtered && level > most ? level : most;
     }
     lmb_denoise_run run = {levels, cfg->denoise_strength, (int)cfg->threads, own_variance ? "all light" : "gathered light"};
+    const char *stage = own_variance ? "denoise all light" : "denoise gathered light";
+    if (env->job->progress)
+        env->job->progress(env->job->progress_user, stage, 0, 1);
     lmb_status st = lmb_denoise_steps(env->job->steps, atlases, n, &run, &ds, err);
+    if (env->job->progress && st == LMB_OK)
+        env->job->progress(env->job->progress_user, stage, 1, 1);
     free(atlases);
     env->stats->denoised_texels += ds.texels;
     if (st == LMB_OK && ds.texels)
@@ -260,7 +265,8 @@ static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_
         }
         lmb_direct_atlas da = {w->t, w->direct, w->direct_dir, w->deferred, NULL, w->variance, w->direct_rays};
         st = lmb_direct_refine_step(env->job->steps, cfg, env->job->direct, env->cache->scene, env->cache->layout, a,
-                                    shown, &da, &env->stats->rays, &noise, &estimates, &estimate_count, err);
+                                    shown, env->job->progress, env->job->progress_user, &da, &env->stats->rays, &noise,
+                                    &estimates, &estimate_count, err);
         free(shown);
     }
     lmb_direct_noise_finish(&noise, estimates, estimate_count);
@@ -531,8 +537,12 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     }
     for (uint32_t a = 0; a < n && st == LMB_OK && w[a].shadowmask; a++)
         st = lmb_cache_store_shadowmask(cache, a, &w[a].t, w[a].shadowmask, err);
+    if (st == LMB_OK && cfg->directional && progress)
+        progress(user, "directions", 0, 1);
     if (st == LMB_OK && cfg->directional)
         st = light_directions(&env, err);
+    if (st == LMB_OK && cfg->directional && progress)
+        progress(user, "directions", 1, 1);
     lmb_ic_records_free(&shared);
     work_free(w, n);
     return st;

@@ -52,7 +52,7 @@ lmb_status lmb_cache_init(lmb_cache *c, const lmb_scene *scene, const lmb_layout
 
 /* img := e at t's texels (0 at invalid ones), st := their states; then dilated. */
 static lmb_status scatter(float *img, uint8_t *st, uint32_t w, uint32_t h, const lmb_texels *t, const float *e,
-                          lmb_error *err)
+                          int threads, lmb_error *err)
 {
     memset(img, 0, (size_t)w * h * 3 * sizeof *img);
     memset(st, LMB_TEXEL_EMPTY, (size_t)w * h);
@@ -61,7 +61,7 @@ static lmb_status scatter(float *img, uint8_t *st, uint32_t w, uint32_t h, const
         for (int k = 0; k < 3; k++)
             img[3 * (size_t)t->texel[i] + k] = t->valid[i] ? e[3 * (size_t)i + k] : 0.0f;
     }
-    return lmb_dilate(img, st, w, h, err);
+    return lmb_dilate(img, st, w, h, threads, err);
 }
 
 void lmb_cache_release(lmb_cache *c)
@@ -78,7 +78,7 @@ lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const 
         c->irradiance[a] = malloc((3 * (size_t)c->layout->width[a] * c->layout->height[a] + 1) * sizeof **c->irradiance);
     if (!c->irradiance[a])
         return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u", a);
-    return scatter(c->irradiance[a], c->state[a], c->layout->width[a], c->layout->height[a], t, e, err);
+    return scatter(c->irradiance[a], c->state[a], c->layout->width[a], c->layout->height[a], t, e, (int)c->threads, err);
 }
 
 lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *d, lmb_error *err)
@@ -90,7 +90,7 @@ lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels 
         c->direction[a] = malloc((3 * n + 1) * sizeof **c->direction);
     uint8_t *st = malloc(n + 1);
     lmb_status s = c->direction && c->direction[a] && st
-                       ? scatter(c->direction[a], st, c->layout->width[a], c->layout->height[a], t, d, err)
+                       ? scatter(c->direction[a], st, c->layout->width[a], c->layout->height[a], t, d, (int)c->threads, err)
                        : lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for atlas %u's directions", a);
     free(st);
     return s;
@@ -114,7 +114,7 @@ lmb_status lmb_cache_store_shadowmask(lmb_cache *c, uint32_t a, const lmb_texels
         for (uint32_t i = 0; i < t->count; i++)
             for (int k = 0; k < 3; k++)
                 part[3 * (size_t)i + k] = half == 0 ? v[4 * (size_t)i + k] : k == 0 ? v[4 * (size_t)i + 3] : 0.0f;
-        s = scatter(img, st, w, h, t, part, err);
+        s = scatter(img, st, w, h, t, part, (int)c->threads, err);
         for (size_t p = 0; p < n && s == LMB_OK; p++)
             for (int k = 0; k < (half ? 1 : 3); k++)
                 c->shadowmask[a][4 * p + (half ? 3 : k)] = img[3 * p + k];

@@ -30,6 +30,7 @@ typedef struct lmb_cache {
     const lmb_rt *rt;             /* borrowed */
     const lmb_textures *textures; /* borrowed, may be NULL */
     uint32_t atlas_count;
+    uint32_t threads;   /* for dilation; 0: all cores (the bake sets it from the config) */
     float **irradiance; /* owned: per atlas width x height x 3, dilated (NULL after lmb_cache_release) */
     uint8_t **state;    /* owned: per atlas width x height LMB_TEXEL_* */
     float **direction;  /* owned, NULL until lmb_cache_store_direction: per atlas width x height x 3,

@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "node_tool.h"
 #include "progress.h"
+#include "timings.h"
 
 #include <limits.h>
 #include <stdio.h>
@@ -33,6 +34,8 @@ static const char help[] =
     "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
     "      --print-config  print the effective config (every key, after -c and the options\n"
     "                      above) as YAML that -c reads back, and exit; SCENE may be left out\n"
+    "      --timings[=CSV] at the end, per stage: wall time, CPU time over all threads and the\n"
+    "                      share of the wall time when at most one thread ran (also as CSV)\n"
     "  -q, --quiet         no progress or warnings\n"
     "  -h, --help          this help\n"
     "\n"
@@ -47,6 +50,8 @@ static const char help[] =
 
 typedef struct bake_args {
     const char *scene, *config, *outdir, *plan, *farm;
+    const char *timings_csv; /* --timings=CSV */
+    int timings;
     long long threads, seed, rays, method; /* -1: from the config */
     int quiet, reference, preview, print_config;
     long long step;               /* -1: not given */
@@ -136,6 +141,11 @@ static int parse_args(int argc, char **argv, bake_args *a)
         } else if ((r = cli_opt_value(argc, argv, &i, "--shards", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 100000, &a->shards) || a->shards < 1)
                 return cli_usage_error("bake", "--shards needs a number 1..100000");
+        } else if (cli_is_flag(argv[i], "--timings", NULL) || !strncmp(argv[i], "--timings=", 10)) {
+            a->timings = 1;
+            a->timings_csv = argv[i][9] == '=' ? argv[i] + 10 : NULL;
+            if (a->timings_csv && !*a->timings_csv)
+                return cli_usage_error("bake", "--timings= needs a CSV file name");
         } else if (cli_is_flag(argv[i], "--print-config", NULL)) {
             a->print_config = 1;
         } else if (cli_is_flag(argv[i], "--quiet", "-q")) {
@@ -247,6 +257,19 @@ static const char worker_help[] =
 typedef enum stage_kind { STAGE_BAKE, STAGE_PLAN, STAGE_STEP, STAGE_MERGE, STAGE_FINISH, STAGE_WORKER } stage_kind;
 
 static int run(int argc, char **argv, stage_kind stage);
+
+/* The progress callback with --timings: each stage's first call starts its timing. */
+typedef struct timed_progress {
+    cli_progress *progress;
+    cli_timings *timings;
+} timed_progress;
+
+static void timed_progress_update(void *user, const char *stage, uint64_t done, uint64_t total)
+{
+    timed_progress *tp = user;
+    cli_timings_stage(tp->timings, stage);
+    cli_progress_update(tp->progress, stage, done, total);
+}
 
 static int with_help(int argc, char **argv, const char *text, stage_kind stage)
 {
@@ -371,9 +394,14 @@ static int run(int argc, char **argv, stage_kind stage)
     cli_warnings warnings = {0, a.quiet};
     lmb_log log = cli_log(&warnings);
     double t0 = cli_now();
+    cli_timings *timings = a.timings ? cli_timings_start("load") : NULL;
+    if (a.timings && !timings)
+        fprintf(stderr, "lmbake: warning: --timings: the sampling thread did not start; no timings\n");
     lmb_scene *scene;
-    if (lmb_scene_load(a.scene, &cfg, &scene, &log, &err) != LMB_OK)
+    if (lmb_scene_load(a.scene, &cfg, &scene, &log, &err) != LMB_OK) {
+        cli_timings_finish(timings, NULL, NULL);
         return cli_fail(&err);
+    }
     lmb_scene_select_lightmapped(scene, &cfg);
     lmb_scene_stats st;
     lmb_scene_stats_compute(scene, &st);
@@ -388,15 +416,19 @@ static int run(int argc, char **argv, stage_kind stage)
         lmb_error_set(&err, LMB_ERR_INPUT, "%s: nothing to lightmap (see 'lmbake inspect' for each instance's reason)",
                       a.scene);
         lmb_scene_free(scene);
+        cli_timings_finish(timings, NULL, NULL);
         return cli_fail(&err);
     }
     cli_progress progress;
     cli_progress_init(&progress, stderr, a.quiet);
+    timed_progress timed = {&progress, timings};
     if (plan_stage) {
         lmb_status rc = a.farm ? lmb_farm_make_dirs(a.farm, &err) : LMB_OK;
         if (rc == LMB_OK)
-            rc = lmb_plan_write(scene, &cfg, a.outdir, cli_progress_update, &progress, &log, &err);
+            rc = lmb_plan_write(scene, &cfg, a.outdir, timings ? timed_progress_update : cli_progress_update,
+                                timings ? (void *)&timed : (void *)&progress, &log, &err);
         lmb_scene_free(scene);
+        cli_timings_finish(timings, rc == LMB_OK ? stdout : NULL, a.timings_csv);
         if (rc != LMB_OK)
             return cli_fail(&err);
         if (!a.quiet)
@@ -407,6 +439,7 @@ static int run(int argc, char **argv, stage_kind stage)
         lmb_farm_merge_report mr;
         lmb_status rc = lmb_farm_merge(scene, &cfg, plan_path, a.farm, (uint32_t)a.step, (uint32_t)a.shards, &mr, &err);
         lmb_scene_free(scene);
+        cli_timings_finish(timings, rc == LMB_OK ? stdout : NULL, a.timings_csv);
         if (rc != LMB_OK)
             return cli_fail(&err);
         if (!a.quiet && mr.end)
@@ -428,11 +461,16 @@ static int run(int argc, char **argv, stage_kind stage)
     lmb_bake_stats bs;
     double ts = cli_now();
     lmb_status rc = lmb_bake_farm(scene, &cfg, a.farm ? plan_path : a.plan, &fr, writes_bake ? a.outdir : NULL,
-                                  cli_progress_update,
-                                  &progress, &bs, &log, &err);
+                                  timings ? timed_progress_update : cli_progress_update,
+                                  timings ? (void *)&timed : (void *)&progress, &bs, &log, &err);
     lmb_scene_free(scene);
-    if (rc != LMB_OK)
+    if (rc != LMB_OK) {
+        cli_timings_finish(timings, NULL, NULL);
         return cli_fail(&err);
+    }
+    cli_timings_stage(timings, "report"); /* the bake's own time ends here */
+    if (!writes_bake || stage == STAGE_STEP) /* no summary follows: the timings now */
+        cli_timings_finish(timings, stdout, a.timings_csv);
     if (!writes_bake && stage == STAGE_WORKER) {
         if (!a.quiet)
             printf("worker %llu/%llu: %u steps, %.2f s\n", a.worker, a.workers, fr.steps, cli_now() - ts);
@@ -479,6 +517,8 @@ static int run(int argc, char **argv, stage_kind stage)
                bs.seconds, bs.light_seconds, bs.atlases, (unsigned long long)bs.texels,
                (unsigned long long)bs.valid_texels, (unsigned long long)bs.rays,
                bs.light_seconds > 0 ? (double)bs.rays / bs.light_seconds : 0.0, bs.gltf_path);
+    if (writes_bake && stage != STAGE_STEP)
+        cli_timings_finish(timings, stdout, a.timings_csv);
     if (a.preview) {
         char *args[] = {bs.gltf_path, (char *)a.outdir, NULL};
         int code = node_tool_run(script, args);

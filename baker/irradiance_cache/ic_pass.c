@@ -146,7 +146,7 @@ static lmb_status uncovered_again(pass_ctx *c, uint32_t slot, uint32_t *cand, ui
         }
     uint8_t *keep = NULL;
     if (st == LMB_OK && shrunk.count) {
-        st = lmb_ic_records_index(&shrunk, err);
+        st = lmb_ic_records_index(&shrunk, c->threads, err);
         keep = malloc(*n + 1);
         if (st == LMB_OK && !keep)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu candidates",
@@ -222,7 +222,7 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint
     free(fresh);
     free(cand);
     if (st == LMB_OK && m) /* no new record: the index stands */
-        st = lmb_ic_records_index(&c->records, err);
+        st = lmb_ic_records_index(&c->records, c->threads, err);
     *placed = m;
     if (st == LMB_OK && m && clamp)
         st = lmb_ic_records_clamp(&c->records, (uint32_t)c->threads, err);
@@ -440,7 +440,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     if (st == LMB_OK && (!c.tested_reach || !c.tested_count))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
     if (st == LMB_OK)
-        st = lmb_ic_records_index(&c.records, err);
+        st = lmb_ic_records_index(&c.records, c.threads, err);
     if (st == LMB_OK && reuse)
         st = regather(&c, stats, err);
     /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a

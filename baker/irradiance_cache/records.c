@@ -90,6 +90,9 @@ static void select_kth(const lmb_ic_records *s, int axis, uint32_t *o, uint32_t 
     }
 }
 
+/* Subtrees of more records than this are built as tasks of their own. */
+#define BUILD_TASK_RECORDS 8192
+
 /* point[i]: record i's position as a float box, rounded outward so that it holds the double
  * position (computed once per index, not at every level of the tree). */
 static void build(lmb_ic_records *s, const float (*point)[6], uint32_t node, uint32_t lo, uint32_t hi)
@@ -112,8 +115,17 @@ static void build(lmb_ic_records *s, const float (*point)[6], uint32_t node, uin
             axis = a;
     uint32_t mid = lo + (hi - lo) / 2;
     select_kth(s, axis, s->order, lo, hi, mid);
-    build(s, point, 2 * node, lo, mid);
-    build(s, point, 2 * node + 1, mid, hi);
+    /* the halves own disjoint ranges of order[] and disjoint nodes: large ones are tasks (the
+     * tree is the same whichever thread builds a part) */
+    if (hi - lo > BUILD_TASK_RECORDS) {
+#pragma omp task default(none) firstprivate(s, point, node, lo, mid)
+        build(s, point, 2 * node, lo, mid);
+        build(s, point, 2 * node + 1, mid, hi);
+#pragma omp taskwait
+    } else {
+        build(s, point, 2 * node, lo, mid);
+        build(s, point, 2 * node + 1, mid, hi);
+    }
 }
 
 /* Every node's largest reach below it (positions, hence the tree, unchanged). */
@@ -134,8 +146,9 @@ static float refresh_reach(lmb_ic_records *s, uint32_t node, uint32_t lo, uint32
     return reach;
 }
 
-lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err)
+lmb_status lmb_ic_records_index(lmb_ic_records *s, int threads, lmb_error *err)
 {
+    threads = threads > 0 ? threads : omp_get_max_threads();
     uint32_t depth = 0;
     while (((uint64_t)s->count >> depth) > LEAF)
         depth++;
@@ -154,12 +167,15 @@ lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err)
     float (*point)[6] = malloc(((size_t)s->count + 1) * sizeof *point);
     if (!point)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory indexing %u records", s->count);
+#pragma omp parallel for num_threads(threads) schedule(static) if (s->count > BUILD_TASK_RECORDS)
     for (uint32_t k = 0; k < s->count; k++)
         for (int a = 0; a < 3; a++) {
             point[k][a] = nextafterf((float)s->rec[k].p[a], -FLT_MAX);
             point[k][3 + a] = nextafterf((float)s->rec[k].p[a], FLT_MAX);
         }
     if (s->count) {
+#pragma omp parallel num_threads(threads) if (s->count > BUILD_TASK_RECORDS)
+#pragma omp single
         build(s, (const float (*)[6])point, 1, 0, s->count);
         refresh_reach(s, 1, 0, s->count);
     }

@@ -60,8 +60,9 @@ void lmb_ic_records_free(lmb_ic_records *s);
 /* Appends records (copied). LMB_ERR_INTERNAL when out of memory. */
 lmb_status lmb_ic_records_append(lmb_ic_records *s, const lmb_ic_record *r, uint32_t n, lmb_error *err);
 
-/* Rebuilds the k-d tree after records were added or their reach changed. */
-lmb_status lmb_ic_records_index(lmb_ic_records *s, lmb_error *err);
+/* Rebuilds the k-d tree after records were added or their reach changed; large subtrees are
+ * built in parallel on `threads` (0: all cores), the tree the same at any count. */
+lmb_status lmb_ic_records_index(lmb_ic_records *s, int threads, lmb_error *err);
 
 /* The reach of r from its harmonic distance and clamps: clamp(error x harmonic, r_min, r_max). */
 double lmb_ic_reach(const lmb_ic_records *s, const lmb_ic_record *r);

@@ -100,8 +100,6 @@ void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t 
 typedef struct lmb_direct_job {
     const lmb_direct *direct;
     uint32_t atlas;      /* keys the random streams */
-    lmb_progress_fn progress;
-    void *progress_user;
     float *direction;    /* NULL, or 3 floats per listed texel: lmb_direct_at's dir, averaged over the
                             texel's points as the irradiance is (directional lightmaps) */
     float *deferred;     /* NULL, or 3 floats per listed texel: the `indirect` lights' part of the irradiance */
@@ -113,10 +111,13 @@ typedef struct lmb_direct_job {
                                direct step's two and without them; 0: the texel is left as it is */
 } lmb_direct_job;
 
-/* Fills irradiance (3 floats per listed texel of t), t->valid and t->gather_at. Counts rays
- * and adds the sampled lights' samples to *samples. */
-lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays,
-                              uint64_t *samples, lmb_error *err);
+/* Direct light of `bands` sets of texels in one parallel loop (a set is a band of atlas rows;
+ * band b: jobs[b], t[b], irradiance[b]): fills irradiance (3 floats per listed texel),
+ * t->valid and t->gather_at. A texel's light depends on its atlas, texel and rounds only, not
+ * on the bands, their number or the threads. The jobs' rounds are all NULL (the direct step)
+ * or all set (a refinement). Counts rays and adds the sampled lights' samples to *samples. */
+lmb_status lmb_direct_compute_bands(const lmb_direct_job *jobs, lmb_texels *t, float *const *irradiance, uint32_t bands,
+                                    uint64_t *rays, uint64_t *samples, lmb_error *err);
 
 /* Samples per point in one round of the sampled lights: half samples.direct (rounded up). */
 uint32_t lmb_direct_round_samples(const lmb_config *cfg);

@@ -4,6 +4,8 @@
 
 #include "util/lmb_math.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +27,8 @@ typedef struct refine_ctx {
     const uint32_t *rounds;  /* per listed texel: 0 (kept) or its rounds */
     uint32_t *first;         /* per band (+1): its first listed texel */
     lmb_instance_rows instance_rows; /* which instances a band visits */
+    lmb_progress_fn progress;
+    void *progress_user;
 } refine_ctx;
 
 /* The rounds texel i needs: its standard error after R rounds is sqrt(variance / R); R is the
@@ -52,7 +56,7 @@ static uint32_t rounds_needed(const lmb_config *cfg, double k, double variance, 
  * estimate alone biased a sun map's mean 1% high. Returns 0 when out of memory. */
 #define NEIGHBOURS 2
 static int neighbourhood_means(const lmb_direct_atlas *da, const double *shown, uint32_t width, uint32_t height,
-                               float *mean_var, float *mean_lum)
+                               int threads, float *mean_var, float *mean_lum)
 {
     int32_t *at = malloc(((size_t)width * height + 1) * sizeof *at);
     if (!at)
@@ -62,6 +66,7 @@ static int neighbourhood_means(const lmb_direct_atlas *da, const double *shown, 
     for (uint32_t i = 0; i < da->t.count; i++)
         if (da->t.valid[i])
             at[da->t.texel[i]] = (int32_t)i;
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (uint32_t i = 0; i < da->t.count; i++) {
         int64_t x = da->t.texel[i] % width, y = da->t.texel[i] / width;
         double v = 0, l = 0;
@@ -84,24 +89,27 @@ static int neighbourhood_means(const lmb_direct_atlas *da, const double *shown, 
 
 /* rounds[i] := the rounds every texel needs at k x samples.noise, from its neighbourhood's
  * variance and light (rim texels keep the limit post/rim.c set); returns their sum; with noise,
- * counts the refined and capped texels. */
+ * counts the refined and capped texels. In parallel: the sums are of integers, exact in any order. */
 static double plan_rounds(const lmb_config *cfg, const lmb_direct_atlas *da, const float *mean_var,
-                          const float *mean_lum, double k, uint32_t *rounds, lmb_direct_noise *noise)
+                          const float *mean_lum, double k, int threads, uint32_t *rounds, lmb_direct_noise *noise)
 {
-    double sum = 0;
+    uint64_t sum = 0, refined = 0, capped = 0;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : sum, refined, capped)
     for (uint32_t i = 0; i < da->t.count; i++) {
         rounds[i] = 0;
         if (!da->t.valid[i] || !(da->variance[i] > 0) || da->t.partly_covered[i])
             continue;
-        int capped;
-        rounds[i] = rounds_needed(cfg, k, mean_var[i], mean_lum[i], &capped);
+        int was_capped;
+        rounds[i] = rounds_needed(cfg, k, mean_var[i], mean_lum[i], &was_capped);
         sum += rounds[i];
-        if (noise && rounds[i]) {
-            noise->refined++;
-            noise->capped += capped;
-        }
+        refined += rounds[i] > 0;
+        capped += rounds[i] > 0 && was_capped;
     }
-    return sum;
+    if (noise) {
+        noise->refined += refined;
+        noise->capped += capped;
+    }
+    return (double)sum;
 }
 
 /* Valid texels of the atlas with sampled direct light. */
@@ -113,65 +121,133 @@ static uint64_t noise_texels_here(const lmb_direct_atlas *da)
     return n;
 }
 
-/* A band's bytes: u32 refined; per refined texel u32 listed index, f32 variance, 3 f32 direct,
+/* The refined texels of one band and their new light. */
+typedef struct band_refined {
+    uint32_t i0, i1, refined; /* its listed texels [i0, i1), how many of them are refined */
+    lmb_texels texels;
+    float *e, *var, *dir, *deferred;
+} band_refined;
+
+static void band_refined_free(band_refined *r)
+{
+    lmb_texels_free(&r->texels);
+    free(r->e);
+    free(r->var);
+    free(r->dir);
+    free(r->deferred);
+    memset(r, 0, sizeof *r);
+}
+
+/* Band b's bytes: u32 refined; per refined texel u32 listed index, f32 variance, 3 f32 direct,
  * then 3 f32 direction sum when directional and 3 f32 deferred light with mixed lighting. */
+static lmb_status put_refined(const refine_ctx *c, const band_refined *r, lmb_buf *out, lmb_error *err)
+{
+    lmb_status st = lmb_buf_append(out, &r->refined, 4, err);
+    for (uint32_t j = 0; st == LMB_OK && r->refined && j < r->i1 - r->i0; j++) {
+        if (!c->rounds[r->i0 + j])
+            continue;
+        uint32_t listed = r->i0 + j;
+        st = lmb_buf_append(out, &listed, 4, err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, &r->var[j], 4, err);
+        if (st == LMB_OK)
+            st = lmb_buf_append(out, &r->e[3 * j], 12, err);
+        if (st == LMB_OK && r->dir)
+            st = lmb_buf_append(out, &r->dir[3 * j], 12, err);
+        if (st == LMB_OK && r->deferred)
+            st = lmb_buf_append(out, &r->deferred[3 * j], 12, err);
+    }
+    return st;
+}
+
+/* Builds and refines the bands of group[0..n) (their texels at once, a band per thread; then
+ * every refined texel of them in one loop, longest first: lmb_direct_compute_bands). */
+static lmb_status refine_group(const refine_ctx *c, uint64_t b0, uint64_t b1, const uint8_t *skip, band_refined *r,
+                               lmb_direct_job *jobs, lmb_texels *texels, float **e,
+                               uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    uint32_t n = (uint32_t)(b1 - b0), used = 0;
+    lmb_status st = lmb_direct_build_bands(c->cfg, c->scene, c->layout, c->atlas, c->rows, b0, b1, &c->instance_rows,
+                                           skip, texels, err);
+    for (uint32_t k = 0; k < n && st == LMB_OK; k++) { /* r owns the texels from here */
+        r[k].i0 = c->first[b0 + k];
+        r[k].i1 = c->first[b0 + k + 1];
+        r[k].texels = texels[k];
+        memset(&texels[k], 0, sizeof texels[k]);
+    }
+    for (uint32_t k = 0; k < n && st == LMB_OK; k++) {
+        band_refined *br = &r[k];
+        if (skip[k])
+            continue;
+        for (uint32_t i = br->i0; i < br->i1; i++)
+            br->refined += c->rounds[i] > 0;
+        size_t count = br->texels.count;
+        uint32_t y0 = (uint32_t)(b0 + k) * c->rows;
+        if (count != br->i1 - br->i0) {
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light of atlas %u: rows from %u list %zu texels, not %u",
+                               c->atlas, y0, count, br->i1 - br->i0);
+            break;
+        }
+        for (uint32_t j = 0; st == LMB_OK && j < count; j++)
+            if (br->texels.texel[j] != c->da->t.texel[br->i0 + j])
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light of atlas %u: texel lists disagree", c->atlas);
+        br->e = calloc(3 * count + 1, sizeof *br->e);
+        br->var = calloc(count + 1, sizeof *br->var);
+        br->dir = c->da->direction ? calloc(3 * count + 1, sizeof *br->dir) : NULL;
+        br->deferred = c->da->deferred ? calloc(3 * count + 1, sizeof *br->deferred) : NULL;
+        if (st == LMB_OK && (!br->e || !br->var || (c->da->direction && !br->dir) || (c->da->deferred && !br->deferred)))
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light: out of memory refining atlas %u", c->atlas);
+        jobs[used] = (lmb_direct_job){c->direct, c->atlas, br->dir, br->deferred, NULL, br->var, c->rounds + br->i0};
+        texels[used] = br->texels; /* a shallow copy: the texels stay br's */
+        e[used++] = br->e;
+    }
+    if (st == LMB_OK)
+        st = lmb_direct_compute_bands(jobs, texels, e, used, &counters[0], &counters[1], err);
+    /* lmb_direct_compute_bands wrote valid and gather_at into the copies: the same arrays as br's */
+    memset(texels, 0, (size_t)n * sizeof *texels);
+    return st;
+}
+
+/* Bands [first, last): those with refined texels in groups of lmb_direct_group_bands (empty
+ * bands cost nothing and do not count), each group refined at once (refine_group). */
 static lmb_status refine_bands(void *user, uint64_t first, uint64_t last, lmb_buf *out,
                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
     const refine_ctx *c = user;
+    uint32_t group = lmb_direct_group_bands(c->cfg);
+    uint64_t most = last - first;
+    band_refined *r = calloc(most + 1, sizeof *r);
+    uint8_t *skip = calloc(most + 1, 1);
+    lmb_direct_job *jobs = calloc(most + 1, sizeof *jobs);
+    lmb_texels *texels = calloc(most + 1, sizeof *texels);
+    float **e = calloc(most + 1, sizeof *e);
     lmb_status st = LMB_OK;
-    for (uint64_t b = first; b < last && st == LMB_OK; b++) {
-        uint32_t i0 = c->first[b], i1 = c->first[b + 1], refined = 0;
-        for (uint32_t i = i0; i < i1; i++)
-            refined += c->rounds[i] > 0;
-        if (!refined) {
-            st = lmb_buf_append(out, &refined, 4, err);
-            continue;
+    if (!r || !skip || !jobs || !texels || !e)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light: out of memory refining atlas %u", c->atlas);
+    for (uint64_t b0 = first; b0 < last && st == LMB_OK;) {
+        uint64_t b1 = b0;
+        for (uint32_t nonempty = 0; b1 < last && nonempty < group; b1++) {
+            int any = 0;
+            for (uint32_t i = c->first[b1]; i < c->first[b1 + 1] && !any; i++)
+                any = c->rounds[i] > 0;
+            skip[b1 - b0] = (uint8_t)!any;
+            nonempty += (uint32_t)any;
         }
-        uint32_t y0 = (uint32_t)b * c->rows, y1 = y0 + c->rows < c->height ? y0 + c->rows : c->height;
-        lmb_texels band;
-        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &c->instance_rows,
-                                   &band, err);
-        if (st != LMB_OK)
-            break;
-        size_t n = band.count;
-        int has_deferred = c->da->deferred != NULL, directional = c->da->direction != NULL;
-        float *e = calloc(3 * n + 1, sizeof *e), *var = calloc(n + 1, sizeof *var);
-        float *dir = directional ? calloc(3 * n + 1, sizeof *dir) : NULL;
-        float *deferred = has_deferred ? calloc(3 * n + 1, sizeof *deferred) : NULL;
-        if (!e || !var || (directional && !dir) || (has_deferred && !deferred))
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light: out of memory refining atlas %u", c->atlas);
-        if (st == LMB_OK && n != i1 - i0)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light of atlas %u: rows %u-%u list %zu texels, not %u",
-                               c->atlas, y0, y1, n, i1 - i0);
-        for (uint32_t j = 0; st == LMB_OK && j < n; j++)
-            if (band.texel[j] != c->da->t.texel[i0 + j])
-                st = lmb_error_set(err, LMB_ERR_INTERNAL, "direct light of atlas %u: texel lists disagree", c->atlas);
-        lmb_direct_job job = {c->direct, c->atlas, NULL, NULL, dir, deferred, NULL, var, c->rounds + i0};
-        if (st == LMB_OK)
-            st = lmb_direct_compute(&job, &band, e, &counters[0], &counters[1], err);
-        if (st == LMB_OK)
-            st = lmb_buf_append(out, &refined, 4, err);
-        for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
-            if (!c->rounds[i0 + j])
-                continue;
-            uint32_t listed = i0 + j;
-            st = lmb_buf_append(out, &listed, 4, err);
+        st = refine_group(c, b0, b1, skip, r, jobs, texels, e, counters, err);
+        for (uint64_t b = b0; b < b1; b++) {
             if (st == LMB_OK)
-                st = lmb_buf_append(out, &var[j], 4, err);
-            if (st == LMB_OK)
-                st = lmb_buf_append(out, &e[3 * j], 12, err);
-            if (st == LMB_OK && directional)
-                st = lmb_buf_append(out, &dir[3 * j], 12, err);
-            if (st == LMB_OK && has_deferred)
-                st = lmb_buf_append(out, &deferred[3 * j], 12, err);
+                st = put_refined(c, &r[b - b0], out, err);
+            band_refined_free(&r[b - b0]);
         }
-        free(e);
-        free(var);
-        free(dir);
-        free(deferred);
-        lmb_texels_free(&band);
+        if (st == LMB_OK && c->progress)
+            c->progress(c->progress_user, "direct refinement", b1 - first, last - first);
+        b0 = b1;
     }
+    free(r);
+    free(skip);
+    free(jobs);
+    free(texels);
+    free(e);
     return st;
 }
 
@@ -196,7 +272,7 @@ static lmb_status take_refined(lmb_buf *in, uint64_t bands, lmb_direct_atlas *da
 
 lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
                                   const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const double *shown,
-                                  lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
+                                  lmb_progress_fn progress, void *progress_user, lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
                                   uint64_t *estimate_count, lmb_error *err)
 {
     uint32_t count = da->t.count, width = layout->width[a], height = layout->height[a];
@@ -231,8 +307,9 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     uint64_t sampled = noise_texels_here(da);
     double round_rays = sampled ? (double)da->rays / (2.0 * (double)sampled) : 0;
     double budget = REFINE_BUDGET * (double)da->rays, k = 1;
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
     float *mean_var = malloc(((size_t)count + 1) * sizeof *mean_var), *mean_lum = malloc(((size_t)count + 1) * sizeof *mean_lum);
-    if (!mean_var || !mean_lum || !neighbourhood_means(da, shown, width, height, mean_var, mean_lum)) {
+    if (!mean_var || !mean_lum || !neighbourhood_means(da, shown, width, height, threads, mean_var, mean_lum)) {
         free(mean_var);
         free(mean_lum);
         free(rounds);
@@ -240,13 +317,13 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
         free(cost);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "direct light: out of memory refining atlas %u", a);
     }
-    if (cfg->adaptive && plan_rounds(cfg, da, mean_var, mean_lum, 1, rounds, NULL) * round_rays > budget) {
+    if (cfg->adaptive && plan_rounds(cfg, da, mean_var, mean_lum, 1, threads, rounds, NULL) * round_rays > budget) {
         double lo = 1, hi = 2;
-        while (hi < 1e6 && plan_rounds(cfg, da, mean_var, mean_lum, hi, rounds, NULL) * round_rays > budget)
+        while (hi < 1e6 && plan_rounds(cfg, da, mean_var, mean_lum, hi, threads, rounds, NULL) * round_rays > budget)
             hi *= 2;
         for (int it = 0; it < 40 && hi < 1e6; it++) {
             double mid = 0.5 * (lo + hi);
-            if (plan_rounds(cfg, da, mean_var, mean_lum, mid, rounds, NULL) * round_rays > budget)
+            if (plan_rounds(cfg, da, mean_var, mean_lum, mid, threads, rounds, NULL) * round_rays > budget)
                 lo = mid;
             else
                 hi = mid;
@@ -257,7 +334,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     if (k > noise->loosened)
         noise->loosened = k;
     if (cfg->adaptive)
-        plan_rounds(cfg, da, mean_var, mean_lum, k < 1e6 ? k : 1e300, rounds, noise);
+        plan_rounds(cfg, da, mean_var, mean_lum, k < 1e6 ? k : 1e300, threads, rounds, noise);
     free(mean_var);
     free(mean_lum);
     for (uint32_t i = 0, bb = 0; i < count; i++) {
@@ -269,7 +346,8 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     }
     lmb_status st = LMB_OK;
     if (noise->refined) {
-        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first, {NULL, NULL}};
+        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first, {NULL, NULL},
+                        progress, progress_user};
         st = lmb_instance_rows_make(scene, layout, a, &c.instance_rows, err);
         char name[64];
         snprintf(name, sizeof name, "direct, atlas %u: more samples", a);

@@ -30,7 +30,7 @@ typedef struct lmb_direct_noise {
  * da->variance holds each texel's estimate's variance (a round's over its rounds), not a round's. */
 lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
                                   const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const double *shown,
-                                  lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
+                                  lmb_progress_fn progress, void *progress_user, lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
                                   uint64_t *estimate_count, lmb_error *err);
 
 /* noise->median and p95 from the estimates collected over every atlas (frees them). */

@@ -1,6 +1,8 @@
 /* An atlas's gather points and direct light as a step of bands (direct_step.h). */
 #include "direct_step.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,16 +17,63 @@ typedef struct band_ctx {
     uint32_t atlas, width, height, rows; /* rows per band */
     lmb_progress_fn progress;
     void *progress_user;
-    uint64_t row0, band_rows;            /* the band being computed, for progress */
     lmb_instance_rows instance_rows;     /* which instances a band visits */
 } band_ctx;
 
-/* In atlas texels: the band's rows before it, plus its share of its own rows. */
-static void band_progress(void *user, const char *stage, uint64_t done, uint64_t total)
+uint32_t lmb_direct_group_bands(const lmb_config *cfg)
 {
-    const band_ctx *b = user;
-    b->progress(b->progress_user, stage, b->row0 * b->width + (total ? done * b->band_rows * b->width / total : 0),
-                (uint64_t)b->height * b->width);
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    return 4 * (uint32_t)(threads > 0 ? threads : 1);
+}
+
+lmb_status lmb_direct_build_bands(const lmb_config *cfg, const lmb_scene *scene, const lmb_layout *layout,
+                                  uint32_t atlas, uint32_t rows, uint64_t first, uint64_t last,
+                                  const lmb_instance_rows *instance_rows, const uint8_t *skip, lmb_texels *out,
+                                  lmb_error *err)
+{
+    uint32_t height = layout->height[atlas];
+    int64_t n = (int64_t)(last - first), failed_at = n;
+    lmb_error *errs = calloc((size_t)n + 1, sizeof *errs);
+    if (!errs)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", atlas);
+    memset(out, 0, (size_t)n * sizeof *out);
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    /* one band per thread at a time: a band's texels are built on one thread, the bands at once */
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int64_t k = 0; k < n; k++) {
+        if (skip && skip[k])
+            continue;
+        uint32_t y0 = (uint32_t)(first + (uint64_t)k) * rows, y1 = y0 + rows < height ? y0 + rows : height;
+        if (lmb_texels_build_rows(scene, layout, atlas, cfg->texel_samples, y0, y1, instance_rows, &out[k],
+                                  &errs[k]) != LMB_OK) {
+            memset(&out[k], 0, sizeof out[k]);
+#pragma omp critical(lmb_build_bands_failed)
+            failed_at = k < failed_at ? k : failed_at;
+        }
+    }
+    lmb_status st = LMB_OK;
+    if (failed_at < n) { /* the first band's error, whatever the threads did */
+        *err = errs[failed_at];
+        st = err->status;
+        for (int64_t k = 0; k < n; k++)
+            lmb_texels_free(&out[k]);
+    }
+    free(errs);
+    return st;
+}
+
+/* The bands' output arrays (one allocation per array and band). */
+typedef struct band_light {
+    float *e, *variance, *dir, *deferred, *mask;
+} band_light;
+
+static void band_light_free(band_light *l)
+{
+    free(l->e);
+    free(l->variance);
+    free(l->dir);
+    free(l->deferred);
+    free(l->mask);
 }
 
 /* A band's bytes: u32 count; per texel u32 texel, f32 size, lmb_point_ref, u8 valid, u8 partly;
@@ -58,40 +107,60 @@ static lmb_status put_band(const lmb_texels *t, const float *e, const float *var
     return st;
 }
 
+/* Bands [first, last) in groups of lmb_direct_group_bands: a group's bands are built at once
+ * (a band per thread) and lit in one parallel loop over all their texels, then written in order. */
 static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_buf *out,
                                 uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
     band_ctx *c = user;
     lmb_status st = LMB_OK;
-    for (uint64_t b = first; b < last && st == LMB_OK; b++) {
-        uint32_t y0 = (uint32_t)b * c->rows, y1 = y0 + c->rows < c->height ? y0 + c->rows : c->height;
-        lmb_texels band;
-        st = lmb_texels_build_rows(c->scene, c->layout, c->atlas, c->cfg->texel_samples, y0, y1, &c->instance_rows,
-                                   &band, err);
+    uint32_t group = lmb_direct_group_bands(c->cfg);
+    lmb_texels *bands = calloc(group, sizeof *bands);
+    band_light *light = calloc(group, sizeof *light);
+    lmb_direct_job *jobs = calloc(group, sizeof *jobs);
+    float **irradiance = calloc(group, sizeof *irradiance);
+    if (!bands || !light || !jobs || !irradiance)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
+    int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
+    for (uint64_t g = first; g < last && st == LMB_OK; g += group) {
+        uint32_t n = (uint32_t)(last - g < group ? last - g : group);
+        st = lmb_direct_build_bands(c->cfg, c->scene, c->layout, c->atlas, c->rows, g, g + n, &c->instance_rows, NULL,
+                                    bands, err);
         if (st != LMB_OK)
             break;
-        float *e = calloc(3 * (size_t)band.count + 1, sizeof *e);
-        float *variance = calloc((size_t)band.count + 1, sizeof *variance);
-        float *dir = c->cfg->directional ? calloc(3 * (size_t)band.count + 1, sizeof *dir) : NULL;
-        int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
-        float *deferred = has_deferred ? calloc(3 * (size_t)band.count + 1, sizeof *deferred) : NULL;
-        float *mask = has_mask ? calloc(LMB_SHADOWMASK_CHANNELS * (size_t)band.count + 1, sizeof *mask) : NULL;
-        if (!e || !variance || (c->cfg->directional && !dir) || (has_deferred && !deferred) || (has_mask && !mask))
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
-        c->row0 = y0;
-        c->band_rows = y1 - y0;
-        lmb_direct_job job = {c->direct, c->atlas, c->progress ? band_progress : NULL, c, dir, deferred, mask, variance, NULL};
+        for (uint32_t k = 0; k < n && st == LMB_OK; k++) {
+            size_t count = bands[k].count;
+            band_light *l = &light[k];
+            memset(l, 0, sizeof *l);
+            l->e = calloc(3 * count + 1, sizeof *l->e);
+            l->variance = calloc(count + 1, sizeof *l->variance);
+            l->dir = c->cfg->directional ? calloc(3 * count + 1, sizeof *l->dir) : NULL;
+            l->deferred = has_deferred ? calloc(3 * count + 1, sizeof *l->deferred) : NULL;
+            l->mask = has_mask ? calloc(LMB_SHADOWMASK_CHANNELS * count + 1, sizeof *l->mask) : NULL;
+            if (!l->e || !l->variance || (c->cfg->directional && !l->dir) || (has_deferred && !l->deferred) ||
+                (has_mask && !l->mask))
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
+            jobs[k] = (lmb_direct_job){c->direct, c->atlas, l->dir, l->deferred, l->mask, l->variance, NULL};
+            irradiance[k] = l->e;
+        }
         if (st == LMB_OK)
-            st = lmb_direct_compute(&job, &band, e, &counters[0], &counters[1], err);
-        if (st == LMB_OK)
-            st = put_band(&band, e, variance, dir, deferred, mask, out, err);
-        free(e);
-        free(variance);
-        free(dir);
-        free(deferred);
-        free(mask);
-        lmb_texels_free(&band);
+            st = lmb_direct_compute_bands(jobs, bands, irradiance, n, &counters[0], &counters[1], err);
+        for (uint32_t k = 0; k < n && st == LMB_OK; k++)
+            st = put_band(&bands[k], light[k].e, light[k].variance, light[k].dir, light[k].deferred, light[k].mask, out,
+                          err);
+        for (uint32_t k = 0; k < n; k++) {
+            band_light_free(&light[k]);
+            memset(&light[k], 0, sizeof light[k]);
+            lmb_texels_free(&bands[k]);
+        }
+        uint64_t rows_done = (g + n) * c->rows < c->height ? (g + n) * c->rows : c->height;
+        if (st == LMB_OK && c->progress)
+            c->progress(c->progress_user, "direct", rows_done * c->width, (uint64_t)c->height * c->width);
     }
+    free(bands);
+    free(light);
+    free(jobs);
+    free(irradiance);
     return st;
 }
 
@@ -221,7 +290,7 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
                                  void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
-    band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user, 0, 0,
+    band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user,
                   {NULL, NULL}};
     c.rows = c.width ? (LMB_DIRECT_BAND_TEXELS + c.width - 1) / c.width : c.height;
     if (!c.rows)
@@ -243,7 +312,8 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
                        compute_bands, &c};
     uint64_t counters[LMB_STEP_COUNTERS];
     bands_taken taken = {out, &c, 0};
-    st = lmb_steps_run_streamed(steps, &d, 1, take_bands, &taken, counters, err);
+    /* a group of bands at a time (compute_bands): the bytes of one group are held at once */
+    st = lmb_steps_run_streamed(steps, &d, lmb_direct_group_bands(cfg), take_bands, &taken, counters, err);
     *rays += counters[0];
     out->rays = counters[0];
     if (st == LMB_OK && taken.bands != bands)

@@ -135,35 +135,73 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
     *rays += r;
 }
 
-lmb_status lmb_direct_compute(const lmb_direct_job *job, lmb_texels *t, float *irradiance, uint64_t *rays,
-                              uint64_t *samples, lmb_error *err)
+/* Refinement items first by their rounds, most first (longest-processing-time order: the
+ * texels with thousands of rays start early and do not end the loop alone), then in list order. */
+static int by_rounds(const void *a, const void *b)
 {
-    const uint32_t block = 1024;
-    uint64_t total = 0;
-    int threads = lmb_direct_config(job->direct)->threads ? (int)lmb_direct_config(job->direct)->threads : omp_get_max_threads();
-    int failed = 0;
-    for (uint32_t start = 0; start < t->count && !failed; start += block) {
-        uint32_t end = start + block < t->count ? start + block : t->count;
-        uint64_t block_rays = 0, block_samples = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : block_rays, block_samples, failed)
-        {
-            lmb_rt_thread_init();
-            point_sum *ps = malloc(((size_t)t->samples + 1) * sizeof *ps);
-            failed += !ps;
-#pragma omp for schedule(dynamic, 16)
-            for (uint32_t i = start; i < end; i++)
-                if (ps && (!job->rounds || job->rounds[i]))
-                    texel_direct(job, t, i, job->rounds ? 2 : 0, job->rounds ? job->rounds[i] : 2, irradiance,
-                                 &block_rays, ps, &block_samples);
-            free(ps);
-        }
-        total += block_rays;
-        *samples += block_samples;
-        if (job->progress)
-            job->progress(job->progress_user, "direct", end, t->count);
+    const uint64_t *x = a, *y = b;
+    uint32_t rx = (uint32_t)(x[1] >> 32), ry = (uint32_t)(y[1] >> 32);
+    if (rx != ry)
+        return rx < ry ? 1 : -1;
+    return x[0] < y[0] ? -1 : x[0] > y[0];
+}
+
+lmb_status lmb_direct_compute_bands(const lmb_direct_job *jobs, lmb_texels *t, float *const *irradiance, uint32_t bands,
+                                    uint64_t *rays, uint64_t *samples, lmb_error *err)
+{
+    if (!bands)
+        return LMB_OK;
+    const lmb_config *cfg = lmb_direct_config(jobs[0].direct);
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    int refine = jobs[0].rounds != NULL;
+    /* the work: (band << 32 | texel), with the refinement's rounds beside it for the order */
+    uint64_t n = 0;
+    uint32_t most_samples = 1;
+    for (uint32_t b = 0; b < bands; b++) {
+        most_samples = t[b].samples > most_samples ? t[b].samples : most_samples;
+        for (uint32_t i = 0; i < t[b].count; i++)
+            n += !refine || jobs[b].rounds[i];
     }
-    *rays += total;
+    uint64_t *items = malloc((2 * n + 1) * sizeof *items);
+    if (!items)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory for %llu texels", (unsigned long long)n);
+    n = 0;
+    for (uint32_t b = 0; b < bands; b++)
+        for (uint32_t i = 0; i < t[b].count; i++)
+            if (!refine || jobs[b].rounds[i]) {
+                items[2 * n] = (uint64_t)b << 32 | i;
+                items[2 * n + 1] = (uint64_t)(refine ? jobs[b].rounds[i] : 0) << 32;
+                n++;
+            }
+    if (refine)
+        qsort(items, n, 2 * sizeof *items, by_rounds);
+    uint64_t total_rays = 0, total_samples = 0;
+    int failed = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : total_rays, total_samples, failed)
+    {
+        lmb_rt_thread_init();
+        point_sum *ps = malloc(((size_t)most_samples + 1) * sizeof *ps);
+        failed += !ps;
+        /* the direct step's texels cost alike and neighbours share cache lines: chunks of 16
+         * in atlas order; the refinement's differ a thousandfold: one at a time, longest first */
+#pragma omp for schedule(dynamic, 16)
+        for (uint64_t k = 0; k < (refine ? 0 : n); k++) {
+            uint32_t b = (uint32_t)(items[2 * k] >> 32), i = (uint32_t)items[2 * k];
+            if (ps)
+                texel_direct(&jobs[b], &t[b], i, 0, 2, irradiance[b], &total_rays, ps, &total_samples);
+        }
+#pragma omp for schedule(dynamic, 1)
+        for (uint64_t k = 0; k < (refine ? n : 0); k++) {
+            uint32_t b = (uint32_t)(items[2 * k] >> 32), i = (uint32_t)items[2 * k];
+            if (ps)
+                texel_direct(&jobs[b], &t[b], i, 2, jobs[b].rounds[i], irradiance[b], &total_rays, ps, &total_samples);
+        }
+        free(ps);
+    }
+    free(items);
+    *rays += total_rays;
+    *samples += total_samples;
     if (failed)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory for %u points per texel", t->samples);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory for %u points per texel", most_samples);
     return LMB_OK;
 }

@@ -2,6 +2,8 @@
  * so the result does not depend on visiting order. */
 #include "dilate.h"
 
+#include <omp.h>
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -11,38 +13,51 @@ static int fillable(const uint8_t *kind, size_t i, uint32_t ring)
     return kind[i] == LMB_TEXEL_EMPTY || ring <= LMB_DILATE_INSIDE_RINGS;
 }
 
-lmb_status lmb_dilate(float *rgb, const uint8_t *kind, uint32_t w, uint32_t h, lmb_error *err)
+/* Is some neighbour of texel i (8-connected) filled? */
+static int near_filled(const uint8_t *state, uint32_t w, uint32_t h, size_t i)
+{
+    uint32_t x = (uint32_t)(i % w), y = (uint32_t)(i / w);
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            long xx = (long)x + dx, yy = (long)y + dy;
+            if (xx >= 0 && yy >= 0 && xx < (long)w && yy < (long)h && state[(size_t)yy * w + (size_t)xx] == 1)
+                return 1;
+        }
+    return 0;
+}
+
+lmb_status lmb_dilate(float *rgb, const uint8_t *kind, uint32_t w, uint32_t h, int threads, lmb_error *err)
 {
     size_t n = (size_t)w * h;
+    threads = threads > 0 ? threads : omp_get_max_threads();
     uint32_t *ring = malloc((n + 1) * sizeof *ring), *next = malloc((n + 1) * sizeof *next);
     uint8_t *state = malloc(n + 1); /* 0 empty, 1 filled, 2 queued for this ring */
-    if (!ring || !next || !state) {
+    uint8_t *first = malloc(n + 1);
+    if (!ring || !next || !state || !first) {
         free(ring);
         free(next);
         free(state);
+        free(first);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "dilate: out of memory for %ux%u", w, h);
     }
     size_t nr = 0;
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (size_t i = 0; i < n; i++)
         state[i] = kind[i] == LMB_TEXEL_VALID ? 1 : 0;
-    /* first ring: empty texels next to a filled one */
-    for (size_t i = 0; i < n; i++) {
-        if (state[i])
-            continue;
-        uint32_t x = (uint32_t)(i % w), y = (uint32_t)(i / w);
-        int near = 0;
-        for (int dy = -1; dy <= 1 && !near; dy++)
-            for (int dx = -1; dx <= 1 && !near; dx++) {
-                long xx = (long)x + dx, yy = (long)y + dy;
-                near = xx >= 0 && yy >= 0 && xx < (long)w && yy < (long)h && state[(size_t)yy * w + (size_t)xx] == 1;
-            }
-        if (near && fillable(kind, i, 1)) {
+    /* first ring: empty texels next to a filled one (found in parallel, listed in texel order) */
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (size_t i = 0; i < n; i++)
+        first[i] = !state[i] && fillable(kind, i, 1) && near_filled(state, w, h, i);
+    for (size_t i = 0; i < n; i++)
+        if (first[i]) {
             ring[nr++] = (uint32_t)i;
             state[i] = 2;
         }
-    }
+    free(first);
     for (uint32_t ring_no = 1; nr; ring_no++) {
-        /* average filled neighbours into each ring texel */
+        /* average filled neighbours into each ring texel: each reads filled texels only and
+         * writes itself, so the ring's texels go in parallel in any order */
+#pragma omp parallel for num_threads(threads) schedule(static) if (nr > 4096)
         for (size_t r = 0; r < nr; r++) {
             uint32_t i = ring[r], x = i % w, y = i / w, cnt = 0;
             float s[3] = {0, 0, 0};
@@ -61,7 +76,8 @@ lmb_status lmb_dilate(float *rgb, const uint8_t *kind, uint32_t w, uint32_t h, l
             for (int c = 0; c < 3; c++)
                 rgb[3 * (size_t)i + c] = cnt ? s[c] / (float)cnt : 0.0f;
         }
-        /* mark the ring filled, then collect the next one */
+        /* mark the ring filled, then collect the next one (the list's order does not change
+         * the result: a ring's texels read only earlier rings) */
         for (size_t r = 0; r < nr; r++)
             state[ring[r]] = 1;
         size_t nn = 0;

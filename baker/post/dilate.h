@@ -14,7 +14,8 @@
 enum { LMB_TEXEL_EMPTY = 0, LMB_TEXEL_VALID = 1, LMB_TEXEL_INSIDE = 2 };
 #define LMB_DILATE_INSIDE_RINGS 2
 
-/* rgb: width*height*3 floats, modified in place; state: width*height LMB_TEXEL_* values. */
-lmb_status lmb_dilate(float *rgb, const uint8_t *state, uint32_t width, uint32_t height, lmb_error *err);
+/* rgb: width*height*3 floats, modified in place; state: width*height LMB_TEXEL_* values.
+ * threads: 0 for all cores; the result does not depend on it. */
+lmb_status lmb_dilate(float *rgb, const uint8_t *state, uint32_t width, uint32_t height, int threads, lmb_error *err);
 
 #endif

@@ -3,6 +3,8 @@
 
 #include "dilate.h"
 
+#include <omp.h>
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,47 +44,69 @@ static float window_median(const float *lum, const uint8_t *state, uint32_t w, u
     return n % 2 ? v[n / 2] : 0.5f * (v[n / 2 - 1] + v[n / 2]);
 }
 
-lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, uint32_t h, lmb_firefly_stats *stats,
-                                lmb_error *err)
+/* The part of texel i's light it keeps when it is a lone spike (0 < keep < 1), with its m valid
+ * neighbours in nb; 1 when it is no spike. Reads only lum and state: any texel, any order. */
+static float spike_keep(const float *lum, const uint8_t *state, uint32_t w, uint32_t h, size_t i, size_t nb[8], int *m)
+{
+    *m = 0;
+    if (state[i] != LMB_TEXEL_VALID || !(lum[i] > 0))
+        return 1.0f;
+    long x = (long)(i % w), y = (long)(i / w);
+    float median = window_median(lum, state, w, h, x, y);
+    if (median < 0 || lum[i] <= LMB_FIREFLY_FACTOR * median)
+        return 1.0f;
+    float brightest = 0;
+    for (long dy = -1; dy <= 1; dy++)
+        for (long dx = -1; dx <= 1; dx++) {
+            long xx = x + dx, yy = y + dy;
+            if ((dx || dy) && xx >= 0 && yy >= 0 && xx < (long)w && yy < (long)h &&
+                state[(size_t)yy * w + (size_t)xx] == LMB_TEXEL_VALID) {
+                nb[*m] = (size_t)yy * w + (size_t)xx;
+                brightest = lum[nb[*m]] > brightest ? lum[nb[*m]] : brightest;
+                (*m)++;
+            }
+        }
+    /* a lone spike: a line of light one texel wide (light through a slit) has neighbours as
+     * bright along it, a lit area beside a shadow has lit neighbours: neither is touched */
+    if (!*m || lum[i] <= LMB_FIREFLY_LONE * brightest)
+        return 1.0f;
+    return (float)(LMB_FIREFLY_FACTOR * median / lum[i]);
+}
+
+lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, uint32_t h, int threads,
+                                lmb_firefly_stats *stats, lmb_error *err)
 {
     size_t n = (size_t)w * h;
     float *lum = malloc((n + 1) * sizeof *lum), *before = malloc((3 * n + 1) * sizeof *before);
-    if (!lum || !before) {
+    uint8_t *spike = malloc(n + 1);
+    if (!lum || !before || !spike) {
         free(lum);
         free(before);
+        free(spike);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "fireflies: out of memory for a %ux%u atlas", w, h);
     }
+    threads = threads > 0 ? threads : omp_get_max_threads();
     memcpy(before, rgb, 3 * n * sizeof *rgb);
-    for (size_t i = 0; i < n; i++) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (size_t i = 0; i < n; i++)
         lum[i] = luminance(before + 3 * i);
+    for (size_t i = 0; i < n; i++) /* in texel order: the same sum at any thread count */
         if (state[i] == LMB_TEXEL_VALID)
             stats->total += lum[i];
-    }
+    /* finding the spikes (a 5 x 5 median per texel) is the work: in parallel */
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4096)
     for (size_t i = 0; i < n; i++) {
-        if (state[i] != LMB_TEXEL_VALID || !(lum[i] > 0))
-            continue;
-        long x = (long)(i % w), y = (long)(i / w);
-        float median = window_median(lum, state, w, h, x, y);
-        if (median < 0 || lum[i] <= LMB_FIREFLY_FACTOR * median)
+        size_t nb[8];
+        int m;
+        spike[i] = spike_keep(lum, state, w, h, i, nb, &m) < 1.0f;
+    }
+    /* moving their light adds into shared neighbours: in texel order, as one thread would */
+    for (size_t i = 0; i < n; i++) {
+        if (!spike[i])
             continue;
         size_t nb[8];
-        int m = 0;
-        float brightest = 0;
-        for (long dy = -1; dy <= 1; dy++)
-            for (long dx = -1; dx <= 1; dx++) {
-                long xx = x + dx, yy = y + dy;
-                if ((dx || dy) && xx >= 0 && yy >= 0 && xx < (long)w && yy < (long)h &&
-                    state[(size_t)yy * w + (size_t)xx] == LMB_TEXEL_VALID) {
-                    nb[m] = (size_t)yy * w + (size_t)xx;
-                    brightest = lum[nb[m]] > brightest ? lum[nb[m]] : brightest;
-                    m++;
-                }
-            }
-        /* a lone spike: a line of light one texel wide (light through a slit) has neighbours as
-         * bright along it, a lit area beside a shadow has lit neighbours: neither is touched */
-        if (!m || lum[i] <= LMB_FIREFLY_LONE * brightest)
-            continue;
-        float keep = (float)(LMB_FIREFLY_FACTOR * median / lum[i]);
+        int m;
+        float keep = spike_keep(lum, state, w, h, i, nb, &m);
         for (int c = 0; c < 3; c++) {
             float moved = before[3 * i + c] * (1.0f - keep);
             rgb[3 * i + c] -= moved;
@@ -94,5 +118,6 @@ lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t w, ui
     }
     free(lum);
     free(before);
+    free(spike);
     return LMB_OK;
 }

@@ -24,8 +24,10 @@ typedef struct lmb_firefly_stats {
     double total;     /* luminance of every valid texel, summed */
 } lmb_firefly_stats;
 
-/* rgb: width x height x 3 floats, changed in place; state: LMB_TEXEL_* per texel. Adds to *stats. */
-lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t width, uint32_t height,
+/* rgb: width x height x 3 floats, changed in place; state: LMB_TEXEL_* per texel. Adds to *stats.
+ * threads: 0 for all cores; the result does not depend on it (spikes are found in parallel, their
+ * light moved in texel order). */
+lmb_status lmb_fireflies_spread(float *rgb, const uint8_t *state, uint32_t width, uint32_t height, int threads,
                                 lmb_firefly_stats *stats, lmb_error *err);
 
 #endif

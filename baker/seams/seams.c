@@ -7,6 +7,8 @@
 #include "util/lmb_math.h"
 #include "util/spd_solve.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -99,21 +101,73 @@ static double snap_size(const lmb_layout *l)
     return d > 0 ? 1e-3 / d : 1e-6;
 }
 
-static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double snap, edge_ref **out, size_t *count,
-                                lmb_error *err)
+/* Sorts e[0..n) by edge_ref_order with `threads` threads: runs sorted at once, then merged
+ * pairwise (in parallel). edge_ref_order is a total order (no two refs are equal), so the
+ * result is the one order whatever the threads. tmp: room for n refs. */
+static void sort_edges(edge_ref *e, edge_ref *tmp, size_t n, int threads)
 {
+    size_t runs = (size_t)threads * 2, run = (n + runs - 1) / (runs ? runs : 1);
+    if (n < 65536 || threads < 2 || !run) {
+        qsort(e, n, sizeof *e, edge_ref_order);
+        return;
+    }
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (size_t r = 0; r < runs; r++) {
+        size_t lo = r * run < n ? r * run : n, hi = lo + run < n ? lo + run : n;
+        qsort(e + lo, hi - lo, sizeof *e, edge_ref_order);
+    }
+    edge_ref *src = e, *dst = tmp;
+    for (size_t width = run; width < n; width *= 2) {
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+        for (size_t lo = 0; lo < n; lo += 2 * width) {
+            size_t mid = lo + width < n ? lo + width : n, hi = lo + 2 * width < n ? lo + 2 * width : n;
+            size_t i = lo, j = mid, k = lo;
+            while (i < mid && j < hi)
+                dst[k++] = edge_ref_order(&src[i], &src[j]) < 0 ? src[i++] : src[j++];
+            while (i < mid)
+                dst[k++] = src[i++];
+            while (j < hi)
+                dst[k++] = src[j++];
+        }
+        edge_ref *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != e)
+        memcpy(e, src, n * sizeof *e);
+}
+
+/* Every lightmapped triangle's three edges, sorted by hash; in parallel over instances (each
+ * writes its own range, found by a prefix sum of their triangles). */
+static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double snap, int threads, edge_ref **out,
+                                size_t *count, lmb_error *err)
+{
+    size_t *first = malloc(((size_t)l->instance_count + 1) * sizeof *first);
+    if (!first)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %u instances", l->instance_count);
     size_t n = 0;
-    for (uint32_t i = 0; i < l->instance_count; i++)
-        if (l->instances[i].lightmapped)
-            n += 3 * (size_t)l->meshes[s->instances[i].mesh].soup.triangle_count;
-    edge_ref *e = malloc((n + 1) * sizeof *e);
-    if (!e)
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        first[i] = n;
+        if (!l->instances[i].lightmapped)
+            continue;
+        const lmb_mesh_soup *soup = &l->meshes[s->instances[i].mesh].soup;
+        for (uint32_t f = 0; f < soup->triangle_count; f++)
+            n += soup->skip[f] ? 0 : 3;
+    }
+    first[l->instance_count] = n;
+    edge_ref *e = malloc((n + 1) * sizeof *e), *tmp = malloc((n + 1) * sizeof *tmp);
+    if (!e || !tmp) {
+        free(first);
+        free(e);
+        free(tmp);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu edges", n);
-    size_t m = 0;
+    }
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (uint32_t i = 0; i < l->instance_count; i++) {
         if (!l->instances[i].lightmapped)
             continue;
         const lmb_mesh_soup *soup = &l->meshes[s->instances[i].mesh].soup;
+        size_t m = first[i];
         for (uint32_t f = 0; f < soup->triangle_count; f++) {
             if (soup->skip[f])
                 continue;
@@ -125,9 +179,11 @@ static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double 
             }
         }
     }
-    qsort(e, m, sizeof *e, edge_ref_order);
+    sort_edges(e, tmp, n, threads);
+    free(tmp);
+    free(first);
     *out = e;
-    *count = m;
+    *count = n;
     return LMB_OK;
 }
 
@@ -349,40 +405,104 @@ static int open_across(const lmb_rt *rt, const seam_side sides[2], double t)
     return 1;
 }
 
-/* Every seam point seen from both sides, in a deterministic order (the sorted edges). rows may
- * be NULL to count. */
-static size_t seam_rows(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, const uint8_t *const *state,
-                        double snap, const edge_ref *e, size_t ne, seam_row *rows, uint64_t *edges)
+/* The points of the seam whose two edge refs are e[0] and e[1] (rows may be NULL to count);
+ * 0 when they are no seam (a hash collision, or is_seam says no). *is_edge: they are one edge. */
+static uint32_t edge_rows(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, const uint8_t *const *state,
+                          double snap, const edge_ref *e, seam_row *rows, int *is_edge)
 {
-    size_t m = 0;
+    int64_t ka[6], kb[6];
+    int sa, sb;
+    seam_side sides[2];
+    *is_edge = 0;
+    edge_key(s, l, e[0].instance, e[0].triangle, e[0].corner, snap, ka, &sa);
+    edge_key(s, l, e[1].instance, e[1].triangle, e[1].corner, snap, kb, &sb);
+    if (memcmp(ka, kb, sizeof ka) || !is_seam(s, l, &e[0], &e[1], sides))
+        return 0;
+    *is_edge = 1;
+    uint32_t n = seam_points(sides), m = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        seam_row r;
+        row_at(l, sides, (k + 0.5) / n, &r);
+        if (!seen_from_both_sides(state, &r) || !open_across(rt, sides, (k + 0.5) / n))
+            continue;
+        if (rows)
+            rows[m] = r;
+        m++;
+    }
+    return m;
+}
+
+/* Every seam point seen from both sides, in a deterministic order (the sorted edges): the
+ * pairs (hashes held by exactly two refs) are found, their points counted in parallel, placed
+ * by a prefix sum and computed again into *rows in parallel. */
+static lmb_status seam_rows(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, const uint8_t *const *state,
+                            double snap, const edge_ref *e, size_t ne, int threads, seam_row **rows, size_t *nr,
+                            uint64_t *edges, lmb_error *err)
+{
+    *rows = NULL;
+    *nr = 0;
     *edges = 0;
+    size_t pairs = 0;
     for (size_t i = 0; i < ne;) {
         size_t j = i + 1;
         while (j < ne && e[j].hash == e[i].hash)
             j++;
-        if (j - i == 2) { /* two triangles share it: check it really is one edge (not a hash collision) */
-            int64_t ka[6], kb[6];
-            int sa, sb;
-            seam_side sides[2];
-            edge_key(s, l, e[i].instance, e[i].triangle, e[i].corner, snap, ka, &sa);
-            edge_key(s, l, e[i + 1].instance, e[i + 1].triangle, e[i + 1].corner, snap, kb, &sb);
-            if (!memcmp(ka, kb, sizeof ka) && is_seam(s, l, &e[i], &e[i + 1], sides)) {
-                uint32_t n = seam_points(sides);
-                for (uint32_t k = 0; k < n; k++) {
-                    seam_row r;
-                    row_at(l, sides, (k + 0.5) / n, &r);
-                    if (!seen_from_both_sides(state, &r) || !open_across(rt, sides, (k + 0.5) / n))
-                        continue;
-                    if (rows)
-                        rows[m] = r;
-                    m++;
-                }
-                (*edges)++;
-            }
-        }
+        pairs += j - i == 2;
         i = j;
     }
-    return m;
+    size_t *pair = malloc((pairs + 1) * sizeof *pair), *first = malloc((pairs + 1) * sizeof *first);
+    if (!pair || !first) {
+        free(pair);
+        free(first);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu edges", pairs);
+    }
+    pairs = 0;
+    for (size_t i = 0; i < ne;) {
+        size_t j = i + 1;
+        while (j < ne && e[j].hash == e[i].hash)
+            j++;
+        if (j - i == 2)
+            pair[pairs++] = i;
+        i = j;
+    }
+    uint64_t found = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : found)
+    {
+        lmb_rt_thread_init();
+#pragma omp for schedule(dynamic, 256)
+        for (size_t p = 0; p < pairs; p++) {
+            int is_edge;
+            first[p] = edge_rows(s, l, rt, state, snap, &e[pair[p]], NULL, &is_edge);
+            found += (uint64_t)is_edge;
+        }
+    }
+    size_t m = 0;
+    for (size_t p = 0; p < pairs; p++) {
+        size_t k = first[p];
+        first[p] = m;
+        m += k;
+    }
+    lmb_status st = LMB_OK;
+    seam_row *r = m ? malloc(m * sizeof *r) : NULL;
+    if (m && !r)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu seam points", m);
+    if (r) {
+#pragma omp parallel num_threads(threads)
+        {
+            lmb_rt_thread_init();
+#pragma omp for schedule(dynamic, 256)
+            for (size_t p = 0; p < pairs; p++) {
+                int is_edge;
+                edge_rows(s, l, rt, state, snap, &e[pair[p]], r + first[p], &is_edge);
+            }
+        }
+    }
+    free(pair);
+    free(first);
+    *rows = r;
+    *nr = st == LMB_OK ? m : 0;
+    *edges = found;
+    return st;
 }
 
 /* The normal equations (upper triangle) over the active rows, solved into out (3 columns of
@@ -487,21 +607,22 @@ static lmb_status stitch(solve_ctx *c, const seam_row *rows, size_t nr, lmb_seam
 }
 
 lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, float *const *rgb,
-                            const uint8_t *const *state, lmb_seam_report *report, lmb_error *err)
+                            const uint8_t *const *state, int threads, lmb_seam_report *report, lmb_error *err)
 {
     double t0 = lmb_seconds();
     memset(report, 0, sizeof *report);
+    threads = threads > 0 ? threads : omp_get_max_threads();
     double snap = snap_size(l);
     edge_ref *e = NULL;
-    size_t ne = 0;
-    lmb_status st = collect_edges(s, l, snap, &e, &ne, err);
+    size_t ne = 0, nr = 0;
+    seam_row *rows = NULL;
+    lmb_status st = collect_edges(s, l, snap, threads, &e, &ne, err);
     if (st != LMB_OK)
         return st;
     lmb_rt_thread_init();
-    size_t nr = seam_rows(s, l, rt, state, snap, e, ne, NULL, &report->edges);
-    seam_row *rows = nr ? malloc(nr * sizeof *rows) : NULL;
+    st = seam_rows(s, l, rt, state, snap, e, ne, threads, &rows, &nr, &report->edges, err);
     solve_ctx c = {l, rgb, state, calloc((size_t)l->atlas_count + 1, sizeof *c.unknown), NULL, NULL, 0, 0};
-    if ((nr && !rows) || !c.unknown)
+    if (st == LMB_OK && !c.unknown)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu seam points", nr);
     for (uint32_t a = 0; st == LMB_OK && nr && a < l->atlas_count; a++) {
         size_t texels = (size_t)l->width[a] * l->height[a];
@@ -511,10 +632,8 @@ lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_r
         else
             memset(c.unknown[a], 0xff, texels * sizeof *c.unknown[a]);
     }
-    if (st == LMB_OK && nr) {
-        seam_rows(s, l, rt, state, snap, e, ne, rows, &report->edges);
+    if (st == LMB_OK && nr)
         st = stitch(&c, rows, nr, report, err);
-    }
     for (uint32_t a = 0; c.unknown && a < l->atlas_count; a++)
         free(c.unknown[a]);
     free(c.unknown);

@@ -46,8 +46,9 @@ typedef struct lmb_seam_report {
 } lmb_seam_report;
 
 /* Stitches the atlases in place. rgb[a]: 3 floats per texel of atlas a (dilated: padding
- * holds values); state[a]: LMB_TEXEL_* per texel. */
+ * holds values); state[a]: LMB_TEXEL_* per texel. The edges are found and their points placed
+ * on `threads` threads (0: all cores); the result does not depend on it. */
 lmb_status lmb_seams_stitch(const lmb_scene *scene, const lmb_layout *l, const lmb_rt *rt, float *const *rgb,
-                            const uint8_t *const *state, lmb_seam_report *report, lmb_error *err);
+                            const uint8_t *const *state, int threads, lmb_seam_report *report, lmb_error *err);
 
 #endif

@@ -1,7 +1,8 @@
 /*
  * The lightmap images of one atlas (see atlas_images.h): EXR (the accurate one), Radiance
  * .hdr, a tonemapped PNG preview and, when asked, KTX2, RGBM and the texel mask; every file
- * but the mask holds what output.scale says.
+ * but the mask holds what output.scale says. The files of an atlas are encoded at once, a file
+ * per thread.
  */
 #include "atlas_images.h"
 
@@ -11,15 +12,49 @@
 #include "post/dilate.h"
 #include "util/lmb_math.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* The k-th smallest of v[0..n) (v is reordered): Hoare's selection, O(n) expected. */
+static float select_kth(float *v, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        float a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi];
+        float pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
+        size_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot)
+                i++;
+            while (v[j] > pivot)
+                j--;
+            if (i <= j) {
+                float t = v[i];
+                v[i++] = v[j];
+                v[j] = t;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return v[k];
+    }
+    return v[k];
+}
+
 /* Tonemapped 8-bit preview of irradiance: exposure maps the 95th percentile of the valid
  * texels' luminance to 0.8 before Reinhard x/(1+x) and the sRGB curve. For a quick look
  * only; the EXR is the lightmap. */
-static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t h, uint8_t *out)
+static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t h, int threads, uint8_t *out)
 {
     size_t n = (size_t)w * h, m = 0;
     float *lum = malloc((n + 1) * sizeof *lum);
@@ -29,24 +64,59 @@ static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t
             if (valid[i] == LMB_TEXEL_VALID)
                 lum[m++] = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
         if (m) {
-            /* 95th percentile by partial selection would be faster; a sort is fine at atlas sizes */
-            for (size_t gap = m / 2; gap > 0; gap /= 2)
-                for (size_t i = gap; i < m; i++)
-                    for (size_t j = i; j >= gap && lum[j - gap] > lum[j]; j -= gap) {
-                        float t = lum[j];
-                        lum[j] = lum[j - gap];
-                        lum[j - gap] = t;
-                    }
-            double p95 = lum[(size_t)(0.95 * (double)(m - 1))];
+            double p95 = select_kth(lum, m, (size_t)(0.95 * (double)(m - 1)));
             scale = p95 > 0 ? 0.8 / p95 : 1.0;
         }
         free(lum);
     }
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (size_t i = 0; i < 3 * n; i++) {
         double x = rgb[i] * scale, y = x / (1.0 + x);
         y = y <= 0.0031308 ? 12.92 * y : 1.055 * pow(y, 1 / 2.4) - 0.055;
         out[i] = (uint8_t)(y <= 0 ? 0 : y >= 1 ? 255 : lround(y * 255.0));
     }
+}
+
+/* One file to write: float or 8-bit pixels through OpenImageIO, or float pixels as KTX2. */
+typedef enum image_kind { IMAGE_F32, IMAGE_U8, IMAGE_KTX2 } image_kind;
+
+typedef struct image_job {
+    image_kind kind;
+    char path[8600];
+    uint32_t channels;
+    const float *f32;
+    const uint8_t *u8;
+    lmb_ktx2_format ktx2_format;
+    int zstd_level;
+} image_job;
+
+/* Writes the files of jobs[0..n) at once, a file per thread (each encoder runs on one thread,
+ * and the files do not depend on each other); the error is the first job's that failed. */
+static lmb_status write_images(const image_job *jobs, int n, uint32_t w, uint32_t h, int threads, lmb_error *err)
+{
+    lmb_error errs[16];
+    lmb_status sts[16];
+    if (n > 16)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: %d files at once", n);
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int k = 0; k < n; k++) {
+        const image_job *j = &jobs[k];
+        errs[k] = (lmb_error){LMB_OK, ""};
+        sts[k] = j->kind == IMAGE_F32  ? lmb_image_write_f32(j->path, w, h, j->channels, j->f32, &errs[k])
+                 : j->kind == IMAGE_U8 ? lmb_image_write_u8(j->path, w, h, j->channels, j->u8, &errs[k])
+                                       : lmb_ktx2_write(j->path, w, h, j->f32, j->ktx2_format, j->zstd_level, &errs[k]);
+    }
+    for (int k = 0; k < n; k++)
+        if (sts[k] != LMB_OK) {
+            *err = errs[k];
+            return sts[k];
+        }
+    return LMB_OK;
+}
+
+static int image_threads(const lmb_config *cfg)
+{
+    return cfg->threads ? (int)cfg->threads : omp_get_max_threads();
 }
 
 /* The lightmap as output.scale says: E, or E / pi (NULL when out of memory). */
@@ -59,96 +129,90 @@ static float *scaled_copy(const lmb_config *cfg, const float *rgb, size_t texels
     return out;
 }
 
-static lmb_status write_rgbm(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a, const float *rgb,
-                             const uint8_t *valid, uint32_t w, uint32_t h, lmb_atlas_output *info, lmb_error *err)
-{
-    size_t n = (size_t)w * h;
-    uint8_t *px = malloc(4 * n + 1);
-    if (!px)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "rgbm: out of memory");
-    info->rgbm_range = lmb_rgbm_range(cfg->rgbm_range, rgb, valid, n);
-    info->rgbm_clamped = lmb_rgbm_encode(rgb, valid, n, info->rgbm_range, px);
-    char path[8600];
-    snprintf(path, sizeof path, "%s/%s-lightmap-%u-rgbm.png", dir, stem, a);
-    lmb_status st = lmb_image_write_u8(path, w, h, 4, px, err);
-    free(px);
-    return st;
-}
-
 lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
                                   const float *irradiance, const uint8_t *valid, uint32_t w, uint32_t h,
                                   lmb_atlas_output *info, lmb_error *err)
 {
-    char path[8600];
     memset(info, 0, sizeof *info);
-    float *rgb = scaled_copy(cfg, irradiance, (size_t)w * h);
-    if (!rgb)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
+    size_t n = (size_t)w * h;
+    int threads = image_threads(cfg);
+    float *rgb = scaled_copy(cfg, irradiance, n);
+    uint8_t *png = malloc(3 * n + 1), *rgbm = NULL, *mask = NULL;
+    if ((cfg->output_formats & LMB_OUTPUT_RGBM))
+        rgbm = malloc(4 * n + 1);
+    if ((cfg->output_formats & LMB_OUTPUT_MASK))
+        mask = malloc(n + 1);
+    image_job *jobs = calloc(6, sizeof *jobs);
     lmb_status st = LMB_OK;
-    if (cfg->output_formats & LMB_OUTPUT_EXR) {
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u.exr", dir, stem, a);
-        st = lmb_image_write_f32(path, w, h, 3, rgb, err);
+    if (!rgb || !png || !jobs || ((cfg->output_formats & LMB_OUTPUT_RGBM) && !rgbm) ||
+        ((cfg->output_formats & LMB_OUTPUT_MASK) && !mask))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
+    int count = 0;
+    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_EXR)) {
+        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, 0, 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.exr", dir, stem, a);
     }
-    /* the glTF references the .hdr and .png: write them whatever the formats say */
+    /* the glTF references the .hdr and .png: written whatever the formats say */
     if (st == LMB_OK) {
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
-        st = lmb_image_write_f32(path, w, h, 3, rgb, err);
-    }
-    if (st == LMB_OK) {
-        uint8_t *png = malloc((size_t)w * h * 3 + 1);
-        if (!png)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "png: out of memory");
-        if (png) {
-            tonemap(rgb, valid, w, h, png);
-            snprintf(path, sizeof path, "%s/%s-lightmap-%u.png", dir, stem, a);
-            st = lmb_image_write_u8(path, w, h, 3, png, err);
-        }
-        free(png);
+        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, 0, 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
+        tonemap(rgb, valid, w, h, threads, png);
+        jobs[count] = (image_job){IMAGE_U8, "", 3, NULL, png, 0, 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.png", dir, stem, a);
     }
     if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_KTX2)) {
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u.ktx2", dir, stem, a);
-        st = lmb_ktx2_write(path, w, h, rgb, (lmb_ktx2_format)cfg->ktx2_format, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0,
-                            err);
+        jobs[count] = (image_job){IMAGE_KTX2, "", 3, rgb, NULL, (lmb_ktx2_format)cfg->ktx2_format,
+                                  cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.ktx2", dir, stem, a);
     }
-    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_RGBM))
-        st = write_rgbm(cfg, dir, stem, a, rgb, valid, w, h, info, err);
-    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_MASK)) {
-        uint8_t *mask = malloc((size_t)w * h + 1);
-        if (!mask)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "mask: out of memory");
-        for (size_t i = 0; mask && i < (size_t)w * h; i++)
+    if (st == LMB_OK && rgbm) {
+        info->rgbm_range = lmb_rgbm_range(cfg->rgbm_range, rgb, valid, n);
+        info->rgbm_clamped = lmb_rgbm_encode(rgb, valid, n, info->rgbm_range, rgbm);
+        jobs[count] = (image_job){IMAGE_U8, "", 4, NULL, rgbm, 0, 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-rgbm.png", dir, stem, a);
+    }
+    if (st == LMB_OK && mask) {
+        for (size_t i = 0; i < n; i++)
             mask[i] = valid[i] == LMB_TEXEL_VALID ? 255 : valid[i] == LMB_TEXEL_INSIDE ? 128 : 0;
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u-mask.png", dir, stem, a);
-        if (mask)
-            st = lmb_image_write_u8(path, w, h, 1, mask, err);
-        free(mask);
+        jobs[count] = (image_job){IMAGE_U8, "", 1, NULL, mask, 0, 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-mask.png", dir, stem, a);
     }
+    if (st == LMB_OK)
+        st = write_images(jobs, count, w, h, threads, err);
+    free(jobs);
     free(rgb);
+    free(png);
+    free(rgbm);
+    free(mask);
     return st;
 }
 
 lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
                                       const float *d, uint32_t w, uint32_t h, lmb_error *err)
 {
-    char path[8600];
-    snprintf(path, sizeof path, "%s/%s-lightmap-%u-dir.exr", dir, stem, a);
-    lmb_status st = lmb_image_write_f32(path, w, h, 3, d, err);
-    if (st != LMB_OK)
-        return st;
     uint8_t *png = malloc((size_t)w * h * 3 + 1);
-    if (!png)
+    image_job *jobs = calloc(3, sizeof *jobs);
+    if (!png || !jobs) {
+        free(png);
+        free(jobs);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "png: out of memory");
+    }
     for (size_t i = 0; i < (size_t)w * h * 3; i++) { /* (D + 1) / 2, linear: a data texture, not a colour */
         double v = 0.5 * ((double)d[i] + 1.0);
         png[i] = (uint8_t)(v <= 0 ? 0 : v >= 1 ? 255 : lround(v * 255.0));
     }
-    snprintf(path, sizeof path, "%s/%s-lightmap-%u-dir.png", dir, stem, a);
-    st = lmb_image_write_u8(path, w, h, 3, png, err);
-    free(png);
-    if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_KTX2)) { /* signed: half floats */
-        snprintf(path, sizeof path, "%s/%s-lightmap-%u-dir.ktx2", dir, stem, a);
-        st = lmb_ktx2_write(path, w, h, d, LMB_KTX2_RGBA16F, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0, err);
+    int count = 0;
+    jobs[count] = (image_job){IMAGE_F32, "", 3, d, NULL, 0, 0};
+    snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-dir.exr", dir, stem, a);
+    jobs[count] = (image_job){IMAGE_U8, "", 3, NULL, png, 0, 0};
+    snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-dir.png", dir, stem, a);
+    if (cfg->output_formats & LMB_OUTPUT_KTX2) { /* signed: half floats */
+        jobs[count] = (image_job){IMAGE_KTX2, "", 3, d, NULL, LMB_KTX2_RGBA16F, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0};
+        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-dir.ktx2", dir, stem, a);
     }
+    lmb_status st = write_images(jobs, count, w, h, image_threads(cfg), err);
+    free(jobs);
+    free(png);
     return st;
 }
 

@@ -1,17 +1,65 @@
 #!/usr/bin/env bash
-# Same input and seed, 1 thread and 2 threads: byte-identical EXR lightmaps and glTF.
-# usage: check_determinism.sh LMBAKE SCENE WORKDIR
+# Same input and seed at 1, 2, 3 and 7 threads: every output file byte-identical (EXR, HDR,
+# PNG, KTX2, RGBM, mask, shadowmask, directional maps, glTF, buffers, records), on two bakes
+# that between them run every stage:
+#   bevy's Cornell box under a sky: emissive ceiling and sky, the direct light's refinement,
+#     both denoiser passes, fireflies, directional maps;
+#   bevy's mixed-lighting scene under a sky: curved meshes (seams stitched), its sun an
+#     `indirect` light (deferred light and the shadowmask), textures.
+# The logs must show each stage, so that the test cannot pass with one silently off. 3 and 7
+# threads cut every loop unevenly on any machine.
+# usage: check_determinism.sh LMBAKE SCENES_DIR WORKDIR
 set -euo pipefail
-lmbake=$1 scene=$2 work=$3
-rm -rf "$work/t1" "$work/t2"
+lmbake=$1 scenes=$2 work=$3
+rm -rf "$work"
 mkdir -p "$work"
-printf 'samples: {texel: 4, direct: 16}\ntexel_density: 0.25\n' > "$work/det.yaml"
-"$lmbake" bake "$scene" -c "$work/det.yaml" -o "$work/t1" --threads 1 -q
-"$lmbake" bake "$scene" -c "$work/det.yaml" -o "$work/t2" --threads 2 -q
-n=0
-for f in "$work/t1"/*.exr "$work/t1"/*.gltf "$work/t1"/*.bin; do
-  cmp "$f" "$work/t2/$(basename "$f")"
-  n=$((n + 1))
-done
-echo "determinism: $n files byte-identical at 1 and 2 threads"
-[ "$n" -ge 3 ]
+cat > "$work/box.yaml" <<'EOF'
+atlas: {texels: 30000}
+sky: {intensity: 2}
+output: {formats: [exr, hdr, png, ktx2, rgbm, mask], directional: true}
+EOF
+cat > "$work/mixed.yaml" <<'EOF'
+atlas: {texels: 10000}
+samples: {gather: 64}
+sky: {intensity: 2}
+output: {formats: [exr, hdr, png, ktx2, rgbm, mask], directional: true, shadowmask: true}
+lights: {modes: [{match: "*", mode: indirect}]}
+EOF
+
+# bake NAME SCENE: NAME at 1, 2, 3 and 7 threads, then every file compared with 1 thread's
+bake() {
+  local name=$1 scene=$2 n=0
+  for t in 1 2 3 7; do
+    "$lmbake" bake "$scene" -c "$work/$name.yaml" -o "$work/$name-t$t" --threads "$t" > "$work/$name-t$t.log" 2>&1
+  done
+  for f in "$work/$name-t1"/*; do
+    for t in 2 3 7; do
+      cmp "$f" "$work/$name-t$t/$(basename "$f")"
+    done
+    n=$((n + 1))
+  done
+  for t in 2 3 7; do
+    [ "$(ls "$work/$name-t$t" | wc -l)" -eq "$n" ] || { echo "determinism: $name at $t threads wrote other files"; exit 1; }
+  done
+  echo "determinism: $name: $n files byte-identical at 1, 2, 3 and 7 threads"
+  [ "$n" -ge 12 ]
+}
+
+# ran LOG PATTERN...: each pattern is in the log
+ran() {
+  local log=$1
+  shift
+  for stage in "$@"; do
+    grep -q -e "$stage" "$log" || { echo "determinism: the bake did not run '$stage' (see $log)"; exit 1; }
+  done
+}
+
+bake box "$scenes/cornell-box-bevy/CornellBox.glb"
+ran "$work/box-t1.log" 'sky: uniform' ' 2 emissive triangles' 'took more samples' 'denoise: the final gather' \
+  'denoise: the light with its direct part' 'directions: done'
+if grep -q ' 0 of [0-9]* texels (0.0%) took more samples' "$work/box-t1.log"; then
+  echo "determinism: no texel was refined"
+  exit 1
+fi
+bake mixed "$scenes/mixed-lighting-bevy/MixedLightingExample.gltf"
+ran "$work/mixed-t1.log" 'sky: uniform' "light 'Sun': indirect, shadowmask channel R" 'seams: [1-9][0-9]* edges stitched'

@@ -67,7 +67,7 @@ static void test_constant_plane(void)
     lmb_error err;
     lmb_ic_records_init(&s, 0.3);
     floor_grid(&s, 0.1, 20, constant);
-    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, 0, &err) == LMB_OK);
     CHECK(lmb_ic_records_fit_gradients(&s, 1, &err) == LMB_OK);
     double n[3] = {0, 0, 1}, worst = 0;
     for (int k = 0; k < 400; k++) {
@@ -92,7 +92,7 @@ static void test_corner_and_facing_away(void)
         rec(0.5, 0.5, 0.1, 0, 0, 1, 7.0, 0.3),    /* a shelf 10 cm above, facing up */
     };
     CHECK(lmb_ic_records_append(&s, r, 4, &err) == LMB_OK);
-    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, 0, &err) == LMB_OK);
     double up[3] = {0, 0, 1};
     /* floor points near the corner: within the wall record's reach, never its value */
     for (int k = 0; k < 10; k++) {
@@ -112,7 +112,7 @@ static void test_gradients(void)
     lmb_error err;
     lmb_ic_records_init(&s, 0.3);
     floor_grid(&s, 0.1, 20, linear);
-    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, 0, &err) == LMB_OK);
     CHECK(lmb_ic_records_fit_gradients(&s, 2, &err) == LMB_OK);
     const lmb_ic_record *mid = &s.rec[10 * 20 + 10];
     CHECK_NEAR(mid->grad_t[0][0], 0.5, 0.005);
@@ -140,7 +140,7 @@ static void test_neighbour_clamp(void)
     a.r_max = b.r_max = 10;
     CHECK(lmb_ic_records_append(&s, &a, 1, &err) == LMB_OK);
     CHECK(lmb_ic_records_append(&s, &b, 1, &err) == LMB_OK);
-    CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, 0, &err) == LMB_OK);
     CHECK(lmb_ic_records_clamp(&s, 1, &err) == LMB_OK);
     CHECK_NEAR(s.rec[0].harmonic, 0.25, 1e-12);
     CHECK_NEAR(s.rec[0].r, 0.125, 1e-12);
@@ -189,7 +189,7 @@ static void test_reach_only_shrinks(void)
             r.r = lmb_ic_reach(&s, &r);
             CHECK(lmb_ic_records_append(&s, &r, 1, &err) == LMB_OK);
         }
-        CHECK(lmb_ic_records_index(&s, &err) == LMB_OK);
+        CHECK(lmb_ic_records_index(&s, 0, &err) == LMB_OK);
         double before[200];
         for (int i = 0; i < 200; i++)
             before[i] = s.rec[i].r;

@@ -44,7 +44,7 @@ static void test_fireflies(void)
     double sum0 = lum_sum(rgb, state);
     lmb_firefly_stats st = {0, 0, 0};
     lmb_error err;
-    CHECK(lmb_fireflies_spread(rgb, state, W, H, &st, &err) == LMB_OK);
+    CHECK(lmb_fireflies_spread(rgb, state, W, H, 0, &st, &err) == LMB_OK);
     CHECK_INT(st.texels, 1);
     CHECK_NEAR(lum_sum(rgb, state) / sum0, 1.0, 1e-6);   /* moved, not removed */
     CHECK_NEAR(st.total, sum0, 1e-6 * sum0);
