@@ -27,6 +27,8 @@
 #include "write/output_dir.h"
 #include "write/records_file.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -71,6 +73,15 @@ static lmb_status instanced_node(const lmb_scene *s, const lmb_layout *l, uint32
     return st;
 }
 
+/* One instance's new primitives (instance_primitives) and the arrays they point into. */
+typedef struct instance_prims {
+    int needed;
+    lmb_gltf_prim_out *prims;
+    uint32_t n, owned_n;
+    void **owned;
+    lmb_error err;
+} instance_prims;
+
 static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                              const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
                              int directional, int shadowmask, lmb_error *err)
@@ -113,8 +124,41 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
     }
     uint8_t *node_done = calloc((size_t)s->node_count + 1, 1);
     int64_t *shared_by = malloc(((size_t)s->mesh_count + 1) * sizeof *shared_by); /* mesh -> its first node's index */
-    if (!node_done || !shared_by)
+    instance_prims *prims = calloc((size_t)s->instance_count + 1, sizeof *prims);
+    if (!node_done || !shared_by || !prims)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
+    for (uint32_t m = 0; shared_by && m < s->mesh_count; m++)
+        shared_by[m] = -1;
+    /* which instances write primitives of their own (the rest share a node's or a mesh's), as
+     * the writing below visits them */
+    for (uint32_t i = 0; st == LMB_OK && i < s->instance_count; i++) {
+        const lmb_instance *in = &s->instances[i];
+        const lmb_layout_instance *li = &l->instances[i];
+        if (!li->lightmapped || (in->gpu_instance >= 0 && node_done[in->node]))
+            continue;
+        if (in->gpu_instance < 0 && li->shared_layout && shared_by[in->mesh] >= 0)
+            continue;
+        prims[i].needed = 1;
+        if (in->gpu_instance < 0 && li->shared_layout)
+            shared_by[in->mesh] = in->node;
+        node_done[in->node] = 1;
+    }
+    /* their vertices in parallel (the work); the glTF document is written on one thread */
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads(), failed = 0;
+    uint32_t to_build = st == LMB_OK ? s->instance_count : 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) reduction(| : failed)
+    for (uint32_t i = 0; i < to_build; i++)
+        if (prims[i].needed)
+            failed |= instance_primitives(s, l, i, &prims[i].prims, &prims[i].n, &prims[i].owned, &prims[i].owned_n,
+                                          &prims[i].err) != LMB_OK;
+    for (uint32_t i = 0; failed && i < s->instance_count; i++) /* the first instance's error */
+        if (prims[i].needed && prims[i].err.status != LMB_OK) {
+            *err = prims[i].err;
+            st = err->status;
+            break;
+        }
+    if (node_done)
+        memset(node_done, 0, (size_t)s->node_count + 1);
     for (uint32_t m = 0; shared_by && m < s->mesh_count; m++)
         shared_by[m] = -1;
     for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
@@ -127,24 +171,25 @@ static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layo
                                                  li->scale_offset, err);
             continue;
         }
-        lmb_gltf_prim_out *prims = NULL;
-        uint32_t n = 0, owned_n = 0;
-        void **owned = NULL;
-        st = instance_primitives(s, l, i, &prims, &n, &owned, &owned_n, err);
+        const lmb_gltf_prim_out *pr = prims[i].prims;
+        uint32_t n = prims[i].n;
         int32_t t = tex[l->instances[i].atlas], d = dir_tex[l->instances[i].atlas];
-        if (st == LMB_OK && in->gpu_instance >= 0) /* every copy of the node: one mesh, a rectangle each */
-            st = instanced_node(s, l, in->node, prims, n, t, d, err);
-        else if (st == LMB_OK && li->shared_layout) { /* the first node of a shared mesh */
-            st = lmb_gltf_lightmap_shared_mesh(s->doc, in->node, prims, n, t, d, li->scale_offset, err);
+        if (in->gpu_instance >= 0) /* every copy of the node: one mesh, a rectangle each */
+            st = instanced_node(s, l, in->node, pr, n, t, d, err);
+        else if (li->shared_layout) { /* the first node of a shared mesh */
+            st = lmb_gltf_lightmap_shared_mesh(s->doc, in->node, pr, n, t, d, li->scale_offset, err);
             shared_by[in->mesh] = in->node;
-        } else if (st == LMB_OK)
-            st = lmb_gltf_lightmap_node(s->doc, in->node, prims, n, t, d, l->instances[i].scale_offset, err);
+        } else
+            st = lmb_gltf_lightmap_node(s->doc, in->node, pr, n, t, d, l->instances[i].scale_offset, err);
         node_done[in->node] = 1;
-        for (uint32_t k = 0; k < owned_n; k++)
-            free(owned[k]);
-        free(owned);
-        free(prims);
     }
+    for (uint32_t i = 0; prims && i < s->instance_count; i++) {
+        for (uint32_t k = 0; k < prims[i].owned_n; k++)
+            free(prims[i].owned[k]);
+        free(prims[i].owned);
+        free(prims[i].prims);
+    }
+    free(prims);
     free(node_done);
     free(shared_by);
     if (st == LMB_OK)
@@ -175,6 +220,12 @@ static int keep(void ***owned, uint32_t *n, void *p)
     *owned = q;
     q[(*n)++] = p;
     return 1;
+}
+
+static int key_order(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
 }
 
 static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, uint32_t i, lmb_gltf_prim_out **out,
@@ -214,13 +265,7 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
         if (!keep(owned, owned_n, sorted))
             return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: out of memory");
         memcpy(sorted, key, (size_t)3 * nt * sizeof *sorted);
-        for (uint32_t gap = (3 * nt) / 2; gap > 0; gap /= 2) /* shell sort: no qsort context needed */
-            for (uint32_t a = gap; a < 3 * nt; a++)
-                for (uint32_t b = a; b >= gap && sorted[b - gap] > sorted[b]; b -= gap) {
-                    uint64_t t = sorted[b];
-                    sorted[b] = sorted[b - gap];
-                    sorted[b - gap] = t;
-                }
+        qsort(sorted, (size_t)3 * nt, sizeof *sorted, key_order); /* O(n log n): shell sort took seconds at 1M */
         uint32_t distinct = 0;
         for (uint32_t a = 0; a < 3 * nt; a++)
             if (a == 0 || sorted[a] != sorted[a - 1])
@@ -382,6 +427,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
     else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
+    if (st == LMB_OK && progress)
+        progress(user, "scene set-up", 0, 1); /* ray-tracing scene, textures, lights, bounce cache */
     if (st == LMB_OK)
         st = lmb_rt_build(s, &rt, err);
     if (st == LMB_OK && !shard)
@@ -397,6 +444,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     cache.threads = cfg->threads;
+    if (st == LMB_OK && progress)
+        progress(user, "scene set-up", 1, 1);
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
                                                                                                    : LMB_STEPS_LOCAL;
     lmb_steps_worker sw = {run->shards, run->worker, run->workers, run->wait_timeout};

@@ -79,32 +79,43 @@ static void band_light_free(band_light *l)
 /* A band's bytes: u32 count; per texel u32 texel, f32 size, lmb_point_ref, u8 valid, u8 partly;
  * then 3 f32 direct light per texel, 3 f32 direction sum per texel when directional, 3 f32
  * deferred light (mixed lighting) and 4 f32 shadowmask visibilities when those are on; 1 f32
- * round variance per texel (lmb_direct_job). */
-static lmb_status put_band(const lmb_texels *t, const float *e, const float *variance, const float *dir,
-                           const float *deferred, const float *mask, lmb_buf *out, lmb_error *err)
+ * round variance per texel (lmb_direct_job). band_bytes is their size, put_band writes them
+ * at dst (any band on any thread: each owns its range of the step's bytes). */
+static size_t band_bytes(const lmb_texels *t, const band_light *l)
 {
-    lmb_status st = lmb_buf_append(out, &t->count, 4, err);
-    for (uint32_t i = 0; i < t->count && st == LMB_OK; i++) {
+    size_t per = 4 + 4 + sizeof(lmb_point_ref) + 2 + 12 + 4;
+    per += (l->dir ? 12 : 0) + (l->deferred ? 12 : 0) + (l->mask ? 4 * LMB_SHADOWMASK_CHANNELS : 0);
+    return 4 + per * t->count;
+}
+
+static void put_band(const lmb_texels *t, const band_light *l, uint8_t *dst)
+{
+    memcpy(dst, &t->count, 4);
+    dst += 4;
+    for (uint32_t i = 0; i < t->count; i++) {
         uint8_t flags[2] = {t->valid[i], t->partly_covered[i]};
-        st = lmb_buf_append(out, &t->texel[i], 4, err);
-        if (st == LMB_OK)
-            st = lmb_buf_append(out, &t->texel_size[i], 4, err);
-        if (st == LMB_OK)
-            st = lmb_buf_append(out, &t->refs[(size_t)i * t->samples + t->gather_at[i]], sizeof(lmb_point_ref), err);
-        if (st == LMB_OK)
-            st = lmb_buf_append(out, flags, 2, err);
+        memcpy(dst, &t->texel[i], 4);
+        memcpy(dst + 4, &t->texel_size[i], 4);
+        memcpy(dst + 8, &t->refs[(size_t)i * t->samples + t->gather_at[i]], sizeof(lmb_point_ref));
+        memcpy(dst + 8 + sizeof(lmb_point_ref), flags, 2);
+        dst += 10 + sizeof(lmb_point_ref);
     }
-    if (st == LMB_OK)
-        st = lmb_buf_append(out, e, 3 * sizeof *e * t->count, err);
-    if (st == LMB_OK && dir)
-        st = lmb_buf_append(out, dir, 3 * sizeof *dir * t->count, err);
-    if (st == LMB_OK && deferred)
-        st = lmb_buf_append(out, deferred, 3 * sizeof *deferred * t->count, err);
-    if (st == LMB_OK && mask)
-        st = lmb_buf_append(out, mask, LMB_SHADOWMASK_CHANNELS * sizeof *mask * t->count, err);
-    if (st == LMB_OK)
-        st = lmb_buf_append(out, variance, sizeof *variance * t->count, err);
-    return st;
+    size_t n = t->count;
+    memcpy(dst, l->e, 3 * sizeof(float) * n);
+    dst += 3 * sizeof(float) * n;
+    if (l->dir) {
+        memcpy(dst, l->dir, 3 * sizeof(float) * n);
+        dst += 3 * sizeof(float) * n;
+    }
+    if (l->deferred) {
+        memcpy(dst, l->deferred, 3 * sizeof(float) * n);
+        dst += 3 * sizeof(float) * n;
+    }
+    if (l->mask) {
+        memcpy(dst, l->mask, LMB_SHADOWMASK_CHANNELS * sizeof(float) * n);
+        dst += LMB_SHADOWMASK_CHANNELS * sizeof(float) * n;
+    }
+    memcpy(dst, l->variance, sizeof(float) * n);
 }
 
 /* Bands [first, last) in groups of lmb_direct_group_bands: a group's bands are built at once
@@ -145,9 +156,24 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
         }
         if (st == LMB_OK)
             st = lmb_direct_compute_bands(jobs, bands, irradiance, n, &counters[0], &counters[1], err);
+        size_t at = out->size, total = 0;
         for (uint32_t k = 0; k < n && st == LMB_OK; k++)
-            st = put_band(&bands[k], light[k].e, light[k].variance, light[k].dir, light[k].deferred, light[k].mask, out,
-                          err);
+            total += band_bytes(&bands[k], &light[k]);
+        uint8_t *bytes = st == LMB_OK ? lmb_buf_extend(out, total, err) : NULL;
+        if (st == LMB_OK && !bytes)
+            st = err->status;
+        if (bytes) {
+            size_t *offset = calloc((size_t)n + 1, sizeof *offset);
+            for (uint32_t k = 0; offset && k + 1 < n; k++)
+                offset[k + 1] = offset[k] + band_bytes(&bands[k], &light[k]);
+            if (!offset)
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
+            int threads = c->cfg->threads ? (int)c->cfg->threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+            for (uint32_t k = 0; k < (offset ? n : 0); k++)
+                put_band(&bands[k], &light[k], out->data + at + offset[k]);
+            free(offset);
+        }
         for (uint32_t k = 0; k < n; k++) {
             band_light_free(&light[k]);
             memset(&light[k], 0, sizeof light[k]);

@@ -3,6 +3,8 @@
 
 #include "pack.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -291,11 +293,20 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
     lmb_status st =
         fit && area && floor_d && fixed ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     double fixed_texels = 0, free_area = 0;
+    /* each instance's fit, area and floor (its charts' boxes: the work) in parallel; the
+     * decisions, messages and sums after, in instance order */
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    uint32_t to_measure = st == LMB_OK ? n : 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
+    for (uint32_t k = 0; k < to_measure; k++) {
+        uint32_t i = list[k];
+        fit[k] = lmb_density_fit(s, l, cfg, i);
+        area[k] = lmb_instance_world_area(s, l, i);
+        floor_d[k] = lmb_density_override_for(s, cfg, i) > 0 ? 0 : fmin(lmb_density_floor(s, l, cfg, i), fit[k]);
+    }
     for (uint32_t k = 0; st == LMB_OK && k < n; k++) {
         uint32_t i = list[k];
         double o = lmb_density_override_for(s, cfg, i), d = o > 0 ? o : cfg->texel_density;
-        fit[k] = lmb_density_fit(s, l, cfg, i);
-        area[k] = lmb_instance_world_area(s, l, i);
         if (!(fit[k] > 0)) {
             st = lmb_error_set(err, LMB_ERR_INPUT,
                                "instance '%s' (mesh '%s') has %u charts: their padding alone (atlas.padding %u) "
@@ -306,8 +317,7 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
                                cfg->max_atlas_size);
             break;
         }
-        if (o <= 0) /* an override is the artist's word for this instance: no floor */
-            floor_d[k] = fmin(lmb_density_floor(s, l, cfg, i), fit[k]);
+        /* floor_d[k]: 0 where an override is the artist's word for this instance */
         if (d > 0) { /* explicit: it wins (raised to the floor), or it is refused now */
             if (d > fit[k] && d > fit_at_share(s, l, cfg, i, TRY_AREA_SHARE))
                 st = explicit_too_high(s, cfg, i, d, fit[k], o > 0, err);

@@ -14,6 +14,8 @@
 #include "unwrap/metrics.h"
 #include "../util/mat4.h"
 
+#include <omp.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -132,7 +134,7 @@ static lmb_status pack_instances(const lmb_scene *s, const lmb_config *cfg, lmb_
             chart_id[q] = k;
         }
     }
-    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1};
+    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1, cfg->threads};
     if (st == LMB_OK)
         st = lmb_pack_charts(charts, nc, &opt, &r, err);
     if (st == LMB_ERR_INPUT && r.failed_group < n) {
@@ -216,14 +218,29 @@ static lmb_status pack_level(const lmb_scene *s, const lmb_config *cfg, lmb_layo
     }
 }
 
+/* A mesh and its triangles, for ordering the unwrap (largest first). */
+typedef struct mesh_size {
+    uint64_t triangles;
+    uint32_t mesh;
+} mesh_size;
+
+static int by_triangles_desc(const void *pa, const void *pb)
+{
+    const mesh_size *a = pa, *b = pb;
+    if (a->triangles != b->triangles)
+        return a->triangles < b->triangles ? 1 : -1;
+    return a->mesh < b->mesh ? -1 : a->mesh > b->mesh;
+}
+
+/* Every used mesh unwrapped (or its TEXCOORD_1 kept), the meshes in parallel, largest first:
+ * a mesh's charts depend on the mesh and the options only, not on the thread that made them.
+ * Progress comes from the driving thread (OpenMP's thread 0) as meshes finish. */
 static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, lmb_progress_fn progress,
                                 void *user, lmb_error *err)
 {
-    uint64_t total = 0, done = 0;
+    uint64_t total = 0;
     for (uint32_t m = 0; m < s->mesh_count; m++)
         total += l->meshes[m].used ? s->meshes[m].triangle_count : 0;
-    lmb_unwrap_options opt;
-    lmb_unwrap_options_default(&opt);
     for (uint32_t m = 0; m < s->mesh_count; m++) {
         lmb_status st = l->meshes[m].used ? build_soup(s, m, &l->meshes[m].soup, err) : LMB_OK;
         if (st != LMB_OK)
@@ -231,34 +248,63 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
     }
     /* narrow charts are glued at the density each mesh is expected to get */
     double *expected = calloc((size_t)s->mesh_count + 1, sizeof *expected);
-    if (!expected)
+    mesh_size *order = calloc((size_t)s->mesh_count + 1, sizeof *order);
+    lmb_error *errs = calloc((size_t)s->mesh_count + 1, sizeof *errs);
+    if (!expected || !order || !errs) {
+        free(expected);
+        free(order);
+        free(errs);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    }
     lmb_density_expected(s, cfg, l, expected);
-    for (uint32_t m = 0; m < s->mesh_count; m++) {
+    uint32_t n = 0;
+    for (uint32_t m = 0; m < s->mesh_count; m++)
+        if (l->meshes[m].used)
+            order[n++] = (mesh_size){s->meshes[m].triangle_count, m};
+    qsort(order, n, sizeof *order, by_triangles_desc);
+    uint64_t done = 0, reported = 0; /* triangles of the meshes finished; the last count thread 0 reported */
+    if (progress)
+        progress(user, "unwrap", 0, total);
+    int64_t failed = INT64_MAX;
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t m = order[k].mesh;
         lmb_layout_mesh *lm = &l->meshes[m];
-        if (!lm->used)
-            continue;
+        lmb_unwrap_options opt;
+        lmb_unwrap_options_default(&opt);
         opt.name = s->meshes[m].name;
         opt.glue_below = cfg->min_chart_texels > 0 && expected[m] > 0 ? cfg->min_chart_texels / expected[m] : 0;
-        lmb_status st = LMB_OK;
         double t0 = lmb_seconds();
         lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
                                lm->soup.skip};
         lm->kept_uv1 = cfg->keep_uv1 && lmb_mesh_has_uv1(s, m);
-        if (st == LMB_OK)
-            st = lm->kept_uv1 ? lmb_charts_from_uv1(s, m, &lm->soup, &lm->charts, err)
-                              : lmb_unwrap_mesh(&in, &opt, &lm->charts, err);
+        lmb_status st = lm->kept_uv1 ? lmb_charts_from_uv1(s, m, &lm->soup, &lm->charts, &errs[m])
+                                     : lmb_unwrap_mesh(&in, &opt, &lm->charts, &errs[m]);
         lm->chart_seconds = lmb_seconds() - t0;
         if (st != LMB_OK) {
-            free(expected);
-            return st;
+#pragma omp critical(lmb_unwrap_failed)
+            failed = (int64_t)m < failed ? (int64_t)m : failed;
         }
-        done += s->meshes[m].triangle_count;
-        if (progress)
-            progress(user, "unwrap", done, total);
+        uint64_t now;
+#pragma omp atomic capture
+        now = done += s->meshes[m].triangle_count;
+        if (progress && omp_get_thread_num() == 0) {
+            progress(user, "unwrap", now, total);
+            reported = now;
+        }
+    }
+    lmb_status st = LMB_OK;
+    if (failed != INT64_MAX) { /* the first mesh's error, whatever the threads did */
+        *err = errs[failed];
+        st = err->status;
+    } else if (progress && reported != total) {
+        progress(user, "unwrap", total, total);
     }
     free(expected);
-    return LMB_OK;
+    free(order);
+    free(errs);
+    return st;
 }
 
 lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progress_fn progress, void *user,
@@ -280,8 +326,14 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             list[n++] = i;
         }
     lmb_status st = unwrap_meshes(s, cfg, l, progress, user, err);
+    if (st == LMB_OK && progress)
+        progress(user, "texel density", 0, 1);
     if (st == LMB_OK)
         st = lmb_density_choose(s, cfg, l, list, n, log, &l->density, err);
+    if (st == LMB_OK && progress)
+        progress(user, "texel density", 1, 1);
+    if (st == LMB_OK && progress)
+        progress(user, "pack", 0, 1);
     /* atlas.share_meshes: the lightmapped nodes (not instanced copies) of each mesh */
     uint32_t *users = calloc((size_t)s->mesh_count + 1, sizeof *users);
     uint8_t *as_rect = calloc((size_t)s->instance_count + 1, 1);
@@ -294,16 +346,21 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
         as_rect[list[j]] = l->meshes[in->mesh].kept_uv1 || in->gpu_instance >= 0 ||
                            (cfg->share_meshes && users[in->mesh] >= 2);
     }
-    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
+    int out_of_memory = 0, threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    uint32_t to_scale = st == LMB_OK ? n : 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(| : out_of_memory)
+    for (uint32_t j = 0; j < to_scale; j++) { /* every instance's charts at its density: its own uv1 */
         lmb_layout_instance *li = &l->instances[list[j]];
         li->lightmapped = 1;
         li->uv1_count = (size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6;
         li->uv1 = calloc(li->uv1_count + 1, sizeof *li->uv1);
         if (!li->uv1)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+            out_of_memory = 1;
         else if (!as_rect[list[j]])
             lmb_layout_scale_instance(s, l, list[j]);
     }
+    if (out_of_memory)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     free(users);
     /* kept TEXCOORD_1 and instanced copies: rectangles of shared atlases, after the packed ones;
      * the rest is packed chart by chart */

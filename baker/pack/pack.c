@@ -18,6 +18,7 @@
 #include "pack_internal.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -413,9 +414,24 @@ lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const l
     out->placements = calloc((size_t)count + 1, sizeof *out->placements);
     lmb_status st = (items && out->placements) ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
     uint64_t total = 0;
-    for (uint32_t i = 0; st == LMB_OK && i < count; i++, prepared++) {
-        double bw = 0, bh = 0;
-        int r = lmb_pack_prepare(&charts[i], i, border, size, &items[i], &bw, &bh);
+    /* every chart's footprint masks at once (the work, and independent); then, in chart order,
+     * the first chart that failed and the totals, as one thread would find them */
+    int *ready = st == LMB_OK ? malloc(((size_t)count + 1) * sizeof *ready) : NULL;
+    double *box = st == LMB_OK ? malloc((2 * (size_t)count + 1) * sizeof *box) : NULL;
+    if (st == LMB_OK && (!ready || !box))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
+    int threads = opt->threads ? (int)opt->threads : omp_get_max_threads();
+    uint32_t to_prepare = st == LMB_OK ? count : 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
+    for (uint32_t i = 0; i < to_prepare; i++) {
+        box[2 * i] = box[2 * i + 1] = 0;
+        ready[i] = lmb_pack_prepare(&charts[i], i, border, size, &items[i], &box[2 * i], &box[2 * i + 1]);
+    }
+    if (st == LMB_OK) /* all are prepared: all are freed at the end */
+        prepared = count;
+    for (uint32_t i = 0; st == LMB_OK && i < count; i++) {
+        double bw = box[2 * i], bh = box[2 * i + 1];
+        int r = ready[i];
         if (opt->grouped)
             groups = charts[i].group + 1 > groups ? charts[i].group + 1 : groups;
         else
@@ -432,6 +448,8 @@ lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const l
         }
         total += items[i].area;
     }
+    free(ready);
+    free(box);
     uint32_t bad = st == LMB_OK && opt->grouped ? oversized_group(items, count, groups, size) : NONE;
     if (bad != NONE) {
         out->failed_group = bad;

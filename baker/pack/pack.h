@@ -20,6 +20,8 @@ typedef struct lmb_pack_options {
     uint32_t max_size; /* atlas side limit, texels */
     uint32_t padding;  /* texels between footprints */
     int grouped;       /* every group lands whole in one atlas; a group that cannot is an error */
+    uint32_t threads;  /* charts' footprints are made on this many threads (0: all cores); the
+                          packing itself, and so its result, does not depend on it */
 } lmb_pack_options;
 
 /* Chart-local uv -> atlas texel coordinates: x = m[0] u + m[1] v + m[2], y = m[3] u + m[4] v + m[5]

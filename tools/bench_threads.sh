@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Thread scaling per stage, before and after, side by side in one run (tools/bench_threads.py;
+# docs/benchmarks.md#threads). Builds this checkout (build/) and the commit BEFORE (default
+# e468856, the last commit before the work on threads) in a git worktree of its own
+# (bench/threads/before-src, bench/threads/before-build), then bakes level-single-10
+# (tools/make_levels.py) and bevy's Cornell box at defaults with each binary at each thread
+# count, alternating. Prints per stage the seconds and speed-ups, the serial fraction, and
+# writes bench/threads/threads.csv and bench/threads/threads.png. Not part of the tests
+# (about 8 minutes on 2 cores, plus about 4 to build BEFORE the first time).
+#   usage: tools/bench_threads.sh [--before REF] [--threads 1,2] [SCENE[=CONFIG] ...]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+before_ref=e468856
+threads=1,2
+scenes=()
+while [ $# -gt 0 ]; do
+  case $1 in
+    --before) before_ref=$2; shift 2 ;;
+    --threads) threads=$2; shift 2 ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    *) scenes+=("$1"); shift ;;
+  esac
+done
+[[ $threads =~ ^[1-9][0-9]*(,[1-9][0-9]*)+$ ]] || { echo "bench_threads: --threads needs a list such as 1,2"; exit 2; }
+tools/setup.sh build
+work=bench/threads
+mkdir -p "$work" bench/levels
+[ -f bench/levels/level-single-10.glb ] || /usr/bin/python3 tools/make_levels.py bench/levels single:10
+if [ ${#scenes[@]} -eq 0 ]; then
+  scenes=(bench/levels/level-single-10.glb assets/scenes/cornell-box-bevy/CornellBox.glb)
+fi
+
+# the binary of BEFORE, built once per commit
+commit=$(git rev-parse --verify "$before_ref^{commit}")
+src=$work/before-src bld=$work/before-build
+if [ ! -x "$bld/lmbake" ] || [ "$(cat "$bld/commit" 2>/dev/null)" != "$commit" ]; then
+  echo "bench_threads: building $before_ref ($commit) in $bld"
+  git worktree remove --force "$src" 2>/dev/null || rm -rf "$src"
+  git worktree prune
+  git worktree add --detach "$src" "$commit" > /dev/null
+  cmake -S "$src" -B "$bld" -DCMAKE_BUILD_TYPE=Release > "$work/before-build.log" 2>&1 &&
+    cmake --build "$bld" -j2 --target lmbake >> "$work/before-build.log" 2>&1 ||
+    { tail -n 20 "$work/before-build.log"; echo "bench_threads: building $before_ref failed"; exit 1; }
+  echo "$commit" > "$bld/commit"
+fi
+/usr/bin/python3 tools/bench_threads.py "$bld/lmbake" build/lmbake "$work/runs" "$work/threads.csv" \
+  "$work/threads.png" "$threads" "${scenes[@]}"
