@@ -16,10 +16,16 @@ stage's first line, as ../shared/tools/portable/scaling.sh cuts a log):
   rest               -> exit (second denoiser pass, directions, fireflies, seams, images, glTF)
 
 A stage whose lines a bake does not print (no bounce pass, no refinement) is left out of it.
+Then T copies of the after binary's 1-thread bake run at once (T the largest thread count):
+what T farm workers of one thread each do on this machine. Each copy's time against the
+1-thread bake alone is the machine's own scaling (shared caches, memory, a busy host); the
+T-thread bake's time against theirs divided by T says whether threads keep up with processes.
 The after binary also runs with --timings=CSV: per stage (its own, finer stages) the CPU time
 over all threads and the serial share; the serial seconds summed over the stages, S, at T
 threads with wall time W give the serial fraction of the work, f = S / (S + T (W - S)).
 From the wall times alone, Amdahl's f = (T / speed-up - 1) / (T - 1) for each T > 1.
+The same serial share is also sampled from outside the process for both binaries
+(SerialSampler: /proc/PID/task/*/stat every 0.1 s), so before and after are measured alike.
 Every output of every bake is compared with the after binary's at the first thread count,
 byte for byte (before and after must agree too: the work changes the speed, not the bits).
 
@@ -32,6 +38,7 @@ import re
 import shutil
 import subprocess
 import sys
+import threading
 import time
 
 STAGES = [("set-up", None), ("direct", r"direct:"), ("bounce passes", r"bounce pass \d"),
@@ -40,11 +47,55 @@ STAGES = [("set-up", None), ("direct", r"direct:"), ("bounce passes", r"bounce p
           ("rest", r"direct light: estimated noise")]
 
 
-def timed(args, log_path):
-    """Runs args, time-stamping each line of its output; returns (wall seconds, [(t, line)])."""
+TICK = os.sysconf("SC_CLK_TCK")
+
+
+class SerialSampler(threading.Thread):
+    """Samples a process's threads' CPU ticks (/proc/PID/task/*/stat, utime + stime) every
+    INTERVAL s from outside, so that any binary (before or after) is measured alike; an
+    interval in which at most one thread ran more than half of it counts as serial. Coarser
+    than --timings (the kernel counts in 1/TICK s) but the same rule."""
+    INTERVAL = 0.1
+
+    def __init__(self, pid):
+        super().__init__(daemon=True)
+        self.pid, self.serial, self.sampled, self.done = pid, 0.0, 0.0, threading.Event()
+
+    def ticks(self):
+        out = {}
+        try:
+            for tid in os.listdir("/proc/%d/task" % self.pid):
+                try:
+                    with open("/proc/%d/task/%s/stat" % (self.pid, tid)) as f:
+                        fields = f.read().rsplit(")", 1)[1].split()
+                    out[tid] = int(fields[11]) + int(fields[12])
+                except (OSError, IndexError, ValueError):
+                    pass
+        except OSError:
+            pass
+        return out
+
+    def run(self):
+        last, t_last = self.ticks(), time.time()
+        while not self.done.wait(self.INTERVAL):
+            now, t_now = self.ticks(), time.time()
+            if not now:
+                break
+            dt = t_now - t_last
+            busy = sum(1 for tid, v in now.items() if (v - last.get(tid, 0)) / TICK > 0.5 * dt)
+            self.sampled += dt
+            self.serial += dt if busy <= 1 else 0.0
+            last, t_last = now, t_now
+
+
+def timed(args, log_path, serial=None):
+    """Runs args, time-stamping each line of its output; returns (wall seconds, [(t, line)]).
+    serial: a list that gets the seconds sampled as serial and the seconds sampled."""
     t0 = time.time()
     lines, buf = [], b""
     proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    sampler = SerialSampler(proc.pid)
+    sampler.start()
     while True:
         chunk = proc.stdout.read1(65536)
         if not chunk:
@@ -58,6 +109,10 @@ def timed(args, log_path):
         lines.append((time.time() - t0, buf.decode(errors="replace")))
     rc = proc.wait()
     wall = time.time() - t0
+    sampler.done.set()
+    sampler.join()
+    if serial is not None:
+        serial[:] = [sampler.serial, sampler.sampled]
     with open(log_path, "w") as f:
         f.writelines("%8.3f %s\n" % (t, l) for t, l in lines)
     if rc != 0:
@@ -125,8 +180,10 @@ def main():
                 tcsv = out + "-timings.csv"
                 if which == "after":
                     args.append("--timings=" + tcsv)
-                wall, lines = timed(args, out + ".log")
+                outside = []
+                wall, lines = timed(args, out + ".log", outside)
                 walls[which, t] = wall
+                walls[which, t, "outside"] = tuple(outside)
                 stages[which, t] = stage_times(lines, wall)
                 if which == "after":
                     serial[t] = timings_csv(tcsv)
@@ -140,6 +197,31 @@ def main():
                 for stage, sec in stages[which, t].items():
                     rows.append([name, which, t, stage, "%.3f" % sec])
                 rows.append([name, which, t, "whole bake", "%.3f" % wall])
+        # threads against processes: T copies of the 1-thread bake at once on the same
+        # machine (what a farm of T workers does), against the T-thread bake
+        tn = threads[-1]
+        if threads[0] != 1:
+            summary.append((name, walls, stages, serial))
+            continue
+        procs, outs = [], []
+        t0 = time.time()
+        for k in range(tn):
+            out = os.path.join(work, "%s-process-%d" % (name, k))
+            shutil.rmtree(out, ignore_errors=True)
+            outs.append(out)
+            procs.append(subprocess.Popen([after, "bake", scene, *cfg, "-o", out, "--threads", "1", "-q"]))
+        ends = []
+        for p in procs:
+            if p.wait() != 0:
+                sys.exit("bench_threads: a 1-thread copy of %s failed" % name)
+            ends.append(time.time() - t0)
+        for out in outs:
+            if not identical(reference, out):
+                sys.exit("bench_threads: %s differs from %s" % (out, reference))
+        walls["processes", tn] = max(ends)
+        print("%-22s %d processes x 1 thread at once: %7.2f s (each %s)" % (name, tn, max(ends),
+              ", ".join("%.2f s" % e for e in ends)), flush=True)
+        rows.append([name, "processes", tn, "whole bake", "%.3f" % max(ends)])
         summary.append((name, walls, stages, serial))
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
@@ -165,8 +247,21 @@ def main():
             for which in ("before", "after"):
                 s = walls[which, t1] / walls[which, t] * t1
                 f = (t / s - 1) / (t - 1)
+                sec, sampled = walls[which, t, "outside"]
+                w = walls[which, t]
+                sec *= w / sampled if sampled else 0  # the share sampled, over the whole wall time
+                fo = sec / (sec + t * (w - sec)) if w > sec else 1.0
                 print("%s: %-6s at %d threads: speed-up %.2fx over %d thread(s); Amdahl serial fraction from the "
-                      "wall times %.1f%%" % (name, which, t, walls[which, t1] / walls[which, t], t1, 100 * f))
+                      "wall times %.1f%%; sampled from outside: %.2f s of %.2f s with at most one thread running, "
+                      "serial fraction of the work %.2f%%" % (name, which, t, walls[which, t1] / walls[which, t], t1,
+                                                             100 * f, sec, w, 100 * fo))
+            if t == tn and ("processes", tn) in walls:
+                solo, together = walls["after", t1] * t1, walls["processes", tn]
+                print("%s: %d 1-thread bakes at once took %.2f s against %.2f s alone: each core does %.1f%% of the "
+                      "work it does alone (the machine's own scaling); %d threads take %.2f s per bake, %d processes "
+                      "%.2f s per bake: threads / processes = %.3f" % (
+                          name, tn, together, solo, 100 * solo / together, tn, walls["after", tn], tn,
+                          together / tn, walls["after", tn] / (together / tn)))
             sec, wall, cpu = serial[t]
             f = sec / (sec + t * (wall - sec)) if wall > sec else 1.0
             print("%s: after  at %d threads: %.2f s of %.2f s wall with at most one thread running (--timings); "

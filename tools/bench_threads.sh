@@ -4,9 +4,10 @@
 # e468856, the last commit before the work on threads) in a git worktree of its own
 # (bench/threads/before-src, bench/threads/before-build), then bakes level-single-10
 # (tools/make_levels.py) and bevy's Cornell box at defaults with each binary at each thread
-# count, alternating. Prints per stage the seconds and speed-ups, the serial fraction, and
+# count, alternating, then as many 1-thread bakes at once as the largest count (threads against
+# processes). Prints per stage the seconds and speed-ups, the serial fraction, and
 # writes bench/threads/threads.csv and bench/threads/threads.png. Not part of the tests
-# (about 8 minutes on 2 cores, plus about 4 to build BEFORE the first time).
+# (about 11 minutes on 2 cores, plus about 4 to build BEFORE the first time).
 #   usage: tools/bench_threads.sh [--before REF] [--threads 1,2] [SCENE[=CONFIG] ...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,7 +18,7 @@ while [ $# -gt 0 ]; do
   case $1 in
     --before) before_ref=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
     *) scenes+=("$1"); shift ;;
   esac
 done

@@ -338,6 +338,8 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
                        compute_bands, &c};
     uint64_t counters[LMB_STEP_COUNTERS];
     bands_taken taken = {out, &c, 0};
+    if (progress) /* the stage starts now, not when its first group is done */
+        progress(progress_user, "direct", 0, (uint64_t)c.height * c.width);
     /* a group of bands at a time (compute_bands): the bytes of one group are held at once */
     st = lmb_steps_run_streamed(steps, &d, lmb_direct_group_bands(cfg), take_bands, &taken, counters, err);
     *rays += counters[0];

@@ -14,13 +14,13 @@ lmbake=$1 scenes=$2 work=$3
 rm -rf "$work"
 mkdir -p "$work"
 cat > "$work/box.yaml" <<'EOF'
-atlas: {texels: 30000}
+atlas: {texels: 15000}
 sky: {intensity: 2}
 output: {formats: [exr, hdr, png, ktx2, rgbm, mask], directional: true}
 EOF
 cat > "$work/mixed.yaml" <<'EOF'
-atlas: {texels: 10000}
-samples: {gather: 64}
+atlas: {texels: 6000}
+samples: {gather: 32, bounce: 16}
 sky: {intensity: 2}
 output: {formats: [exr, hdr, png, ktx2, rgbm, mask], directional: true, shadowmask: true}
 lights: {modes: [{match: "*", mode: indirect}]}

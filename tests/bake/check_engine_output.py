@@ -38,7 +38,7 @@ from PIL import Image
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
-from object_means import _accessor, _cover, _image, lightmap_uv  # noqa: E402
+from object_means import _accessor, _cover_window, _image, lightmap_uv  # noqa: E402
 
 MIXED = os.path.join(ROOT, "assets", "scenes", "mixed-lighting-bevy", "MixedLightingExample.gltf")
 CORNELL = os.path.join(ROOT, "assets", "scenes", "cornell-box-bevy", "CornellBox.glb")
@@ -119,9 +119,12 @@ def rects(lmbake, work):
             atlas_uv = lightmap_uv(node, uv)
             tri = atlas_uv[idx].reshape(-1, 3, 2)
             for t in tri:
-                cover = _cover(t, W, H)
-                clash += int((cover & (owner != 0) & (owner != label)).sum())
-                owner[cover & (owner == 0)] = label
+                win, cover = _cover_window(t, W, H)
+                if cover is None:
+                    continue
+                o = owner[win]
+                clash += int((cover & (o != 0) & (o != label)).sum())
+                o[cover & (o == 0)] = label
             c = tri.mean(axis=1)
             centroids[label] = np.minimum((c * [W, H]).astype(int), [W - 1, H - 1])
     check(same_uv, "TEXCOORD_1 is the input's, untouched (each node's rectangle places it)")

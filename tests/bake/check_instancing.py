@@ -35,7 +35,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
-from object_means import _accessor, _cover, _image  # noqa: E402
+from object_means import _accessor, _cover_window, _image  # noqa: E402
 
 failures = []
 
@@ -179,9 +179,12 @@ def copies(lmbake, work):
     for k in range(n):
         a = tri_uv * scale[k] + offset[k]
         for t in a:
-            cover = _cover(t, W, H)
-            clash += int((cover & (owner != 0) & (owner != k + 1)).sum())
-            owner[cover & (owner == 0)] = k + 1
+            win, cover = _cover_window(t, W, H)
+            if cover is None:
+                continue
+            o = owner[win]
+            clash += int((cover & (o != 0) & (o != k + 1)).sum())
+            o[cover & (o == 0)] = k + 1
     for k in range(n):
         c = (tri_uv * scale[k] + offset[k]).mean(axis=1)
         x = np.minimum((c[:, 0] * W).astype(int), W - 1)

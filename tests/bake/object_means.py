@@ -37,12 +37,22 @@ def _image(path):
 
 def _cover(uv, w, h, reach=0.75):
     """Texels (boolean h x w) whose centre lies in the UV triangle or within reach texels of it."""
+    mask = np.zeros((h, w), bool)
+    win, local = _cover_window(uv, w, h, reach)
+    if local is not None:
+        mask[win] = local
+    return mask
+
+
+def _cover_window(uv, w, h, reach=0.75):
+    """_cover within the triangle's bounding window only: (slices, boolean mask of the window),
+    or (None, None) when the triangle is off the atlas. A level's thousands of triangles each
+    touch a few texels: a whole-atlas mask per triangle cost most of a test's time."""
     p = uv * np.array([w, h])
     x0, y0 = np.maximum(np.floor(p.min(axis=0) - 1).astype(int), 0)
     x1, y1 = np.minimum(np.ceil(p.max(axis=0) + 1).astype(int), [w - 1, h - 1])
-    mask = np.zeros((h, w), bool)
     if x1 < x0 or y1 < y0:
-        return mask
+        return None, None
     ys, xs = np.mgrid[y0:y1 + 1, x0:x1 + 1]
     c = np.stack([xs + 0.5, ys + 0.5], axis=-1)
     dist = np.full(xs.shape, np.inf)
@@ -57,8 +67,7 @@ def _cover(uv, w, h, reach=0.75):
         t = np.clip(((c - a) @ e) / l2, 0, 1) if l2 > 0 else np.zeros(xs.shape)
         q = a + t[..., None] * e
         dist = np.minimum(dist, np.linalg.norm(c - q, axis=-1))
-    mask[y0:y1 + 1, x0:x1 + 1] = inside | (dist <= reach)
-    return mask
+    return (slice(y0, y1 + 1), slice(x0, x1 + 1)), inside | (dist <= reach)
 
 
 def lightmap_uv(node, uv):
@@ -98,8 +107,11 @@ def object_means(out):
             uv = lightmap_uv(node, _accessor(doc, bins, prim["attributes"]["TEXCOORD_1"]))
             idx = _accessor(doc, bins, prim["indices"]).reshape(-1)
             for k in range(0, len(idx), 3):
-                cover = _cover(uv[idx[k:k + 3]], w, h) & valid & (owner[tex] == 0)
-                owner[tex][cover] = label
+                win, local = _cover_window(uv[idx[k:k + 3]], w, h)
+                if local is None:
+                    continue
+                o = owner[tex][win]
+                o[local & valid[win] & (o == 0)] = label
     sums = {n: [np.zeros(3), 0] for n in nodes + ["all"]}
     for tex, (exr, valid) in atlases.items():
         for label, n in enumerate(nodes, 1):

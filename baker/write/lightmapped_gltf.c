@@ -1,35 +1,18 @@
 /*
- * The bake pipeline driver: layout (unwrap + pack) -> ray-tracing scene, textures, lights ->
- * lighting (lighting.h: texels, direct light, bounce passes, final gather, dilation) ->
- * images (write/atlas_images.h); then the final gather's irradiance-cache records
- * (write/records_file.h) and the glTF with TEXCOORD_1 and MOZ_lightmap. Output is written
- * into a staging folder beside outdir and swapped into place only when everything succeeded
- * (write/output_dir.h), so a failed or killed bake leaves nothing behind; outdir may
- * not be the input's own folder (the input and its .bin files are never written over).
+ * The output glTF of a bake (lightmapped_gltf.h): each lightmapped instance's primitives with
+ * new vertices where charts split them and TEXCOORD_1, the lightmap textures and their
+ * MOZ_lightmap links, instanced copies' rectangles, the irradiance-cache records file, and the
+ * input's textures copied beside it. The primitives are built in parallel, an instance per
+ * thread; the document itself on one thread (tinygltf, write/gltf_write.h).
  */
-#include <lmbake/lmbake.h>
+#include "lightmapped_gltf.h"
 
-#include "util/clock.h"
-#include "steps/plan.h"
-#include "steps/runner.h"
-#include "lighting.h"
-#include "lights/direct.h"
 #include "load/gltf_adapter.h"
-#include "load/textures.h"
-#include "pack/layout.h"
-#include "post/dilate.h"
-#include "post/fireflies.h"
-#include "seams/seams.h"
-#include "texels/texels.h"
 #include "write/gltf_write.h"
 #include "write/ktx2.h"
-#include "write/atlas_images.h"
-#include "write/output_dir.h"
-#include "write/records_file.h"
 
 #include <omp.h>
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,7 +23,7 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
 
 /* Texture files the input references by relative path go along with the output glTF
  * (read from the view before lightmap images are added; tinygltf keeps the strings). */
-static void copy_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
+void lmb_copy_input_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log)
 {
     const lmb_gltf_view *v = lmb_gltf_get_view(s->doc);
     for (uint32_t k = 0; k < v->image_count; k++) {
@@ -82,9 +65,9 @@ typedef struct instance_prims {
     lmb_error err;
 } instance_prims;
 
-static lmb_status write_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
-                             const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
-                             int directional, int shadowmask, lmb_error *err)
+lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
+                                      const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
+                                      int directional, int shadowmask, lmb_error *err)
 {
     int32_t *tex = malloc(((size_t)l->atlas_count + 1) * 2 * sizeof *tex), *dir_tex = tex + l->atlas_count + 1;
     if (!tex)
@@ -313,226 +296,4 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
         tbase += nt;
     }
     return LMB_OK;
-}
-
-/* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
- * neighbours, then seams stitched. */
-static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
-                               lmb_cache *cache, lmb_progress_fn progress, void *user, lmb_bake_stats *stats,
-                               const lmb_log *log, lmb_error *err)
-{
-    lmb_status st = LMB_OK;
-    if (st == LMB_OK && cfg->firefly_spread && !cfg->reference) {
-        lmb_firefly_stats fs = {0, 0, 0};
-        for (uint32_t a = 0; st == LMB_OK && a < l->atlas_count; a++) {
-            if (progress)
-                progress(user, "fireflies", a, l->atlas_count);
-            uint64_t before = fs.texels, last = ~0ull;
-            /* a spike shared with its neighbours may leave them above the bound: again, a few times */
-            for (int pass = 0; pass < LMB_FIREFLY_PASSES && st == LMB_OK && fs.texels != last; pass++) {
-                last = fs.texels;
-                double total = fs.total;
-                st = lmb_fireflies_spread(cache->irradiance[a], cache->state[a], l->width[a], l->height[a],
-                                          (int)cfg->threads, &fs, err);
-                if (pass)
-                    fs.total = total; /* the atlas's light counts once */
-            }
-            if (st == LMB_OK && fs.texels > before) /* padding follows the texels it was dilated from */
-                st = lmb_dilate(cache->irradiance[a], cache->state[a], l->width[a], l->height[a], (int)cfg->threads,
-                                err);
-        }
-        if (progress && st == LMB_OK)
-            progress(user, "fireflies", l->atlas_count, l->atlas_count);
-        stats->firefly_texels = fs.texels;
-        stats->firefly_moved = fs.total > 0 ? fs.moved / fs.total : 0;
-        if (st == LMB_OK && fs.texels)
-            lmb_info(log, "fireflies: %llu texels above %gx the median around them; %.4f%% of the light moved to their "
-                     "neighbours (none removed)", (unsigned long long)fs.texels, LMB_FIREFLY_FACTOR,
-                     100 * stats->firefly_moved);
-    }
-    if (st == LMB_OK && cfg->seam_stitch) {
-        lmb_seam_report sr;
-        if (progress)
-            progress(user, "seams", 0, 1);
-        st = lmb_seams_stitch(s, l, rt, cache->irradiance, (const uint8_t *const *)cache->state, (int)cfg->threads, &sr,
-                              err);
-        if (progress && st == LMB_OK)
-            progress(user, "seams", 1, 1);
-        stats->seam_edges = sr.edges;
-        stats->seam_jump_before = sr.jump_before;
-        stats->seam_jump_after = sr.jump_after;
-        if (st == LMB_OK && sr.edges)
-            lmb_info(log, "seams: %llu edges stitched (%llu points, %llu left unmatched, %llu texels) in %.2fs; largest "
-                     "jump %.2f%% -> %.2f%%; points over 1%%: %llu -> %llu", (unsigned long long)sr.edges,
-                     (unsigned long long)sr.samples, (unsigned long long)sr.dropped, (unsigned long long)sr.texels,
-                     sr.seconds, 100 * sr.jump_before, 100 * sr.jump_after, (unsigned long long)sr.over_1pct_before,
-                     (unsigned long long)sr.over_1pct);
-    }
-    return st;
-}
-
-lmb_status lmb_bake(lmb_scene *s, const lmb_config *cfg, const char *outdir, lmb_progress_fn progress, void *user,
-                    lmb_bake_stats *stats, const lmb_log *log, lmb_error *err)
-{
-    return lmb_bake_planned(s, cfg, NULL, outdir, progress, user, stats, log, err);
-}
-
-lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *plan_path, const char *outdir,
-                            lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
-                            lmb_error *err)
-{
-    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0};
-    return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
-}
-
-lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_path, lmb_farm_run *run,
-                         const char *outdir, lmb_progress_fn progress, void *user, lmb_bake_stats *stats,
-                         const lmb_log *log, lmb_error *err)
-{
-    lmb_bake_stats unused;
-    if (!stats)
-        stats = &unused;
-    int worker = run->mode == LMB_FARM_WORKER, finishes = worker && outdir && run->worker == 0;
-    int shard = run->mode == LMB_FARM_STEP || (worker && !finishes), writes = !shard;
-    if (run->mode != LMB_FARM_LOCAL && !plan_path)
-        return lmb_error_set(err, LMB_ERR_USAGE, "a farm step, worker or finish needs the plan ('lmbake plan')");
-    if (shard && (run->shards == 0 || run->shard >= run->shards))
-        return lmb_error_set(err, LMB_ERR_USAGE, "shard %u of %u: out of range", run->shard + 1, run->shards);
-    run->ended = 0;
-    double t0 = lmb_seconds();
-    memset(stats, 0, sizeof *stats);
-    lmb_scene_set_light_modes(s, cfg, shard ? NULL : log); /* mixed lighting: which lights the bake holds */
-    lmb_output_dir od;
-    memset(&od, 0, sizeof od);
-    lmb_status st = writes ? lmb_output_dir_open(&od, outdir, s->path, log, err) : LMB_OK;
-    if (st != LMB_OK)
-        return st;
-    lmb_part_identity id;
-    memset(&id, 0, sizeof id);
-    lmb_steps *steps = NULL;
-    lmb_layout l;
-    lmb_rt rt;
-    lmb_emitters *em = NULL;
-    lmb_direct *direct = NULL;
-    lmb_sky *sky = NULL;
-    lmb_textures tx;
-    lmb_cache cache;
-    lmb_ic_points records = {NULL, 0};
-    memset(&l, 0, sizeof l);
-    memset(&rt, 0, sizeof rt);
-    memset(&tx, 0, sizeof tx);
-    memset(&cache, 0, sizeof cache);
-    st = lmb_sky_create(cfg, s, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
-    if (st == LMB_OK && plan_path) /* the plan stage's layout (steps/plan.h), checked against this scene and config */
-        st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
-    else if (st == LMB_OK)
-        st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
-    if (st == LMB_OK && progress)
-        progress(user, "scene set-up", 0, 1); /* ray-tracing scene, textures, lights, bounce cache */
-    if (st == LMB_OK)
-        st = lmb_rt_build(s, &rt, err);
-    if (st == LMB_OK && !shard)
-        lmb_info(log, "ray tracing: %llu triangles placed, %llu stored (meshes used more than once are Embree "
-                 "instances), built in %.2f s", (unsigned long long)rt.placed_triangles,
-                 (unsigned long long)rt.stored_triangles, rt.build_seconds);
-    if (st == LMB_OK)
-        st = lmb_textures_load(s, &tx, log, err);
-    if (st == LMB_OK)
-        st = lmb_emitters_build(s, cfg, &tx, &em, err);
-    if (st == LMB_OK)
-        st = lmb_direct_create(s, cfg, &rt, em, sky, &direct, err);
-    if (st == LMB_OK)
-        st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
-    cache.threads = cfg->threads;
-    if (st == LMB_OK && progress)
-        progress(user, "scene set-up", 1, 1);
-    lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH
-                                                                                                   : LMB_STEPS_LOCAL;
-    lmb_steps_worker sw = {run->shards, run->worker, run->workers, run->wait_timeout};
-    if (st == LMB_OK && worker)
-        st = lmb_steps_create_worker(run->farm_dir, &id, &sw, (double)cfg->farm_min_step_rays, log, &steps, err);
-    else if (st == LMB_OK)
-        st = lmb_steps_create(mode, run->farm_dir, &id, run->step, run->shard, run->shards,
-                              (double)cfg->farm_min_step_rays, log, &steps, err);
-    double tl = lmb_seconds();
-    if (st == LMB_OK && !shard && !lmb_direct_any_light(direct))
-        lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material, no sky): the "
-                 "lightmaps are black", s->path);
-    if (st == LMB_OK)
-        st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
-    if (st == LMB_OK && worker)
-        st = lmb_steps_worker_end(steps, err);
-    if (worker && !finishes) {
-        run->steps = lmb_steps_count(steps);
-        goto done;
-    }
-    if (shard) { /* the shard's part is written (stopped), or the bake ended before its step */
-        if (st == LMB_OK) {
-            st = lmb_steps_write_end(steps, err);
-            run->ended = 1;
-        } else if (st == LMB_STEP_STOPPED) {
-            st = LMB_OK;
-        }
-        run->steps = lmb_steps_count(steps);
-        goto done;
-    }
-    run->steps = lmb_steps_count(steps);
-    if (st == LMB_OK)
-        st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
-    lmb_atlas_output *outputs = calloc((size_t)l.atlas_count + 1, sizeof *outputs);
-    if (st == LMB_OK && !outputs)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "output: out of memory");
-    uint64_t clamped = 0;
-    for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
-        if (progress)
-            progress(user, "images", a, l.atlas_count);
-        st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
-                                    l.height[a], &outputs[a], err);
-        clamped += outputs[a].rgbm_clamped;
-        if (st == LMB_OK && outputs[a].rgbm_clamped)
-            lmb_warn(log, "atlas %u: %llu texels brighter than RGBM's range %g were clamped (output.rgbm_range; auto "
-                     "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
-    }
-    if (progress && st == LMB_OK)
-        progress(user, "images", l.atlas_count, l.atlas_count);
-    stats->rgbm_clamped = clamped;
-    for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
-        st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
-    for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)
-        st = lmb_write_direction_images(cfg, od.staging, od.stem, a, cache.direction[a], l.width[a], l.height[a], err);
-    stats->light_seconds = lmb_seconds() - tl;
-    stats->atlases = l.atlas_count;
-    stats->texel_density = l.density.scene_density;
-    stats->density_auto = l.density.automatic;
-    stats->density_capped = l.density.capped;
-    stats->density_raised = l.density.raised;
-    if (st == LMB_OK && progress)
-        progress(user, "glTF", 0, 1);
-    if (st == LMB_OK) {
-        copy_textures(s, &od, log);
-        st = write_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
-                        cache.shadowmask != NULL, err);
-    }
-    free(outputs);
-    if (st == LMB_OK)
-        st = lmb_output_dir_commit(&od, err);
-    else
-        lmb_output_dir_abort(&od);
-    if (st == LMB_OK && progress)
-        progress(user, "glTF", 1, 1);
-    if (st == LMB_OK)
-        snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
-done:
-    lmb_steps_free(steps);
-    lmb_part_identity_free(&id);
-    lmb_cache_free(&cache);
-    free(records.xyzr);
-    lmb_direct_free(direct);
-    lmb_sky_free(sky);
-    lmb_emitters_free(em);
-    lmb_textures_free(&tx);
-    lmb_rt_free(&rt);
-    lmb_layout_free(&l);
-    stats->seconds = lmb_seconds() - t0;
-    return st;
 }
