@@ -29,7 +29,10 @@ The same serial share is also sampled from outside the process for both binaries
 Every output of every bake is compared with the after binary's at the first thread count,
 byte for byte (before and after must agree too: the work changes the speed, not the bits).
 
-usage: bench_threads.py BEFORE AFTER WORKDIR CSV PNG THREADS(e.g. 1,2) SCENE[=CONFIG] ...
+With ROUNDS > 1 the whole sequence repeats and every figure printed is the rounds' median (the
+CSV keeps each round): on a machine others share, one round's times move by 10% or more.
+
+usage: bench_threads.py BEFORE AFTER WORKDIR CSV PNG THREADS(e.g. 1,2) ROUNDS SCENE[=CONFIG] ...
 """
 import csv
 import filecmp
@@ -37,6 +40,7 @@ import os
 import re
 import shutil
 import subprocess
+import statistics
 import sys
 import threading
 import time
@@ -158,79 +162,100 @@ def identical(a, b):
         filecmp.cmp(os.path.join(a, n), os.path.join(b, n), shallow=False) for n in names)
 
 
+def measure_round(name, scene, cfg, before, after, threads, work, reference, rows, r):
+    """One round on one scene: each thread count with both binaries, alternating, then T 1-thread
+    processes at once. Returns (walls, stages, serial) dicts for this round."""
+    walls, stages, serial = {}, {}, {}
+    for t in threads:
+        for which, binary in (("before", before), ("after", after)):
+            out = os.path.join(work, "%s-%s-t%d" % (name, which, t))
+            shutil.rmtree(out, ignore_errors=True)
+            args = [binary, "bake", scene, *cfg, "-o", out, "--threads", str(t)]
+            tcsv = out + "-timings.csv"
+            if which == "after":
+                args.append("--timings=" + tcsv)
+            outside = []
+            wall, lines = timed(args, out + ".log", outside)
+            walls[which, t] = wall
+            sec, sampled = outside
+            walls[which, t, "outside"] = sec * wall / sampled if sampled else 0.0  # over the whole wall time
+            stages[which, t] = stage_times(lines, wall)
+            if which == "after":
+                serial[t] = timings_csv(tcsv)
+            if reference[0] is None:
+                reference[0] = out + "-reference"
+                shutil.rmtree(reference[0], ignore_errors=True)
+                shutil.copytree(out, reference[0])
+            same = identical(reference[0], out)
+            print("%-22s round %d %-6s %2d thread(s): %7.2f s%s" % (name, r + 1, which, t, wall,
+                  "" if same else "  OUTPUT DIFFERS from " + reference[0]), flush=True)
+            if not same:
+                sys.exit("bench_threads: %s differs from %s" % (out, reference[0]))
+            for stage, sec in stages[which, t].items():
+                rows.append([name, r + 1, which, t, stage, "%.3f" % sec])
+            rows.append([name, r + 1, which, t, "whole bake", "%.3f" % wall])
+    # threads against processes: T copies of the 1-thread bake at once on the same machine
+    # (what a farm of T workers does), against the T-thread bake
+    tn = threads[-1]
+    if threads[0] != 1:
+        return walls, stages, serial
+    procs, outs = [], []
+    t0 = time.time()
+    for k in range(tn):
+        out = os.path.join(work, "%s-process-%d" % (name, k))
+        shutil.rmtree(out, ignore_errors=True)
+        outs.append(out)
+        procs.append(subprocess.Popen([after, "bake", scene, *cfg, "-o", out, "--threads", "1", "-q"]))
+    ends = []
+    for p in procs:
+        if p.wait() != 0:
+            sys.exit("bench_threads: a 1-thread copy of %s failed" % name)
+        ends.append(time.time() - t0)
+    for out in outs:
+        if not identical(reference[0], out):
+            sys.exit("bench_threads: %s differs from %s" % (out, reference[0]))
+    walls["processes", tn] = max(ends)
+    print("%-22s round %d %d processes x 1 thread at once: %7.2f s (each %s)" % (name, r + 1, tn, max(ends),
+          ", ".join("%.2f s" % e for e in ends)), flush=True)
+    rows.append([name, r + 1, "processes", tn, "whole bake", "%.3f" % max(ends)])
+    return walls, stages, serial
+
+
+def medians(runs):
+    """The rounds' medians, key by key: (walls, stages, serial)."""
+    walls = {k: statistics.median(w[k] for w, _, _ in runs) for k in runs[0][0]}
+    stages = {k: {s: statistics.median(st[k][s] for _, st, _ in runs if s in st[k]) for s in runs[0][1][k]}
+              for k in runs[0][1]}
+    serial = {t: tuple(statistics.median(se[t][i] for _, _, se in runs) for i in range(3)) for t in runs[0][2]}
+    return walls, stages, serial
+
+
 def main():
-    if len(sys.argv) < 8:
+    if len(sys.argv) < 9:
         sys.exit(__doc__)
-    before, after, work, csv_path, png_path, threads_arg = sys.argv[1:7]
+    before, after, work, csv_path, png_path, threads_arg, rounds_arg = sys.argv[1:8]
     threads = [int(t) for t in threads_arg.split(",")]
-    scenes = sys.argv[7:]
+    rounds = int(rounds_arg)
+    scenes = sys.argv[8:]
     os.makedirs(work, exist_ok=True)
     rows, summary = [], []
     for spec in scenes:
         scene, _, config = spec.partition("=")
         name = os.path.splitext(os.path.basename(scene))[0]
         cfg = ["-c", config] if config else []
-        walls, stages, serial = {}, {}, {}
-        reference = None
-        for t in threads:
-            for which, binary in (("before", before), ("after", after)):
-                out = os.path.join(work, "%s-%s-t%d" % (name, which, t))
-                shutil.rmtree(out, ignore_errors=True)
-                args = [binary, "bake", scene, *cfg, "-o", out, "--threads", str(t)]
-                tcsv = out + "-timings.csv"
-                if which == "after":
-                    args.append("--timings=" + tcsv)
-                outside = []
-                wall, lines = timed(args, out + ".log", outside)
-                walls[which, t] = wall
-                walls[which, t, "outside"] = tuple(outside)
-                stages[which, t] = stage_times(lines, wall)
-                if which == "after":
-                    serial[t] = timings_csv(tcsv)
-                if reference is None:
-                    reference = out
-                same = identical(reference, out)
-                print("%-22s %-6s %2d thread(s): %7.2f s%s" % (name, which, t, wall,
-                      "" if same else "  OUTPUT DIFFERS from " + reference), flush=True)
-                if not same:
-                    sys.exit("bench_threads: %s differs from %s" % (out, reference))
-                for stage, sec in stages[which, t].items():
-                    rows.append([name, which, t, stage, "%.3f" % sec])
-                rows.append([name, which, t, "whole bake", "%.3f" % wall])
-        # threads against processes: T copies of the 1-thread bake at once on the same
-        # machine (what a farm of T workers does), against the T-thread bake
-        tn = threads[-1]
-        if threads[0] != 1:
-            summary.append((name, walls, stages, serial))
-            continue
-        procs, outs = [], []
-        t0 = time.time()
-        for k in range(tn):
-            out = os.path.join(work, "%s-process-%d" % (name, k))
-            shutil.rmtree(out, ignore_errors=True)
-            outs.append(out)
-            procs.append(subprocess.Popen([after, "bake", scene, *cfg, "-o", out, "--threads", "1", "-q"]))
-        ends = []
-        for p in procs:
-            if p.wait() != 0:
-                sys.exit("bench_threads: a 1-thread copy of %s failed" % name)
-            ends.append(time.time() - t0)
-        for out in outs:
-            if not identical(reference, out):
-                sys.exit("bench_threads: %s differs from %s" % (out, reference))
-        walls["processes", tn] = max(ends)
-        print("%-22s %d processes x 1 thread at once: %7.2f s (each %s)" % (name, tn, max(ends),
-              ", ".join("%.2f s" % e for e in ends)), flush=True)
-        rows.append([name, "processes", tn, "whole bake", "%.3f" % max(ends)])
-        summary.append((name, walls, stages, serial))
+        runs = []  # per round: (walls, stages, serial) as measure_round gives them
+        reference = [None]
+        for r in range(rounds):
+            runs.append(measure_round(name, scene, cfg, before, after, threads, work, reference, rows, r))
+        summary.append((name,) + medians(runs))
     with open(csv_path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["scene", "binary", "threads", "stage", "wall_s"])
+        w.writerow(["scene", "round", "binary", "threads", "stage", "wall_s"])
         w.writerows(rows)
     t1, tn = threads[0], threads[-1]
     for name, walls, stages, serial in summary:
-        print("\n%s: seconds per stage, %d and %d thread(s); speed-up = %d-thread time / %d-thread time"
-              % (name, t1, tn, t1, tn))
+        print("\n%s (median of %d round(s)): seconds per stage, %d and %d thread(s); speed-up = %d-thread time / "
+              "%d-thread time" % (name, rounds, t1, tn, t1, tn))
         print("%-20s %9s %9s %8s   %9s %9s %8s" % ("stage", "before t%d" % t1, "t%d" % tn, "speed-up",
                                                   "after t%d" % t1, "t%d" % tn, "speed-up"))
         for stage, _ in STAGES + [("whole bake", None)]:
@@ -247,9 +272,8 @@ def main():
             for which in ("before", "after"):
                 s = walls[which, t1] / walls[which, t] * t1
                 f = (t / s - 1) / (t - 1)
-                sec, sampled = walls[which, t, "outside"]
+                sec = walls[which, t, "outside"]
                 w = walls[which, t]
-                sec *= w / sampled if sampled else 0  # the share sampled, over the whole wall time
                 fo = sec / (sec + t * (w - sec)) if w > sec else 1.0
                 print("%s: %-6s at %d threads: speed-up %.2fx over %d thread(s); Amdahl serial fraction from the "
                       "wall times %.1f%%; sampled from outside: %.2f s of %.2f s with at most one thread running, "

@@ -8,21 +8,25 @@
 # processes). Prints per stage the seconds and speed-ups, the serial fraction, and
 # writes bench/threads/threads.csv and bench/threads/threads.png. Not part of the tests
 # (about 11 minutes on 2 cores, plus about 4 to build BEFORE the first time).
-#   usage: tools/bench_threads.sh [--before REF] [--threads 1,2] [SCENE[=CONFIG] ...]
+#   usage: tools/bench_threads.sh [--before REF] [--threads 1,2] [--rounds N] [SCENE[=CONFIG] ...]
+#   --rounds N: the whole sequence N times (default 1); figures are the rounds' medians
 set -euo pipefail
 cd "$(dirname "$0")/.."
 before_ref=e468856
 threads=1,2
+rounds=1
 scenes=()
 while [ $# -gt 0 ]; do
   case $1 in
     --before) before_ref=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
-    -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+    --rounds) rounds=$2; shift 2 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
     *) scenes+=("$1"); shift ;;
   esac
 done
 [[ $threads =~ ^[1-9][0-9]*(,[1-9][0-9]*)+$ ]] || { echo "bench_threads: --threads needs a list such as 1,2"; exit 2; }
+[[ $rounds =~ ^[1-9][0-9]?$ ]] || { echo "bench_threads: --rounds needs a number 1..99"; exit 2; }
 tools/setup.sh build
 work=bench/threads
 mkdir -p "$work" bench/levels
@@ -45,4 +49,4 @@ if [ ! -x "$bld/lmbake" ] || [ "$(cat "$bld/commit" 2>/dev/null)" != "$commit" ]
   echo "$commit" > "$bld/commit"
 fi
 /usr/bin/python3 tools/bench_threads.py "$bld/lmbake" build/lmbake "$work/runs" "$work/threads.csv" \
-  "$work/threads.png" "$threads" "${scenes[@]}"
+  "$work/threads.png" "$threads" "$rounds" "${scenes[@]}"
