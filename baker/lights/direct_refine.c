@@ -3,6 +3,7 @@
 #include "direct_refine.h"
 
 #include "util/lmb_math.h"
+#include "util/select.h"
 
 #include <omp.h>
 
@@ -377,47 +378,11 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     return st;
 }
 
-/* The k-th smallest of v[0..n) (0-based; v is reordered): Hoare's selection with a median-of-
- * three pivot, O(n) expected; the value a sort would put at k. A million texels' estimates: a
- * sort cost about 0.3 s of the bake's serial time. */
-static float select_kth(float *v, uint64_t n, uint64_t k)
-{
-    uint64_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        uint64_t mid = lo + (hi - lo) / 2;
-        float a = v[lo], b = v[mid], c = v[hi];
-        float pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        uint64_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] < pivot)
-                i++;
-            while (v[j] > pivot)
-                j--;
-            if (i <= j) {
-                float t = v[i];
-                v[i] = v[j];
-                v[j] = t;
-                i++;
-                if (j == 0)
-                    break;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return v[k];
-    }
-    return v[k];
-}
-
 void lmb_direct_noise_finish(lmb_direct_noise *noise, float *estimates, uint64_t count)
 {
     if (count) {
-        noise->median = select_kth(estimates, count, count / 2);
-        noise->p95 = select_kth(estimates, count, (uint64_t)(0.95 * (double)(count - 1)));
+        noise->median = lmb_select_kth(estimates, count, count / 2);
+        noise->p95 = lmb_select_kth(estimates, count, (uint64_t)(0.95 * (double)(count - 1)));
     }
     free(estimates);
 }

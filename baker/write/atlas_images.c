@@ -11,6 +11,7 @@
 #include "rgbm.h"
 #include "post/dilate.h"
 #include "util/lmb_math.h"
+#include "util/select.h"
 
 #include <omp.h>
 
@@ -18,38 +19,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* The k-th smallest of v[0..n) (v is reordered): Hoare's selection, O(n) expected. */
-static float select_kth(float *v, size_t n, size_t k)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        float a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi];
-        float pivot = a < b ? (b < c ? b : (a < c ? c : a)) : (a < c ? a : (b < c ? c : b));
-        size_t i = lo, j = hi;
-        while (i <= j) {
-            while (v[i] < pivot)
-                i++;
-            while (v[j] > pivot)
-                j--;
-            if (i <= j) {
-                float t = v[i];
-                v[i++] = v[j];
-                v[j] = t;
-                if (j == 0)
-                    break;
-                j--;
-            }
-        }
-        if (k <= j)
-            hi = j;
-        else if (k >= i)
-            lo = i;
-        else
-            return v[k];
-    }
-    return v[k];
-}
 
 /* Tonemapped 8-bit preview of irradiance: exposure maps the 95th percentile of the valid
  * texels' luminance to 0.8 before Reinhard x/(1+x) and the sRGB curve. For a quick look
@@ -64,7 +33,7 @@ static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t
             if (valid[i] == LMB_TEXEL_VALID)
                 lum[m++] = 0.2126f * rgb[3 * i] + 0.7152f * rgb[3 * i + 1] + 0.0722f * rgb[3 * i + 2];
         if (m) {
-            double p95 = select_kth(lum, m, (size_t)(0.95 * (double)(m - 1)));
+            double p95 = lmb_select_kth(lum, m, (size_t)(0.95 * (double)(m - 1)));
             scale = p95 > 0 ? 0.8 / p95 : 1.0;
         }
         free(lum);
