@@ -20,8 +20,9 @@ Then T copies of the after binary's 1-thread bake run at once (T the largest thr
 what T farm workers of one thread each do on this machine. Each copy's time against the
 1-thread bake alone is the machine's own scaling (shared caches, memory, a busy host); the
 T-thread bake's time against theirs divided by T says whether threads keep up with processes.
-The after binary also runs with --timings=CSV: per stage (its own, finer stages) the CPU time
-over all threads and the serial share; the serial seconds summed over the stages, S, at T
+The after binary also runs once more at each T > 1 with --timings=CSV (a run of its own: its
+sampling thread stays out of the times compared): per stage the CPU time over all threads and
+the serial share; the serial seconds summed over the stages, S, at T
 threads with wall time W give the serial fraction of the work, f = S / (S + T (W - S)).
 From the wall times alone, Amdahl's f = (T / speed-up - 1) / (T - 1) for each T > 1.
 The same serial share is also sampled from outside the process for both binaries
@@ -171,17 +172,12 @@ def measure_round(name, scene, cfg, before, after, threads, work, reference, row
             out = os.path.join(work, "%s-%s-t%d" % (name, which, t))
             shutil.rmtree(out, ignore_errors=True)
             args = [binary, "bake", scene, *cfg, "-o", out, "--threads", str(t)]
-            tcsv = out + "-timings.csv"
-            if which == "after":
-                args.append("--timings=" + tcsv)
             outside = []
             wall, lines = timed(args, out + ".log", outside)
             walls[which, t] = wall
             sec, sampled = outside
             walls[which, t, "outside"] = sec * wall / sampled if sampled else 0.0  # over the whole wall time
             stages[which, t] = stage_times(lines, wall)
-            if which == "after":
-                serial[t] = timings_csv(tcsv)
             if reference[0] is None:
                 reference[0] = out + "-reference"
                 shutil.rmtree(reference[0], ignore_errors=True)
@@ -194,6 +190,13 @@ def measure_round(name, scene, cfg, before, after, threads, work, reference, row
             for stage, sec in stages[which, t].items():
                 rows.append([name, r + 1, which, t, stage, "%.3f" % sec])
             rows.append([name, r + 1, which, t, "whole bake", "%.3f" % wall])
+    # --timings in a run of its own, so that its sampling thread does not touch the times above
+    for t in threads[1:]:
+        tcsv = os.path.join(work, "%s-timings-t%d.csv" % (name, t))
+        out = os.path.join(work, "%s-timings-t%d" % (name, t))
+        shutil.rmtree(out, ignore_errors=True)
+        timed([after, "bake", scene, *cfg, "-o", out, "--threads", str(t), "--timings=" + tcsv], out + ".log")
+        serial[t] = timings_csv(tcsv)
     # threads against processes: T copies of the 1-thread bake at once on the same machine
     # (what a farm of T workers does), against the T-thread bake
     tn = threads[-1]

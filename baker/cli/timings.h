@@ -5,7 +5,7 @@
  * a log): its wall time, the CPU time summed over the process's threads, and the serial
  * share: the part of its wall time during which at most one thread ran.
  *
- * How: a sampling thread reads every thread's CPU clock each SAMPLE_MS (Linux's per-thread
+ * How: a sampling thread reads every thread's CPU clock every 10 ms (Linux's per-thread
  * CPU-time clocks, found from /proc/self/task). An interval in which one thread or none used
  * more than half of it counts as serial. The sampler's own thread is left out. Threads that
  * a busy machine preempts look idle, so the serial share is an upper bound on a loaded machine.
