@@ -169,7 +169,8 @@ lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double 
     const lmb_layout_instance *li = &c->layout->instances[g->instance];
     if (!li->lightmapped)
         return LMB_HIT_UNMAPPED;
-    const double *uv = li->uv1 + 6 * ((size_t)g->first_triangle + hit->prim);
+    double uv[6];
+    lmb_layout_uv(c->layout, g->instance, (size_t)g->first_triangle + hit->prim, uv);
     double b1 = hit->u, b2 = hit->v, b0 = 1.0 - b1 - b2;
     double x = b0 * uv[0] + b1 * uv[2] + b2 * uv[4], y = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
     bilinear(c->irradiance[li->atlas], c->layout->width[li->atlas], c->layout->height[li->atlas], x, y, e);

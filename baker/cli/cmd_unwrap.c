@@ -81,7 +81,7 @@ static lmb_status atlas_metrics(const lmb_scene *s, const lmb_layout *l, uint32_
             if (lm->charts.chart_of[f] == UINT32_MAX)
                 continue;
             lmb_layout_world_triangle(s, l, i, f, pos + 9 * n);
-            memcpy(uv + 6 * n, li->uv1 + 6 * f, 6 * sizeof(double));
+            lmb_layout_uv(l, i, f, uv + 6 * n);
             n++;
         }
     }
@@ -128,7 +128,9 @@ static lmb_status write_png(const lmb_scene *s, const lmb_layout *l, uint32_t a,
         for (uint32_t f = 0; f < c->triangle_count; f++)
             if (c->chart_of[f] != UINT32_MAX) {
                 chart_colour(i, c->chart_of[f], p.colour);
-                lmb_raster_triangle_centres(li->uv1 + 6 * f, l->width[a], l->height[a], paint_texel, &p);
+                double uv[6];
+                lmb_layout_uv(l, i, f, uv);
+                lmb_raster_triangle_centres(uv, l->width[a], l->height[a], paint_texel, &p);
             }
     }
     char path[4096];
@@ -185,7 +187,7 @@ static void print_chart_sizes(const lmb_scene *s, const lmb_layout *l)
     for (uint32_t i = 0; i < l->instance_count; i++) {
         const lmb_layout_instance *li = &l->instances[i];
         const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
-        if (!li->lightmapped || !li->uv1 || c->chart_count == 0)
+        if (!li->lightmapped || c->chart_count == 0)
             continue;
         chart_box *b = malloc(sizeof(chart_box) * c->chart_count);
         if (!b)
@@ -196,7 +198,8 @@ static void print_chart_sizes(const lmb_scene *s, const lmb_layout *l)
             uint32_t k = c->chart_of[f];
             if (k == UINT32_MAX)
                 continue;
-            const double *u = li->uv1 + 6 * f;
+            double u[6];
+            lmb_layout_uv(l, i, f, u);
             for (int v = 0; v < 3; v++) {
                 b[k].x0 = fmin(b[k].x0, u[2 * v]);
                 b[k].x1 = fmax(b[k].x1, u[2 * v]);

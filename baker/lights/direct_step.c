@@ -290,10 +290,11 @@ static void band_costs(const lmb_layout *layout, uint32_t a, uint32_t width, uin
     }
     for (uint32_t i = 0; i < layout->instance_count; i++) {
         const lmb_layout_instance *li = &layout->instances[i];
-        if (!li->lightmapped || li->atlas != a || !li->uv1)
+        if (!li->lightmapped || li->atlas != a)
             continue;
-        for (size_t f = 0; f + 6 <= li->uv1_count; f += 6) {
-            const double *q = li->uv1 + f;
+        for (size_t f = 0; f < li->triangle_count; f++) {
+            double q[6];
+            lmb_layout_uv(layout, i, f, q);
             double area = 0.5 * fabs((q[2] - q[0]) * (q[5] - q[1]) - (q[4] - q[0]) * (q[3] - q[1]));
             double lo = fmin(q[1], fmin(q[3], q[5])), hi = fmax(q[1], fmax(q[3], q[5]));
             if (!(area > 0) || hi < 0 || lo >= height)

@@ -281,29 +281,51 @@ static double auto_density(double left, uint32_t n, const uint8_t *fixed, const 
     return lo > 0 ? lo : hi;
 }
 
+lmb_status lmb_density_measure(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const uint32_t *list,
+                               uint32_t n, lmb_density_measures *m, lmb_error *err)
+{
+    m->fit = malloc(sizeof(double) * n + 1);
+    m->area = malloc(sizeof(double) * n + 1);
+    m->floor_d = calloc((size_t)n + 1, sizeof(double));
+    if (!m->fit || !m->area || !m->floor_d) {
+        lmb_density_measures_free(m);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    }
+    /* each instance's charts' boxes (the work) in parallel */
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
+    for (uint32_t k = 0; k < n; k++) {
+        uint32_t i = list[k];
+        m->fit[k] = lmb_density_fit(s, l, cfg, i);
+        m->area[k] = lmb_instance_world_area(s, l, i);
+        m->floor_d[k] =
+            lmb_density_override_for(s, cfg, i) > 0 ? 0 : fmin(lmb_density_floor(s, l, cfg, i), m->fit[k]);
+    }
+    return LMB_OK;
+}
+
+void lmb_density_measures_free(lmb_density_measures *m)
+{
+    free(m->fit);
+    free(m->area);
+    free(m->floor_d);
+    m->fit = m->area = m->floor_d = NULL;
+}
+
 lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
-                              uint32_t n, const lmb_log *log, lmb_density_report *rep, lmb_error *err)
+                              uint32_t n, const lmb_density_measures *m, uint64_t budget, const lmb_log *log,
+                              lmb_density_report *rep, lmb_error *err)
 {
     memset(rep, 0, sizeof *rep);
     rep->automatic = !(cfg->texel_density > 0);
-    rep->budget = lmb_config_atlas_texels(cfg);
-    double *fit = malloc(sizeof(double) * n + 1), *area = malloc(sizeof(double) * n + 1),
-           *floor_d = calloc((size_t)n + 1, sizeof(double));
+    rep->budget = budget;
+    const double *fit = m->fit, *area = m->area;
+    double *floor_d = malloc(sizeof(double) * n + 1);
     uint8_t *fixed = calloc((size_t)n + 1, 1);
-    lmb_status st =
-        fit && area && floor_d && fixed ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    lmb_status st = floor_d && fixed ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     double fixed_texels = 0, free_area = 0;
-    /* each instance's fit, area and floor (its charts' boxes: the work) in parallel; the
-     * decisions, messages and sums after, in instance order */
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
-    uint32_t to_measure = st == LMB_OK ? n : 0;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
-    for (uint32_t k = 0; k < to_measure; k++) {
-        uint32_t i = list[k];
-        fit[k] = lmb_density_fit(s, l, cfg, i);
-        area[k] = lmb_instance_world_area(s, l, i);
-        floor_d[k] = lmb_density_override_for(s, cfg, i) > 0 ? 0 : fmin(lmb_density_floor(s, l, cfg, i), fit[k]);
-    }
+    for (uint32_t k = 0; st == LMB_OK && k < n; k++)
+        floor_d[k] = m->floor_d[k];
     for (uint32_t k = 0; st == LMB_OK && k < n; k++) {
         uint32_t i = list[k];
         double o = lmb_density_override_for(s, cfg, i), d = o > 0 ? o : cfg->texel_density;
@@ -354,6 +376,12 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
             l->instances[i].texel_density = di > 0 ? di : d;
             if (floor_d[k] > d && di > d)
                 rep->raised++;
+            if (m->floor_d[k] > 0 && di < m->floor_d[k] * (1 - 1e-9)) { /* the budget won over the floor */
+                rep->short_of_floor++;
+                double share = di / m->floor_d[k];
+                rep->floor_share_min = rep->short_of_floor == 1 || share < rep->floor_share_min ? share
+                                                                                                  : rep->floor_share_min;
+            }
             if (fit[k] < d) {
                 rep->capped++;
                 lmb_warn(log,
@@ -369,8 +397,6 @@ lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_lay
                  "%u instance(s) get more than the scene's %.4g texels per unit so that their charts span at least %u "
                  "texels (atlas.min_chart_texels)",
                  rep->raised, rep->scene_density, cfg->min_chart_texels);
-    free(fit);
-    free(area);
     free(floor_d);
     free(fixed);
     return st;

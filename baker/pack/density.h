@@ -28,13 +28,25 @@ double lmb_density_fit(const lmb_scene *s, const lmb_layout *l, const lmb_config
  * TEXCOORD_1. A few-centimetre prop in a 100 m level would otherwise get 1-3 texel charts. */
 double lmb_density_floor(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, uint32_t instance);
 
-/* Sets l->instances[list[k]].texel_density for the lightmapped instances list[0..n).
+/* What the density choice needs of each instance list[k], whatever the budget: its fit, its
+ * lightmapped world area and its atlas.min_chart_texels floor (0: none, or an override). */
+typedef struct lmb_density_measures {
+    double *fit, *area, *floor_d; /* per list entry */
+} lmb_density_measures;
+
+lmb_status lmb_density_measure(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const uint32_t *list,
+                               uint32_t n, lmb_density_measures *out, lmb_error *err);
+void lmb_density_measures_free(lmb_density_measures *m);
+
+/* Sets l->instances[list[k]].texel_density for the lightmapped instances list[0..n), auto's
+ * scene density filling `budget` texels (measures: lmb_density_measure of the same list).
  * Explicit densities far above what fits one atlas (their charts' boxes with padding over
  * 130% of it, or the longest chart longer than its side) are LMB_ERR_INPUT naming the instance
  * and the density estimated to fit, before anything is packed; nearer ones are left to the
  * packer, which names the instance if it cannot place it. */
 lmb_status lmb_density_choose(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
-                              uint32_t n, const lmb_log *log, lmb_density_report *report, lmb_error *err);
+                              uint32_t n, const lmb_density_measures *measures, uint64_t budget, const lmb_log *log,
+                              lmb_density_report *report, lmb_error *err);
 
 /* The first density_overrides entry matching instance i's node or mesh name, or 0. */
 double lmb_density_override_for(const lmb_scene *s, const lmb_config *cfg, uint32_t instance);

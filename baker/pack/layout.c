@@ -7,6 +7,7 @@
  */
 #include "../util/clock.h"
 #include "layout.h"
+#include "coverage.h"
 #include "density.h"
 #include "keep_uv1.h"
 #include "rect_instances.h"
@@ -71,10 +72,11 @@ void lmb_layout_world_triangle(const lmb_scene *s, const lmb_layout *l, uint32_t
     }
 }
 
-/* Scales instance i's charts into uv1 (texel units, chart-local) and returns its texel area. */
-double lmb_layout_scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
+/* Scales instance i's charts into uv (6 per mesh triangle; texel units, chart-local) and returns
+ * its texel area. */
+double lmb_layout_scale_instance(const lmb_scene *s, const lmb_layout *l, uint32_t i, double *uv)
 {
-    lmb_layout_instance *li = &l->instances[i];
+    const lmb_layout_instance *li = &l->instances[i];
     const lmb_layout_mesh *lm = &l->meshes[s->instances[i].mesh];
     const lmb_charts *c = &lm->charts;
     double texels = 0;
@@ -91,7 +93,7 @@ double lmb_layout_scale_instance(const lmb_scene *s, lmb_layout *l, uint32_t i)
         for (uint32_t j = c->first[k]; j < c->first[k + 1]; j++) {
             uint32_t f = c->order[j];
             for (int d = 0; d < 6; d++)
-                li->uv1[6 * f + d] = c->uv[6 * f + d] * sc;
+                uv[6 * f + d] = c->uv[6 * f + d] * sc;
         }
         texels += aw * li->texel_density * li->texel_density;
     }
@@ -214,7 +216,7 @@ static lmb_status pack_level(const lmb_scene *s, const lmb_config *cfg, lmb_layo
                  s->instances[failed].name, s->meshes[s->instances[failed].mesh].name, li->texel_density,
                  cfg->max_atlas_size, cfg->max_atlas_size);
         /* a failed packing wrote nothing back: only this instance's charts change scale */
-        lmb_layout_scale_instance(s, l, failed);
+        lmb_layout_scale_instance(s, l, failed, li->uv1);
     }
 }
 
@@ -307,6 +309,144 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
     return st;
 }
 
+/* One placement of the lightmapped instances list[0..n) (their charts unwrapped, measures
+ * taken): densities for `budget` texels (quietly: lmb_layout_build said them for the whole
+ * budget), then packing. log: the packer's messages, NULL to keep a trial quiet. */
+static lmb_status place(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *all, uint32_t n,
+                        const lmb_density_measures *measures, uint64_t budget, const lmb_log *log, lmb_error *err)
+{
+    uint32_t *list = malloc(((size_t)n + 1) * sizeof *list);
+    if (!list)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    memcpy(list, all, (size_t)n * sizeof *list);
+    lmb_status st = lmb_density_choose(s, cfg, l, list, n, measures, budget, NULL, &l->density, err);
+    /* atlas.share_meshes: the lightmapped nodes (not instanced copies) of each mesh */
+    uint32_t *users = calloc((size_t)s->mesh_count + 1, sizeof *users);
+    uint8_t *as_rect = calloc((size_t)s->instance_count + 1, 1);
+    if (st == LMB_OK && (!users || !as_rect))
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++)
+        users[s->instances[list[j]].mesh] += s->instances[list[j]].gpu_instance < 0;
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
+        const lmb_instance *in = &s->instances[list[j]];
+        as_rect[list[j]] = l->meshes[in->mesh].kept_uv1 || in->gpu_instance >= 0 ||
+                           (cfg->share_meshes && users[in->mesh] >= 2);
+    }
+    int out_of_memory = 0, threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    uint32_t to_scale = st == LMB_OK ? n : 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(| : out_of_memory)
+    for (uint32_t j = 0; j < to_scale; j++) { /* the packed instances' charts at their density: their own uv1 */
+        lmb_layout_instance *li = &l->instances[list[j]];
+        li->lightmapped = 1;
+        li->block = UINT32_MAX;
+        li->triangle_count = l->meshes[s->instances[list[j]].mesh].soup.triangle_count;
+        if (as_rect[list[j]])
+            continue; /* a rectangle: its block and place say where its triangles are */
+        li->uv1 = calloc((size_t)li->triangle_count * 6 + 1, sizeof *li->uv1);
+        if (!li->uv1)
+            out_of_memory = 1;
+        else
+            lmb_layout_scale_instance(s, l, list[j], li->uv1);
+    }
+    if (out_of_memory)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    free(users);
+    /* kept TEXCOORD_1 and instanced copies: rectangles of shared atlases, after the packed ones;
+     * the rest is packed chart by chart */
+    uint32_t packed = 0, kept = 0;
+    uint32_t *kept_list = malloc(((size_t)n + 1) * sizeof *kept_list);
+    if (st == LMB_OK && !kept_list)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
+        lmb_layout_instance *li = &l->instances[list[j]];
+        li->scale_offset[0] = li->scale_offset[1] = 1;
+        if (as_rect[list[j]])
+            kept_list[kept++] = list[j];
+        else
+            list[packed++] = list[j];
+    }
+    if (st == LMB_OK && packed)
+        st = pack_level(s, cfg, l, list, packed, log, err);
+    if (st == LMB_OK && kept)
+        st = lmb_layout_rect_instances(s, cfg, l, kept_list, kept, log, err);
+    free(kept_list);
+    free(as_rect);
+    free(list);
+    return st;
+}
+
+/* Undoes place(): the charts stay, every placement goes. */
+static void unplace(lmb_layout *l)
+{
+    for (uint32_t i = 0; i < l->instance_count; i++) {
+        free(l->instances[i].uv1);
+        memset(&l->instances[i], 0, sizeof l->instances[i]);
+    }
+    for (uint32_t b = 0; l->blocks && b < l->block_count; b++)
+        free(l->blocks[b].uv);
+    free(l->blocks);
+    free(l->width);
+    free(l->height);
+    l->blocks = NULL;
+    l->width = l->height = NULL;
+    l->block_count = l->atlas_count = l->chart_total = 0;
+}
+
+/* A bake may make at most this share of atlas.texels (padding, partly covered edge texels and
+ * raised small props included); a layout over it is made again at a lower density. */
+#define BUDGET_SLACK 1.10
+#define BUDGET_ROUNDS 8
+
+/* texel_density: auto: places for the budget and counts the texels the layout makes; while it
+ * makes more than BUDGET_SLACK x the budget (the density's estimate counts surface, not the
+ * texels small charts touch at their edges, their padding or their floors), the budget asked
+ * of the density is lowered by the ratio and the layout made again. A level within it keeps
+ * its first layout, unchanged. */
+static lmb_status place_within_budget(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                                      uint32_t n, const lmb_density_measures *measures, const lmb_log *log,
+                                      lmb_error *err)
+{
+    uint64_t budget = lmb_config_atlas_texels(cfg), asked = budget, made = 0;
+    uint32_t round = 0;
+    lmb_status st = LMB_OK;
+    for (;;) {
+        round++;
+        st = place(s, cfg, l, list, n, measures, asked, round == 1 ? log : NULL, err); /* its densities said already */
+        if (st != LMB_OK || !l->density.automatic)
+            break;
+        made = lmb_layout_count_texels(s, l, cfg->texel_samples, cfg->threads, err, &st);
+        if (st != LMB_OK || made <= BUDGET_SLACK * (double)budget || round >= BUDGET_ROUNDS)
+            break;
+        /* texels grow about as the density squared, a little slower (edges): aim under the budget */
+        double ratio = 0.97 * (double)budget / (double)made;
+        asked = (uint64_t)fmax(1.0, floor((double)asked * ratio));
+        unplace(l);
+    }
+    if (st != LMB_OK)
+        return st;
+    l->density.budget = budget;
+    l->density.texels = made;
+    l->density.rounds = round;
+    if (round > 1)
+        lmb_info(log,
+                 "texel budget: the layout at the budget's density made more than %.0f%% of atlas.texels %llu (small "
+                 "charts' edge texels and padding, raised props); the density was lowered %u time(s) to %.4g texels "
+                 "per unit: %llu texels (%.0f%% of the budget)",
+                 100 * BUDGET_SLACK, (unsigned long long)budget, round - 1, l->density.scene_density,
+                 (unsigned long long)made, 100.0 * (double)made / (double)budget);
+    if (made > BUDGET_SLACK * (double)budget)
+        lmb_warn(log, "texel budget: %llu texels made, %.0f%% of atlas.texels %llu, after %u layouts",
+                 (unsigned long long)made, 100.0 * (double)made / (double)budget, (unsigned long long)budget, round);
+    if (l->density.short_of_floor)
+        lmb_warn(log,
+                 "atlas.min_chart_texels: %u small instance(s) fall short of charts %u texels wide to keep the texel "
+                 "budget: they get %.0f%% of that density at least (charts down to %.1f texels); raise atlas.texels "
+                 "to give them more",
+                 l->density.short_of_floor, cfg->min_chart_texels, 100 * l->density.floor_share_min,
+                 cfg->min_chart_texels * l->density.floor_share_min);
+    return LMB_OK;
+}
+
 lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progress_fn progress, void *user,
                             const lmb_log *log, lmb_layout *l, lmb_error *err)
 {
@@ -326,67 +466,25 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             list[n++] = i;
         }
     lmb_status st = unwrap_meshes(s, cfg, l, progress, user, err);
+    lmb_density_measures measures = {NULL, NULL, NULL};
     if (st == LMB_OK && progress)
         progress(user, "texel density", 0, 1);
     if (st == LMB_OK)
-        st = lmb_density_choose(s, cfg, l, list, n, log, &l->density, err);
+        st = lmb_density_measure(s, cfg, l, list, n, &measures, err);
+    /* densities for the whole budget: its messages, and explicit densities refused before packing */
+    if (st == LMB_OK)
+        st = lmb_density_choose(s, cfg, l, list, n, &measures, lmb_config_atlas_texels(cfg), log, &l->density, err);
     if (st == LMB_OK && progress)
         progress(user, "texel density", 1, 1);
     if (st == LMB_OK && progress)
         progress(user, "pack", 0, 1);
-    /* atlas.share_meshes: the lightmapped nodes (not instanced copies) of each mesh */
-    uint32_t *users = calloc((size_t)s->mesh_count + 1, sizeof *users);
-    uint8_t *as_rect = calloc((size_t)s->instance_count + 1, 1);
-    if (st == LMB_OK && (!users || !as_rect))
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    for (uint32_t j = 0; st == LMB_OK && j < n; j++)
-        users[s->instances[list[j]].mesh] += s->instances[list[j]].gpu_instance < 0;
-    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
-        const lmb_instance *in = &s->instances[list[j]];
-        as_rect[list[j]] = l->meshes[in->mesh].kept_uv1 || in->gpu_instance >= 0 ||
-                           (cfg->share_meshes && users[in->mesh] >= 2);
-    }
-    int out_of_memory = 0, threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
-    uint32_t to_scale = st == LMB_OK ? n : 0;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 16) reduction(| : out_of_memory)
-    for (uint32_t j = 0; j < to_scale; j++) { /* every instance's charts at its density: its own uv1 */
-        lmb_layout_instance *li = &l->instances[list[j]];
-        li->lightmapped = 1;
-        li->uv1_count = (size_t)l->meshes[s->instances[list[j]].mesh].soup.triangle_count * 6;
-        li->uv1 = calloc(li->uv1_count + 1, sizeof *li->uv1);
-        if (!li->uv1)
-            out_of_memory = 1;
-        else if (!as_rect[list[j]])
-            lmb_layout_scale_instance(s, l, list[j]);
-    }
-    if (out_of_memory)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    free(users);
-    /* kept TEXCOORD_1 and instanced copies: rectangles of shared atlases, after the packed ones;
-     * the rest is packed chart by chart */
-    uint32_t packed = 0, kept = 0;
-    uint32_t *kept_list = malloc(((size_t)n + 1) * sizeof *kept_list);
-    if (st == LMB_OK && !kept_list)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    for (uint32_t j = 0; st == LMB_OK && j < n; j++) {
-        lmb_layout_instance *li = &l->instances[list[j]];
-        li->scale_offset[0] = li->scale_offset[1] = 1;
-        if (as_rect[list[j]])
-            kept_list[kept++] = list[j];
-        else
-            list[packed++] = list[j];
-    }
-    n = packed;
     double t0 = lmb_seconds();
-    if (st == LMB_OK && n)
-        st = pack_level(s, cfg, l, list, n, log, err);
-    if (st == LMB_OK && kept)
-        st = lmb_layout_rect_instances(s, cfg, l, kept_list, kept, log, err);
-    free(kept_list);
-    free(as_rect);
+    if (st == LMB_OK)
+        st = place_within_budget(s, cfg, l, list, n, &measures, log, err);
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);
+    lmb_density_measures_free(&measures);
     free(list);
     return st;
 }
@@ -403,6 +501,9 @@ void lmb_layout_free(lmb_layout *l)
     }
     for (uint32_t i = 0; l->instances && i < l->instance_count; i++)
         free(l->instances[i].uv1);
+    for (uint32_t b = 0; l->blocks && b < l->block_count; b++)
+        free(l->blocks[b].uv);
+    free(l->blocks);
     free(l->meshes);
     free(l->instances);
     free(l->width);

@@ -22,6 +22,10 @@ typedef struct lmb_density_report {
     uint64_t budget;        /* auto: the texel budget */
     uint32_t capped;        /* auto: instances lowered to fit one atlas */
     uint32_t raised;        /* instances raised above the scene density by atlas.min_chart_texels */
+    uint32_t short_of_floor; /* instances below their atlas.min_chart_texels floor: the budget won */
+    double floor_share_min;  /* of those, the lowest share of its floor density one got */
+    uint64_t texels;         /* texels the layout makes (coverage.h); 0 when not counted (explicit density) */
+    uint32_t rounds;         /* layouts made to keep the budget: 1 when the first kept it */
 } lmb_density_report;
 
 /* One mesh's primitives as a single triangle list (vertex ids offset per primitive). */
@@ -46,14 +50,26 @@ typedef struct lmb_layout_instance {
     int lightmapped;
     uint32_t atlas;
     double texel_density; /* texels per world unit used for it */
-    double *uv1;          /* 6 per mesh triangle, atlas texel coordinates; 0 for skipped triangles */
+    uint32_t triangle_count; /* its mesh's triangles */
+    double *uv1;          /* packed instances: 6 per mesh triangle, atlas texel coordinates; 0 for skipped
+                             triangles. NULL for instances placed as rectangles: see block */
+    uint32_t block;       /* placed as a rectangle (rect_instances.h): its layout in l->blocks, which the
+                             copies of a node share, else UINT32_MAX; read either through lmb_layout_uv */
+    double rect[4];       /* with a block: its size and place in the atlas, texels (w, h, x, y) */
     int shared_layout;    /* its TEXCOORD_1 is a layout other instances share (EXT_mesh_gpu_instancing copies,
                              atlas.share_meshes): the output writes it once, uv = (atlas uv - o) / s */
     double scale_offset[4]; /* (sx, sy, ox, oy): the output TEXCOORD_1 uv lands at uv * s + o in the atlas ([0,1]):
                                (1, 1, 0, 0) for unwrapped meshes (their TEXCOORD_1 is written in atlas space), the
                                instance's rectangle for a mesh that kept its own TEXCOORD_1 */
-    size_t uv1_count;     /* doubles in uv1 */
 } lmb_layout_instance;
+
+/* A TEXCOORD_1 layout that instances placed as rectangles share: 6 per mesh triangle in
+ * [0, 1]^2 (0 for skipped triangles). Copies keep no UVs of their own, only their rectangle,
+ * so memory grows with the unique triangles, not the copies. */
+typedef struct lmb_layout_block {
+    uint32_t mesh;
+    double *uv;
+} lmb_layout_block;
 
 typedef struct lmb_layout {
     uint32_t mesh_count, instance_count;
@@ -61,6 +77,8 @@ typedef struct lmb_layout {
     lmb_layout_instance *instances;
     uint32_t atlas_count;
     uint32_t *width, *height;
+    uint32_t block_count;
+    lmb_layout_block *blocks; /* layouts shared by rectangle-placed instances */
     uint32_t chart_total;  /* charts placed, over all instances */
     lmb_density_report density;    /* how densities were chosen */
     double pack_seconds;
@@ -72,6 +90,24 @@ lmb_status lmb_layout_build(const lmb_scene *scene, const lmb_config *cfg, lmb_p
                             void *progress_user, const lmb_log *log, lmb_layout *out, lmb_error *err);
 
 void lmb_layout_free(lmb_layout *l);
+
+/* Instance i's mesh triangle f in atlas texel coordinates (6 doubles): its own uv1, or its block
+ * scaled and moved to its rectangle; zeros for a skipped (zero-area) triangle. */
+static inline void lmb_layout_uv(const lmb_layout *l, uint32_t i, size_t f, double out[6])
+{
+    const lmb_layout_instance *li = &l->instances[i];
+    if (li->uv1) {
+        for (int k = 0; k < 6; k++)
+            out[k] = li->uv1[6 * f + k];
+        return;
+    }
+    const lmb_layout_block *b = &l->blocks[li->block];
+    const lmb_charts *c = &l->meshes[b->mesh].charts;
+    for (int k = 0; k < 6; k++)
+        out[k] = c->chart_of[f] == UINT32_MAX ? 0
+                 : k % 2                      ? b->uv[6 * f + k] * li->rect[1] + li->rect[3]
+                                              : b->uv[6 * f + k] * li->rect[0] + li->rect[2];
+}
 
 /* Area of a triangle given as 9 doubles (three corners). */
 double lmb_triangle_area(const double q[9]);

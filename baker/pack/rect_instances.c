@@ -90,13 +90,14 @@ static lmb_status pack_block(const lmb_scene *s, const lmb_config *cfg, lmb_layo
                              lmb_error *err)
 {
     const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
-    lmb_layout_scale_instance(s, l, i); /* chart-local texel units in uv1 */
-    const double *uv1 = l->instances[i].uv1;
+    double *uv1 = calloc((size_t)6 * c->triangle_count + 1, sizeof *uv1);
     lmb_pack_chart *charts = calloc((size_t)c->chart_count + 1, sizeof *charts);
     double *buf = malloc(sizeof(double) * 6 * c->triangle_count + 1);
     lmb_pack_result r;
     memset(&r, 0, sizeof r);
-    lmb_status st = charts && buf ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    lmb_status st = uv1 && charts && buf ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    if (st == LMB_OK)
+        lmb_layout_scale_instance(s, l, i, uv1); /* chart-local texel units */
     for (uint32_t k = 0, at = 0; st == LMB_OK && k < c->chart_count; k++) {
         uint32_t len = c->first[k + 1] - c->first[k];
         for (uint32_t t = 0; t < len; t++)
@@ -125,6 +126,7 @@ static lmb_status pack_block(const lmb_scene *s, const lmb_config *cfg, lmb_layo
         }
     }
     lmb_pack_result_free(&r);
+    free(uv1);
     free(charts);
     free(buf);
     return st;
@@ -276,12 +278,18 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
     }
     if (st == LMB_OK)
         l->atlas_count += r.atlas_count;
-    for (uint32_t g = 0; st == LMB_OK && g < ng; g++)
+    lmb_layout_block *blocks = st == LMB_OK ? realloc(l->blocks, ((size_t)l->block_count + ng + 1) * sizeof *blocks) : NULL;
+    if (st == LMB_OK && !blocks)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    if (blocks)
+        l->blocks = blocks;
+    for (uint32_t g = 0; st == LMB_OK && g < ng; g++) {
+        uint32_t block = l->block_count++;
+        l->blocks[block].mesh = s->instances[order[groups[g].first]].mesh;
+        l->blocks[block].uv = groups[g].block; /* the layout owns it now */
+        groups[g].block = NULL;
         for (uint32_t j = groups[g].first; j < groups[g].first + groups[g].count; j++) {
             lmb_layout_instance *li = &l->instances[order[j]];
-            const double *b = groups[g].block;
-            const lmb_charts *c = &l->meshes[s->instances[order[j]].mesh].charts;
-            size_t nt = li->uv1_count / 6;
             li->atlas = base + r.atlas[j];
             li->shared_layout = !l->meshes[s->instances[order[j]].mesh].kept_uv1;
             double W = l->width[li->atlas], H = l->height[li->atlas], rw = items[j].w, rh = items[j].h;
@@ -289,10 +297,14 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
             li->scale_offset[1] = rh / H;
             li->scale_offset[2] = r.x[j] / W;
             li->scale_offset[3] = r.y[j] / H;
-            for (size_t k = 0; k < 6 * nt; k++) /* skipped (zero-area) triangles: 0, as packed instances */
-                li->uv1[k] = c->chart_of[k / 6] == UINT32_MAX ? 0 : k % 2 ? b[k] * rh + r.y[j] : b[k] * rw + r.x[j];
+            li->block = block; /* its triangles: the block at (x, y), w x h texels (lmb_layout_uv) */
+            li->rect[0] = rw;
+            li->rect[1] = rh;
+            li->rect[2] = r.x[j];
+            li->rect[3] = r.y[j];
             l->chart_total++;
         }
+    }
     for (uint32_t g = 0; groups && g < ng; g++)
         free(groups[g].block);
     lmb_rect_result_free(&r);

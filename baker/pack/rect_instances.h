@@ -10,12 +10,13 @@
 #include "layout.h"
 
 /* Lays out instances list[0..n) (kept TEXCOORD_1 or GPU copies; their texel densities chosen)
- * as rectangles in new atlases after l's: sets each one's atlas, uv1 and scale_offset. */
+ * as rectangles in new atlases after l's: adds their shared layouts to l->blocks and sets each
+ * one's atlas, block, rect and scale_offset. */
 lmb_status lmb_layout_rect_instances(const lmb_scene *scene, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
                                      uint32_t n, const lmb_log *log, lmb_error *err);
 
-/* Instance i's charts scaled to its texel density, chart-local, into its uv1 (layout.c);
- * returns its texel area. */
-double lmb_layout_scale_instance(const lmb_scene *scene, lmb_layout *l, uint32_t i);
+/* Instance i's charts scaled to its texel density, chart-local, into uv (6 per mesh triangle;
+ * layout.c); returns its texel area. */
+double lmb_layout_scale_instance(const lmb_scene *scene, const lmb_layout *l, uint32_t i, double *uv);
 
 #endif

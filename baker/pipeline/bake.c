@@ -16,6 +16,7 @@
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
 #include "load/textures.h"
+#include "pack/coverage.h"
 #include "pack/layout.h"
 #include "post/dilate.h"
 #include "post/fireflies.h"
@@ -34,6 +35,35 @@
 
 /* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
  * neighbours, then seams stitched. */
+/* Nothing emits light: every lightmap is exactly black whatever the passes would compute, so
+ * none runs (no gather points, no rays, no seams). Each atlas's texels are those the layout
+ * lists (coverage.h), marked valid for the mask and the dilation; no texel is tested for lying
+ * inside geometry. Directional maps, when asked for, point nowhere (D = 0). */
+static lmb_status dark_atlases(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, lmb_cache *cache,
+                               lmb_bake_stats *stats, lmb_error *err)
+{
+    stats->no_light = 1;
+    if (cfg->directional && !cache->direction)
+        cache->direction = calloc((size_t)l->atlas_count + 1, sizeof *cache->direction);
+    if (cfg->directional && !cache->direction)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
+    for (uint32_t a = 0; a < l->atlas_count; a++) {
+        size_t n = (size_t)l->width[a] * l->height[a];
+        uint8_t *map = lmb_layout_texel_map(s, l, a, cfg->texel_samples, cfg->threads);
+        if (!map)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+        for (size_t k = 0; k < n; k++) {
+            cache->state[a][k] = map[k] ? LMB_TEXEL_VALID : LMB_TEXEL_EMPTY;
+            stats->texels += map[k];
+        }
+        stats->valid_texels = stats->texels;
+        free(map);
+        if (cfg->directional && !(cache->direction[a] = calloc(3 * n + 1, sizeof **cache->direction)))
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
+    }
+    return LMB_OK;
+}
+
 static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
                                lmb_cache *cache, lmb_progress_fn progress, void *user, lmb_bake_stats *stats,
                                const lmb_log *log, lmb_error *err)
@@ -172,10 +202,13 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_steps_create(mode, run->farm_dir, &id, run->step, run->shard, run->shards,
                               (double)cfg->farm_min_step_rays, log, &steps, err);
     double tl = lmb_seconds();
-    if (st == LMB_OK && !shard && !lmb_direct_any_light(direct))
+    int dark = st == LMB_OK && !lmb_direct_any_light(direct);
+    if (dark && !shard)
         lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material, no sky): the "
-                 "lightmaps are black", s->path);
-    if (st == LMB_OK)
+                 "lightmaps are black; no light is computed", s->path);
+    if (st == LMB_OK && dark)
+        st = dark_atlases(s, cfg, &l, &cache, stats, err);
+    else if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
     if (st == LMB_OK && worker)
         st = lmb_steps_worker_end(steps, err);
@@ -194,7 +227,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         goto done;
     }
     run->steps = lmb_steps_count(steps);
-    if (st == LMB_OK)
+    if (st == LMB_OK && !dark)
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
     lmb_atlas_output *outputs = calloc((size_t)l.atlas_count + 1, sizeof *outputs);
     if (st == LMB_OK && !outputs)

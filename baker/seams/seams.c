@@ -240,7 +240,8 @@ static void side_of(const lmb_scene *s, const lmb_layout *l, const edge_ref *e, 
     side->normal[2] = sg * (e1[0] * e2[1] - e1[1] * e2[0]);
     normalize(side->normal);
     side->texel = 1.0 / li->texel_density;
-    const double *uv = li->uv1 + 6 * (size_t)e->triangle;
+    double uv[6];
+    lmb_layout_uv(l, e->instance, e->triangle, uv);
     int a = e->corner, b = (e->corner + 1) % 3;
     if (e->swapped) {
         int t = a;

@@ -60,6 +60,10 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
     put_u64(&w, l->density.budget);
     put_u32(&w, l->density.capped);
     put_u32(&w, l->density.raised);
+    put_u32(&w, l->density.short_of_floor);
+    put_f64(&w, l->density.floor_share_min);
+    put_u64(&w, l->density.texels);
+    put_u32(&w, l->density.rounds);
     for (uint32_t m = 0; m < l->mesh_count; m++) {
         const lmb_layout_mesh *lm = &l->meshes[m];
         const lmb_mesh_soup *s = &lm->soup;
@@ -84,6 +88,13 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
         put_u32(&w, c->glued);
         put(&w, &c->topology, sizeof c->topology); /* uint32_t fields only: no padding */
     }
+    /* shared layouts: 6 per triangle of the block's mesh */
+    put_u32(&w, l->block_count);
+    for (uint32_t b = 0; b < l->block_count; b++) {
+        put_u32(&w, l->blocks[b].mesh);
+        put_array(&w, l->blocks[b].uv, 6 * (uint64_t)l->meshes[l->blocks[b].mesh].soup.triangle_count,
+                  sizeof *l->blocks[b].uv);
+    }
     for (uint32_t i = 0; i < l->instance_count; i++) {
         const lmb_layout_instance *in = &l->instances[i];
         put_u32(&w, (uint32_t)in->lightmapped);
@@ -92,10 +103,12 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
         put_u32(&w, (uint32_t)in->shared_layout);
         for (int k = 0; k < 4; k++)
             put_f64(&w, in->scale_offset[k]);
-        /* uv1: 6 per triangle of the instance's mesh; the count is stored with it */
-        put_u64(&w, in->uv1 ? (uint64_t)in->uv1_count : ABSENT);
-        if (in->uv1)
-            put(&w, in->uv1, (size_t)in->uv1_count * sizeof *in->uv1);
+        put_u32(&w, in->triangle_count);
+        put_u32(&w, in->block);
+        for (int k = 0; k < 4; k++)
+            put_f64(&w, in->rect[k]);
+        /* uv1: 6 per triangle of the instance's mesh (NULL for a block's instance) */
+        put_array(&w, in->uv1, 6 * (uint64_t)in->triangle_count, sizeof *in->uv1);
     }
     if (w.failed) {
         free(w.buf);
@@ -177,6 +190,10 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
     l->density.budget = get_u64(&r);
     l->density.capped = get_u32(&r);
     l->density.raised = get_u32(&r);
+    l->density.short_of_floor = get_u32(&r);
+    l->density.floor_share_min = get_f64(&r);
+    l->density.texels = get_u64(&r);
+    l->density.rounds = get_u32(&r);
     for (uint32_t m = 0; m < l->mesh_count && !r.failed; m++) {
         lmb_layout_mesh *lm = &l->meshes[m];
         lmb_mesh_soup *s = &lm->soup;
@@ -212,19 +229,42 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
             r.failed = c->order[k] >= c->triangle_count;
 
     }
+    l->block_count = r.failed ? 0 : get_u32(&r);
+    r.failed |= (uint64_t)l->block_count > size / 8;
+    l->blocks = r.failed ? NULL : calloc((size_t)l->block_count + 1, sizeof *l->blocks);
+    if (!r.failed && !l->blocks)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", name);
+    for (uint32_t b = 0; b < l->block_count && !r.failed; b++) {
+        uint64_t n = 0;
+        l->blocks[b].mesh = get_u32(&r);
+        r.failed |= l->blocks[b].mesh >= l->mesh_count;
+        l->blocks[b].uv = r.failed ? NULL : get_array(&r, ABSENT, sizeof *l->blocks[b].uv, &n);
+        r.failed |= !l->blocks[b].uv ||
+                    n != 6 * (uint64_t)l->meshes[l->blocks[b].mesh].soup.triangle_count ||
+                    l->meshes[l->blocks[b].mesh].charts.triangle_count != l->meshes[l->blocks[b].mesh].soup.triangle_count ||
+                    !l->meshes[l->blocks[b].mesh].charts.chart_of;
+    }
     for (uint32_t i = 0; i < l->instance_count && !r.failed; i++) {
         lmb_layout_instance *in = &l->instances[i];
+        uint32_t mesh_triangles = l->meshes[scene->instances[i].mesh].soup.triangle_count;
         in->lightmapped = (int)get_u32(&r);
         in->atlas = get_u32(&r);
         in->texel_density = get_f64(&r);
         in->shared_layout = (int)get_u32(&r);
         for (int k = 0; k < 4; k++)
             in->scale_offset[k] = get_f64(&r);
+        in->triangle_count = get_u32(&r);
+        in->block = get_u32(&r);
+        for (int k = 0; k < 4; k++)
+            in->rect[k] = get_f64(&r);
         uint64_t n = 0;
         in->uv1 = get_array(&r, ABSENT, sizeof *in->uv1, &n);
-        in->uv1_count = (size_t)n;
         r.failed |= in->lightmapped && in->atlas >= l->atlas_count;
-        r.failed |= in->uv1 && n != 6 * (uint64_t)l->meshes[scene->instances[i].mesh].soup.triangle_count;
+        r.failed |= in->lightmapped && in->triangle_count != mesh_triangles;
+        r.failed |= in->uv1 && n != 6 * (uint64_t)mesh_triangles;
+        /* a lightmapped instance's triangles are its uv1 or a block of its own mesh */
+        r.failed |= in->lightmapped && !in->uv1 &&
+                    (in->block >= l->block_count || l->blocks[in->block].mesh != scene->instances[i].mesh);
     }
     if (r.failed || r.left)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: the plan's layout is damaged (%s)", name,

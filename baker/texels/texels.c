@@ -8,6 +8,8 @@
  */
 #include "texels.h"
 
+#include "util/triangle2d.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -18,13 +20,6 @@ typedef struct best {
     float b1, b2;
     uint32_t instance, triangle;
 } best;
-
-void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2])
-{
-    uint32_t sx = (uint32_t)ceil(sqrt((double)samples)), sy = (samples + sx - 1) / sx;
-    out[0] = ((k % sx) + 0.5) / sx;
-    out[1] = ((k / sx) + 0.5) / sy;
-}
 
 static void copy_band(lmb_texels *dst, const lmb_texels *band);
 
@@ -86,43 +81,6 @@ void lmb_texels_free(lmb_texels *t)
     memset(t, 0, sizeof *t);
 }
 
-/* Closest point of triangle uv (6) to p, as barycentrics (b1, b2 of corners 1 and 2); returns
- * the distance (0 inside). */
-static double closest_on_triangle(const double *uv, const double p[2], double *b1, double *b2)
-{
-    double ax = uv[0], ay = uv[1];
-    double e1x = uv[2] - ax, e1y = uv[3] - ay, e2x = uv[4] - ax, e2y = uv[5] - ay;
-    double det = e1x * e2y - e2x * e1y;
-    *b1 = *b2 = 0;
-    if (!(fabs(det) > 0))
-        return DBL_MAX; /* zero UV area: never a gather point */
-    double px = p[0] - ax, py = p[1] - ay;
-    double u = (px * e2y - e2x * py) / det, v = (e1x * py - px * e1y) / det;
-    if (u >= 0 && v >= 0 && u + v <= 1) {
-        *b1 = u;
-        *b2 = v;
-        return 0;
-    }
-    /* closest over the three edges, each as a parameter t along it */
-    const double c[3][2] = {{uv[0], uv[1]}, {uv[2], uv[3]}, {uv[4], uv[5]}};
-    double bestd = DBL_MAX;
-    for (int k = 0; k < 3; k++) {
-        const double *a = c[k], *b = c[(k + 1) % 3];
-        double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
-        double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
-        t = t < 0 ? 0 : (t > 1 ? 1 : t);
-        double qx = a[0] + t * dx - p[0], qy = a[1] + t * dy - p[1], d = sqrt(qx * qx + qy * qy);
-        if (d < bestd) {
-            bestd = d;
-            double w[3] = {0, 0, 0};
-            w[k] = 1 - t;
-            w[(k + 1) % 3] = t;
-            *b1 = w[1];
-            *b2 = w[2];
-        }
-    }
-    return bestd;
-}
 
 /* The rows triangle uv (3 atlas points) reaches: its texels' and their neighbours'. */
 static void triangle_rows(const double *uv, long *y0, long *y1)
@@ -151,7 +109,9 @@ lmb_status lmb_instance_rows_make(const lmb_scene *s, const lmb_layout *l, uint3
             if (c->chart_of[f] == UINT32_MAX)
                 continue;
             long y0, y1;
-            triangle_rows(li->uv1 + 6 * f, &y0, &y1);
+            double uv[6];
+            lmb_layout_uv(l, i, f, uv);
+            triangle_rows(uv, &y0, &y1);
             out->lo[i] = y0 < out->lo[i] ? y0 : out->lo[i];
             out->hi[i] = y1 > out->hi[i] ? y1 : out->hi[i];
         }
@@ -181,7 +141,8 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
         for (uint32_t f = 0; f < c->triangle_count; f++) {
             if (c->chart_of[f] == UINT32_MAX)
                 continue;
-            const double *uv = li->uv1 + 6 * f;
+            double uv[6];
+            lmb_layout_uv(l, i, f, uv);
             long x0 = (long)floor(fmin(uv[0], fmin(uv[2], uv[4]))) - 1,
                  x1 = (long)floor(fmax(uv[0], fmax(uv[2], uv[4]))) + 1, y0, y1;
             triangle_rows(uv, &y0, &y1);
@@ -196,7 +157,7 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
                         lmb_texel_subsample(k, samples, sp);
                         sp[0] += (double)x;
                         sp[1] += (double)y;
-                        double d = closest_on_triangle(uv, sp, &b1, &b2);
+                        double d = lmb_closest_on_triangle_2d(uv, sp, &b1, &b2);
                         best *bb = &b[((size_t)(y - (long)y0_band) * w + (size_t)x) * samples + k];
                         if (d <= 1.0 && d < bb->dist) {
                             bb->dist = (float)d;

@@ -13,6 +13,7 @@
 #include <lmbake/lmbake.h>
 
 #include "pack/layout.h"
+#include "util/triangle2d.h"
 
 typedef struct lmb_gather_point {
     double p[3];   /* world position on the surface */
@@ -85,8 +86,5 @@ void lmb_texels_point(const lmb_texels *t, uint32_t i, uint32_t k, lmb_gather_po
  * normalised (the vertex normals through the inverse transpose of the instance matrix).
  * Returns 0 when the triangle is shaded flat (no NORMAL: out is then meaningless). */
 int lmb_triangle_corner_normals(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, double out[9]);
-
-/* Sub-sample k of `samples` inside a texel, in [0,1)^2: stratum centres of a sx x sy grid. */
-void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2]);
 
 #endif

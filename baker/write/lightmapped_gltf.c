@@ -273,13 +273,17 @@ static lmb_status instance_primitives(const lmb_scene *s, const lmb_layout *l, u
             if (lm->kept_uv1) { /* its own TEXCOORD_1, untouched: the node's rectangle places it */
                 uv1[2 * (size_t)lo] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3)];
                 uv1[2 * (size_t)lo + 1] = (float)lm->charts.uv[6 * (size_t)f + 2 * (c % 3) + 1];
-            } else if (li->shared_layout) { /* the layout it shares: back through its rectangle */
-                const double *so = li->scale_offset;
-                uv1[2 * (size_t)lo] = (float)((li->uv1[6 * (size_t)f + 2 * (c % 3)] / w - so[2]) / so[0]);
-                uv1[2 * (size_t)lo + 1] = (float)((li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h - so[3]) / so[1]);
             } else {
-                uv1[2 * (size_t)lo] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3)] / w);
-                uv1[2 * (size_t)lo + 1] = (float)(li->uv1[6 * (size_t)f + 2 * (c % 3) + 1] / h);
+                double t[6];
+                lmb_layout_uv(l, i, f, t);
+                if (li->shared_layout) { /* the layout it shares: back through its rectangle */
+                    const double *so = li->scale_offset;
+                    uv1[2 * (size_t)lo] = (float)((t[2 * (c % 3)] / w - so[2]) / so[0]);
+                    uv1[2 * (size_t)lo + 1] = (float)((t[2 * (c % 3) + 1] / h - so[3]) / so[1]);
+                } else {
+                    uv1[2 * (size_t)lo] = (float)(t[2 * (c % 3)] / w);
+                    uv1[2 * (size_t)lo + 1] = (float)(t[2 * (c % 3) + 1] / h);
+                }
             }
         }
         nv = distinct;
