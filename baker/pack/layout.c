@@ -395,48 +395,77 @@ static void unplace(lmb_layout *l)
 /* A bake may make at most this share of atlas.texels (padding, partly covered edge texels and
  * raised small props included); a layout over it is made again at a lower density. */
 #define BUDGET_SLACK 1.10
-#define BUDGET_ROUNDS 8
+#define BUDGET_AIM 0.97
+#define BUDGET_ROUNDS 6
 
-/* texel_density: auto: places for the budget and counts the texels the layout makes; while it
- * makes more than BUDGET_SLACK x the budget (the density's estimate counts surface, not the
- * texels small charts touch at their edges, their padding or their floors), the budget asked
- * of the density is lowered by the ratio and the layout made again. A level within it keeps
- * its first layout, unchanged. */
+/* texel_density: auto: places for the budget and counts the texels the layout makes
+ * (coverage.h). The density's estimate counts surface only; small charts also touch texels at
+ * their edges and are padded, so a level of many small charts makes more. While a layout makes
+ * more than BUDGET_SLACK x the budget, the budget asked of the density is lowered and the layout
+ * made again: first by the ratio, then along the line through the last two layouts (texels =
+ * a x asked + m: m is what the charts take at any density, their edges and padding). When m
+ * alone is over the budget, no density keeps it: lowering would only take texels from the
+ * surfaces that can use them, so the first layout stays and a warning gives the numbers. A
+ * level within the budget keeps its first layout, unchanged. */
 static lmb_status place_within_budget(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
                                       uint32_t n, const lmb_density_measures *measures, const lmb_log *log,
                                       lmb_error *err)
 {
-    uint64_t budget = lmb_config_atlas_texels(cfg), asked = budget, made = 0;
+    uint64_t budget = lmb_config_atlas_texels(cfg), made = 0, first_made = 0;
+    double asked = (double)budget, prev_asked = 0, prev_made = 0, floor_texels = 0;
     uint32_t round = 0;
+    int impossible = 0;
     lmb_status st = LMB_OK;
     for (;;) {
         round++;
-        st = place(s, cfg, l, list, n, measures, asked, round == 1 ? log : NULL, err); /* its densities said already */
+        st = place(s, cfg, l, list, n, measures, (uint64_t)asked, round == 1 ? log : NULL, err);
         if (st != LMB_OK || !l->density.automatic)
             break;
         made = lmb_layout_count_texels(s, l, cfg->texel_samples, cfg->threads, err, &st);
+        first_made = round == 1 ? made : first_made;
         if (st != LMB_OK || made <= BUDGET_SLACK * (double)budget || round >= BUDGET_ROUNDS)
             break;
-        /* texels grow about as the density squared, a little slower (edges): aim under the budget */
-        double ratio = 0.97 * (double)budget / (double)made;
-        asked = (uint64_t)fmax(1.0, floor((double)asked * ratio));
+        double next = asked * BUDGET_AIM * (double)budget / (double)made;
+        if (round >= 2) {
+            double a = ((double)prev_made - (double)made) / (prev_asked - asked);
+            floor_texels = (double)made - a * asked;
+            impossible = !(a > 0) || floor_texels >= BUDGET_AIM * (double)budget;
+            if (!impossible)
+                next = (BUDGET_AIM * (double)budget - floor_texels) / a;
+        }
         unplace(l);
+        if (impossible) { /* the first layout again: the density for the whole budget */
+            st = place(s, cfg, l, list, n, measures, budget, NULL, err);
+            made = first_made;
+            break;
+        }
+        prev_asked = asked;
+        prev_made = (double)made;
+        asked = fmax(1.0, floor(next));
     }
     if (st != LMB_OK)
         return st;
     l->density.budget = budget;
     l->density.texels = made;
     l->density.rounds = round;
-    if (round > 1)
-        lmb_info(log,
-                 "texel budget: the layout at the budget's density made more than %.0f%% of atlas.texels %llu (small "
-                 "charts' edge texels and padding, raised props); the density was lowered %u time(s) to %.4g texels "
-                 "per unit: %llu texels (%.0f%% of the budget)",
-                 100 * BUDGET_SLACK, (unsigned long long)budget, round - 1, l->density.scene_density,
-                 (unsigned long long)made, 100.0 * (double)made / (double)budget);
-    if (made > BUDGET_SLACK * (double)budget)
+    double share = 100.0 * (double)made / (double)budget;
+    if (impossible)
+        lmb_warn(log,
+                 "texel budget: the layout makes %llu texels, %.0f%% of atlas.texels %llu, and no density keeps it: "
+                 "its %u charts take about %.0f texels whatever the density (every chart touches a few texels and "
+                 "is padded; instanced copies repeat their mesh's charts), so the density stays %.4g texels per unit. "
+                 "Raise atlas.texels, or give small props fewer charts or no lightmap",
+                 (unsigned long long)made, share, (unsigned long long)budget, l->chart_total, floor_texels,
+                 l->density.scene_density);
+    else if (made > BUDGET_SLACK * (double)budget)
         lmb_warn(log, "texel budget: %llu texels made, %.0f%% of atlas.texels %llu, after %u layouts",
-                 (unsigned long long)made, 100.0 * (double)made / (double)budget, (unsigned long long)budget, round);
+                 (unsigned long long)made, share, (unsigned long long)budget, round);
+    else if (round > 1)
+        lmb_info(log,
+                 "texel budget: the layout at the budget's density made %.0f%% of atlas.texels %llu (small charts' "
+                 "edge texels and padding, raised props); made again at %.4g texels per unit: %llu texels (%.0f%%)",
+                 100.0 * (double)first_made / (double)budget, (unsigned long long)budget, l->density.scene_density,
+                 (unsigned long long)made, share);
     if (l->density.short_of_floor)
         lmb_warn(log,
                  "atlas.min_chart_texels: %u small instance(s) fall short of charts %u texels wide to keep the texel "

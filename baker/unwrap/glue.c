@@ -142,6 +142,18 @@ static int inside(const double *t, const double *p)
     return lmb_uv_orient(t, t + 2, p) > 0 && lmb_uv_orient(t + 2, t + 4, p) > 0 && lmb_uv_orient(t + 4, t, p) > 0;
 }
 
+/* Point p inside triangle t by more than a sliver: each edge function above eps x the edge's
+ * length (a vertex the move put on the host's edge or corner, up to rounding, is not inside). */
+static int inside_by(const double *t, const double *p, double eps)
+{
+    for (int k = 0; k < 3; k++) {
+        const double *a = t + 2 * k, *b = t + 2 * ((k + 1) % 3);
+        if (!(lmb_uv_orient(a, b, p) > eps * hypot(b[0] - a[0], b[1] - a[1])))
+            return 0;
+    }
+    return 1;
+}
+
 static void tri_box(const double *t, double box[4])
 {
     box[0] = fmin(t[0], fmin(t[2], t[4]));
@@ -179,6 +191,13 @@ static int overlaps(const chart_list *cl, uint32_t c, uint32_t h, const double *
             double pc[2] = {(p[0] + p[2] + p[4]) / 3, (p[1] + p[3] + p[5]) / 3};
             if (inside(q, pc) || inside(p, qc))
                 return 1;
+            /* a corner inside the other triangle: the glued chart keeps its own edge lengths (within
+             * 10%), so beside the anchor its triangle can fold over the host's in a thin wedge that
+             * no edge crosses properly and no centroid lies in */
+            double eps = 1e-9 * fmax(cb[2] - cb[0], cb[3] - cb[1]);
+            for (int a = 0; a < 3; a++)
+                if (inside_by(q, p + 2 * a, eps) || inside_by(p, q + 2 * a, eps))
+                    return 1;
             for (int a = 0; a < 3; a++)
                 for (int b = 0; b < 3; b++)
                     if (lmb_uv_crosses(p + 2 * a, p + 2 * ((a + 1) % 3), q + 2 * b, q + 2 * ((b + 1) % 3)))
@@ -277,6 +296,33 @@ static void move_chart(const chart_list *cl, uint32_t c, const double *uv, uint3
         }
 }
 
+/* The moved chart's copies of the anchor edge's two vertices put exactly on the host's: the two
+ * flattenings give the edge lengths up to 10% apart, and a glued edge left longer than the
+ * host's would reach past its ends, on the line of the host's edge, where the atlas's
+ * rounding makes slivers that two triangles cover (texels shared across the seam). Only copies
+ * that the move put near the host's (within a tenth of the edge) are welded; returns 0 when that
+ * would flip or collapse a triangle of the chart (its area more than halved): no glue there. */
+static int weld_anchor(const lmb_topology *t, const chart_list *cl, uint32_t c, const double *uv, uint32_t g,
+                       const int corners[4], double *moved)
+{
+    uint32_t w0 = t->weld[3 * g + corners[2]], w1 = t->weld[3 * g + corners[3]], i = 0;
+    const double *q0 = uv + 6 * g + 2 * corners[2], *q1 = uv + 6 * g + 2 * corners[3];
+    double tol = 0.1 * hypot(q1[0] - q0[0], q1[1] - q0[1]);
+    for (uint32_t m = cl->head[c]; m != LMB_NONE; m = cl->next[m], i++) {
+        double *p = moved + 6 * i, before = lmb_uv_orient(p, p + 2, p + 4);
+        for (int v = 0; v < 3; v++) {
+            uint32_t w = t->weld[3 * m + v];
+            const double *q = w == w0 ? q0 : w == w1 ? q1 : NULL;
+            if (q && hypot(p[2 * v] - q[0], p[2 * v + 1] - q[1]) <= tol)
+                memcpy(p + 2 * v, q, 2 * sizeof *p);
+        }
+        double after = lmb_uv_orient(p, p + 2, p + 4);
+        if (!(before > 0 ? after > 0.5 * before : after < 0.5 * before))
+            return 0;
+    }
+    return 1;
+}
+
 /* c becomes part of h: its moved UVs, h's id, its members appended to h's list. */
 static void attach(chart_list *cl, uint32_t *chart_of, double *uv, uint32_t c, uint32_t h, const double *moved)
 {
@@ -313,7 +359,7 @@ static uint32_t glue_one(const lmb_topology *t, const seam_index *si, const lmb_
         if (!find_anchor(t, si, cl, chart_of, uv, c, h, &f, &g, corners))
             continue;
         move_chart(cl, c, uv, f, g, corners, moved);
-        if (overlaps(cl, c, h, uv, moved))
+        if (!weld_anchor(t, cl, c, uv, g, corners, moved) || overlaps(cl, c, h, uv, moved))
             continue;
         attach(cl, chart_of, uv, c, h, moved);
         return h;
