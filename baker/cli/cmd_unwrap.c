@@ -257,8 +257,9 @@ static void print_report(const lmb_scene *s, const lmb_layout *l)
     printf("total: charting %.3f s, packing %.3f s, %u charts in %u atlas(es)\n", chart_total, l->pack_seconds,
            l->chart_total, l->atlas_count);
     if (l->density.automatic)
-        printf("texel density: auto, %.4g texels per unit (budget %llu texels)", l->density.scene_density,
-               (unsigned long long)l->density.budget);
+        printf("texel density: auto, %.4g texels per unit (budget %llu texels; %llu made, %.0f%%)",
+               l->density.scene_density, (unsigned long long)l->density.budget, (unsigned long long)l->density.texels,
+               l->density.budget ? 100.0 * (double)l->density.texels / (double)l->density.budget : 0.0);
     else
         printf("texel density: %.4g texels per unit", l->density.scene_density);
     if (l->density.capped)

@@ -236,15 +236,21 @@ static int by_triangles_desc(const void *pa, const void *pb)
 
 /* Every used mesh unwrapped (or its TEXCOORD_1 kept), the meshes in parallel, largest first:
  * a mesh's charts depend on the mesh and the options only, not on the thread that made them.
- * Progress comes from the driving thread (OpenMP's thread 0) as meshes finish. */
+ * Progress comes from the driving thread (OpenMP's thread 0) as meshes finish. glue_all: the
+ * second unwrap of a level whose charts cannot keep the texel budget (the soups exist; every
+ * chart is glued onto a neighbour where it can be, whatever its width). */
 static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, lmb_progress_fn progress,
-                                void *user, lmb_error *err)
+                                void *user, int glue_all, lmb_error *err)
 {
     uint64_t total = 0;
     for (uint32_t m = 0; m < s->mesh_count; m++)
         total += l->meshes[m].used ? s->meshes[m].triangle_count : 0;
     for (uint32_t m = 0; m < s->mesh_count; m++) {
-        lmb_status st = l->meshes[m].used ? build_soup(s, m, &l->meshes[m].soup, err) : LMB_OK;
+        lmb_status st = LMB_OK;
+        if (glue_all)
+            lmb_charts_free(&l->meshes[m].charts);
+        else if (l->meshes[m].used)
+            st = build_soup(s, m, &l->meshes[m].soup, err);
         if (st != LMB_OK)
             return st;
     }
@@ -277,6 +283,8 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
         lmb_unwrap_options_default(&opt);
         opt.name = s->meshes[m].name;
         opt.glue_below = cfg->min_chart_texels > 0 && expected[m] > 0 ? cfg->min_chart_texels / expected[m] : 0;
+        if (glue_all)
+            opt.glue_below = INFINITY;
         double t0 = lmb_seconds();
         lmb_unwrap_input in = {lm->soup.vertex_count, lm->soup.positions, lm->soup.triangle_count, lm->soup.indices,
                                lm->soup.skip};
@@ -409,7 +417,7 @@ static void unplace(lmb_layout *l)
  * level within the budget keeps its first layout, unchanged. */
 static lmb_status place_within_budget(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
                                       uint32_t n, const lmb_density_measures *measures, const lmb_log *log,
-                                      lmb_error *err)
+                                      int retry_if_over, int *over, lmb_error *err)
 {
     uint64_t budget = lmb_config_atlas_texels(cfg), made = 0, first_made = 0;
     double asked = (double)budget, prev_asked = 0, prev_made = 0, floor_texels = 0;
@@ -449,6 +457,9 @@ static lmb_status place_within_budget(const lmb_scene *s, const lmb_config *cfg,
     l->density.texels = made;
     l->density.rounds = round;
     double share = 100.0 * (double)made / (double)budget;
+    *over = impossible;
+    if (impossible && retry_if_over)
+        return LMB_OK; /* the caller tries fewer charts first */
     if (impossible)
         lmb_warn(log,
                  "texel budget: the layout makes %llu texels, %.0f%% of atlas.texels %llu, and no density keeps it: "
@@ -494,7 +505,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
             l->meshes[s->instances[i].mesh].used = 1;
             list[n++] = i;
         }
-    lmb_status st = unwrap_meshes(s, cfg, l, progress, user, err);
+    lmb_status st = unwrap_meshes(s, cfg, l, progress, user, 0, err);
     lmb_density_measures measures = {NULL, NULL, NULL};
     if (st == LMB_OK && progress)
         progress(user, "texel density", 0, 1);
@@ -508,8 +519,24 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     if (st == LMB_OK && progress)
         progress(user, "pack", 0, 1);
     double t0 = lmb_seconds();
+    int over = 0;
     if (st == LMB_OK)
-        st = place_within_budget(s, cfg, l, list, n, &measures, log, err);
+        st = place_within_budget(s, cfg, l, list, n, &measures, log, 1, &over, err);
+    if (st == LMB_OK && over) {
+        /* no density keeps the budget with these charts: glue every chart that can be, and again */
+        uint32_t before = l->chart_total;
+        unplace(l);
+        lmb_density_measures_free(&measures);
+        st = unwrap_meshes(s, cfg, l, NULL, NULL, 1, err);
+        if (st == LMB_OK)
+            st = lmb_density_measure(s, cfg, l, list, n, &measures, err);
+        if (st == LMB_OK)
+            st = place_within_budget(s, cfg, l, list, n, &measures, log, 0, &over, err);
+        if (st == LMB_OK)
+            lmb_info(log, "texel budget: the charts could not keep it at any density; every chart that can be was "
+                     "glued onto a neighbour: %u charts, were %u (%.0f%% of atlas.texels made)", l->chart_total, before,
+                     100.0 * (double)l->density.texels / (double)l->density.budget);
+    }
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);

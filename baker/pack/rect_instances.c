@@ -1,19 +1,19 @@
 /*
  * Instances as rectangles of shared atlases (see rect_instances.h). Instances form groups that
- * share one TEXCOORD_1 layout, the "block" (normalized to [0, 1]^2, W x H texels at the group's
- * first instance's density):
+ * share one TEXCOORD_1 layout, the "block" (normalized to [0, 1]^2, W x H texels at its first
+ * member's density):
  *  - a kept-TEXCOORD_1 mesh (atlas.keep_uv1): the block is its UVs as they are, W = H = S,
  *    S = density x sqrt(world area / UV area) (keep_uv1.c); every instance is a group of its own,
  *    or, for EXT_mesh_gpu_instancing copies, the copies of one node are one group;
  *  - the copies of an EXT_mesh_gpu_instancing node, or (atlas.share_meshes) the nodes of one mesh,
- *    with a mesh lmbake unwraps: the mesh's charts are packed once (pack.h), at the first
- *    instance's density, into one W x H block.
- * A group's members are cut into size classes by texel scale t_m = sqrt(A_m) x d_m (A world
- * area, d texel density): members within CLASS_RATIO of a class's smallest share one block,
- * packed at that smallest member's density, and each member m gets it at s_m = t_m / t_0 >= 1,
- * rounded up to whole texels, so no member's charts come closer than atlas.padding texels. Every
- * member of a group lands in one atlas (the copies of a node share its material, so one lightmap
- * texture). A copy that is not a uniformly scaled version of the first (its triangles' area ratios spread)
+ *    with a mesh lmbake unwraps: the mesh's charts are packed once (pack.h) into one W x H block.
+ * The block is packed at the density of the group's member with the smallest texel scale
+ * t = sqrt(A) x d (A world area, d texel density), and each member m gets it at s_m = t_m / t_0
+ * >= 1, rounded up to whole texels, so no member's charts come closer than atlas.padding texels
+ * (a member scaled down from a larger one's block would shrink its padding, and its charts would
+ * share texels). Every member of a group lands in one atlas and shares one TEXCOORD_1 (the
+ * copies of a node are one mesh in the output, with one material: one lightmap texture).
+ * A copy that is not a uniformly scaled version of the first (its triangles' area ratios spread)
  * has stretched texels: the log says how many. With an automatic density, a group too large for
  * one atlas is lowered (x 0.85, a warning) and the placement redone.
  */
@@ -210,19 +210,6 @@ static uint32_t make_groups(const lmb_scene *s, const lmb_config *cfg, const lmb
     return ng;
 }
 
-/* A run of a group's members that share one block: the group's members sorted by texel
- * scale, cut where the scale passes CLASS_RATIO x the run's smallest. The block is packed at
- * the run's smallest member's density, so every member's chart padding is at least
- * atlas.padding texels (a copy scaled below the block's scale would shrink its padding and its
- * charts would share texels) and at most CLASS_RATIO x it. */
-typedef struct size_class {
-    uint32_t group, first, count; /* members: order[first .. first + count) */
-    double *block;                /* as group.block */
-    double w, h;                  /* the block's size at the first member's density, texels */
-} size_class;
-
-#define CLASS_RATIO 1.25
-
 /* Member j's texel scale: texels per unit of the mesh's charts (sqrt(world area) x density). */
 static double texel_scale(const lmb_layout *l, const uint32_t *order, const double *area, uint32_t j)
 {
@@ -243,50 +230,26 @@ static int by_scale(const void *pa, const void *pb)
     return a->instance < b->instance ? -1 : a->instance > b->instance;
 }
 
-/* Cuts group g into size classes (kept-TEXCOORD_1 groups: one class, their block is their UVs),
- * sorting its members by texel scale; appends them to classes and returns how many. */
-static uint32_t make_classes(const lmb_scene *s, lmb_layout *l, uint32_t g, const group *gr, uint32_t *order,
-                             double *area, size_class *classes)
+/* Puts group g's smallest member (by texel scale) first, the rest after it by scale: the block
+ * is packed at the first member's density and every other member gets it scaled up, so no
+ * member's charts come closer than atlas.padding texels. Kept-TEXCOORD_1 groups stay in
+ * instance order (their block is their UVs). Returns 0 when out of memory. */
+static int smallest_first(const lmb_scene *s, const lmb_layout *l, const group *g, uint32_t *order, double *area)
 {
-    int kept = l->meshes[s->instances[order[gr->first]].mesh].kept_uv1;
-    if (kept || gr->count == 1) {
-        classes[0] = (size_class){g, gr->first, gr->count, NULL, 0, 0};
+    if (g->count < 2 || l->meshes[s->instances[order[g->first]].mesh].kept_uv1)
         return 1;
-    }
-    scaled_member *m = malloc(sizeof *m * gr->count);
+    scaled_member *m = malloc(sizeof *m * g->count);
     if (!m)
-        return UINT32_MAX;
-    for (uint32_t k = 0; k < gr->count; k++)
-        m[k] = (scaled_member){texel_scale(l, order, area, gr->first + k), order[gr->first + k], area[gr->first + k]};
-    qsort(m, gr->count, sizeof *m, by_scale);
-    uint32_t nc = 0;
-    for (uint32_t k = 0; k < gr->count; k++) {
-        order[gr->first + k] = m[k].instance;
-        area[gr->first + k] = m[k].area;
-        if (k == 0 || m[k].t > CLASS_RATIO * m[classes[nc - 1].first - gr->first].t)
-            classes[nc++] = (size_class){g, gr->first + k, 0, NULL, 0, 0};
-        classes[nc - 1].count++;
+        return 0;
+    for (uint32_t k = 0; k < g->count; k++)
+        m[k] = (scaled_member){texel_scale(l, order, area, g->first + k), order[g->first + k], area[g->first + k]};
+    qsort(m, g->count, sizeof *m, by_scale);
+    for (uint32_t k = 0; k < g->count; k++) {
+        order[g->first + k] = m[k].instance;
+        area[g->first + k] = m[k].area;
     }
     free(m);
-    return nc;
-}
-
-/* The blocks of classes[0..nc): each packed at its first (smallest) member's density. */
-static lmb_status make_class_blocks(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *order,
-                                    size_class *classes, uint32_t nc, const lmb_log *log, lmb_error *err)
-{
-    for (uint32_t k = 0; k < nc; k++) {
-        group tmp = {classes[k].first, classes[k].count, NULL, 0, 0};
-        free(classes[k].block);
-        classes[k].block = NULL;
-        lmb_status st = make_block(s, cfg, l, order[classes[k].first], &tmp, log, err);
-        classes[k].block = tmp.block;
-        classes[k].w = tmp.w;
-        classes[k].h = tmp.h;
-        if (st != LMB_OK)
-            return st;
-    }
-    return LMB_OK;
+    return 1;
 }
 
 lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
@@ -294,29 +257,19 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
 {
     uint32_t *order = malloc(((size_t)n + 1) * sizeof *order);
     group *groups = calloc((size_t)n + 1, sizeof *groups);
-    size_class *classes = calloc((size_t)n + 1, sizeof *classes);
-    uint32_t *class_start = calloc((size_t)n + 2, sizeof *class_start); /* per group: its first class */
     lmb_rect_item *items = calloc((size_t)n + 1, sizeof *items);
     double *area = malloc(((size_t)n + 1) * sizeof *area);
     lmb_rect_result r;
     memset(&r, 0, sizeof r);
-    uint32_t ng = order && groups && classes && class_start && items && area ? make_groups(s, cfg, l, list, n, order, groups)
-                                                                             : UINT32_MAX;
+    uint32_t ng = order && groups && items && area ? make_groups(s, cfg, l, list, n, order, groups) : UINT32_MAX;
     lmb_status st = ng != UINT32_MAX ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     for (uint32_t j = 0; st == LMB_OK && j < n; j++)
         area[j] = world_area(s, l, order[j]);
-    uint32_t nc = 0;
     for (uint32_t g = 0; st == LMB_OK && g < ng; g++) {
-        class_start[g] = nc;
-        uint32_t k = make_classes(s, l, g, &groups[g], order, area, classes + nc);
-        if (k == UINT32_MAX)
+        if (!smallest_first(s, l, &groups[g], order, area))
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-        else
-            nc += k;
-        class_start[g + 1] = nc;
         if (st == LMB_OK)
-            st = make_class_blocks(s, cfg, l, order, classes + class_start[g], class_start[g + 1] - class_start[g], log,
-                                   err);
+            st = make_block(s, cfg, l, order[groups[g].first], &groups[g], log, err);
         uint32_t stretched = st == LMB_OK ? stretched_members(s, l, order, &groups[g]) : 0;
         if (stretched)
             lmb_warn(log, "'%s': %u of the %u instances that share its lightmap layout are not uniformly scaled "
@@ -325,14 +278,13 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
     }
     /* place; an automatic density lowers a group that does not fit one atlas and retries */
     for (int attempt = 0; st == LMB_OK; attempt++) {
-        for (uint32_t c = 0; c < nc; c++) {
-            const size_class *k = &classes[c];
-            double t0 = texel_scale(l, order, area, k->first);
-            for (uint32_t j = k->first; j < k->first + k->count; j++) {
+        for (uint32_t g = 0; g < ng; g++) {
+            double t0 = texel_scale(l, order, area, groups[g].first);
+            for (uint32_t j = groups[g].first; j < groups[g].first + groups[g].count; j++) {
                 double sc = t0 > 0 ? texel_scale(l, order, area, j) / t0 : 1;
-                items[j].w = (uint32_t)fmax(1.0, ceil(k->w * sc - 1e-9));
-                items[j].h = (uint32_t)fmax(1.0, ceil(k->h * sc - 1e-9));
-                items[j].group = k->group;
+                items[j].w = (uint32_t)fmax(1.0, ceil(groups[g].w * sc - 1e-9));
+                items[j].h = (uint32_t)fmax(1.0, ceil(groups[g].h * sc - 1e-9));
+                items[j].group = g;
             }
         }
         lmb_rect_result_free(&r);
@@ -346,9 +298,10 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
                  cfg->max_atlas_size);
         for (uint32_t j = g->first; j < g->first + g->count; j++)
             l->instances[order[j]].texel_density *= 0.85;
-        /* the blocks again at the lower density: their padding stays atlas.padding texels */
-        st = make_class_blocks(s, cfg, l, order, classes + class_start[r.failed_group],
-                               class_start[r.failed_group + 1] - class_start[r.failed_group], NULL, err);
+        /* the block again at the lower density: its padding stays atlas.padding texels */
+        free(g->block);
+        g->block = NULL;
+        st = make_block(s, cfg, l, first, g, NULL, err);
     }
     if (st == LMB_ERR_INPUT && r.failed_group < ng)
         st = lmb_error_set(err, LMB_ERR_INPUT,
@@ -373,17 +326,17 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
     }
     if (st == LMB_OK)
         l->atlas_count += r.atlas_count;
-    lmb_layout_block *blocks = st == LMB_OK ? realloc(l->blocks, ((size_t)l->block_count + nc + 1) * sizeof *blocks) : NULL;
+    lmb_layout_block *blocks = st == LMB_OK ? realloc(l->blocks, ((size_t)l->block_count + ng + 1) * sizeof *blocks) : NULL;
     if (st == LMB_OK && !blocks)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     if (blocks)
         l->blocks = blocks;
-    for (uint32_t c = 0; st == LMB_OK && c < nc; c++) {
+    for (uint32_t g = 0; st == LMB_OK && g < ng; g++) {
         uint32_t block = l->block_count++;
-        l->blocks[block].mesh = s->instances[order[classes[c].first]].mesh;
-        l->blocks[block].uv = classes[c].block; /* the layout owns it now */
-        classes[c].block = NULL;
-        for (uint32_t j = classes[c].first; j < classes[c].first + classes[c].count; j++) {
+        l->blocks[block].mesh = s->instances[order[groups[g].first]].mesh;
+        l->blocks[block].uv = groups[g].block; /* the layout owns it now */
+        groups[g].block = NULL;
+        for (uint32_t j = groups[g].first; j < groups[g].first + groups[g].count; j++) {
             lmb_layout_instance *li = &l->instances[order[j]];
             li->atlas = base + r.atlas[j];
             li->shared_layout = !l->meshes[s->instances[order[j]].mesh].kept_uv1;
@@ -397,16 +350,14 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
             li->rect[1] = rh;
             li->rect[2] = r.x[j];
             li->rect[3] = r.y[j];
-            l->chart_total++;
+            l->chart_total += l->meshes[s->instances[order[j]].mesh].charts.chart_count;
         }
     }
-    for (uint32_t c = 0; classes && c < nc; c++)
-        free(classes[c].block);
+    for (uint32_t g = 0; groups && g < ng; g++)
+        free(groups[g].block);
     lmb_rect_result_free(&r);
     free(order);
     free(groups);
-    free(classes);
-    free(class_start);
     free(items);
     free(area);
     return st;

@@ -10,6 +10,7 @@
 #include <lmbake/lmbake.h>
 
 #include "util/clock.h"
+#include "util/memory.h"
 #include "steps/plan.h"
 #include "steps/runner.h"
 #include "pipeline/lighting.h"
@@ -35,6 +36,30 @@
 
 /* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
  * neighbours, then seams stitched. */
+/* A bake of `texels` texels (0: not known yet) must fit the memory left: otherwise an error
+ * naming the key, the estimate and what fits, before the work that would be killed. */
+static lmb_status texels_fit_memory(const lmb_config *cfg, uint64_t texels, lmb_error *err)
+{
+    uint64_t avail = lmb_memory_available();
+    double need = (double)LMB_BAKE_BASE_BYTES + 1.1 * (double)texels * (double)LMB_BAKE_BYTES_PER_TEXEL;
+    if (!texels || !avail || need <= (double)avail)
+        return LMB_OK;
+    double fits = ((double)avail - (double)LMB_BAKE_BASE_BYTES) / (1.1 * (double)LMB_BAKE_BYTES_PER_TEXEL);
+    const char *where = cfg->config_path[0] ? cfg->config_path : "the config";
+    if (cfg->texel_density > 0)
+        return lmb_error_set(err, LMB_ERR_INPUT,
+                             "%s: texel_density %g makes %llu texels: a bake of them needs about %.1f GB (%llu bytes "
+                             "per texel over a %llu MB base) and %.1f GB is available; lower texel_density (about %.0f "
+                             "texels fit)",
+                             where, cfg->texel_density, (unsigned long long)texels, need / 1e9,
+                             LMB_BAKE_BYTES_PER_TEXEL, LMB_BAKE_BASE_BYTES >> 20, (double)avail / 1e9, fmax(fits, 0));
+    return lmb_error_set(err, LMB_ERR_INPUT,
+                         "%s: atlas.texels %llu: a bake of that many texels needs about %.1f GB (%llu bytes per texel "
+                         "over a %llu MB base) and %.1f GB is available; lower atlas.texels (at most about %.0f fits)",
+                         where, (unsigned long long)texels, need / 1e9, LMB_BAKE_BYTES_PER_TEXEL,
+                         LMB_BAKE_BASE_BYTES >> 20, (double)avail / 1e9, fmax(fits, 0));
+}
+
 /* Nothing emits light: every lightmap is exactly black whatever the passes would compute, so
  * none runs (no gather points, no rays, no seams). Each atlas's texels are those the layout
  * lists (coverage.h), marked valid for the mask and the dilation; no texel is tested for lying
@@ -108,7 +133,10 @@ static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const 
         stats->seam_edges = sr.edges;
         stats->seam_jump_before = sr.jump_before;
         stats->seam_jump_after = sr.jump_after;
-        if (st == LMB_OK && sr.edges)
+        if (st == LMB_OK && sr.equal)
+            lmb_info(log, "seams: %llu edges (%llu points): both sides read the same light everywhere, nothing to "
+                     "stitch (%.2fs)", (unsigned long long)sr.edges, (unsigned long long)sr.samples, sr.seconds);
+        else if (st == LMB_OK && sr.edges)
             lmb_info(log, "seams: %llu edges stitched (%llu points, %llu left unmatched, %llu texels) in %.2fs; largest "
                      "jump %.2f%% -> %.2f%%; points over 1%%: %llu -> %llu", (unsigned long long)sr.edges,
                      (unsigned long long)sr.samples, (unsigned long long)sr.dropped, (unsigned long long)sr.texels,
@@ -170,10 +198,25 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
     st = lmb_sky_create(cfg, s, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
+    if (st == LMB_OK && !plan_path)
+        st = texels_fit_memory(cfg, cfg->texel_density > 0 ? 0 : lmb_config_atlas_texels(cfg), err);
     if (st == LMB_OK && plan_path) /* the plan stage's layout (steps/plan.h), checked against this scene and config */
         st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
     else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
+    if (st == LMB_OK && !plan_path && cfg->texel_density > 0) { /* an explicit density: the texels it made */
+        uint64_t made = 0;
+        for (uint32_t a = 0; a < l.atlas_count && st == LMB_OK; a++) {
+            uint8_t *map = lmb_layout_texel_map(s, &l, a, cfg->texel_samples, cfg->threads);
+            if (!map)
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+            for (size_t k = 0; map && k < (size_t)l.width[a] * l.height[a]; k++)
+                made += map[k];
+            free(map);
+        }
+        if (st == LMB_OK)
+            st = texels_fit_memory(cfg, made, err);
+    }
     if (st == LMB_OK && progress)
         progress(user, "scene set-up", 0, 1); /* ray-tracing scene, textures, lights, bounce cache */
     if (st == LMB_OK)

@@ -137,22 +137,105 @@ static void sort_edges(edge_ref *e, edge_ref *tmp, size_t n, int threads)
         memcpy(e, src, n * sizeof *e);
 }
 
-/* Every lightmapped triangle's three edges, sorted by hash; in parallel over instances (each
- * writes its own range, found by a prefix sum of their triangles). */
+/* A mesh edge by its two endpoints' object-space coordinates (bit for bit), smaller first. */
+typedef struct mesh_edge {
+    float key[6];
+    uint32_t triangle;
+    uint8_t corner;
+} mesh_edge;
+
+static int mesh_edge_order(const void *pa, const void *pb)
+{
+    const mesh_edge *a = pa, *b = pb;
+    int c = memcmp(a->key, b->key, sizeof a->key);
+    if (c)
+        return c;
+    if (a->triangle != b->triangle)
+        return a->triangle < b->triangle ? -1 : 1;
+    return (int)a->corner - (int)b->corner;
+}
+
+/* Per edge (3 per triangle) of mesh m: 1 when it lies inside one chart: exactly two of the mesh's
+ * triangles share its endpoints, in the same chart, with the same chart UVs at both ends. Such
+ * an edge has the same texels on both sides in every instance (is_seam says no to it), so it is
+ * never collected: a level's copies cost the seams only their charts' borders. NULL when out of
+ * memory (every edge is then collected). */
+static uint8_t *chart_interior_edges(const lmb_layout *l, uint32_t m)
+{
+    const lmb_mesh_soup *soup = &l->meshes[m].soup;
+    const lmb_charts *c = &l->meshes[m].charts;
+    size_t n = 3 * (size_t)soup->triangle_count;
+    uint8_t *interior = calloc(n + 1, 1);
+    mesh_edge *e = malloc((n + 1) * sizeof *e);
+    if (!interior || !e || c->triangle_count != soup->triangle_count) {
+        free(e);
+        free(interior);
+        return NULL;
+    }
+    for (uint32_t f = 0; f < soup->triangle_count; f++)
+        for (int k = 0; k < 3; k++) {
+            mesh_edge *x = &e[3 * (size_t)f + k];
+            const float *a = soup->positions + 3 * soup->indices[3 * f + k],
+                        *b = soup->positions + 3 * soup->indices[3 * f + (k + 1) % 3];
+            int swap = memcmp(b, a, 3 * sizeof *a) < 0;
+            memcpy(x->key, swap ? b : a, 3 * sizeof *a);
+            memcpy(x->key + 3, swap ? a : b, 3 * sizeof *a);
+            x->triangle = f;
+            x->corner = (uint8_t)k;
+        }
+    qsort(e, n, sizeof *e, mesh_edge_order);
+    for (size_t i = 0; i < n;) {
+        size_t j = i + 1;
+        while (j < n && !memcmp(e[j].key, e[i].key, sizeof e[i].key))
+            j++;
+        if (j - i == 2) {
+            uint32_t f = e[i].triangle, g = e[i + 1].triangle;
+            int fa = e[i].corner, fb = (fa + 1) % 3, ga = e[i + 1].corner, gb = (ga + 1) % 3;
+            const double *uf = c->uv + 6 * (size_t)f, *ug = c->uv + 6 * (size_t)g;
+            /* the edge runs f: fa -> fb and, the other way, g: gb -> ga (or the same way: a fold) */
+            int same = soup->indices[3 * f + fa] == soup->indices[3 * g + gb] ||
+                       !memcmp(soup->positions + 3 * soup->indices[3 * f + fa],
+                               soup->positions + 3 * soup->indices[3 * g + gb], 3 * sizeof(float));
+            int g0 = same ? gb : ga, g1 = same ? ga : gb;
+            if (c->chart_of[f] != UINT32_MAX && c->chart_of[f] == c->chart_of[g] && !soup->skip[f] && !soup->skip[g] &&
+                uf[2 * fa] == ug[2 * g0] && uf[2 * fa + 1] == ug[2 * g0 + 1] && uf[2 * fb] == ug[2 * g1] &&
+                uf[2 * fb + 1] == ug[2 * g1 + 1])
+                interior[3 * (size_t)f + fa] = interior[3 * (size_t)g + ga] = 1;
+        }
+        i = j;
+    }
+    free(e);
+    return interior;
+}
+
+/* Every lightmapped triangle's edges but those inside a chart, sorted by hash; in parallel over
+ * instances (each writes its own range, found by a prefix sum of their edges). */
 static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double snap, int threads, edge_ref **out,
                                 size_t *count, lmb_error *err)
 {
     size_t *first = malloc(((size_t)l->instance_count + 1) * sizeof *first);
-    if (!first)
+    uint8_t **interior = calloc((size_t)l->mesh_count + 1, sizeof *interior);
+    size_t *mesh_edges = calloc((size_t)l->mesh_count + 1, sizeof *mesh_edges);
+    if (!first || !interior || !mesh_edges) {
+        free(first);
+        free(interior);
+        free(mesh_edges);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %u instances", l->instance_count);
+    }
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (uint32_t m = 0; m < l->mesh_count; m++) {
+        if (!l->meshes[m].used)
+            continue;
+        const lmb_mesh_soup *soup = &l->meshes[m].soup;
+        interior[m] = chart_interior_edges(l, m);
+        for (uint32_t f = 0; f < soup->triangle_count; f++)
+            for (int k = 0; k < 3 && !soup->skip[f]; k++)
+                mesh_edges[m] += !(interior[m] && interior[m][3 * (size_t)f + k]);
+    }
     size_t n = 0;
     for (uint32_t i = 0; i < l->instance_count; i++) {
         first[i] = n;
-        if (!l->instances[i].lightmapped)
-            continue;
-        const lmb_mesh_soup *soup = &l->meshes[s->instances[i].mesh].soup;
-        for (uint32_t f = 0; f < soup->triangle_count; f++)
-            n += soup->skip[f] ? 0 : 3;
+        n += l->instances[i].lightmapped ? mesh_edges[s->instances[i].mesh] : 0;
     }
     first[l->instance_count] = n;
     edge_ref *e = malloc((n + 1) * sizeof *e), *tmp = malloc((n + 1) * sizeof *tmp);
@@ -160,6 +243,10 @@ static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double 
         free(first);
         free(e);
         free(tmp);
+        for (uint32_t m = 0; m < l->mesh_count; m++)
+            free(interior[m]);
+        free(interior);
+        free(mesh_edges);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu edges", n);
     }
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
@@ -167,11 +254,14 @@ static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double 
         if (!l->instances[i].lightmapped)
             continue;
         const lmb_mesh_soup *soup = &l->meshes[s->instances[i].mesh].soup;
+        const uint8_t *inside = interior[s->instances[i].mesh];
         size_t m = first[i];
         for (uint32_t f = 0; f < soup->triangle_count; f++) {
             if (soup->skip[f])
                 continue;
             for (int c = 0; c < 3; c++) {
+                if (inside && inside[3 * (size_t)f + c])
+                    continue;
                 int64_t key[6];
                 int swapped;
                 edge_key(s, l, i, f, c, snap, key, &swapped);
@@ -182,6 +272,10 @@ static lmb_status collect_edges(const lmb_scene *s, const lmb_layout *l, double 
     sort_edges(e, tmp, n, threads);
     free(tmp);
     free(first);
+    for (uint32_t m = 0; m < l->mesh_count; m++)
+        free(interior[m]);
+    free(interior);
+    free(mesh_edges);
     *out = e;
     *count = n;
     return LMB_OK;
@@ -364,6 +458,24 @@ static double jump_at(float *const *rgb, const seam_row *r)
     }
     double a = lmb_luminance(side[0]), b = lmb_luminance(side[1]), m = 0.5 * (a + b);
     return m > 0 ? fabs(a - b) / m : 0;
+}
+
+/* Whether the two sides of some point read different light (any channel), from the atlases
+ * as they are; in parallel. With none, the stitch's solution is the atlases themselves. */
+static int any_side_differs(float *const *rgb, const seam_row *rows, size_t nr, int threads)
+{
+    int differs = 0;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(| : differs)
+    for (size_t r = 0; r < nr; r++) {
+        double side[2][3] = {{0, 0, 0}, {0, 0, 0}};
+        for (int j = 0; j < 8; j++) {
+            const float *p = rgb[rows[r].atlas[j]] + 3 * (size_t)rows[r].texel[j];
+            for (int c = 0; c < 3; c++)
+                side[j / 4][c] += fabs(rows[r].w[j]) * p[c];
+        }
+        differs |= side[0][0] != side[1][0] || side[0][1] != side[1][1] || side[0][2] != side[1][2];
+    }
+    return differs;
 }
 
 /* Does each side of the point read a valid texel? Where one side lies under other geometry
@@ -622,10 +734,13 @@ lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_r
         return st;
     lmb_rt_thread_init();
     st = seam_rows(s, l, rt, state, snap, e, ne, threads, &rows, &nr, &report->edges, err);
+    free(e); /* the points hold what the solve needs */
+    e = NULL;
+    report->equal = st == LMB_OK && nr && !any_side_differs(rgb, rows, nr, threads);
     solve_ctx c = {l, rgb, state, calloc((size_t)l->atlas_count + 1, sizeof *c.unknown), NULL, NULL, 0, 0};
     if (st == LMB_OK && !c.unknown)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu seam points", nr);
-    for (uint32_t a = 0; st == LMB_OK && nr && a < l->atlas_count; a++) {
+    for (uint32_t a = 0; st == LMB_OK && nr && !report->equal && a < l->atlas_count; a++) {
         size_t texels = (size_t)l->width[a] * l->height[a];
         c.unknown[a] = malloc((texels + 1) * sizeof *c.unknown[a]);
         if (!c.unknown[a])
@@ -633,7 +748,9 @@ lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_r
         else
             memset(c.unknown[a], 0xff, texels * sizeof *c.unknown[a]);
     }
-    if (st == LMB_OK && nr)
+    if (report->equal)
+        report->samples = nr;
+    else if (st == LMB_OK && nr)
         st = stitch(&c, rows, nr, report, err);
     for (uint32_t a = 0; c.unknown && a < l->atlas_count; a++)
         free(c.unknown[a]);

@@ -42,6 +42,8 @@ typedef struct lmb_seam_report {
     double jump_after;       /* ... and after */
     uint64_t over_1pct_before;
     uint64_t over_1pct;      /* points whose jump is over 1% after (over_1pct_before: before) */
+    int equal;               /* both sides of every point read the same light (black, or equal in
+                                every channel): nothing was solved, the atlases are as they were */
     double seconds;
 } lmb_seam_report;
 
