@@ -1,0 +1,30 @@
+/* Seam edges (seam_edges.c), shared by the stitcher (seams.c): every lightmapped triangle
+ * edge that is not inside a chart, keyed by its snapped world endpoints. */
+#ifndef LMBAKE_SEAM_EDGES_H
+#define LMBAKE_SEAM_EDGES_H
+
+#include "pack/layout.h"
+
+/* One triangle edge, found by a hash of its endpoints (snapped to 1/1000 texel, in order). */
+typedef struct edge_ref {
+    uint64_t hash;
+    uint32_t instance, triangle;
+    uint8_t corner;  /* the edge runs from corner `corner` to corner + 1 (mod 3) */
+    uint8_t swapped; /* corner + 1 holds the smaller endpoint */
+} edge_ref;
+
+/* The snapping grid: 1/1000 of the finest texel of any lightmapped instance. */
+double lmb_seam_snap_size(const lmb_layout *l);
+
+/* The snapped endpoints of instance's triangle f's edge from `corner`, smaller first; *swapped
+ * as in edge_ref. */
+void lmb_seam_edge_key(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, int corner, double snap,
+                       int64_t key[6], int *swapped);
+
+/* Every lightmapped triangle's edges but those inside a chart (the same texels on both sides in
+ * every instance), sorted by hash then instance, triangle, corner: the order does not depend on
+ * `threads`. *out: owned by the caller. */
+lmb_status lmb_seam_collect_edges(const lmb_scene *s, const lmb_layout *l, double snap, int threads, edge_ref **out,
+                                  size_t *count, lmb_error *err);
+
+#endif
