@@ -39,19 +39,7 @@ levels+=("bench/levels/level-instances-2000.glb" "assets/scenes/cornell-box-bevy
 
 before=-
 if [ "$before_ref" != "-" ]; then
-  commit=$(git rev-parse --verify "$before_ref^{commit}")
-  src=$work/before-src bld=$work/before-build
-  if [ ! -x "$bld/lmbake" ] || [ "$(cat "$bld/commit" 2>/dev/null)" != "$commit" ]; then
-    echo "bench_scale: building $before_ref ($commit) in $bld"
-    git worktree remove --force "$src" 2>/dev/null || rm -rf "$src"
-    git worktree prune
-    git worktree add --detach "$src" "$commit" > /dev/null
-    cmake -S "$src" -B "$bld" -DCMAKE_BUILD_TYPE=Release > "$work/before-build.log" 2>&1 &&
-      cmake --build "$bld" -j2 --target lmbake >> "$work/before-build.log" 2>&1 ||
-      { tail -n 20 "$work/before-build.log"; echo "bench_scale: building $before_ref failed"; exit 1; }
-    echo "$commit" > "$bld/commit"
-  fi
-  before=$bld/lmbake
+  before=$(tools/build_ref.sh "$before_ref" "$work")
 fi
 /usr/bin/python3 tools/bench_scale.py "$before" build/lmbake "$work" "$work/scale.csv" "$work/scale.png" "$timeout" \
   "${levels[@]}"

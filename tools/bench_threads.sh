@@ -36,17 +36,6 @@ if [ ${#scenes[@]} -eq 0 ]; then
 fi
 
 # the binary of BEFORE, built once per commit
-commit=$(git rev-parse --verify "$before_ref^{commit}")
-src=$work/before-src bld=$work/before-build
-if [ ! -x "$bld/lmbake" ] || [ "$(cat "$bld/commit" 2>/dev/null)" != "$commit" ]; then
-  echo "bench_threads: building $before_ref ($commit) in $bld"
-  git worktree remove --force "$src" 2>/dev/null || rm -rf "$src"
-  git worktree prune
-  git worktree add --detach "$src" "$commit" > /dev/null
-  cmake -S "$src" -B "$bld" -DCMAKE_BUILD_TYPE=Release > "$work/before-build.log" 2>&1 &&
-    cmake --build "$bld" -j2 --target lmbake >> "$work/before-build.log" 2>&1 ||
-    { tail -n 20 "$work/before-build.log"; echo "bench_threads: building $before_ref failed"; exit 1; }
-  echo "$commit" > "$bld/commit"
-fi
-/usr/bin/python3 tools/bench_threads.py "$bld/lmbake" build/lmbake "$work/runs" "$work/threads.csv" \
+before=$(tools/build_ref.sh "$before_ref" "$work")
+/usr/bin/python3 tools/bench_threads.py "$before" build/lmbake "$work/runs" "$work/threads.csv" \
   "$work/threads.png" "$threads" "$rounds" "${scenes[@]}"
