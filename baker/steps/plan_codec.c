@@ -260,8 +260,8 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
         uint64_t n = 0;
         in->uv1 = get_array(&r, ABSENT, sizeof *in->uv1, &n);
         r.failed |= in->lightmapped && in->atlas >= l->atlas_count;
-        r.failed |= in->lightmapped && in->triangle_count != mesh_triangles;
-        r.failed |= in->uv1 && n != 6 * (uint64_t)mesh_triangles;
+        r.failed |= (in->lightmapped || in->uv1) && in->triangle_count != mesh_triangles;
+        r.failed |= in->uv1 && n != 6 * (uint64_t)in->triangle_count;
         /* a lightmapped instance's triangles are its uv1 or a block of its own mesh */
         r.failed |= in->lightmapped && !in->uv1 &&
                     (in->block >= l->block_count || l->blocks[in->block].mesh != scene->instances[i].mesh);
