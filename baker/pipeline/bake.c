@@ -205,15 +205,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
     if (st == LMB_OK && !plan_path && cfg->texel_density > 0) { /* an explicit density: the texels it made */
-        uint64_t made = 0;
-        for (uint32_t a = 0; a < l.atlas_count && st == LMB_OK; a++) {
-            uint8_t *map = lmb_layout_texel_map(s, &l, a, cfg->texel_samples, cfg->threads);
-            if (!map)
-                st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-            for (size_t k = 0; map && k < (size_t)l.width[a] * l.height[a]; k++)
-                made += map[k];
-            free(map);
-        }
+        uint64_t made = lmb_layout_count_texels(s, &l, cfg->texel_samples, cfg->threads, err, &st);
         if (st == LMB_OK)
             st = texels_fit_memory(cfg, made, err);
     }
