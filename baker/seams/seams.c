@@ -2,12 +2,12 @@
 #include "seams.h"
 
 #include "seam_edges.h"
+#include "seam_solve.h"
 
 #include "post/dilate.h"
 #include "texels/texels.h"
 #include "util/clock.h"
 #include "util/lmb_math.h"
-#include "util/spd_solve.h"
 
 #include <omp.h>
 
@@ -23,16 +23,6 @@ typedef struct seam_side {
     double uv[4];
     double p[6], inward[3], normal[3], texel;
 } seam_side;
-
-typedef struct solve_ctx {
-    const lmb_layout *l;
-    float *const *rgb;
-    const uint8_t *const *state;
-    int32_t **unknown;   /* per atlas, per texel: its unknown index or -1 */
-    uint32_t *atlas_of;  /* per unknown */
-    uint32_t *texel_of;  /* per unknown */
-    uint32_t count, cap;
-} solve_ctx;
 
 /* Unit shading normal at corner c of a triangle (the face normal when it is shaded flat). */
 static void corner_normal(const lmb_scene *s, const lmb_layout *l, uint32_t instance, uint32_t f, int c, double n[3])
@@ -143,30 +133,6 @@ static void bilinear_taps(double x, double y, uint32_t w, uint32_t h, uint32_t i
         }
 }
 
-/* Unknown index of a texel, made on first use. -1: out of memory. */
-static int64_t unknown_of(solve_ctx *c, uint32_t atlas, uint32_t texel)
-{
-    int32_t *u = &c->unknown[atlas][texel];
-    if (*u >= 0)
-        return *u;
-    if (c->count == c->cap) {
-        uint32_t cap = c->cap ? 2 * c->cap : 1024;
-        uint32_t *a = realloc(c->atlas_of, (size_t)cap * sizeof *a);
-        if (a)
-            c->atlas_of = a;
-        uint32_t *t = realloc(c->texel_of, (size_t)cap * sizeof *t);
-        if (t)
-            c->texel_of = t;
-        if (!a || !t)
-            return -1;
-        c->cap = cap;
-    }
-    c->atlas_of[c->count] = atlas;
-    c->texel_of[c->count] = texel;
-    *u = (int32_t)c->count;
-    return c->count++;
-}
-
 /* Points along a seam: four per texel of its longer side (two left the bilinear lookups
  * between them up to 0.5% apart on a sphere), at least two. */
 static uint32_t seam_points(const seam_side sides[2])
@@ -177,12 +143,6 @@ static uint32_t seam_points(const seam_side sides[2])
     double n = ceil(4 * len);
     return n < 2 ? 2 : n > 4096 ? 4096 : (uint32_t)n;
 }
-
-/* One seam point: 8 taps (4 per side; side B's weights negated), as unknowns. */
-typedef struct seam_row {
-    uint32_t atlas[8], texel[8];
-    double w[8];
-} seam_row;
 
 static void row_at(const lmb_layout *l, const seam_side sides[2], double t, seam_row *r)
 {
@@ -198,19 +158,6 @@ static void row_at(const lmb_layout *l, const seam_side sides[2], double t, seam
             r->w[4 * k + j] = k ? -wt[j] : wt[j];
         }
     }
-}
-
-/* |lum A - lum B| / their mean at a seam point, from the atlases as they are. */
-static double jump_at(float *const *rgb, const seam_row *r)
-{
-    double side[2][3] = {{0, 0, 0}, {0, 0, 0}};
-    for (int j = 0; j < 8; j++) {
-        const float *p = rgb[r->atlas[j]] + 3 * (size_t)r->texel[j];
-        for (int c = 0; c < 3; c++)
-            side[j / 4][c] += fabs(r->w[j]) * p[c];
-    }
-    double a = lmb_luminance(side[0]), b = lmb_luminance(side[1]), m = 0.5 * (a + b);
-    return m > 0 ? fabs(a - b) / m : 0;
 }
 
 /* Whether the two sides of some point read different light (any channel), from the atlases
@@ -371,107 +318,6 @@ static lmb_status seam_rows(const lmb_scene *s, const lmb_layout *l, const lmb_r
     return st;
 }
 
-/* The normal equations (upper triangle) over the active rows, solved into out (3 columns of
- * c->count: R, G, B). */
-static lmb_status solve(solve_ctx *c, const seam_row *rows, const uint8_t *active, size_t nr, double *out,
-                        lmb_error *err)
-{
-    size_t n = c->count;
-    lmb_spd sys;
-    lmb_status st = LMB_OK;
-    /* at most 8 x 8 pairs per row (its taps may repeat a texel), and the diagonal */
-    if (lmb_spd_begin(&sys, n, nr * 64 + n, 3)) {
-        cholmod_triplet *T = sys.a;
-        int *ti = T->i, *tj = T->j;
-        double *tx = T->x, *bx = sys.b->x;
-        for (size_t u = 0; u < n; u++) {
-            uint32_t a = c->atlas_of[u], t = c->texel_of[u];
-            double d = c->state[a][t] == LMB_TEXEL_VALID ? 1.0 : LMB_SEAM_FREE;
-            ti[T->nnz] = tj[T->nnz] = (int)u;
-            tx[T->nnz++] = d;
-            for (int k = 0; k < 3; k++)
-                bx[u + k * n] = d * c->rgb[a][3 * (size_t)t + k];
-        }
-        for (size_t r = 0; r < nr; r++)
-            for (int p = 0; active[r] && p < 8; p++)
-                for (int q = 0; q < 8; q++) {
-                    int up = c->unknown[rows[r].atlas[p]][rows[r].texel[p]];
-                    int uq = c->unknown[rows[r].atlas[q]][rows[r].texel[q]];
-                    if (up > uq)
-                        continue;
-                    ti[T->nnz] = up;
-                    tj[T->nnz] = uq;
-                    tx[T->nnz++] = LMB_SEAM_WEIGHT * rows[r].w[p] * rows[r].w[q];
-                }
-        if (!lmb_spd_solve(&sys, out))
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: the stitching solve failed (CHOLMOD status %d, %zu unknowns)",
-                               sys.cm.status, n);
-    } else {
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu unknowns", n);
-    }
-    lmb_spd_end(&sys);
-    return st;
-}
-
-/*
- * Solves, then drops the points whose texels the solution would make negative (light that
- * two sides cannot share: where the sides meet other geometry, the match would have to
- * overshoot) and solves again, at most LMB_SEAM_ROUNDS times; writes the result back.
- * Reports the largest jump over the points kept, before and after.
- */
-static lmb_status stitch(solve_ctx *c, const seam_row *rows, size_t nr, lmb_seam_report *report, lmb_error *err)
-{
-    for (size_t r = 0; r < nr; r++)
-        for (int j = 0; j < 8; j++)
-            if (unknown_of(c, rows[r].atlas[j], rows[r].texel[j]) < 0)
-                return lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for the unknowns");
-    size_t n = c->count;
-    uint8_t *active = malloc(nr + 1), *negative = calloc(n + 1, 1);
-    double *x = malloc((3 * n + 1) * sizeof *x);
-    lmb_status st = active && negative && x ? LMB_OK
-                                            : lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu unknowns", n);
-    if (st == LMB_OK)
-        memset(active, 1, nr);
-    for (int round = 0; st == LMB_OK && round < LMB_SEAM_ROUNDS; round++) {
-        st = solve(c, rows, active, nr, x, err);
-        size_t dropped = 0;
-        for (size_t u = 0; st == LMB_OK && u < n; u++)
-            negative[u] = x[u] < 0 || x[u + n] < 0 || x[u + 2 * n] < 0;
-        for (size_t r = 0; st == LMB_OK && r < nr; r++)
-            for (int j = 0; active[r] && j < 8; j++)
-                if (negative[c->unknown[rows[r].atlas[j]][rows[r].texel[j]]]) {
-                    active[r] = 0;
-                    dropped++;
-                }
-        if (!dropped)
-            break;
-    }
-    for (size_t r = 0; st == LMB_OK && r < nr; r++)
-        if (active[r]) {
-            double j = jump_at(c->rgb, &rows[r]);
-            report->jump_before = fmax(report->jump_before, j);
-            report->over_1pct_before += j > 0.01;
-            report->samples++;
-        }
-    for (size_t u = 0; st == LMB_OK && u < n; u++)
-        for (int k = 0; k < 3; k++) {
-            double v = x[u + k * n];
-            c->rgb[c->atlas_of[u]][3 * (size_t)c->texel_of[u] + k] = (float)(isfinite(v) && v > 0 ? v : 0);
-        }
-    for (size_t r = 0; st == LMB_OK && r < nr; r++)
-        if (active[r]) {
-            double j = jump_at(c->rgb, &rows[r]);
-            report->jump_after = fmax(report->jump_after, j);
-            report->over_1pct += j > 0.01;
-        }
-    report->dropped = nr - report->samples;
-    report->texels = n;
-    free(active);
-    free(negative);
-    free(x);
-    return st;
-}
-
 lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_rt *rt, float *const *rgb,
                             const uint8_t *const *state, int threads, lmb_seam_report *report, lmb_error *err)
 {
@@ -490,26 +336,10 @@ lmb_status lmb_seams_stitch(const lmb_scene *s, const lmb_layout *l, const lmb_r
     free(e); /* the points hold what the solve needs */
     e = NULL;
     report->equal = st == LMB_OK && nr && !any_side_differs(rgb, rows, nr, threads);
-    solve_ctx c = {l, rgb, state, calloc((size_t)l->atlas_count + 1, sizeof *c.unknown), NULL, NULL, 0, 0};
-    if (st == LMB_OK && !c.unknown)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for %zu seam points", nr);
-    for (uint32_t a = 0; st == LMB_OK && nr && !report->equal && a < l->atlas_count; a++) {
-        size_t texels = (size_t)l->width[a] * l->height[a];
-        c.unknown[a] = malloc((texels + 1) * sizeof *c.unknown[a]);
-        if (!c.unknown[a])
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for atlas %u", a);
-        else
-            memset(c.unknown[a], 0xff, texels * sizeof *c.unknown[a]);
-    }
     if (report->equal)
         report->samples = nr;
     else if (st == LMB_OK && nr)
-        st = stitch(&c, rows, nr, report, err);
-    for (uint32_t a = 0; c.unknown && a < l->atlas_count; a++)
-        free(c.unknown[a]);
-    free(c.unknown);
-    free(c.atlas_of);
-    free(c.texel_of);
+        st = lmb_seam_solve(l, rgb, state, rows, nr, threads, report, err);
     free(rows);
     free(e);
     report->seconds = lmb_seconds() - t0;

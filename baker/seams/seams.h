@@ -10,7 +10,8 @@
  *
  * (d_i = 1 at valid texels, LMB_SEAM_FREE at padding and filled texels, which may move
  * freely; W = LMB_SEAM_WEIGHT; b_A, b_B the bilinear weights of point s on each side). The
- * normal equations are sparse and positive definite: one CHOLMOD factorisation, three
+ * normal equations are sparse and positive definite: one CHOLMOD factorisation per
+ * independent block of texels (seam_solve.h), three
  * right-hand sides (RGB).
  *
  * A seam edge: the same world-space edge (endpoints equal to 1/1000 of a texel) in two
