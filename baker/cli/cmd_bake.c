@@ -393,6 +393,9 @@ static int run(int argc, char **argv, stage_kind stage)
     }
     cli_warnings warnings = {0, a.quiet};
     lmb_log log = cli_log(&warnings);
+    /* once per bake: not in every farm shard */
+    if ((stage == STAGE_BAKE || stage == STAGE_PLAN) && lmb_config_lint(&cfg, &log, &err) != LMB_OK)
+        return cli_fail(&err);
     double t0 = cli_now();
     cli_timings *timings = a.timings ? cli_timings_start("load") : NULL;
     if (a.timings && !timings)

@@ -309,6 +309,8 @@ int cmd_unwrap(int argc, char **argv)
         return cli_fail(&err);
     cli_warnings warnings = {0, quiet};
     lmb_log log = cli_log(&warnings);
+    if (lmb_config_lint(&cfg, &log, &err) != LMB_OK)
+        return cli_fail(&err);
     lmb_scene *scene;
     if (lmb_scene_load(scene_path, &cfg, &scene, &log, &err) != LMB_OK)
         return cli_fail(&err);

@@ -159,10 +159,9 @@ static lmb_status build_tables(lmb_sky *s, lmb_error *err)
     return LMB_OK;
 }
 
-/* The image at cfg->sky_image, inside the config's folder, as radiance times colour x intensity. */
-static lmb_status read_image(const lmb_config *cfg, const lmb_log *log, lmb_sky *s, lmb_error *err)
+lmb_status lmb_sky_image_path(const lmb_config *cfg, char *real, size_t size, lmb_error *err)
 {
-    char dir[4096], rel[4096], path[8300], real[4096];
+    char dir[4096], rel[4096], path[8300];
     const char *cfg_name = cfg->config_path[0] ? cfg->config_path : "config";
     const char *slash = strrchr(cfg->config_path, '/');
     snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - cfg->config_path) : 1, slash ? cfg->config_path : ".");
@@ -171,9 +170,20 @@ static lmb_status read_image(const lmb_config *cfg, const lmb_log *log, lmb_sky 
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' %s; the map must be a file in the "
                              "config's folder or below", cfg_name, cfg->sky_image, lmb_uri_refusal(kind));
     snprintf(path, sizeof path, "%s/%s", dir, rel);
-    if (!lmb_path_inside(dir, path, real, sizeof real))
+    if (!lmb_path_inside(dir, path, real, size))
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' is not a file inside the config's folder "
                              "'%s'", cfg_name, cfg->sky_image, dir);
+    return LMB_OK;
+}
+
+/* The image at cfg->sky_image, inside the config's folder, as radiance times colour x intensity. */
+static lmb_status read_image(const lmb_config *cfg, const lmb_log *log, lmb_sky *s, lmb_error *err)
+{
+    char real[4096];
+    const char *cfg_name = cfg->config_path[0] ? cfg->config_path : "config";
+    lmb_status st = lmb_sky_image_path(cfg, real, sizeof real, err);
+    if (st != LMB_OK)
+        return st;
     float *rgb = NULL;
     lmb_error read_err = {LMB_OK, ""};
     if (lmb_image_read_rgb(real, NULL, 0, &s->w, &s->h, &rgb, &read_err) != LMB_OK)

@@ -26,6 +26,9 @@ typedef struct lmb_sky lmb_sky; /* opaque, read-only once made: any number of th
  * warning naming how many. */
 lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
                           lmb_error *err);
+/* Where cfg->sky_image lies: a file in the config's folder or below, resolved into real; else
+ * LMB_ERR_INPUT naming the config and the key (read or not: lmb_config_lint checks it too). */
+lmb_status lmb_sky_image_path(const lmb_config *cfg, char *real, size_t size, lmb_error *err);
 void lmb_sky_free(lmb_sky *s);
 
 /* Radiance (nits, RGB) of the sky seen looking along world direction w (unit). */

@@ -514,11 +514,16 @@ lmb_status lmb_config_parse(const char *name, const char *text, size_t length, l
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot start the YAML parser", name);
     yaml_parser_set_input_string(&parser, (const unsigned char *)text, length);
     lmb_status st = load_document(name, &parser, text, length, &doc, err);
+    double intensity_before = cfg->sky_intensity;
     if (st == LMB_OK) {
         parse_ctx c = {name, &doc, err};
+        cfg->sky_intensity = NAN; /* stays NaN when the config does not set it */
         st = apply_root(&c, yaml_document_get_root_node(&doc), cfg);
         yaml_document_delete(&doc);
     }
+    /* sky.image without sky.intensity: the map's own radiance (intensity 1), not no sky */
+    if (isnan(cfg->sky_intensity))
+        cfg->sky_intensity = st == LMB_OK && cfg->sky_image[0] && intensity_before == 0 ? 1 : intensity_before;
     if (st == LMB_OK && cfg->ic_min_spacing > cfg->ic_max_spacing)
         st = lmb_error_set(err, LMB_ERR_INPUT,
                            "%s: irradiance_cache.min_spacing (%g) is larger than irradiance_cache.max_spacing (%g)",

@@ -329,7 +329,8 @@ typedef struct lmb_config {
     /* seams */
     int seam_stitch;               /* least-squares seam stitching after the gather */
     /* sky (lights/sky.h): light from every direction a ray leaves the level by */
-    double sky_intensity;          /* radiance multiplier, nits; 0 = no sky */
+    double sky_intensity;          /* radiance multiplier, nits; 0 = no sky (a config that gives sky.image and
+                                      no sky.intensity reads as 1: the map's own radiance) */
     double sky_color[3];           /* linear RGB, times sky_intensity (and the image) */
     double sky_ground[3];          /* radiance below the horizon, times sky_intensity; [0] < 0: none (the sky or image's own) */
     char sky_image[LMB_PATTERN_LEN]; /* equirectangular HDR/EXR, relative to the config's folder; "" = none */
@@ -363,6 +364,11 @@ lmb_status lmb_config_load(const char *path, lmb_config *cfg, lmb_error *err);
 /* Same, from a string; `name` is used in messages in place of a file name. */
 lmb_status lmb_config_parse(const char *name, const char *text, size_t length, lmb_config *cfg,
                             lmb_error *err);
+
+/* Warns, naming the config and both keys, of every key set (to other than its default) whose
+ * effect another key switches off (sky.color with no sky, output.ktx2_format with no ktx2
+ * output, ...); checks paths whether or not they are used (sky.image: LMB_ERR_INPUT). */
+lmb_status lmb_config_lint(const lmb_config *cfg, const lmb_log *log, lmb_error *err);
 
 /* The effective config as YAML (every key, grouped by section) that lmb_config_parse reads back
  * to the same lmb_config; like snprintf, writes at most size bytes (NUL included) and returns the
