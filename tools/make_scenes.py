@@ -25,6 +25,8 @@ usage: make_scenes.py OUTDIR
   sealed-room.gltf    closed 2 m room (inward faces), point light outside it
   sealed-room-camera.gltf  the same with a glTF camera at (0.3, 1.2, 0.4) looking along -z
   box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
+  probe-point.gltf    black plane (albedo 0, 4 x 4) and a 100 cd point light 2 above it: a probe
+                      above it sees the light alone
   furnace.gltf        closed 2 m box, every face albedo 0.5 and emitting 1 nit (the furnace test;
                       also the benchmark's "light from everywhere" scene)
   furnace-*.gltf      the same box with other materials (FURNACE_MATERIALS: spec-gloss, a
@@ -368,6 +370,11 @@ def analytic(out):
     s.mesh("cube", box(-1, 0, -1, 1, 2, 1), grey)
     s.light("above", "point", 100.0, translation=(1.6, 4, 0.6))
     s.write(os.path.join(out, "box-floor.gltf"))
+
+    s = Scene()
+    s.mesh("plane", plane(4), s.material("black", (0.0, 0.0, 0.0)))
+    s.light("point", "point", 100.0, translation=(0.3, 2, -0.2))
+    s.write(os.path.join(out, "probe-point.gltf"))
 
 
 PLATE_HEIGHT = 1.5  # sun-plate.gltf

@@ -112,26 +112,32 @@ uint32_t lmb_cdf_pick(const double *cdf, uint32_t count, double u, double *prob)
     return lo;
 }
 
+double lmb_punctual_falloff(const lmb_light *l, const double d[3], double dist)
+{
+    if (l->type == LMB_LIGHT_DIRECTIONAL)
+        return 1.0;
+    double w = 1.0 / (dist * dist);
+    if (l->range > 0) {
+        double r = dist / l->range, f = 1.0 - r * r * r * r;
+        f = f < 0 ? 0 : f;
+        w *= f * f;
+    }
+    if (l->type == LMB_LIGHT_SPOT) {
+        double cd = -lmb_dot3(d, l->direction), co = cos(l->outer_cone), ci = cos(l->inner_cone);
+        double t = (cd - co) / fmax(1e-3, ci - co);
+        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+        w *= t * t;
+    }
+    return w;
+}
+
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
-    double scale = c->d->cfg->light_intensity_scale, d[3], dist, cosang, w = 1.0;
+    double scale = c->d->cfg->light_intensity_scale, d[3], dist, cosang, w;
     if (!lmb_light_direction(c, l, d, &dist))
         return;
-    if (l->type != LMB_LIGHT_DIRECTIONAL) {
-        w = 1.0 / (dist * dist);
-        if (l->range > 0) {
-            double r = dist / l->range, f = 1.0 - r * r * r * r;
-            f = f < 0 ? 0 : f;
-            w *= f * f;
-        }
-        if (l->type == LMB_LIGHT_SPOT) {
-            double cd = -lmb_dot3(d, l->direction), co = cos(l->outer_cone), ci = cos(l->inner_cone);
-            double t = (cd - co) / fmax(1e-3, ci - co);
-            t = t < 0 ? 0 : (t > 1 ? 1 : t);
-            w *= t * t;
-        }
-    }
+    w = lmb_punctual_falloff(l, d, dist);
     cosang = lmb_dot3(c->n, d);
     if (w <= 0 || cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
         return;
@@ -199,9 +205,7 @@ static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
     }
 }
 
-/* Emitted radiance of emitter x at barycentrics (b1, b2) seen from direction d (unit, toward
- * the emitter), or 0 when seen from its back and one-sided. */
-static int emitted(const emitter *x, double b1, double b2, const double d[3], double *cos_y, double le[3])
+int lmb_emitter_radiance(const emitter *x, double b1, double b2, const double d[3], double *cos_y, double le[3])
 {
     double cy = -lmb_dot3(x->n, d);
     if (x->two_sided)
@@ -257,7 +261,7 @@ static void area_lights(point_ctx *c, double e[3])
             for (int k = 0; k < 3; k++)
                 d[k] /= dist;
             double cx = lmb_dot3(c->n, d);
-            if (cx > 0 && lmb_dot3(c->ng, d) > 0 && emitted(x, b1, b2, d, &cy, le)) {
+            if (cx > 0 && lmb_dot3(c->ng, d) > 0 && lmb_emitter_radiance(x, b1, b2, d, &cy, le)) {
                 c->rays++;
                 if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
                     double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
@@ -291,7 +295,7 @@ static void area_lights(point_ctx *c, double e[3])
             continue;
         const emitter *x = &es->e[k1 - 1];
         double le[3], cy;
-        if (!emitted(x, h.u, h.v, w, &cy, le))
+        if (!lmb_emitter_radiance(x, h.u, h.v, w, &cy, le))
             continue;
         double pt = (es->cdf[k1] - es->cdf[k1 - 1]) / total;
         double pl = pt / x->area * h.t * h.t / cy, pb = cz * LMB_INV_PI;

@@ -126,4 +126,21 @@ uint32_t lmb_direct_round_samples(const lmb_config *cfg);
  * direct light has noise, and adaptive sampling has something to do. */
 int lmb_direct_has_sampled(const lmb_direct *d);
 
+/* ---- for light probes (probe_lights.c) ---- */
+
+/* One delta light seen from a probe: unit direction toward it and the irradiance (lux, RGB) it
+ * gives a surface facing it there, shadowed. */
+typedef void (*lmb_delta_fn)(void *user, const double dir[3], const double e[3]);
+
+/* Calls fn for every point, spot and directional light in `baked` mode that reaches p unoccluded
+ * (a sun with lights.sun_angle counts as its disc's centre). Returns the shadow rays traced. */
+uint32_t lmb_direct_deltas_at(const lmb_direct *d, const double p[3], lmb_delta_fn fn, void *user);
+
+/* The emitted radiance (nits, RGB) a ray travelling along unit w sees at hit h: 0 and returns 0
+ * when the hit triangle emits nothing or is seen from its back and one-sided. */
+int lmb_direct_emitted_at_hit(const lmb_direct *d, const lmb_rt_hit *h, const double w[3], double le[3]);
+
+/* The sky the lights were made with, or NULL. */
+const lmb_sky *lmb_direct_sky(const lmb_direct *d);
+
 #endif

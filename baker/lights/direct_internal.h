@@ -69,6 +69,15 @@ int lmb_light_direction(const point_ctx *c, const lmb_light *l, double d[3], dou
 /* Emitter index chosen in proportion to power for u in [0, 1); *prob its probability. */
 uint32_t lmb_emitter_pick(const lmb_emitters *es, double u, double *prob);
 
+/* A point or spot light's irradiance per candela at normal incidence from unit direction d (toward
+ * the light) at distance dist: 1/dist^2 times the range window and the spot's cone (the formulas
+ * atop direct.c); 1 for a directional light. */
+double lmb_punctual_falloff(const lmb_light *l, const double d[3], double dist);
+
+/* Emitted radiance of emitter x at barycentrics (b1, b2) seen from direction d (unit, toward
+ * the emitter), its cosine there in *cos_y; 0 when seen from its back and one-sided. */
+int lmb_emitter_radiance(const emitter *x, double b1, double b2, const double d[3], double *cos_y, double le[3]);
+
 /* c := the shading point sp of d, no rays traced yet. */
 void lmb_point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp);
 

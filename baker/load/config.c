@@ -136,6 +136,9 @@ static const key_spec config_keys[] = {
     U32("sky.samples", OFF(sky_samples), 1, 65536),
     ENUM("sky.sampling", OFF(sky_cosine_only), sky_samplings),
     BOOL("seams.stitch", OFF(seam_stitch)),
+    BOOL("probes.auto", OFF(probes_auto)),
+    FLOAT_AUTO("probes.spacing", OFF(probe_spacing), 0, 1e9, OPEN_LO),
+    U32("probes.rays", OFF(probe_rays), 16, 65536),
     BOOL("fireflies.spread", OFF(firefly_spread)),
 };
 
@@ -212,6 +215,9 @@ void lmb_config_default(lmb_config *cfg)
     cfg->sky_ground[0] = cfg->sky_ground[1] = cfg->sky_ground[2] = -1; /* none */
     cfg->sky_up[1] = 1;
     cfg->sky_samples = 64;
+    cfg->probes_auto = 1;
+    cfg->probe_spacing = 0; /* auto */
+    cfg->probe_rays = 1024;
     cfg->ktx2_format = 0; /* e5b9g9r9 */
     cfg->ktx2_zstd = 1;
     cfg->default_albedo[0] = cfg->default_albedo[1] = cfg->default_albedo[2] = -1; /* none: glTF's metal */

@@ -37,6 +37,14 @@ struct lmb_gltf_doc {
     /* writer: meshes a node used before it got its lightmapped copy (gltf_prune.cpp drops the
      * ones no node uses any more) */
     std::vector<int> replaced_meshes;
+    /* light probes to add at saving, after the pruning that renumbers accessors and views
+       (lmb_gltf_set_probes) */
+    std::vector<float> probe_positions, probe_sh, probe_cube;
+    double probe_spacing = 0;
+    int probe_radiance = 0;
+    std::string volume_uri; /* "" when none */
+    double volume_lo[3] = {0, 0, 0}, volume_hi[3] = {0, 0, 0};
+    uint32_t volume_res[3] = {0, 0, 0};
     /* writer: materials.default.albedo for primitives with no material, if given */
     bool has_default_albedo = false;
     double default_albedo[3] = {0, 0, 0};

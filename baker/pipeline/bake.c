@@ -21,6 +21,7 @@
 #include "pack/layout.h"
 #include "post/dilate.h"
 #include "post/fireflies.h"
+#include "probes/probes.h"
 #include "seams/seams.h"
 #include "texels/texels.h"
 #include "write/atlas_images.h"
@@ -193,6 +194,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_textures tx;
     lmb_cache cache;
     lmb_ic_points records = {NULL, 0};
+    lmb_probe_set probes;
+    memset(&probes, 0, sizeof probes);
     memset(&l, 0, sizeof l);
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
@@ -245,6 +248,11 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = dark_atlases(s, cfg, &l, &cache, stats, err);
     else if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
+    /* light probes: placed in every process alike, lit as a step from the finished cache */
+    if (st == LMB_OK)
+        st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
+    if (st == LMB_OK)
+        st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, err);
     if (st == LMB_OK && worker)
         st = lmb_steps_worker_end(steps, err);
     if (worker && !finishes) {
@@ -295,8 +303,12 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         progress(user, "glTF", 0, 1);
     if (st == LMB_OK) {
         lmb_copy_input_textures(s, &od, log);
-        st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
-                                        cache.shadowmask != NULL, err);
+        lmb_gltf_probes out_probes;
+        st = lmb_probes_output(&probes, cfg, od.staging, od.stem, &out_probes, err);
+        if (st == LMB_OK)
+            st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
+                                            cache.shadowmask != NULL, &out_probes, err);
+        lmb_probes_output_free(&out_probes);
     }
     free(outputs);
     if (st == LMB_OK)
@@ -312,6 +324,7 @@ done:
     lmb_part_identity_free(&id);
     lmb_cache_free(&cache);
     free(records.xyzr);
+    lmb_probe_set_free(&probes);
     lmb_direct_free(direct);
     lmb_sky_free(sky);
     lmb_emitters_free(em);

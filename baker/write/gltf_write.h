@@ -95,6 +95,29 @@ lmb_status lmb_gltf_set_light_modes(lmb_gltf_doc *doc, const lmb_light *lights, 
  * the asset's other extras are kept. */
 lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, uint32_t count, lmb_error *err);
 
+/* Light probes (probes/probes.h) as the output holds them: values already in the lightmaps'
+ * scale (E, or E / pi with radiance). */
+typedef struct lmb_gltf_probes {
+    uint32_t count;
+    const float *positions; /* 3 per probe, world */
+    const float *sh;        /* 27 per probe: SH L2 irradiance, coefficient-major RGB */
+    const float *cube;      /* 18 per probe: irradiance for +X, -X, +Y, -Y, +Z, -Z, RGB */
+    double spacing;         /* the grid's cell */
+    int radiance;           /* output.scale radiance */
+    const char *volume_uri; /* the grid as bevy's irradiance volume (KTX2), or NULL */
+    double volume_lo[3], volume_hi[3];
+    uint32_t volume_res[3];
+} lmb_gltf_probes;
+
+/* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes
+ * as buffer views of float32) and names them in asset.extras.lightmap.probes {count, positions,
+ * sh, ambientCube, shBasis, scale, unit, spacing} (docs/probes.md); the asset's other extras
+ * are kept. With a volume_uri, a node "lightmap irradiance volume" in the default scene whose
+ * transform takes a unit cube centred on the origin to the volume's box (bevy's
+ * IrradianceVolume), with extras.lightmap.irradianceVolume {uri, resolution, layout, scale,
+ * unit}. Nothing when count is 0. Added when the document is saved. */
+lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_probes *p, lmb_error *err);
+
 /* Lightmapped primitives with no material get a material of this diffuse albedo (metallic 0:
  * materials.default.albedo, so the level looks as it was baked) instead of glTF's default. */
 void lmb_gltf_set_default_albedo(lmb_gltf_doc *doc, const double albedo[3]);

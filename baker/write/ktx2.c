@@ -217,13 +217,19 @@ static void key_value(bytes *b, const char *key, const char *value)
 lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f, int zstd_level,
                            uint8_t **out, size_t *size, lmb_error *err)
 {
+    return lmb_ktx2_encode_3d(w, h, 0, rgb, f, zstd_level, out, size, err);
+}
+
+lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *rgb, lmb_ktx2_format f, int zstd_level,
+                              uint8_t **out, size_t *size, lmb_error *err)
+{
     *out = NULL;
     *size = 0;
-    size_t texel = f == LMB_KTX2_RGBA16F ? 8 : 4, raw_size = (size_t)w * h * texel;
+    size_t texel = f == LMB_KTX2_RGBA16F ? 8 : 4, raw_size = (size_t)w * h * (d ? d : 1) * texel;
     uint8_t *raw = malloc(raw_size + 1);
     if (!raw)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for a %ux%u level", w, h);
-    for (size_t i = 0; i < (size_t)w * h; i++) {
+    for (size_t i = 0; i < raw_size / texel; i++) {
         const float *p = rgb + 3 * i;
         uint8_t *q = raw + texel * i;
         if (f == LMB_KTX2_RGBA16F) {
@@ -263,7 +269,7 @@ lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_fo
     put32(&b, f == LMB_KTX2_RGBA16F ? 2 : 4); /* typeSize */
     put32(&b, w);
     put32(&b, h);
-    put32(&b, 0); /* pixelDepth */
+    put32(&b, d); /* pixelDepth: 0 for 2D */
     put32(&b, 0); /* layerCount */
     put32(&b, 1); /* faceCount */
     put32(&b, 1); /* levelCount */
@@ -280,7 +286,7 @@ lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_fo
     size_t dfd_at = b.n;
     dfd(&b, f);
     size_t kvd_at = b.n;
-    key_value(&b, "KTXorientation", "rd");
+    key_value(&b, "KTXorientation", d ? "rdi" : "rd");
     key_value(&b, "KTXwriter", "lmbake " LMB_VERSION_STRING);
     size_t kvd_end = b.n;
     pad_to(&b, zstd_level > 0 ? 1 : 8);

@@ -1,5 +1,6 @@
 /*
- * KTX 2.0 lightmaps (output.formats ktx2): one 2D texture, one level, one layer, in an HDR
+ * KTX 2.0 lightmaps (output.formats ktx2) and irradiance volumes (probes/probe_volume.c): one 2D
+ * or 3D texture, one level, one layer, in an HDR
  * format engines sample directly. The container follows the KTX 2.0 specification (Khronos,
  * "KTX File Format Specification", version 2.0): header, level index, a Basic Data Format
  * Descriptor (Khronos Data Format Specification 1.3, the samples KTX-Software's dfdutils
@@ -36,6 +37,11 @@ uint16_t lmb_float_to_half(float v);
  * frees) and its size. zstd_level > 0: Zstandard supercompression at that level; 0: none. */
 lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f, int zstd_level,
                            uint8_t **out, size_t *size, lmb_error *err);
+
+/* The same for a 3D texture of w x h x d texels (slices front to back, each rows top to bottom;
+ * KTXorientation "rdi"); d = 0 is lmb_ktx2_encode's 2D texture. */
+lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *rgb, lmb_ktx2_format f, int zstd_level,
+                              uint8_t **out, size_t *size, lmb_error *err);
 
 /* lmb_ktx2_encode written to path. */
 lmb_status lmb_ktx2_write(const char *path, uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f,

@@ -67,7 +67,8 @@ typedef struct instance_prims {
 
 lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                                       const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
-                                      int directional, int shadowmask, lmb_error *err)
+                                      int directional, int shadowmask, const lmb_gltf_probes *probes,
+                                      lmb_error *err)
 {
     int32_t *tex = malloc(((size_t)l->atlas_count + 1) * 2 * sizeof *tex), *dir_tex = tex + l->atlas_count + 1;
     if (!tex)
@@ -183,6 +184,8 @@ lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const
         st = lmb_write_records(dir, rec, records, err);
     if (st == LMB_OK && records->count)
         st = lmb_gltf_set_records(s->doc, rec, records->count, err);
+    if (st == LMB_OK && probes)
+        st = lmb_gltf_set_probes(s->doc, probes, err);
     snprintf(path, sizeof path, "%s/%s.gltf", dir, stem);
     snprintf(bin, sizeof bin, "%s-lightmap.bin", stem);
     if (st == LMB_OK)

@@ -11,6 +11,7 @@
 
 #include "pack/layout.h"
 #include "write/atlas_images.h"
+#include "write/gltf_write.h"
 #include "write/output_dir.h"
 #include "write/records_file.h"
 
@@ -19,9 +20,10 @@
 void lmb_copy_input_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log);
 
 /* DIR/STEM.gltf (+ STEM-lightmap.bin) and, when records->count, the records file. outputs: per
- * atlas what its images hold (RGBM range). */
+ * atlas what its images hold (RGBM range). probes: NULL or the light probes. */
 lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                                       const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
-                                      int directional, int shadowmask, lmb_error *err);
+                                      int directional, int shadowmask, const lmb_gltf_probes *probes,
+                                      lmb_error *err);
 
 #endif

@@ -346,6 +346,10 @@ typedef struct lmb_config {
     double default_albedo[3];      /* materials.default.albedo: primitives with no material; [0] < 0: none (glTF's metal) */
     lmb_material_override material_overrides[LMB_MAX_PATTERNS];
     uint32_t material_override_count;
+    /* light probes (baker/probes): irradiance for what moves through the level */
+    int probes_auto;               /* probes.auto: a grid over the level, refined near surfaces */
+    double probe_spacing;          /* probes.spacing: the grid's cell, world units; 0 = auto (from the surface area) */
+    uint32_t probe_rays;           /* probes.rays: directions each probe looks in */
     char config_path[4096];        /* the config file it was loaded from (lmb_config_load), "" for none: sky.image is
                                       read from its folder; not a key */
 } lmb_config;

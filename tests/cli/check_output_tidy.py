@@ -70,6 +70,11 @@ def main():
                 read |= set(t.values())
     views = {a["bufferView"] for a in doc["accessors"] if "bufferView" in a}
     views |= {i["bufferView"] for i in doc.get("images", []) if "bufferView" in i}
+    # the light probes (docs/probes.md) are read through asset.extras.lightmap.probes
+    probes = doc["asset"].get("extras", {}).get("lightmap", {}).get("probes")
+    if probes:
+        read.add(probes["positions"])
+        views |= {probes["sh"], probes["ambientCube"]}
     problems = []
     if drawn != set(range(len(doc["meshes"]))):
         problems.append("meshes no node draws: %s" % sorted(set(range(len(doc["meshes"]))) - drawn))

@@ -19,7 +19,7 @@ if (c.supercompressionScheme === 2) {
   await z.init();
   data = z.decode(data, level.uncompressedByteLength);
 }
-const w = c.pixelWidth, h = c.pixelHeight, n = w * h;
+const w = c.pixelWidth, h = c.pixelHeight, n = w * h * Math.max(1, c.pixelDepth); // 3D: slices one after the other
 const rgb = new Float32Array(3 * n);
 const view = new DataView(data.buffer, data.byteOffset, data.byteLength);
 // unsigned float of e exponent bits (bias 15) and m mantissa bits

@@ -1,0 +1,249 @@
+/* Probe placement (see probes.h): the grid, its refinement near surfaces, and the probes
+ * dropped inside geometry or outside the level. */
+#include "probes.h"
+#include "sphere.h"
+
+#include <omp.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TEST_RAYS 64          /* rays that decide whether a probe is inside geometry or outside the level */
+#define AUTO_PROBES 256       /* auto spacing: the level's lightmapped surface area / spacing^2 */
+#define AUTO_MAX_CELLS 4096   /* auto spacing: widened until the grid has at most this many cells (32,768 probes at most) */
+#define FAR_CELLS 3           /* a probe with no surface within this many cells is outside the level */
+
+/* The lightmapped geometry's bounds and surface area. */
+static void bounds_and_area(const lmb_scene *s, const lmb_layout *l, double lo[3], double hi[3], double *area)
+{
+    *area = 0;
+    for (int k = 0; k < 3; k++) {
+        lo[k] = HUGE_VAL;
+        hi[k] = -HUGE_VAL;
+    }
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        if (!l->instances[i].lightmapped)
+            continue;
+        uint32_t nt = s->meshes[s->instances[i].mesh].triangle_count;
+        for (uint32_t f = 0; f < nt; f++) {
+            double q[9];
+            lmb_layout_world_triangle(s, l, i, f, q);
+            for (int c = 0; c < 3; c++)
+                for (int k = 0; k < 3; k++) {
+                    lo[k] = fmin(lo[k], q[3 * c + k]);
+                    hi[k] = fmax(hi[k], q[3 * c + k]);
+                }
+            *area += lmb_triangle_area(q);
+        }
+    }
+}
+
+/* Does triangle q touch the box centre c, half-size h? Its bounding box overlaps (the caller
+ * visits only those cells) and its plane passes within the box (a conservative test: a cell
+ * near a triangle's edge may count, which only refines it). */
+static int plane_meets_box(const double q[9], const double c[3], const double h[3])
+{
+    double e1[3], e2[3], n[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = q[3 + k] - q[k];
+        e2[k] = q[6 + k] - q[k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double dist = n[0] * (c[0] - q[0]) + n[1] * (c[1] - q[1]) + n[2] * (c[2] - q[2]);
+    double reach = h[0] * fabs(n[0]) + h[1] * fabs(n[1]) + h[2] * fabs(n[2]);
+    return fabs(dist) <= reach;
+}
+
+typedef struct grid {
+    double lo[3], cell[3];
+    uint32_t n[3];
+} grid;
+
+static size_t cell_index(const grid *g, uint32_t x, uint32_t y, uint32_t z)
+{
+    return ((size_t)z * g->n[1] + y) * g->n[0] + x;
+}
+
+/* Marks every cell some lightmapped triangle passes through. */
+static void mark_surface_cells(const lmb_scene *s, const lmb_layout *l, const grid *g, uint8_t *marked)
+{
+    double h[3] = {0.5 * g->cell[0], 0.5 * g->cell[1], 0.5 * g->cell[2]};
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        if (!l->instances[i].lightmapped)
+            continue;
+        uint32_t nt = s->meshes[s->instances[i].mesh].triangle_count;
+        for (uint32_t f = 0; f < nt; f++) {
+            double q[9];
+            lmb_layout_world_triangle(s, l, i, f, q);
+            uint32_t a[3], b[3];
+            for (int k = 0; k < 3; k++) {
+                double mn = fmin(q[k], fmin(q[3 + k], q[6 + k])), mx = fmax(q[k], fmax(q[3 + k], q[6 + k]));
+                double u0 = floor((mn - g->lo[k]) / g->cell[k]), u1 = floor((mx - g->lo[k]) / g->cell[k]);
+                a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
+                b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
+            }
+            for (uint32_t z = a[2]; z <= b[2]; z++)
+                for (uint32_t y = a[1]; y <= b[1]; y++)
+                    for (uint32_t x = a[0]; x <= b[0]; x++) {
+                        size_t c = cell_index(g, x, y, z);
+                        if (marked[c])
+                            continue;
+                        double centre[3] = {g->lo[0] + (x + 0.5) * g->cell[0], g->lo[1] + (y + 0.5) * g->cell[1],
+                                            g->lo[2] + (z + 0.5) * g->cell[2]};
+                        marked[c] = (uint8_t)plane_meets_box(q, centre, h);
+                    }
+        }
+    }
+}
+
+/* 0 keep, 1 inside geometry (most rays that hit something hit a back face), 2 outside the level
+ * (no surface within FAR_CELLS cells in any direction). */
+static int probe_fate(const lmb_rt *rt, const double p[3], double far)
+{
+    uint32_t hits = 0, back = 0;
+    double nearest = HUGE_VAL;
+    for (uint32_t j = 0; j < TEST_RAYS; j++) {
+        double w[3];
+        lmb_sphere_direction(j, TEST_RAYS, w);
+        lmb_rt_hit h;
+        if (!lmb_rt_intersect(rt, p, w, rt->eps, 1e300, &h))
+            continue;
+        hits++;
+        back += h.backface != 0;
+        nearest = fmin(nearest, h.t);
+    }
+    if (hits && 2 * back > hits)
+        return 1;
+    return !hits || nearest > far ? 2 : 0;
+}
+
+/* The grid: auto spacing from the surface area (a probe per AUTO_PROBES-th of it), widened to
+ * AUTO_MAX_CELLS cells; a flat level's thin axis gets one cell of the spacing, centred. */
+static void make_grid(const lmb_config *cfg, const double lo[3], const double hi[3], double area, grid *g,
+                      double *spacing)
+{
+    double s = cfg->probe_spacing > 0 ? cfg->probe_spacing : sqrt(area / AUTO_PROBES);
+    for (;;) {
+        size_t cells = 1;
+        for (int k = 0; k < 3; k++) {
+            double ext = hi[k] - lo[k];
+            g->n[k] = ext > s ? (uint32_t)fmin(ceil(ext / s), 1e6) : 1;
+            g->cell[k] = ext > s ? ext / g->n[k] : s;
+            g->lo[k] = ext > s ? lo[k] : 0.5 * (lo[k] + hi[k]) - 0.5 * s;
+            cells *= g->n[k];
+        }
+        if (cfg->probe_spacing > 0 || cells <= AUTO_MAX_CELLS)
+            break;
+        s *= 1.25;
+    }
+    *spacing = s;
+}
+
+lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
+                            const lmb_log *log, lmb_probe_set *out, lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->rays = cfg->probe_rays;
+    if (!cfg->probes_auto)
+        return LMB_OK;
+    double lo[3], hi[3], area;
+    bounds_and_area(s, l, lo, hi, &area);
+    if (!(area > 0) || !(hi[0] >= lo[0]))
+        return LMB_OK;
+    grid g;
+    make_grid(cfg, lo, hi, area, &g, &out->spacing);
+    size_t cells = (size_t)g.n[0] * g.n[1] * g.n[2];
+    if (cells > LMB_PROBES_MAX)
+        return lmb_error_set(err, LMB_ERR_INPUT,
+                             "%s: probes.spacing %g makes a grid of %ux%ux%u = %zu cells over the level's %g x %g x %g "
+                             "bounds: more than the %u probes a bake holds (%d floats each, 200 MB of output); raise "
+                             "probes.spacing", cfg->config_path[0] ? cfg->config_path : "config", cfg->probe_spacing,
+                             g.n[0], g.n[1], g.n[2], cells, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2],
+                             LMB_PROBES_MAX, LMB_PROBE_SH + LMB_PROBE_CUBE);
+    uint8_t *marked = calloc(cells + 1, 1);
+    if (!marked)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu cells", cells);
+    mark_surface_cells(s, l, &g, marked);
+    size_t candidates = 0;
+    for (size_t c = 0; c < cells; c++) {
+        candidates += marked[c] ? 8 : 1;
+        out->refined += marked[c];
+    }
+    double *p = malloc((3 * candidates + 1) * sizeof *p);
+    uint32_t *cell_of = malloc((candidates + 1) * sizeof *cell_of);
+    uint8_t *fate = malloc(candidates + 1);
+    if (!p || !cell_of || !fate || candidates > LMB_PROBES_MAX) {
+        free(marked);
+        free(p);
+        free(cell_of);
+        free(fate);
+        if (candidates > LMB_PROBES_MAX)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: probes.spacing %g places %zu probes near the level's surfaces: "
+                                 "more than the %u a bake holds; raise probes.spacing",
+                                 cfg->config_path[0] ? cfg->config_path : "config", out->spacing, candidates,
+                                 LMB_PROBES_MAX);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu probes", candidates);
+    }
+    size_t m = 0;
+    for (uint32_t z = 0; z < g.n[2]; z++)
+        for (uint32_t y = 0; y < g.n[1]; y++)
+            for (uint32_t x = 0; x < g.n[0]; x++) {
+                uint32_t cell[3] = {x, y, z};
+                int split = marked[cell_index(&g, x, y, z)];
+                for (int child = 0; child < (split ? 8 : 1); child++, m++) {
+                    cell_of[m] = (uint32_t)cell_index(&g, x, y, z);
+                    for (int k = 0; k < 3; k++) {
+                        double at = split ? 0.25 + 0.5 * ((child >> k) & 1) : 0.5;
+                        p[3 * m + k] = g.lo[k] + (cell[k] + at) * g.cell[k];
+                    }
+                }
+            }
+    free(marked);
+    double far = FAR_CELLS * fmax(g.cell[0], fmax(g.cell[1], g.cell[2]));
+    int threads = cfg->threads > 0 ? (int)cfg->threads : omp_get_max_threads();
+#pragma omp parallel num_threads(threads)
+    {
+        lmb_rt_thread_init();
+#pragma omp for schedule(dynamic, 64)
+        for (size_t i = 0; i < candidates; i++)
+            fate[i] = (uint8_t)probe_fate(rt, p + 3 * i, far);
+    }
+    for (size_t i = 0; i < candidates; i++) {
+        out->dropped_inside += fate[i] == 1;
+        out->dropped_outside += fate[i] == 2;
+        if (fate[i] == 0) {
+            memmove(p + 3 * (size_t)out->count, p + 3 * i, 3 * sizeof *p);
+            cell_of[out->count] = cell_of[i];
+            out->count++;
+        }
+    }
+    free(fate);
+    out->position = p;
+    out->cell = cell_of;
+    memcpy(out->grid, g.n, sizeof g.n);
+    memcpy(out->grid_lo, g.lo, sizeof g.lo);
+    memcpy(out->grid_cell, g.cell, sizeof g.cell);
+    out->sh = calloc((size_t)out->count * LMB_PROBE_SH + 1, sizeof *out->sh);
+    out->cube = calloc((size_t)out->count * LMB_PROBE_CUBE + 1, sizeof *out->cube);
+    if (!out->sh || !out->cube) {
+        lmb_probe_set_free(out);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %u probes", out->count);
+    }
+    lmb_info(log, "probes: %u at spacing %g (%s), grid %ux%ux%u, %u cells with surface split in 8; %u inside geometry "
+             "and %u outside the level dropped", out->count, out->spacing,
+             cfg->probe_spacing > 0 ? "probes.spacing" : "auto: from the lightmapped surface's area", g.n[0], g.n[1],
+             g.n[2], out->refined, out->dropped_inside, out->dropped_outside);
+    return LMB_OK;
+}
+
+void lmb_probe_set_free(lmb_probe_set *set)
+{
+    free(set->position);
+    free(set->cell);
+    free(set->sh);
+    free(set->cube);
+    memset(set, 0, sizeof *set);
+}

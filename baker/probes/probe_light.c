@@ -1,0 +1,208 @@
+/*
+ * Probe light (see probes.h). At each probe, probes.rays directions of a spherical Fibonacci
+ * lattice (sphere.h) see: the sky where they leave the level, an emitter's radiance where they
+ * hit one, and where they hit a lightmapped surface its outgoing diffuse radiance
+ * B = albedo / pi x E from the finished bounce cache (a surface without a lightmap: its direct
+ * light, one bounce, as the final gather does); back faces are black. With L(w) so sampled,
+ *   L_lm = 4 pi / n sum_i L(w_i) Y_lm(w_i) + sum_delta E_delta Y_lm(w_delta)
+ * (delta lights, which no ray hits, as their direction and the irradiance they bring), and the
+ * SH irradiance is E_lm = A_l L_lm (Ramamoorthi and Hanrahan 2001, eq. 8).
+ * The ambient cube's six irradiances are computed for each axis normal n directly: the direct
+ * light of every light and the sky at a point facing n, by the direct stage's own estimator
+ * (lmb_direct_at_split: shadow rays, area-light and sky sampling with MIS; minus the `indirect`
+ * lights' part), plus 4 pi / n sum_i B(w_i) max(0, n . w_i) over the rays that hit surfaces.
+ * Random numbers (area lights, the sky's map) are keyed by (seed, probe, axis): a probe's values
+ * do not depend on threads or on how a farm splits the probes.
+ */
+#include "probes.h"
+#include "sphere.h"
+
+#include "util/lmb_math.h"
+#include "util/rng.h"
+
+#include <omp.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CUBE_SAMPLES 64 /* direct-light samples per axis of the ambient cube (area lights, sky) */
+
+static const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+
+/* Real SH up to l = 2 (sky.c's sh9 order and constants). */
+static void sh9(const double w[3], double y[9])
+{
+    double x = w[0], yy = w[1], z = w[2];
+    y[0] = 0.282095;
+    y[1] = 0.488603 * yy;
+    y[2] = 0.488603 * z;
+    y[3] = 0.488603 * x;
+    y[4] = 1.092548 * x * yy;
+    y[5] = 1.092548 * yy * z;
+    y[6] = 0.315392 * (3 * z * z - 1);
+    y[7] = 1.092548 * x * z;
+    y[8] = 0.546274 * (x * x - yy * yy);
+}
+
+static const double band[9] = {LMB_PI,     2 * LMB_PI / 3, 2 * LMB_PI / 3, 2 * LMB_PI / 3, LMB_PI / 4,
+                               LMB_PI / 4, LMB_PI / 4,     LMB_PI / 4,     LMB_PI / 4};
+
+void lmb_probe_sh_irradiance(const float sh[LMB_PROBE_SH], const double n[3], double e[3])
+{
+    double y[9];
+    sh9(n, y);
+    for (int c = 0; c < 3; c++) {
+        e[c] = 0;
+        for (int k = 0; k < 9; k++)
+            e[c] += sh[3 * k + c] * y[k];
+    }
+}
+
+typedef struct probe_job {
+    const lmb_probe_set *set;
+    const lmb_config *cfg;
+    const lmb_direct *direct;
+    const lmb_cache *cache;
+    int threads;
+} probe_job;
+
+typedef struct delta_sum {
+    double l[9][3]; /* radiance SH (not yet convolved) */
+} delta_sum;
+
+static void add_delta(void *user, const double dir[3], const double e[3])
+{
+    delta_sum *d = user;
+    double y[9];
+    sh9(dir, y);
+    for (int k = 0; k < 9; k++)
+        for (int c = 0; c < 3; c++)
+            d->l[k][c] += e[c] * y[k];
+}
+
+/* One probe's 45 floats (SH then cube) into out; returns the rays traced. */
+static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
+{
+    const lmb_rt *rt = job->cache->rt;
+    const double *p = job->set->position + 3 * (size_t)i;
+    const lmb_sky *sky = lmb_direct_sky(job->direct);
+    uint32_t n = job->set->rays;
+    delta_sum sum;
+    double cube[6][3];
+    memset(&sum, 0, sizeof sum);
+    memset(cube, 0, sizeof cube);
+    uint64_t rays = 0;
+    for (uint32_t j = 0; j < n; j++) {
+        double w[3], l[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+        lmb_sphere_direction(j, n, w);
+        lmb_rt_hit h;
+        rays++;
+        if (!lmb_rt_intersect(rt, p, w, rt->eps, 1e300, &h)) {
+            if (sky)
+                lmb_sky_radiance(sky, w, l);
+        } else if (!h.backface) {
+            double albedo[3], e[3];
+            lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
+            if (kind == LMB_HIT_UNMAPPED) {
+                lmb_shading_point y;
+                for (int k = 0; k < 3; k++) {
+                    y.p[k] = p[k] + h.t * w[k];
+                    y.n[k] = y.ng[k] = h.ng[k];
+                }
+                y.eps = 4 * rt->eps;
+                lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, j);
+                rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);
+            }
+            if (kind != LMB_HIT_DARK)
+                for (int c = 0; c < 3; c++)
+                    b[c] = albedo[c] * e[c];
+            lmb_direct_emitted_at_hit(job->direct, &h, w, l);
+            for (int c = 0; c < 3; c++)
+                l[c] += b[c];
+        }
+        double y[9];
+        sh9(w, y);
+        for (int k = 0; k < 9; k++)
+            for (int c = 0; c < 3; c++)
+                sum.l[k][c] += 4 * LMB_PI / n * l[c] * y[k];
+        for (int a = 0; a < 6; a++) {
+            double cosang = axes[a][0] * w[0] + axes[a][1] * w[1] + axes[a][2] * w[2];
+            for (int c = 0; cosang > 0 && c < 3; c++)
+                cube[a][c] += 4 * LMB_PI / n * b[c] * cosang;
+        }
+    }
+    rays += lmb_direct_deltas_at(job->direct, p, add_delta, &sum);
+    for (int a = 0; a < 6; a++) {
+        lmb_shading_point sp;
+        for (int k = 0; k < 3; k++) {
+            sp.p[k] = p[k];
+            sp.n[k] = sp.ng[k] = axes[a][k];
+        }
+        sp.eps = rt->eps;
+        lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x43554245ull ^ i, (uint64_t)a);
+        double e[3], deferred[3] = {0, 0, 0};
+        rays += lmb_direct_at_split(job->direct, &sp, CUBE_SAMPLES, &rng, e, NULL, deferred);
+        for (int c = 0; c < 3; c++)
+            cube[a][c] += fmax(0.0, e[c] - deferred[c]);
+    }
+    for (int k = 0; k < 9; k++)
+        for (int c = 0; c < 3; c++)
+            out[3 * k + c] = (float)(band[k] * sum.l[k][c]);
+    for (int a = 0; a < 6; a++)
+        for (int c = 0; c < 3; c++)
+            out[LMB_PROBE_SH + 3 * a + c] = (float)cube[a][c];
+    return rays;
+}
+
+#define PROBE_FLOATS (LMB_PROBE_SH + LMB_PROBE_CUBE)
+
+static lmb_status probe_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
+                              uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
+{
+    const probe_job *job = user;
+    float *v = lmb_buf_extend(out, (size_t)(last - first) * PROBE_FLOATS * sizeof *v, err);
+    if (!v)
+        return err->status;
+    uint64_t rays = 0;
+#pragma omp parallel num_threads(job->threads) reduction(+ : rays)
+    {
+        lmb_rt_thread_init();
+#pragma omp for schedule(dynamic, 4)
+        for (uint64_t i = first; i < last; i++) {
+            float values[PROBE_FLOATS];
+            rays += light_probe(job, (uint32_t)i, values);
+            memcpy(v + (i - first) * PROBE_FLOATS, values, sizeof values);
+        }
+    }
+    counters[0] += rays;
+    counters[1] += last - first;
+    return LMB_OK;
+}
+
+lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb_direct *direct,
+                            const lmb_cache *cache, lmb_steps *steps, int dark, lmb_progress_fn progress, void *user,
+                            lmb_error *err)
+{
+    if (!set->count || dark) /* nothing emits: every probe is 0 (the arrays are zeroed) */
+        return LMB_OK;
+    if (progress)
+        progress(user, "probes", 0, set->count);
+    probe_job job = {set, cfg, direct, cache, cfg->threads > 0 ? (int)cfg->threads : omp_get_max_threads()};
+    lmb_step_desc d = {"probes", set->count, NULL, (double)set->count * (set->rays + 6.0 * CUBE_SAMPLES), probe_range,
+                       &job};
+    lmb_buf bytes = {NULL, 0, 0, 0};
+    uint64_t counters[LMB_STEP_COUNTERS];
+    lmb_status st = lmb_steps_run(steps, &d, &bytes, counters, err);
+    if (st == LMB_OK && bytes.size != (size_t)set->count * PROBE_FLOATS * sizeof(float))
+        st = lmb_error_set(err, LMB_ERR_INPUT, "probes: the step holds %zu bytes for %u probes", bytes.size, set->count);
+    for (uint32_t i = 0; st == LMB_OK && i < set->count; i++) {
+        const float *v = (const float *)bytes.data + (size_t)i * PROBE_FLOATS;
+        memcpy(set->sh + (size_t)i * LMB_PROBE_SH, v, LMB_PROBE_SH * sizeof *v);
+        memcpy(set->cube + (size_t)i * LMB_PROBE_CUBE, v + LMB_PROBE_SH, LMB_PROBE_CUBE * sizeof *v);
+    }
+    lmb_buf_free(&bytes);
+    if (st == LMB_OK && progress)
+        progress(user, "probes", set->count, set->count);
+    return st;
+}

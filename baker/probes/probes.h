@@ -1,0 +1,95 @@
+/*
+ * Light probes: what moves through the level gets the baked light (docs/probes.md). A probe is
+ * a point in free space holding the irradiance a small diffuse object there would receive
+ * from every direction, all of the level's light: the direct light of every `baked` light and
+ * the sky, and the light the level's surfaces reflect (read from the bounce cache as the final
+ * gather reads it). Stored two ways:
+ *   - SH L2 irradiance, RGB, 27 floats: E(n) ~ sum_lm E_lm Y_lm(n), with E_lm = A_l L_lm the
+ *     radiance's coefficients convolved with the clamped cosine (Ramamoorthi and Hanrahan 2001:
+ *     A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4), in the real SH basis and order of sky.c's sh9
+ *     (glTF axes), the convention of EXT_lights_image_based's irradianceCoefficients;
+ *   - an ambient cube: the irradiance for the six axis normals +X, -X, +Y, -Y, +Z, -Z, computed
+ *     for those normals directly (not from the SH, whose truncation smooths it).
+ * Values are lux (E) or E / pi like the lightmaps (output.scale), set at writing.
+ *
+ * Placement (placement.c): a grid of cells over the lightmapped geometry's bounds at
+ * probes.spacing; a cell with surface in it is split into 8 and holds a probe at each child's
+ * centre, an empty cell one at its centre (Godot and Unreal refine near geometry the same
+ * way). Probes inside geometry (most rays that hit anything hit back faces) or far from every
+ * surface (outside the level) are dropped. Then the light (probe_light.c), one step of the
+ * bake per range of probes, so a farm splits it like texels.
+ */
+#ifndef LMBAKE_PROBES_H
+#define LMBAKE_PROBES_H
+
+#include <lmbake/lmbake.h>
+
+#include "cache/bounce_cache.h"
+#include "lights/direct.h"
+#include "pack/layout.h"
+#include "raytrace/rt_scene.h"
+#include "steps/runner.h"
+#include "write/gltf_write.h"
+
+#define LMB_PROBE_SH 27   /* floats: 9 coefficients x RGB, coefficient-major (c0 r g b, c1 r g b, ...) */
+#define LMB_PROBE_CUBE 18 /* floats: +X, -X, +Y, -Y, +Z, -Z, each r g b */
+#define LMB_PROBES_MAX 1000000 /* 45 floats and a position each: 200 MB of output at most */
+
+typedef struct lmb_probe_set {
+    uint32_t count;
+    double *position;  /* 3 per probe, world */
+    float *sh;         /* LMB_PROBE_SH per probe, lux */
+    float *cube;       /* LMB_PROBE_CUBE per probe, lux */
+    double spacing;    /* the grid's cell size, world units (probes near surfaces: half of it) */
+    uint32_t grid[3];  /* cells per axis */
+    uint32_t refined;  /* cells split because they hold surface */
+    uint32_t dropped_inside, dropped_outside;
+    uint32_t rays;     /* rays per probe (probes.rays) */
+    uint32_t *cell;    /* per probe: its grid cell, x fastest (the irradiance volume's voxel) */
+    double grid_lo[3], grid_cell[3]; /* the grid's corner and cell size per axis */
+} lmb_probe_set;
+
+/* An irradiance volume as bevy reads one (IrradianceVolume: a unit cube centred on the origin,
+ * placed by its transform): the grid's box and per voxel the ambient cube. */
+typedef struct lmb_probe_volume {
+    double lo[3], hi[3];
+    uint32_t res[3];
+    float *cube;       /* LMB_PROBE_CUBE per voxel, x fastest, then y, then z */
+    uint32_t filled;   /* voxels whose probes were all dropped (inside geometry), filled from neighbours */
+} lmb_probe_volume;
+
+/* The set's grid as a volume (probe_volume.c): a voxel per cell, the mean of its probes' cubes;
+ * a cell with none (inside geometry) takes the mean of its neighbours', pass by pass, so that
+ * trilinear filtering next to walls does not read black. Empty (no voxels) when the set is. */
+lmb_status lmb_probe_volume_make(const lmb_probe_set *set, lmb_probe_volume *out, lmb_error *err);
+void lmb_probe_volume_free(lmb_probe_volume *v);
+
+/* The volume in bevy's layout as KTX2 (E5B9G9R9, vkFormat 123, no supercompression): a texture
+ * of (Rx, 2 Ry, 3 Rz) texels, voxel (x, y, z)'s face +A at (x, y, z + k Rz) and -A at
+ * (x, y + Ry, z + k Rz), k = 0, 1, 2 for A = X, Y, Z; values times `scale`. */
+lmb_status lmb_probe_volume_write_ktx2(const lmb_probe_volume *v, double scale, const char *path, lmb_error *err);
+
+/* Places the probes of the level (probes.auto) into out. Empty (count 0) when nothing is
+ * lightmapped or probes.auto is off. */
+lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
+                            const lmb_log *log, lmb_probe_set *out, lmb_error *err);
+
+/* Lights the placed probes as one step of the bake (steps/runner.h): direct light from
+ * `direct`, reflected light from the finished cache. dark: nothing emits (all zero, no rays). */
+lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb_direct *direct,
+                            const lmb_cache *cache, lmb_steps *steps, int dark, lmb_progress_fn progress, void *user,
+                            lmb_error *err);
+
+/* The irradiance the probe's SH gives for unit normal n (RGB). */
+void lmb_probe_sh_irradiance(const float sh[LMB_PROBE_SH], const double n[3], double e[3]);
+
+void lmb_probe_set_free(lmb_probe_set *set);
+
+/* The set as the output holds it (probe_output.c): owned arrays, free with lmb_probes_output_free
+ * (also after an error); its grid as DIR/STEM-irradiance-volume.ktx2 (bevy's layout). Empty, no
+ * file, when the set is. */
+lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
+                             lmb_gltf_probes *out, lmb_error *err);
+void lmb_probes_output_free(lmb_gltf_probes *out);
+
+#endif

@@ -1,0 +1,227 @@
+#!/usr/bin/env python3
+"""Light probes against analytic irradiance (scenes of tools/make_scenes.py; the probes as the
+output glTF holds them: asset.extras.lightmap.probes, docs/probes.md).
+
+usage: check_probes.py LMBAKE WORKDIR CASE
+  sky      an open plane under a uniform sky of L = 1000 nits: every probe lies above the plane
+           (the ones the grid puts under it are inside geometry: dropped), and over the plane's
+           middle the ambient cube's +Y irradiance is pi L within 0.5%, the SH's at +Y within 0.5%
+           (a hemisphere's step has no even band above 0, whose truncation the SH would miss);
+           the reflected light: the cube's -Y irradiance is pi B F, B = albedo L = 0.5 L the
+           plane's radiance (its lightmap holds pi L everywhere) and F the view factor of the
+           10 x 10 plane from the probe (four rectangles from the point's foot), within 1%.
+  point    a black plane and a 100 cd point light: at each probe every face of the ambient cube
+           is I max(0, n . w) / d^2 within 1%, and the SH at n is I / d^2 x (1/4 + c/2 +
+           5 (3c^2 - 1) / 32) with c = n . w (a delta's clamped cosine truncated to L2) within 1%.
+  sealed   the sealed room under a sky of 10^4 nits with a point light outside: every probe 0.
+  solid    a plane with a closed 2 m cube on it: no probe inside the cube, probes around it.
+  scale    output.scale radiance: the same probes' values divided by pi.
+  volume   the closed cube on a plane: the grid as bevy's irradiance volume, read back by an
+           independent reader (tests/ktx2/read_ktx2.mjs, npm ktx-parse): vkFormat 123, (Rx, 2Ry,
+           3Rz) texels for the node's resolution, every face of every voxel with probes equal to
+           the mean of its probes' ambient cubes within E5B9G9R9's precision (2^-9 of the texel's
+           largest channel), and the voxels inside the cube (no probe) filled from their
+           neighbours, not black (two bounces: every probe outside sees some light).
+"""
+import json
+import math
+import os
+import struct
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+BASE = "texel_density: 8\nbounces: 0\noutput: {formats: [exr], directional: false}\n"
+
+
+def bake(lmbake, work, scene, name, config):
+    scenes = os.path.join(work, "scenes")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
+                   stdout=subprocess.DEVNULL)
+    cfg = os.path.join(work, name + ".yaml")
+    base = "".join(line + "\n" for line in BASE.splitlines() if line.split(":")[0] + ":" not in config)
+    with open(cfg, "w") as f:
+        f.write(base + config)
+    out = os.path.join(work, "out-" + name)
+    p = subprocess.run([lmbake, "bake", os.path.join(scenes, scene + ".gltf"), "-c", cfg, "-o", out],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit("bake %s failed (%d): %s" % (name, p.returncode, p.stderr))
+    return load_probes(os.path.join(out, scene + ".gltf")), p.stdout + p.stderr
+
+
+def floats(doc, folder, view, count):
+    v = doc["bufferViews"][view]
+    with open(os.path.join(folder, doc["buffers"][v["buffer"]]["uri"]), "rb") as f:
+        f.seek(v.get("byteOffset", 0))
+        data = f.read(v["byteLength"])
+    values = struct.unpack("<%df" % (len(data) // 4), data)
+    per = len(values) // count
+    return [values[i * per:(i + 1) * per] for i in range(count)]
+
+
+def load_probes(path):
+    with open(path) as f:
+        doc = json.load(f)
+    folder = os.path.dirname(path)
+    p = doc["asset"]["extras"]["lightmap"]["probes"]
+    n = p["count"]
+    acc = doc["accessors"][p["positions"]]
+    return {"count": n, "meta": p, "positions": floats(doc, folder, acc["bufferView"], n),
+            "sh": floats(doc, folder, p["sh"], n), "cube": floats(doc, folder, p["ambientCube"], n)}
+
+
+def sh_basis(n):
+    x, y, z = n
+    return [0.282095, 0.488603 * y, 0.488603 * z, 0.488603 * x, 1.092548 * x * y, 1.092548 * y * z,
+            0.315392 * (3 * z * z - 1), 1.092548 * x * z, 0.546274 * (x * x - y * y)]
+
+
+def sh_irradiance(sh, n, channel=0):
+    return sum(sh[3 * k + channel] * b for k, b in enumerate(sh_basis(n)))
+
+
+AXES = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+
+
+def report(name, good, text):
+    print("%s: %s  %s" % (name, text, "ok" if good else "FAIL"))
+    return good
+
+
+def corner_view_factor(a, b, h):
+    """View factor from a point at height h over a corner of an a x b rectangle, facing it."""
+    if a <= 0 or b <= 0:
+        return 0.0
+    ra, rb = math.hypot(a, h), math.hypot(b, h)
+    return (a / ra * math.atan(b / ra) + b / rb * math.atan(a / rb)) / (2 * math.pi)
+
+
+def plane_view_factor(p, half):
+    x, h, z = p
+    return sum(corner_view_factor(ax, bz, h) for ax in (half - x, half + x) for bz in (half - z, half + z))
+
+
+def sky(lmbake, work):
+    L = 1000.0
+    probes, log = bake(lmbake, work, "sky-plane", "sky", "sky: {intensity: %g}\n" % L)
+    want = math.pi * L
+    mid = [i for i, p in enumerate(probes["positions"]) if abs(p[0]) < 3 and abs(p[2]) < 3]
+    cube = [probes["cube"][i][3 * 2] / want for i in mid]
+    sh = [sh_irradiance(probes["sh"][i], (0, 1, 0)) / want for i in mid]
+    down = [probes["cube"][i][3 * 3] / (math.pi * 0.5 * L * plane_view_factor(probes["positions"][i], 5.0))
+            for i in mid]
+    above = all(p[1] > 0 for p in probes["positions"])
+    good = probes["count"] > 100 and above and len(mid) > 50 and max(abs(r - 1) for r in cube) <= 0.005 \
+        and max(abs(r - 1) for r in sh) <= 0.005 and max(abs(r - 1) for r in down) <= 0.01 and "inside geometry" in log
+    return report("sky", good, "%d probes, all above the plane: %s; %d over its middle: cube +Y / (pi L) %.5f..%.5f, "
+                  "SH +Y / (pi L) %.5f..%.5f (bounds 1 +- 0.5%%); reflected, cube -Y / (pi B F) %.5f..%.5f (1 +- 1%%)"
+                  % (probes["count"], above, len(mid), min(cube), max(cube), min(sh), max(sh), min(down), max(down)))
+
+
+def point(lmbake, work):
+    I, light = 100.0, (0.3, 2.0, -0.2)
+    probes, _ = bake(lmbake, work, "probe-point", "point", "")
+    worst_cube = worst_sh = 0.0
+    for p, sh, cube in zip(probes["positions"], probes["sh"], probes["cube"]):
+        d = [light[k] - p[k] for k in range(3)]
+        dist = math.sqrt(sum(v * v for v in d))
+        w = [v / dist for v in d]
+        e_perp = I / (dist * dist)
+        for a, n in enumerate(AXES):
+            c = sum(n[k] * w[k] for k in range(3))
+            worst_cube = max(worst_cube, abs(cube[3 * a] - e_perp * max(0.0, c)) / e_perp)
+            want = e_perp * (0.25 + c / 2 + 5 * (3 * c * c - 1) / 32)
+            worst_sh = max(worst_sh, abs(sh_irradiance(sh, n) - want) / e_perp)
+    good = probes["count"] > 50 and worst_cube <= 0.01 and worst_sh <= 0.01
+    return report("point", good, "%d probes: largest cube error %.5f, SH error %.5f of I / d^2 (bounds 1%%)"
+                  % (probes["count"], worst_cube, worst_sh))
+
+
+def sealed(lmbake, work):
+    probes, _ = bake(lmbake, work, "sealed-room", "sealed", "sky: {intensity: 10000}\nbounces: 2\n")
+    top = max(max(abs(v) for v in sh + cube) for sh, cube in zip(probes["sh"], probes["cube"]))
+    inside = all(-1 < p[0] < 1 and 0 < p[1] < 2 and -1 < p[2] < 1 for p in probes["positions"])
+    good = probes["count"] > 10 and inside and top == 0.0
+    return report("sealed", good, "%d probes, all in the room: %s, largest value %g (want 0)"
+                  % (probes["count"], inside, top))
+
+
+def solid(lmbake, work):
+    probes, log = bake(lmbake, work, "box-floor", "solid", "")
+    inside = [p for p in probes["positions"] if -1 < p[0] < 1 and 0 < p[1] < 2 and -1 < p[2] < 1]
+    lit = sum(1 for cube in probes["cube"] if cube[3 * 2] > 0)
+    good = probes["count"] > 50 and not inside and lit > probes["count"] // 2
+    return report("solid", good, "%d probes, %d inside the cube (want 0), %d lit from above; log: %s"
+                  % (probes["count"], len(inside), lit, [l for l in log.splitlines() if l.startswith("probes:")][:1]))
+
+
+def scale(lmbake, work):
+    a, _ = bake(lmbake, work, "probe-point", "scale-e", "")
+    b, _ = bake(lmbake, work, "probe-point", "scale-r", "output: {formats: [exr], directional: false, scale: radiance}\n")
+    worst = 0.0
+    for x, y in zip(a["cube"] + a["sh"], b["cube"] + b["sh"]):
+        for u, v in zip(x, y):
+            worst = max(worst, abs(u / math.pi - v) / max(1e-6, abs(u / math.pi)))
+    good = a["count"] == b["count"] > 0 and worst < 1e-5 and b["meta"]["scale"] == "radiance"
+    return report("scale", good, "%d probes, largest relative difference from E / pi %.2g, scale %s"
+                  % (b["count"], worst, b["meta"]["scale"]))
+
+
+def volume(lmbake, work):
+    probes, _ = bake(lmbake, work, "box-floor", "volume", "bounces: 2\n")
+    out = os.path.join(work, "out-volume")
+    with open(os.path.join(out, "box-floor.gltf")) as f:
+        doc = json.load(f)
+    node = [n for n in doc["nodes"] if "irradianceVolume" in n.get("extras", {}).get("lightmap", {})][0]
+    vol = node["extras"]["lightmap"]["irradianceVolume"]
+    rx, ry, rz = vol["resolution"]
+    lo = [node["translation"][k] - node["scale"][k] / 2 for k in range(3)]
+    cell = [node["scale"][k] / vol["resolution"][k] for k in range(3)]
+    texels = os.path.join(work, "volume.f32")
+    p = subprocess.run(["node", os.path.join(ROOT, "tests", "ktx2", "read_ktx2.mjs"), os.path.join(out, vol["uri"]),
+                        texels], capture_output=True, text=True, cwd=ROOT)
+    if p.returncode != 0:
+        return report("volume", False, "the reader failed: %s" % p.stderr)
+    head = json.loads(p.stdout)
+    with open(texels, "rb") as f:
+        data = f.read()
+    rgb = struct.unpack("<%df" % (len(data) // 4), data)
+    sums, counts = {}, {}
+    for pos, cube in zip(probes["positions"], probes["cube"]):
+        v = tuple(min(int((pos[k] - lo[k]) / cell[k]), vol["resolution"][k] - 1) for k in range(3))
+        sums[v] = [a + b for a, b in zip(sums.get(v, [0.0] * 18), cube)]
+        counts[v] = counts.get(v, 0) + 1
+    worst, black_inside, checked = 0.0, 0, 0
+    for z in range(rz):
+        for y in range(ry):
+            for x in range(rx):
+                total = 0.0
+                for face in range(6):
+                    t, pz = y + (face % 2) * ry, z + (face // 2) * rz
+                    i = 3 * ((pz * 2 * ry + t) * rx + x)
+                    got = rgb[i:i + 3]
+                    if (x, y, z) in counts:
+                        want = [sums[(x, y, z)][3 * face + c] / counts[(x, y, z)] for c in range(3)]
+                        tol = max(want) * 2 ** -9 + 1e-6
+                        worst = max(worst, max(abs(a - b) / tol for a, b in zip(got, want)))
+                        checked += 1
+                    total += sum(got)
+                if (x, y, z) not in counts and total <= 0:
+                    black_inside += 1
+    empty = rx * ry * rz - len(counts)
+    good = (head["vkFormat"] == 123 and (head["pixelWidth"], head["pixelHeight"], head["pixelDepth"]) ==
+            (rx, 2 * ry, 3 * rz) and checked > 0 and worst <= 1.0 and empty > 0 and black_inside == 0)
+    return report("volume", good, "vkFormat %d, %dx%dx%d texels for resolution %s; %d faces checked, largest error %.3f "
+                  "of the format's step; %d voxels without probes, %d of them black"
+                  % (head["vkFormat"], head["pixelWidth"], head["pixelHeight"], head["pixelDepth"], vol["resolution"],
+                     checked, worst, empty, black_inside))
+
+
+if __name__ == "__main__":
+    lmbake, work, case = sys.argv[1], sys.argv[2], sys.argv[3]
+    os.makedirs(work, exist_ok=True)
+    cases = {"sky": sky, "point": point, "sealed": sealed, "solid": solid, "scale": scale, "volume": volume}
+    sys.exit(0 if cases[case](lmbake, work) else 1)
