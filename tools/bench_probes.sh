@@ -17,7 +17,7 @@ for level in assets/scenes/cornell-box-bevy/CornellBox.glb bench/levels/level-si
   build/lmbake bake "$level" -o bench/probes/out-$name --timings=bench/probes/$name-on.csv > bench/probes/$name-on.log 2>&1
   build/lmbake bake "$level" -c bench/probes/off.yaml -o bench/probes/out-$name-off --timings=bench/probes/$name-off.csv \
     > bench/probes/$name-off.log 2>&1
-  count=$(grep -o '^probes: [0-9]* at' bench/probes/$name-on.log | grep -o '[0-9]*')
+  count=$(grep -o '^probes: [0-9]* (' bench/probes/$name-on.log | grep -o '[0-9]*')
   on=$(awk -F, '$1=="whole bake"{print $2}' bench/probes/$name-on.csv)
   off=$(awk -F, '$1=="whole bake"{print $2}' bench/probes/$name-off.csv)
   p=$(awk -F, '$1=="probes"{print $2}' bench/probes/$name-on.csv)

@@ -136,9 +136,12 @@ typedef void (*lmb_delta_fn)(void *user, const double dir[3], const double e[3])
  * (a sun with lights.sun_angle counts as its disc's centre). Returns the shadow rays traced. */
 uint32_t lmb_direct_deltas_at(const lmb_direct *d, const double p[3], lmb_delta_fn fn, void *user);
 
-/* The emitted radiance (nits, RGB) a ray travelling along unit w sees at hit h: 0 and returns 0
- * when the hit triangle emits nothing or is seen from its back and one-sided. */
-int lmb_direct_emitted_at_hit(const lmb_direct *d, const lmb_rt_hit *h, const double w[3], double le[3]);
+/* `samples` points on the emitters (triangles by power, uniform on each), seen from p unoccluded:
+ * fn gets each one's direction and Le / (pdf in solid angle x samples), so that summing
+ * f(w) x that over the calls estimates the integral of Le(w) f(w) over the emitters' solid angle
+ * (a probe's SH projection of their light). Returns the shadow rays traced. */
+uint32_t lmb_direct_emitter_samples_at(const lmb_direct *d, const double p[3], uint32_t samples, lmb_rng *rng,
+                                       lmb_delta_fn fn, void *user);
 
 /* The sky the lights were made with, or NULL. */
 const lmb_sky *lmb_direct_sky(const lmb_direct *d);

@@ -1,8 +1,8 @@
 /*
  * What a light probe needs of the lights (probes/probe_light.c): a probe records the radiance
  * arriving from every direction, so delta lights (point, spot, directional) are given as a
- * direction and the irradiance they bring to a surface facing them, and emitters as the
- * radiance a ray that hits them sees. Bake modes as for texels: `realtime` lights are not in
+ * direction and the irradiance they bring to a surface facing them, and emitters by points
+ * sampled on them. Bake modes as for texels: `realtime` lights are not in
  * the light set at all; `indirect` lights give no direct light here (their bounced light comes
  * from the surfaces the cache lights).
  */
@@ -10,6 +10,9 @@
 #include "direct_internal.h"
 
 #include "../util/lmb_math.h"
+#include "../util/frame.h"
+
+#include <math.h>
 
 uint32_t lmb_direct_deltas_at(const lmb_direct *d, const double p[3], lmb_delta_fn fn, void *user)
 {
@@ -38,13 +41,35 @@ uint32_t lmb_direct_deltas_at(const lmb_direct *d, const double p[3], lmb_delta_
     return rays;
 }
 
-int lmb_direct_emitted_at_hit(const lmb_direct *d, const lmb_rt_hit *h, const double w[3], double le[3])
+uint32_t lmb_direct_emitter_samples_at(const lmb_direct *d, const double p[3], uint32_t samples, lmb_rng *rng,
+                                       lmb_delta_fn fn, void *user)
 {
-    const uint32_t *map = d->emitter_of ? d->emitter_of[h->geom] : NULL;
-    uint32_t k1 = map ? map[h->prim] : 0;
-    double cy;
-    le[0] = le[1] = le[2] = 0;
-    return k1 && lmb_emitter_radiance(&d->emitters->e[k1 - 1], h->u, h->v, w, &cy, le);
+    const lmb_emitters *es = d->emitters;
+    if (!es || !es->count || !samples)
+        return 0;
+    uint32_t rays = 0;
+    for (uint32_t s = 0; s < samples; s++) {
+        double prob, u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), u3 = lmb_rng_next(rng);
+        const emitter *x = &es->e[lmb_emitter_pick(es, u1, &prob)];
+        double su = sqrt(u2), b1 = su * (1 - u3), b2 = su * u3, w[3], le[3], cy;
+        for (int k = 0; k < 3; k++)
+            w[k] = (1 - b1 - b2) * x->p[k] + b1 * x->p[3 + k] + b2 * x->p[6 + k] - p[k];
+        double dist2 = lmb_dot3(w, w), dist = sqrt(dist2);
+        if (!(dist > 0) || !(prob > 0))
+            continue;
+        for (int k = 0; k < 3; k++)
+            w[k] /= dist;
+        if (!lmb_emitter_radiance(x, b1, b2, w, &cy, le))
+            continue;
+        rays++;
+        if (lmb_rt_occluded(d->rt, p, w, d->rt->eps, dist * (1 - 1e-4)))
+            continue;
+        double weight = x->area * cy / (prob * dist2 * samples), e[3]; /* 1 / (pdf in solid angle x samples) */
+        for (int k = 0; k < 3; k++)
+            e[k] = le[k] * weight;
+        fn(user, w, e);
+    }
+    return rays;
 }
 
 const lmb_sky *lmb_direct_sky(const lmb_direct *d)

@@ -27,6 +27,8 @@
 #include <yaml.h>
 
 static lmb_status set_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static lmb_status set_probe_volumes(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static const schema probe_volume_schema;
 static lmb_status set_material_overrides(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 static const schema material_override_schema;
 static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
@@ -139,6 +141,9 @@ static const key_spec config_keys[] = {
     BOOL("probes.auto", OFF(probes_auto)),
     FLOAT_AUTO("probes.spacing", OFF(probe_spacing), 0, 1e9, OPEN_LO),
     U32("probes.rays", OFF(probe_rays), 16, 65536),
+    {.path = "probes.volumes", .set = set_probe_volumes, .offset = OFF(probe_volumes),
+     .count_offset = OFF(probe_volume_count), .max_items = LMB_MAX_PROBE_VOLUMES, .items = &probe_volume_schema,
+     .item_size = sizeof(lmb_probe_volume_spec)},
     BOOL("fireflies.spread", OFF(firefly_spread)),
 };
 
@@ -154,6 +159,15 @@ static const key_spec material_override_keys[] = {
     RGB("materials.override.albedo", offsetof(lmb_material_override, albedo), 0, 1, OPEN_NONE),
     RGB("materials.override.emissive", offsetof(lmb_material_override, emissive), 0, 1e9, OPEN_NONE),
 };
+/* One probes.volumes entry, filled into an lmb_probe_volume_spec. */
+static const key_spec probe_volume_keys[] = {
+    {.path = "probes.volumes.min", .set = lmb_cfg_set_point, .offset = offsetof(lmb_probe_volume_spec, min)},
+    {.path = "probes.volumes.max", .set = lmb_cfg_set_point, .offset = offsetof(lmb_probe_volume_spec, max)},
+    {.path = "probes.volumes.resolution", .set = lmb_cfg_set_u32x3, .offset = offsetof(lmb_probe_volume_spec, resolution),
+     .ilo = 1, .ihi = 256},
+};
+static const schema probe_volume_schema = {probe_volume_keys, sizeof probe_volume_keys / sizeof *probe_volume_keys};
+
 /* One lights.modes entry, filled into an lmb_light_mode_rule. */
 static const key_spec light_mode_keys[] = {
     STRING("lights.modes.match", offsetof(lmb_light_mode_rule, pattern)),
@@ -305,6 +319,32 @@ static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_no
 {
     uint32_t count = 0;
     lmb_status st = lmb_cfg_each_item(c, k, n, base, light_mode_item, &count);
+    return lmb_cfg_set_count(k, base, count, st);
+}
+
+/* {min: [x, y, z], max: [x, y, z], resolution: [x, y, z]}, all required, min < max */
+static lmb_status probe_volume_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base,
+                                    uint32_t index)
+{
+    lmb_probe_volume_spec *o = (lmb_probe_volume_spec *)(void *)(base + k->offset) + index;
+    memset(o, 0, sizeof *o); /* resolution 0: missing shows */
+    o->min[0] = o->max[0] = NAN;
+    if (item->type != YAML_MAPPING_NODE)
+        return lmb_cfg_bad_value(c, k, item, "a mapping {min: [x, y, z], max: [x, y, z], resolution: [x, y, z]}");
+    lmb_status st = walk_mapping(c, &probe_volume_schema, item, k->path, (char *)o);
+    if (st == LMB_OK && (isnan(o->min[0]) || isnan(o->max[0]) || !o->resolution[0]))
+        return lmb_cfg_key_error(c, item, k->path, "each entry needs min, max and resolution");
+    for (int a = 0; st == LMB_OK && a < 3; a++)
+        if (!(o->min[a] < o->max[a]))
+            return lmb_cfg_key_error(c, item, k->path, "min %g is not below max %g on the %c axis", o->min[a],
+                                     o->max[a], "xyz"[a]);
+    return st;
+}
+
+static lmb_status set_probe_volumes(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    uint32_t count = 0;
+    lmb_status st = lmb_cfg_each_item(c, k, n, base, probe_volume_item, &count);
     return lmb_cfg_set_count(k, base, count, st);
 }
 

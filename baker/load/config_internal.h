@@ -84,6 +84,10 @@ lmb_status lmb_cfg_set_globs(parse_ctx *c, const key_spec *k, const yaml_node_t 
 lmb_status lmb_cfg_set_rgb(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 /* [x, y, z], finite, not all 0 (stored as given: users normalize) */
 lmb_status lmb_cfg_set_direction(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+/* [x, y, z], finite (a point) */
+lmb_status lmb_cfg_set_point(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+/* [x, y, z], integers in the key's integer range (stored as 3 uint32_t) */
+lmb_status lmb_cfg_set_u32x3(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 /* a relative path of at most LMB_PATTERN_LEN - 1 characters, or "" for none */
 lmb_status lmb_cfg_set_path(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 

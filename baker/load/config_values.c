@@ -332,6 +332,33 @@ lmb_status lmb_cfg_set_direction(parse_ctx *c, const key_spec *k, const yaml_nod
     return LMB_OK;
 }
 
+lmb_status lmb_cfg_set_point(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    double v[3];
+    if (!read_three(c, n, v) || !isfinite(v[0] + v[1] + v[2]))
+        return lmb_cfg_bad_value(c, k, n, "[x, y, z], three finite numbers");
+    memcpy(base + k->offset, v, sizeof v);
+    return LMB_OK;
+}
+
+lmb_status lmb_cfg_set_u32x3(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    double v[3];
+    uint32_t u[3];
+    int ok = read_three(c, n, v);
+    for (int i = 0; ok && i < 3; i++) {
+        ok = v[i] == floor(v[i]) && v[i] >= (double)k->ilo && v[i] <= (double)k->ihi;
+        u[i] = ok ? (uint32_t)v[i] : 0;
+    }
+    if (!ok) {
+        char want[96];
+        snprintf(want, sizeof want, "[x, y, z], integers in %lld..%lld", k->ilo, k->ihi);
+        return lmb_cfg_bad_value(c, k, n, want);
+    }
+    memcpy(base + k->offset, u, sizeof u);
+    return LMB_OK;
+}
+
 /* ---- lists ------------------------------------------------------------------ */
 
 

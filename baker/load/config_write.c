@@ -96,7 +96,11 @@ static void put_value(text_out *o, const key_spec *k, const char *base)
         put(o, "]");
     } else if (k->set == lmb_cfg_set_string || k->set == lmb_cfg_set_path) {
         put_quoted(o, at);
-    } else if (k->set == lmb_cfg_set_rgb || k->set == lmb_cfg_set_direction) {
+    } else if (k->set == lmb_cfg_set_u32x3) {
+        uint32_t v[3];
+        memcpy(v, at, sizeof v);
+        put(o, "[%u, %u, %u]", v[0], v[1], v[2]);
+    } else if (k->set == lmb_cfg_set_rgb || k->set == lmb_cfg_set_direction || k->set == lmb_cfg_set_point) {
         double v[3];
         memcpy(v, at, sizeof v);
         if (k->set == lmb_cfg_set_rgb && (k->open & OPEN_NONE) && v[0] < 0) {
@@ -123,7 +127,7 @@ static void put_value(text_out *o, const key_spec *k, const char *base)
             put_quoted(o, at + (size_t)i * LMB_PATTERN_LEN);
         }
         put(o, "]");
-    } else { /* lists of mappings: density_overrides ({match, texel_density}), materials.override */
+    } else { /* lists of mappings: density_overrides ({match, texel_density}), materials.override, probes.volumes */
         const schema *ov = k->items ? k->items : lmb_cfg_override_schema();
         size_t item_size = k->items ? k->item_size : sizeof(lmb_density_override);
         uint32_t count;

@@ -42,9 +42,12 @@ struct lmb_gltf_doc {
     std::vector<float> probe_positions, probe_sh, probe_cube;
     double probe_spacing = 0;
     int probe_radiance = 0;
-    std::string volume_uri; /* "" when none */
-    double volume_lo[3] = {0, 0, 0}, volume_hi[3] = {0, 0, 0};
-    uint32_t volume_res[3] = {0, 0, 0};
+    struct volume {
+        std::string uri;
+        double lo[3], hi[3];
+        uint32_t res[3], config_entry;
+    };
+    std::vector<volume> volumes;
     /* writer: materials.default.albedo for primitives with no material, if given */
     bool has_default_albedo = false;
     double default_albedo[3] = {0, 0, 0};

@@ -142,13 +142,47 @@ static void make_grid(const lmb_config *cfg, const double lo[3], const double hi
     *spacing = s;
 }
 
-lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
-                            const lmb_log *log, lmb_probe_set *out, lmb_error *err)
+/* Probes before the inside/outside test: position, voxel, and whether the outside test applies
+ * (the auto grid's; an artist's volume keeps the probes it asked for). */
+typedef struct candidates {
+    double *p;
+    uint32_t *voxel;
+    uint8_t *auto_grid;
+    size_t count, cap;
+} candidates;
+
+static int add_candidate(candidates *c, const double p[3], uint32_t voxel, int auto_grid)
 {
-    memset(out, 0, sizeof *out);
-    out->rays = cfg->probe_rays;
-    if (!cfg->probes_auto)
-        return LMB_OK;
+    if (c->count == c->cap) {
+        size_t cap = c->cap ? 2 * c->cap : 4096;
+        double *np = realloc(c->p, 3 * cap * sizeof *np);
+        if (np)
+            c->p = np;
+        uint32_t *nv = realloc(c->voxel, cap * sizeof *nv);
+        if (nv)
+            c->voxel = nv;
+        uint8_t *na = realloc(c->auto_grid, cap);
+        if (na)
+            c->auto_grid = na;
+        if (!np || !nv || !na)
+            return 0;
+        c->cap = cap;
+    }
+    memcpy(c->p + 3 * c->count, p, 3 * sizeof *p);
+    c->voxel[c->count] = voxel;
+    c->auto_grid[c->count++] = (uint8_t)auto_grid;
+    return 1;
+}
+
+static const char *config_name(const lmb_config *cfg)
+{
+    return cfg->config_path[0] ? cfg->config_path : "config";
+}
+
+/* The auto grid's candidates: a probe per empty cell, eight per cell with surface. */
+static lmb_status auto_grid(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, lmb_probe_set *out,
+                            candidates *c, lmb_error *err)
+{
     double lo[3], hi[3], area;
     bounds_and_area(s, l, lo, hi, &area);
     if (!(area > 0) || !(hi[0] >= lo[0]))
@@ -160,82 +194,145 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
         return lmb_error_set(err, LMB_ERR_INPUT,
                              "%s: probes.spacing %g makes a grid of %ux%ux%u = %zu cells over the level's %g x %g x %g "
                              "bounds: more than the %u probes a bake holds (%d floats each, 200 MB of output); raise "
-                             "probes.spacing", cfg->config_path[0] ? cfg->config_path : "config", cfg->probe_spacing,
-                             g.n[0], g.n[1], g.n[2], cells, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2],
-                             LMB_PROBES_MAX, LMB_PROBE_SH + LMB_PROBE_CUBE);
+                             "probes.spacing", config_name(cfg), cfg->probe_spacing, g.n[0], g.n[1], g.n[2], cells,
+                             hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], LMB_PROBES_MAX, LMB_PROBE_SH + LMB_PROBE_CUBE);
     uint8_t *marked = calloc(cells + 1, 1);
     if (!marked)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu cells", cells);
     mark_surface_cells(s, l, &g, marked);
-    size_t candidates = 0;
-    for (size_t c = 0; c < cells; c++) {
-        candidates += marked[c] ? 8 : 1;
-        out->refined += marked[c];
+    size_t want = 0;
+    for (size_t k = 0; k < cells; k++) {
+        want += marked[k] ? 8 : 1;
+        out->refined += marked[k];
     }
-    double *p = malloc((3 * candidates + 1) * sizeof *p);
-    uint32_t *cell_of = malloc((candidates + 1) * sizeof *cell_of);
-    uint8_t *fate = malloc(candidates + 1);
-    if (!p || !cell_of || !fate || candidates > LMB_PROBES_MAX) {
+    if (want > LMB_PROBES_MAX) {
         free(marked);
-        free(p);
-        free(cell_of);
-        free(fate);
-        if (candidates > LMB_PROBES_MAX)
-            return lmb_error_set(err, LMB_ERR_INPUT, "%s: probes.spacing %g places %zu probes near the level's surfaces: "
-                                 "more than the %u a bake holds; raise probes.spacing",
-                                 cfg->config_path[0] ? cfg->config_path : "config", out->spacing, candidates,
-                                 LMB_PROBES_MAX);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu probes", candidates);
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: probes.spacing %g places %zu probes near the level's surfaces: "
+                             "more than the %u a bake holds; raise probes.spacing", config_name(cfg), out->spacing,
+                             want, LMB_PROBES_MAX);
     }
-    size_t m = 0;
+    int ok = 1;
     for (uint32_t z = 0; z < g.n[2]; z++)
         for (uint32_t y = 0; y < g.n[1]; y++)
             for (uint32_t x = 0; x < g.n[0]; x++) {
-                uint32_t cell[3] = {x, y, z};
-                int split = marked[cell_index(&g, x, y, z)];
-                for (int child = 0; child < (split ? 8 : 1); child++, m++) {
-                    cell_of[m] = (uint32_t)cell_index(&g, x, y, z);
-                    for (int k = 0; k < 3; k++) {
-                        double at = split ? 0.25 + 0.5 * ((child >> k) & 1) : 0.5;
-                        p[3 * m + k] = g.lo[k] + (cell[k] + at) * g.cell[k];
-                    }
+                uint32_t cell[3] = {x, y, z}, index = (uint32_t)cell_index(&g, x, y, z);
+                int split = marked[index];
+                for (int child = 0; ok && child < (split ? 8 : 1); child++) {
+                    double p[3];
+                    for (int k = 0; k < 3; k++)
+                        p[k] = g.lo[k] + (cell[k] + (split ? 0.25 + 0.5 * ((child >> k) & 1) : 0.5)) * g.cell[k];
+                    ok = add_candidate(c, p, index, 1);
                 }
             }
     free(marked);
-    double far = FAR_CELLS * fmax(g.cell[0], fmax(g.cell[1], g.cell[2]));
+    if (!ok)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu probes", want);
+    lmb_probe_grid *pg = &out->grids[out->grid_count++];
+    memcpy(pg->lo, g.lo, sizeof g.lo);
+    memcpy(pg->cell, g.cell, sizeof g.cell);
+    memcpy(pg->res, g.n, sizeof g.n);
+    pg->first_voxel = 0;
+    pg->volume = 0;
+    return LMB_OK;
+}
+
+/* probes.volumes entry k's candidates: one at each cell's centre. */
+static lmb_status volume_grid(const lmb_config *cfg, uint32_t k, uint32_t first_voxel, lmb_probe_set *out,
+                              candidates *c, lmb_error *err)
+{
+    const lmb_probe_volume_spec *v = &cfg->probe_volumes[k];
+    size_t cells = (size_t)v->resolution[0] * v->resolution[1] * v->resolution[2];
+    if (c->count + cells > LMB_PROBES_MAX || first_voxel + cells > UINT32_MAX)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: probes.volumes entry %u (%ux%ux%u) brings the probes to %zu: more "
+                             "than the %u a bake holds (%d floats each, 200 MB of output)", config_name(cfg), k + 1,
+                             v->resolution[0], v->resolution[1], v->resolution[2], c->count + cells, LMB_PROBES_MAX,
+                             LMB_PROBE_SH + LMB_PROBE_CUBE);
+    lmb_probe_grid *pg = &out->grids[out->grid_count++];
+    for (int a = 0; a < 3; a++) {
+        pg->lo[a] = v->min[a];
+        pg->res[a] = v->resolution[a];
+        pg->cell[a] = (v->max[a] - v->min[a]) / v->resolution[a];
+    }
+    pg->first_voxel = first_voxel;
+    pg->volume = k + 1;
+    for (uint32_t z = 0; z < pg->res[2]; z++)
+        for (uint32_t y = 0; y < pg->res[1]; y++)
+            for (uint32_t x = 0; x < pg->res[0]; x++) {
+                uint32_t cell[3] = {x, y, z};
+                double p[3];
+                for (int a = 0; a < 3; a++)
+                    p[a] = pg->lo[a] + (cell[a] + 0.5) * pg->cell[a];
+                if (!add_candidate(c, p, first_voxel + (uint32_t)(((size_t)z * pg->res[1] + y) * pg->res[0] + x), 0))
+                    return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu probes", c->count);
+            }
+    return LMB_OK;
+}
+
+lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
+                            const lmb_log *log, lmb_probe_set *out, lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->rays = cfg->probe_rays;
+    candidates c = {NULL, NULL, NULL, 0, 0};
+    lmb_status st = cfg->probes_auto ? auto_grid(s, l, cfg, out, &c, err) : LMB_OK;
+    uint32_t voxels = 0;
+    if (out->grid_count)
+        voxels = out->grids[0].res[0] * out->grids[0].res[1] * out->grids[0].res[2];
+    for (uint32_t k = 0; st == LMB_OK && k < cfg->probe_volume_count; k++) {
+        st = volume_grid(cfg, k, voxels, out, &c, err);
+        const lmb_probe_grid *pg = &out->grids[out->grid_count - 1];
+        voxels += pg->res[0] * pg->res[1] * pg->res[2];
+    }
+    uint8_t *fate = st == LMB_OK ? malloc(c.count + 1) : NULL;
+    if (st == LMB_OK && !fate)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu probes", c.count);
+    if (st != LMB_OK || !c.count) {
+        free(c.p);
+        free(c.voxel);
+        free(c.auto_grid);
+        free(fate);
+        out->grid_count = st == LMB_OK ? out->grid_count : 0;
+        return st;
+    }
+    const lmb_probe_grid *g0 = &out->grids[0];
+    double far = FAR_CELLS * fmax(g0->cell[0], fmax(g0->cell[1], g0->cell[2]));
     int threads = cfg->threads > 0 ? (int)cfg->threads : omp_get_max_threads();
 #pragma omp parallel num_threads(threads)
     {
         lmb_rt_thread_init();
 #pragma omp for schedule(dynamic, 64)
-        for (size_t i = 0; i < candidates; i++)
-            fate[i] = (uint8_t)probe_fate(rt, p + 3 * i, far);
+        for (size_t i = 0; i < c.count; i++) {
+            int f = probe_fate(rt, c.p + 3 * i, c.auto_grid[i] ? far : HUGE_VAL);
+            fate[i] = (uint8_t)(f == 2 && !c.auto_grid[i] ? 0 : f); /* an artist's probe in the open stays */
+        }
     }
-    for (size_t i = 0; i < candidates; i++) {
+    for (size_t i = 0; i < c.count; i++) {
         out->dropped_inside += fate[i] == 1;
         out->dropped_outside += fate[i] == 2;
         if (fate[i] == 0) {
-            memmove(p + 3 * (size_t)out->count, p + 3 * i, 3 * sizeof *p);
-            cell_of[out->count] = cell_of[i];
+            memmove(c.p + 3 * (size_t)out->count, c.p + 3 * i, 3 * sizeof *c.p);
+            c.voxel[out->count] = c.voxel[i];
             out->count++;
         }
     }
     free(fate);
-    out->position = p;
-    out->cell = cell_of;
-    memcpy(out->grid, g.n, sizeof g.n);
-    memcpy(out->grid_lo, g.lo, sizeof g.lo);
-    memcpy(out->grid_cell, g.cell, sizeof g.cell);
+    free(c.auto_grid);
+    out->position = c.p;
+    out->cell = c.voxel;
     out->sh = calloc((size_t)out->count * LMB_PROBE_SH + 1, sizeof *out->sh);
     out->cube = calloc((size_t)out->count * LMB_PROBE_CUBE + 1, sizeof *out->cube);
     if (!out->sh || !out->cube) {
         lmb_probe_set_free(out);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %u probes", out->count);
     }
-    lmb_info(log, "probes: %u at spacing %g (%s), grid %ux%ux%u, %u cells with surface split in 8; %u inside geometry "
-             "and %u outside the level dropped", out->count, out->spacing,
-             cfg->probe_spacing > 0 ? "probes.spacing" : "auto: from the lightmapped surface's area", g.n[0], g.n[1],
-             g.n[2], out->refined, out->dropped_inside, out->dropped_outside);
+    if (cfg->probes_auto && out->grid_count && out->grids[0].volume == 0) {
+        const uint32_t *n = out->grids[0].res;
+        lmb_info(log, "probes: auto grid %ux%ux%u at spacing %g (%s), %u cells with surface split in 8", n[0], n[1],
+                 n[2], out->spacing, cfg->probe_spacing > 0 ? "probes.spacing" : "auto: from the lightmapped surface's area",
+                 out->refined);
+    }
+    lmb_info(log, "probes: %u (%u volume(s) from probes.volumes); %u inside geometry and %u outside the level dropped",
+             out->count, cfg->probe_volume_count, out->dropped_inside, out->dropped_outside);
     return LMB_OK;
 }
 

@@ -1,12 +1,14 @@
 /*
  * Probe light (see probes.h). At each probe, probes.rays directions of a spherical Fibonacci
- * lattice (sphere.h) see: the sky where they leave the level, an emitter's radiance where they
- * hit one, and where they hit a lightmapped surface its outgoing diffuse radiance
- * B = albedo / pi x E from the finished bounce cache (a surface without a lightmap: its direct
- * light, one bounce, as the final gather does); back faces are black. With L(w) so sampled,
+ * lattice (sphere.h) see: the sky where they leave the level, and where they hit a lightmapped
+ * surface its outgoing diffuse radiance B = albedo / pi x E from the finished bounce cache (a
+ * surface without a lightmap: its direct light, one bounce, as the final gather does); back
+ * faces are black. With L(w) so sampled,
  *   L_lm = 4 pi / n sum_i L(w_i) Y_lm(w_i) + sum_delta E_delta Y_lm(w_delta)
- * (delta lights, which no ray hits, as their direction and the irradiance they bring), and the
- * SH irradiance is E_lm = A_l L_lm (Ramamoorthi and Hanrahan 2001, eq. 8).
+ *          + 1 / m sum_j Le(w_j) Y_lm(w_j) / pdf(w_j)
+ * (delta lights, which no ray hits, as their direction and the irradiance they bring; emitters
+ * by m points sampled on them, since a lamp small in the probe's sky is hit by few of the fixed
+ * rays), and the SH irradiance is E_lm = A_l L_lm (Ramamoorthi and Hanrahan 2001, eq. 8).
  * The ambient cube's six irradiances are computed for each axis normal n directly: the direct
  * light of every light and the sky at a point facing n, by the direct stage's own estimator
  * (lmb_direct_at_split: shadow rays, area-light and sky sampling with MIS; minus the `indirect`
@@ -26,7 +28,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CUBE_SAMPLES 64 /* direct-light samples per axis of the ambient cube (area lights, sky) */
+#define CUBE_SAMPLES 64     /* direct-light samples per axis of the ambient cube (area lights, sky) */
+#define EMITTER_SAMPLES 256 /* points on emitters per probe for the SH (a small lamp is hit by few rays) */
 
 static const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
@@ -117,9 +120,8 @@ static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
             if (kind != LMB_HIT_DARK)
                 for (int c = 0; c < 3; c++)
                     b[c] = albedo[c] * e[c];
-            lmb_direct_emitted_at_hit(job->direct, &h, w, l);
-            for (int c = 0; c < 3; c++)
-                l[c] += b[c];
+            for (int c = 0; c < 3; c++) /* emitters' own light: sampled on them below */
+                l[c] = b[c];
         }
         double y[9];
         sh9(w, y);
@@ -133,6 +135,8 @@ static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
         }
     }
     rays += lmb_direct_deltas_at(job->direct, p, add_delta, &sum);
+    lmb_rng erng = lmb_rng_make(job->cfg->seed, 0x454d4954ull ^ i, 0);
+    rays += lmb_direct_emitter_samples_at(job->direct, p, EMITTER_SAMPLES, &erng, add_delta, &sum);
     for (int a = 0; a < 6; a++) {
         lmb_shading_point sp;
         for (int k = 0; k < 3; k++) {

@@ -1,6 +1,6 @@
 /* The probes as the output holds them (write/gltf_write.h's lmb_gltf_probes): float positions,
- * the values in the lightmaps' scale (output.scale radiance: E / pi), and the grid as bevy's
- * irradiance volume, DIR/STEM-irradiance-volume.ktx2. */
+ * the values in the lightmaps' scale (output.scale radiance: E / pi), and each grid as bevy's
+ * irradiance volume. */
 #include "probes.h"
 
 #include "util/lmb_math.h"
@@ -9,28 +9,41 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The volume's file beside the glTF; its name into out->volume_uri (owned). */
-static lmb_status write_volume(const lmb_probe_set *set, double scale, const char *dir, const char *stem,
-                               lmb_gltf_probes *out, lmb_error *err)
+/* Each grid's volume file beside the glTF (STEM-irradiance-volume.ktx2 for the auto grid,
+ * STEM-irradiance-volume-K.ktx2 for probes.volumes entry K); out->volumes owned. */
+static lmb_status write_volumes(const lmb_probe_set *set, double scale, const char *dir, const char *stem,
+                                lmb_gltf_probes *out, lmb_error *err)
 {
-    lmb_probe_volume v;
-    lmb_status st = lmb_probe_volume_make(set, &v, err);
-    char name[512], path[4096 + 520];
-    snprintf(name, sizeof name, "%s-irradiance-volume.ktx2", stem);
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    if (st == LMB_OK)
-        st = lmb_probe_volume_write_ktx2(&v, scale, path, err);
-    char *uri = st == LMB_OK ? malloc(strlen(name) + 1) : NULL;
-    if (st == LMB_OK && !uri)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
-    if (st == LMB_OK) {
-        memcpy(uri, name, strlen(name) + 1);
-        out->volume_uri = uri;
-        memcpy(out->volume_lo, v.lo, sizeof v.lo);
-        memcpy(out->volume_hi, v.hi, sizeof v.hi);
-        memcpy(out->volume_res, v.res, sizeof v.res);
+    lmb_gltf_volume *vols = calloc((size_t)set->grid_count + 1, sizeof *vols);
+    if (!vols)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
+    out->volumes = vols;
+    lmb_status st = LMB_OK;
+    for (uint32_t g = 0; st == LMB_OK && g < set->grid_count; g++) {
+        lmb_probe_volume v;
+        st = lmb_probe_volume_make(set, g, &v, err);
+        char name[512], path[4096 + 520];
+        if (set->grids[g].volume)
+            snprintf(name, sizeof name, "%s-irradiance-volume-%u.ktx2", stem, set->grids[g].volume);
+        else
+            snprintf(name, sizeof name, "%s-irradiance-volume.ktx2", stem);
+        snprintf(path, sizeof path, "%s/%s", dir, name);
+        if (st == LMB_OK)
+            st = lmb_probe_volume_write_ktx2(&v, scale, path, err);
+        char *uri = st == LMB_OK ? malloc(strlen(name) + 1) : NULL;
+        if (st == LMB_OK && !uri)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
+        if (st == LMB_OK) {
+            memcpy(uri, name, strlen(name) + 1);
+            lmb_gltf_volume *o = &vols[out->volume_count++];
+            o->uri = uri;
+            memcpy(o->lo, v.lo, sizeof v.lo);
+            memcpy(o->hi, v.hi, sizeof v.hi);
+            memcpy(o->res, v.res, sizeof v.res);
+            o->config_entry = set->grids[g].volume;
+        }
+        lmb_probe_volume_free(&v);
     }
-    lmb_probe_volume_free(&v);
     return st;
 }
 
@@ -63,7 +76,7 @@ lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, co
     out->cube = cube;
     out->spacing = set->spacing;
     out->radiance = radiance;
-    return write_volume(set, scale, dir, stem, out, err);
+    return write_volumes(set, scale, dir, stem, out, err);
 }
 
 void lmb_probes_output_free(lmb_gltf_probes *out)
@@ -71,6 +84,8 @@ void lmb_probes_output_free(lmb_gltf_probes *out)
     free((void *)out->positions);
     free((void *)out->sh);
     free((void *)out->cube);
-    free((void *)out->volume_uri);
+    for (uint32_t i = 0; out->volumes && i < out->volume_count; i++)
+        free((void *)out->volumes[i].uri);
+    free((void *)out->volumes);
     memset(out, 0, sizeof *out);
 }

@@ -7,12 +7,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-lmb_status lmb_probe_volume_make(const lmb_probe_set *set, lmb_probe_volume *out, lmb_error *err)
+lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, lmb_probe_volume *out, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (!set->count)
-        return LMB_OK;
-    size_t n = (size_t)set->grid[0] * set->grid[1] * set->grid[2];
+    const lmb_probe_grid *grid = &set->grids[g];
+    size_t n = (size_t)grid->res[0] * grid->res[1] * grid->res[2];
     float *sum = calloc(n * LMB_PROBE_CUBE + 1, sizeof *sum), *next = malloc((n * LMB_PROBE_CUBE + 1) * sizeof *next);
     uint32_t *count = calloc(n + 1, sizeof *count);
     uint8_t *has = calloc(n + 1, 1), *had = malloc(n + 1);
@@ -25,9 +24,12 @@ lmb_status lmb_probe_volume_make(const lmb_probe_set *set, lmb_probe_volume *out
         return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for a volume of %zu voxels", n);
     }
     for (uint32_t i = 0; i < set->count; i++) {
-        count[set->cell[i]]++;
+        if (set->cell[i] < grid->first_voxel || set->cell[i] - grid->first_voxel >= n)
+            continue;
+        size_t v = set->cell[i] - grid->first_voxel;
+        count[v]++;
         for (int k = 0; k < LMB_PROBE_CUBE; k++)
-            sum[(size_t)set->cell[i] * LMB_PROBE_CUBE + k] += set->cube[(size_t)i * LMB_PROBE_CUBE + k];
+            sum[v * LMB_PROBE_CUBE + k] += set->cube[(size_t)i * LMB_PROBE_CUBE + k];
     }
     for (size_t v = 0; v < n; v++) {
         has[v] = count[v] > 0;
@@ -36,7 +38,7 @@ lmb_status lmb_probe_volume_make(const lmb_probe_set *set, lmb_probe_volume *out
             sum[v * LMB_PROBE_CUBE + k] /= (float)count[v];
     }
     /* fill: each pass, an empty voxel with filled neighbours (6-connected) takes their mean */
-    const uint32_t *r = set->grid;
+    const uint32_t *r = grid->res;
     for (int changed = 1; changed;) {
         changed = 0;
         memcpy(had, has, n);
@@ -75,8 +77,8 @@ lmb_status lmb_probe_volume_make(const lmb_probe_set *set, lmb_probe_volume *out
     out->cube = sum;
     for (int k = 0; k < 3; k++) {
         out->res[k] = r[k];
-        out->lo[k] = set->grid_lo[k];
-        out->hi[k] = set->grid_lo[k] + r[k] * set->grid_cell[k];
+        out->lo[k] = grid->lo[k];
+        out->hi[k] = grid->lo[k] + r[k] * grid->cell[k];
     }
     return LMB_OK;
 }

@@ -35,18 +35,26 @@
 #define LMB_PROBE_CUBE 18 /* floats: +X, -X, +Y, -Y, +Z, -Z, each r g b */
 #define LMB_PROBES_MAX 1000000 /* 45 floats and a position each: 200 MB of output at most */
 
+/* A grid of probes: the auto grid over the level, or a probes.volumes box. */
+typedef struct lmb_probe_grid {
+    double lo[3], cell[3]; /* corner and cell size per axis */
+    uint32_t res[3];       /* cells per axis */
+    uint32_t first_voxel;  /* its first voxel among all grids' */
+    uint32_t volume;       /* 0: the auto grid; k: probes.volumes entry k (1-based) */
+} lmb_probe_grid;
+
 typedef struct lmb_probe_set {
     uint32_t count;
     double *position;  /* 3 per probe, world */
     float *sh;         /* LMB_PROBE_SH per probe, lux */
     float *cube;       /* LMB_PROBE_CUBE per probe, lux */
-    double spacing;    /* the grid's cell size, world units (probes near surfaces: half of it) */
-    uint32_t grid[3];  /* cells per axis */
-    uint32_t refined;  /* cells split because they hold surface */
+    double spacing;    /* the auto grid's cell size, world units (probes near surfaces: half of it) */
+    uint32_t refined;  /* auto grid cells split because they hold surface */
     uint32_t dropped_inside, dropped_outside;
     uint32_t rays;     /* rays per probe (probes.rays) */
-    uint32_t *cell;    /* per probe: its grid cell, x fastest (the irradiance volume's voxel) */
-    double grid_lo[3], grid_cell[3]; /* the grid's corner and cell size per axis */
+    uint32_t *cell;    /* per probe: its voxel among all grids' (lmb_probe_grid.first_voxel + x fastest) */
+    lmb_probe_grid grids[1 + LMB_MAX_PROBE_VOLUMES];
+    uint32_t grid_count; /* the auto grid (probes.auto) first, then each probes.volumes entry */
 } lmb_probe_set;
 
 /* An irradiance volume as bevy reads one (IrradianceVolume: a unit cube centred on the origin,
@@ -58,10 +66,10 @@ typedef struct lmb_probe_volume {
     uint32_t filled;   /* voxels whose probes were all dropped (inside geometry), filled from neighbours */
 } lmb_probe_volume;
 
-/* The set's grid as a volume (probe_volume.c): a voxel per cell, the mean of its probes' cubes;
- * a cell with none (inside geometry) takes the mean of its neighbours', pass by pass, so that
- * trilinear filtering next to walls does not read black. Empty (no voxels) when the set is. */
-lmb_status lmb_probe_volume_make(const lmb_probe_set *set, lmb_probe_volume *out, lmb_error *err);
+/* Grid g of the set as a volume (probe_volume.c): a voxel per cell, the mean of its probes'
+ * cubes; a cell with none (inside geometry) takes the mean of its neighbours', pass by pass, so
+ * that trilinear filtering next to walls does not read black. */
+lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, lmb_probe_volume *out, lmb_error *err);
 void lmb_probe_volume_free(lmb_probe_volume *v);
 
 /* The volume in bevy's layout as KTX2 (E5B9G9R9, vkFormat 123, no supercompression): a texture
@@ -69,8 +77,8 @@ void lmb_probe_volume_free(lmb_probe_volume *v);
  * (x, y + Ry, z + k Rz), k = 0, 1, 2 for A = X, Y, Z; values times `scale`. */
 lmb_status lmb_probe_volume_write_ktx2(const lmb_probe_volume *v, double scale, const char *path, lmb_error *err);
 
-/* Places the probes of the level (probes.auto) into out. Empty (count 0) when nothing is
- * lightmapped or probes.auto is off. */
+/* Places the probes of the level (probes.auto, then probes.volumes: a probe at each cell's
+ * centre, dropped inside geometry) into out. Empty (count 0) when there are none. */
 lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
                             const lmb_log *log, lmb_probe_set *out, lmb_error *err);
 

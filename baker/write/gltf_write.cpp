@@ -519,6 +519,39 @@ extern "C" lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, u
 
 namespace {
 
+/* One irradiance volume as a node of the default scene (see lmb_gltf_set_probes). */
+void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, int radiance)
+{
+    tinygltf::Node node;
+    node.name = v.config_entry ? "lightmap irradiance volume " + std::to_string(v.config_entry)
+                               : std::string("lightmap irradiance volume");
+    for (int k = 0; k < 3; k++) {
+        node.translation.push_back(0.5 * (v.lo[k] + v.hi[k]));
+        node.scale.push_back(v.hi[k] - v.lo[k]);
+    }
+    Value::Object volume;
+    volume["uri"] = Value(v.uri);
+    volume["resolution"] = Value(Value::Array{Value((int)v.res[0]), Value((int)v.res[1]), Value((int)v.res[2])});
+    volume["layout"] = Value(std::string("bevy IrradianceVolume: a unit cube centred on the origin, placed by this node; "
+                                         "KTX2 E5B9G9R9 of (Rx, 2Ry, 3Rz) texels, ambient cubes"));
+    volume["scale"] = Value(std::string(radiance ? "radiance" : "irradiance"));
+    volume["unit"] = Value(std::string(radiance ? "nits (E / pi)" : "lux (E)"));
+    volume["configEntry"] = Value((int)v.config_entry);
+    Value::Object node_lightmap;
+    node_lightmap["irradianceVolume"] = Value(volume);
+    Value::Object node_extras;
+    node_extras["lightmap"] = Value(node_lightmap);
+    node.extras = Value(node_extras);
+    m.nodes.push_back(node);
+    int index = (int)m.nodes.size() - 1;
+    if (m.scenes.empty()) {
+        m.scenes.push_back(tinygltf::Scene());
+        m.defaultScene = 0;
+    }
+    size_t scene = m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? (size_t)m.defaultScene : 0;
+    m.scenes[scene].nodes.push_back(index);
+}
+
 /* The probes lmb_gltf_set_probes kept: into the new buffer and asset.extras.lightmap.probes. */
 void add_probes(lmb_gltf_doc *doc)
 {
@@ -557,36 +590,8 @@ void add_probes(lmb_gltf_doc *doc)
     lightmap["probes"] = Value(probes);
     extras["lightmap"] = Value(lightmap);
     asset.extras = Value(extras);
-    if (doc->volume_uri.empty())
-        return;
-    tinygltf::Node node;
-    node.name = "lightmap irradiance volume";
-    for (int k = 0; k < 3; k++) {
-        node.translation.push_back(0.5 * (doc->volume_lo[k] + doc->volume_hi[k]));
-        node.scale.push_back(doc->volume_hi[k] - doc->volume_lo[k]);
-    }
-    Value::Object volume;
-    volume["uri"] = Value(doc->volume_uri);
-    volume["resolution"] = Value(Value::Array{Value((int)doc->volume_res[0]), Value((int)doc->volume_res[1]),
-                                              Value((int)doc->volume_res[2])});
-    volume["layout"] = Value(std::string("bevy IrradianceVolume: a unit cube centred on the origin, placed by this node; "
-                                         "KTX2 E5B9G9R9 of (Rx, 2Ry, 3Rz) texels, ambient cubes"));
-    volume["scale"] = Value(std::string(doc->probe_radiance ? "radiance" : "irradiance"));
-    volume["unit"] = Value(std::string(doc->probe_radiance ? "nits (E / pi)" : "lux (E)"));
-    Value::Object node_lightmap;
-    node_lightmap["irradianceVolume"] = Value(volume);
-    Value::Object node_extras;
-    node_extras["lightmap"] = Value(node_lightmap);
-    node.extras = Value(node_extras);
-    m.nodes.push_back(node);
-    int index = (int)m.nodes.size() - 1;
-    if (m.scenes.empty()) {
-        tinygltf::Scene scene;
-        m.scenes.push_back(scene);
-        m.defaultScene = 0;
-    }
-    m.scenes[(size_t)(m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? m.defaultScene : 0)]
-        .nodes.push_back(index);
+    for (const auto &v : doc->volumes)
+        add_volume_node(m, v, doc->probe_radiance);
 }
 
 } // namespace
@@ -599,11 +604,12 @@ extern "C" lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_prob
         doc->probe_cube.assign(p->cube, p->cube + 18 * (size_t)p->count);
         doc->probe_spacing = p->spacing;
         doc->probe_radiance = p->radiance;
-        doc->volume_uri = p->volume_uri ? p->volume_uri : "";
-        for (int k = 0; k < 3; k++) {
-            doc->volume_lo[k] = p->volume_lo[k];
-            doc->volume_hi[k] = p->volume_hi[k];
-            doc->volume_res[k] = p->volume_res[k];
+        doc->volumes.clear();
+        for (uint32_t i = 0; i < p->volume_count; i++) {
+            const lmb_gltf_volume &v = p->volumes[i];
+            lmb_gltf_doc::volume d{v.uri, {v.lo[0], v.lo[1], v.lo[2]}, {v.hi[0], v.hi[1], v.hi[2]},
+                                   {v.res[0], v.res[1], v.res[2]}, v.config_entry};
+            doc->volumes.push_back(d);
         }
         return LMB_OK;
     } catch (const std::exception &e) {

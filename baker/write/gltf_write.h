@@ -104,18 +104,25 @@ typedef struct lmb_gltf_probes {
     const float *cube;      /* 18 per probe: irradiance for +X, -X, +Y, -Y, +Z, -Z, RGB */
     double spacing;         /* the grid's cell */
     int radiance;           /* output.scale radiance */
-    const char *volume_uri; /* the grid as bevy's irradiance volume (KTX2), or NULL */
-    double volume_lo[3], volume_hi[3];
-    uint32_t volume_res[3];
+    uint32_t volume_count;  /* the grids as bevy's irradiance volumes (KTX2) */
+    const struct lmb_gltf_volume *volumes;
 } lmb_gltf_probes;
+
+typedef struct lmb_gltf_volume {
+    const char *uri;
+    double lo[3], hi[3];
+    uint32_t res[3];
+    uint32_t config_entry; /* 0: the auto grid; k: probes.volumes entry k */
+} lmb_gltf_volume;
 
 /* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes
  * as buffer views of float32) and names them in asset.extras.lightmap.probes {count, positions,
  * sh, ambientCube, shBasis, scale, unit, spacing} (docs/probes.md); the asset's other extras
- * are kept. With a volume_uri, a node "lightmap irradiance volume" in the default scene whose
- * transform takes a unit cube centred on the origin to the volume's box (bevy's
- * IrradianceVolume), with extras.lightmap.irradianceVolume {uri, resolution, layout, scale,
- * unit}. Nothing when count is 0. Added when the document is saved. */
+ * are kept. Per volume a node "lightmap irradiance volume" (or "... K" for probes.volumes entry
+ * K) in the default scene whose transform takes a unit cube centred on the origin to the
+ * volume's box (bevy's IrradianceVolume), with extras.lightmap.irradianceVolume {uri,
+ * resolution, layout, scale, unit, configEntry}. Nothing when count is 0. Added when the
+ * document is saved. */
 lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_probes *p, lmb_error *err);
 
 /* Lightmapped primitives with no material get a material of this diffuse albedo (metallic 0:

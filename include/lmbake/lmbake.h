@@ -261,6 +261,14 @@ typedef struct lmb_light_mode_rule {
     int mode; /* lmb_light_mode; -1 before it is read */
 } lmb_light_mode_rule;
 
+/* probes.volumes entry: a box of probes at the centres of a resolution[0] x [1] x [2] grid of
+ * cells (an irradiance volume an artist places) */
+#define LMB_MAX_PROBE_VOLUMES 16
+typedef struct lmb_probe_volume_spec {
+    double min[3], max[3]; /* world corners, min < max on every axis */
+    uint32_t resolution[3]; /* cells per axis, 1..256 */
+} lmb_probe_volume_spec;
+
 typedef struct lmb_config {
     /* unwrap / pack */
     double texel_density;          /* texels per world unit; 0 = auto: the lightmapped surface fills atlas_texels */
@@ -350,6 +358,8 @@ typedef struct lmb_config {
     int probes_auto;               /* probes.auto: a grid over the level, refined near surfaces */
     double probe_spacing;          /* probes.spacing: the grid's cell, world units; 0 = auto (from the surface area) */
     uint32_t probe_rays;           /* probes.rays: directions each probe looks in */
+    lmb_probe_volume_spec probe_volumes[LMB_MAX_PROBE_VOLUMES]; /* probes.volumes */
+    uint32_t probe_volume_count;
     char config_path[4096];        /* the config file it was loaded from (lmb_config_load), "" for none: sky.image is
                                       read from its folder; not a key */
 } lmb_config;

@@ -16,6 +16,11 @@ usage: check_probes.py LMBAKE WORKDIR CASE
   sealed   the sealed room under a sky of 10^4 nits with a point light outside: every probe 0.
   solid    a plane with a closed 2 m cube on it: no probe inside the cube, probes around it.
   scale    output.scale radiance: the same probes' values divided by pi.
+  cornell  bevy's Cornell box at defaults with probes.volumes 1 to 2 units off its floor, walls and
+           ceiling: at each probe, for the axis facing a surface straight ahead (a ray along -n
+           hits a triangle facing n within 8 units), the ambient cube's irradiance for n against
+           the lightmap read there (bilinear, as an engine reads it): the mean ratio per surface
+           within 3%; each probe's ratio and the SH's (its L2 truncation) printed.
   volume   the closed cube on a plane: the grid as bevy's irradiance volume, read back by an
            independent reader (tests/ktx2/read_ktx2.mjs, npm ktx-parse): vkFormat 123, (Rx, 2Ry,
            3Rz) texels for the node's resolution, every face of every voxel with probes equal to
@@ -170,6 +175,100 @@ def scale(lmbake, work):
                   % (b["count"], worst, b["meta"]["scale"]))
 
 
+CORNELL_VOLUMES = """probes:
+  auto: false
+  volumes:
+    - {min: [-540, 0.5, -200], max: [-480, 1.5, -40], resolution: [3, 1, 4]}
+    - {min: [-200, 0.5, -540], max: [-40, 1.5, -320], resolution: [4, 1, 3]}
+    - {min: [-1.5, 100, -500], max: [-0.5, 450, -100], resolution: [1, 4, 4]}
+    - {min: [-500, 100, -558.7], max: [-100, 450, -557.7], resolution: [4, 4, 1]}
+    - {min: [-548.5, 100, -500], max: [-547.5, 450, -100], resolution: [1, 4, 4]}
+    - {min: [-540, 547.3, -540], max: [-420, 548.3, -420], resolution: [3, 1, 3]}
+"""
+
+
+def ray_triangle(o, d, tri):
+    """Distance along unit d from o to triangle tri, or None (Moller-Trumbore)."""
+    e1 = [tri[1][k] - tri[0][k] for k in range(3)]
+    e2 = [tri[2][k] - tri[0][k] for k in range(3)]
+    pv = [d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]]
+    det = sum(e1[k] * pv[k] for k in range(3))
+    if abs(det) < 1e-12:
+        return None
+    tv = [o[k] - tri[0][k] for k in range(3)]
+    u = sum(tv[k] * pv[k] for k in range(3)) / det
+    qv = [tv[1] * e1[2] - tv[2] * e1[1], tv[2] * e1[0] - tv[0] * e1[2], tv[0] * e1[1] - tv[1] * e1[0]]
+    v = sum(d[k] * qv[k] for k in range(3)) / det
+    t = sum(e2[k] * qv[k] for k in range(3)) / det
+    if u < 0 or v < 0 or u + v > 1 or t <= 0:
+        return None
+    return t, u, v
+
+
+def bilinear(img, u, v):
+    h, w = img.shape[0], img.shape[1]
+    x, y = u * w - 0.5, v * h - 0.5
+    x0, y0 = int(math.floor(x)), int(math.floor(y))
+    fx, fy = x - x0, y - y0
+    total = 0.0
+    for j, wy in ((0, 1 - fy), (1, fy)):
+        for i, wx in ((0, 1 - fx), (1, fx)):
+            xx, yy = min(max(x0 + i, 0), w - 1), min(max(y0 + j, 0), h - 1)
+            total += wx * wy * float(img[yy, xx, 0])
+    return total
+
+
+def cornell(lmbake, work):
+    import check_analytic as ca  # numpy and OpenImageIO: this case only
+    cfg = os.path.join(work, "cornell.yaml")
+    with open(cfg, "w") as f:
+        f.write(CORNELL_VOLUMES)
+    out = os.path.join(work, "out-cornell")
+    p = subprocess.run([lmbake, "bake", os.path.join(ROOT, "assets", "scenes", "cornell-box-bevy", "CornellBox.glb"),
+                        "-c", cfg, "-o", out, "-q"], capture_output=True, text=True)
+    if p.returncode != 0:
+        return report("cornell", False, "bake failed (%d): %s" % (p.returncode, p.stderr))
+    probes = load_probes(os.path.join(out, "CornellBox.gltf"))
+    charts, images = ca.load_output(out)
+    tris = [(tex, w, u) for node, tex, ts in charts for w, u in ts]
+    ratios = {}  # axis -> [(cube ratio, sh ratio)]
+    for pos, sh, cube in zip(probes["positions"], probes["sh"], probes["cube"]):
+        for a, n in enumerate(AXES):
+            back = [-c for c in n]
+            best = None
+            for tex, w, uv in tris:
+                hit = ray_triangle(pos, back, w)
+                if not hit or hit[0] > 8:
+                    continue
+                e1 = [w[1][k] - w[0][k] for k in range(3)]
+                e2 = [w[2][k] - w[0][k] for k in range(3)]
+                nn = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+                ln = math.sqrt(sum(c * c for c in nn))
+                if ln == 0 or abs(sum(nn[k] * n[k] for k in range(3)) / ln) < 0.99:
+                    continue
+                if best is None or hit[0] < best[0]:
+                    best = (hit[0], tex, uv, hit[1], hit[2])
+            if best is None:
+                continue
+            t, tex, uv, b1, b2 = best
+            u = (1 - b1 - b2) * uv[0][0] + b1 * uv[1][0] + b2 * uv[2][0]
+            v = (1 - b1 - b2) * uv[0][1] + b1 * uv[1][1] + b2 * uv[2][1]
+            e = bilinear(images[tex], u, v)
+            if e > 0:
+                ratios.setdefault(a, []).append((cube[3 * a] / e, sh_irradiance(sh, n) / e))
+    names = ["+X", "-X", "+Y", "-Y", "+Z", "-Z"]
+    good, lines = len(ratios) >= 4, []
+    for a, rs in sorted(ratios.items()):
+        mean = sum(r[0] for r in rs) / len(rs)
+        ok = abs(mean - 1) <= 0.03
+        good = good and ok
+        lines.append("%s: %d probes, cube / lightmap mean %.4f (%.4f..%.4f), SH / lightmap %.4f..%.4f %s"
+                     % (names[a], len(rs), mean, min(r[0] for r in rs), max(r[0] for r in rs),
+                        min(r[1] for r in rs), max(r[1] for r in rs), "ok" if ok else "FAIL"))
+    return report("cornell", good, "%d probes; per surface normal (bound: mean within 3%%):\n  %s"
+                  % (probes["count"], "\n  ".join(lines)))
+
+
 def volume(lmbake, work):
     probes, _ = bake(lmbake, work, "box-floor", "volume", "bounces: 2\n")
     out = os.path.join(work, "out-volume")
@@ -223,5 +322,6 @@ def volume(lmbake, work):
 if __name__ == "__main__":
     lmbake, work, case = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
-    cases = {"sky": sky, "point": point, "sealed": sealed, "solid": solid, "scale": scale, "volume": volume}
+    cases = {"sky": sky, "point": point, "sealed": sealed, "solid": solid, "scale": scale, "volume": volume,
+             "cornell": cornell}
     sys.exit(0 if cases[case](lmbake, work) else 1)

@@ -582,6 +582,41 @@ static void test_lint(void)
     CHECK_CONTAINS(err.message, "key 'sky.image': 'missing.hdr' is not a file inside the config's folder");
 }
 
+/* probes.*: values, volumes, and the named errors for a bad volume. */
+static void test_probe_keys(void)
+{
+    lmb_config c;
+    lmb_error err;
+    lmb_config_default(&c);
+    CHECK_INT(c.probes_auto, 1);
+    CHECK_NEAR(c.probe_spacing, 0, 0);
+    CHECK_INT(c.probe_rays, 1024);
+    CHECK_INT(c.probe_volume_count, 0);
+    CHECK_INT(parse("probes:\n  auto: false\n  spacing: 2.5\n  rays: 256\n  volumes:\n"
+                    "    - {min: [-1, 0, -2], max: [1, 2.5, 2], resolution: [4, 2, 8]}\n"
+                    "    - {min: [0, 0, 0], max: [1, 1, 1], resolution: [1, 1, 1]}\n", &c, &err), LMB_OK);
+    CHECK_INT(c.probes_auto, 0);
+    CHECK_NEAR(c.probe_spacing, 2.5, 0);
+    CHECK_INT(c.probe_rays, 256);
+    CHECK_INT(c.probe_volume_count, 2);
+    CHECK_NEAR(c.probe_volumes[0].min[2], -2, 0);
+    CHECK_NEAR(c.probe_volumes[0].max[1], 2.5, 0);
+    CHECK_INT(c.probe_volumes[0].resolution[2], 8);
+    CHECK_INT(c.probe_volumes[1].resolution[0], 1);
+    expect_error("probes: {spacing: 0}\n", "level.yaml:1: ", "key 'probes.spacing'");
+    expect_error("probes: {spacing: -1}\n", "level.yaml:1: ", "key 'probes.spacing'");
+    expect_error("probes:\n  volumes:\n    - {min: [0, 2, 0], max: [1, 1, 1], resolution: [2, 2, 2]}\n",
+                 "level.yaml:3: ", "min 2 is not below max 1 on the y axis");
+    expect_error("probes:\n  volumes:\n    - {min: [0, 0, 0], max: [1, 1, 1], resolution: [2, 0, 2]}\n",
+                 "level.yaml:3: ", "key 'probes.volumes.resolution': expected [x, y, z], integers in 1..256");
+    expect_error("probes:\n  volumes:\n    - {min: [0, 0, 0], max: [1, 1, 1], resolution: [2, 257, 2]}\n",
+                 "level.yaml:3: ", "integers in 1..256");
+    expect_error("probes:\n  volumes:\n    - {min: [0, 0, 0], max: [1, 1, 1]}\n", "level.yaml:3: ",
+                 "each entry needs min, max and resolution");
+    expect_error("probes:\n  volumes:\n    - {min: [0, .nan, 0], max: [1, 1, 1], resolution: [1, 1, 1]}\n",
+                 "level.yaml:3: ", "key 'probes.volumes.min'");
+}
+
 int main(int argc, char **argv)
 {
     test_defaults();
@@ -604,5 +639,6 @@ int main(int argc, char **argv)
     test_outdoor_keys();
     test_output_keys();
     test_lint();
+    test_probe_keys();
     return check_failures();
 }
