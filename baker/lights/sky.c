@@ -21,6 +21,7 @@
 #include "load/uri.h"
 #include "util/frame.h"
 #include "util/lmb_math.h"
+#include "util/sh.h"
 #include "write/image_adapter.h"
 
 #include <math.h>
@@ -228,22 +229,6 @@ static void sky_frame(const lmb_config *cfg, lmb_sky *s)
     lmb_cross3(s->up, s->south, s->east);
 }
 
-/* Real spherical harmonics up to l = 2 at unit direction (x, y, z), in the order (0,0) (1,-1)
- * (1,0) (1,1) (2,-2) (2,-1) (2,0) (2,1) (2,2) (Sloan, "Stupid Spherical Harmonics Tricks", with
- * glTF's own axes). */
-static void sh9(double x, double y, double z, double out[9])
-{
-    out[0] = 0.282095;
-    out[1] = 0.488603 * y;
-    out[2] = 0.488603 * z;
-    out[3] = 0.488603 * x;
-    out[4] = 1.092548 * x * y;
-    out[5] = 1.092548 * y * z;
-    out[6] = 0.315392 * (3 * z * z - 1);
-    out[7] = 1.092548 * x * z;
-    out[8] = 0.546274 * (x * x - y * y);
-}
-
 /* v rotated by the inverse of unit quaternion q (x, y, z, w). */
 static void rotate_inverse(const float q[4], const double v[3], double out[3])
 {
@@ -263,8 +248,6 @@ static void rotate_inverse(const float q[4], const double v[3], double out[3])
  */
 static lmb_status sky_from_ibl(const lmb_gltf_ibl *ibl, lmb_sky *s, lmb_error *err)
 {
-    static const double band[9] = {LMB_PI, 2 * LMB_PI / 3, 2 * LMB_PI / 3, 2 * LMB_PI / 3, LMB_PI / 4,
-                                   LMB_PI / 4, LMB_PI / 4, LMB_PI / 4, LMB_PI / 4};
     s->w = 64;
     s->h = 32;
     s->radiance = malloc(3 * (size_t)s->w * s->h * sizeof *s->radiance);
@@ -275,11 +258,11 @@ static lmb_status sky_from_ibl(const lmb_gltf_ibl *ibl, lmb_sky *s, lmb_error *e
             double theta = LMB_PI * (j + 0.5) / s->h, phi = 2 * LMB_PI * ((i + 0.5) / s->w - 0.5);
             double world[3] = {sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi)}, d[3], y[9];
             rotate_inverse(ibl->rotation, world, d);
-            sh9(d[0], d[1], d[2], y);
+            lmb_sh9(d[0], d[1], d[2], y);
             for (int c = 0; c < 3; c++) {
                 double l = 0;
                 for (int k = 0; k < 9; k++)
-                    l += ibl->sh[k][c] / band[k] * y[k];
+                    l += ibl->sh[k][c] / lmb_sh_cosine_band(k) * y[k];
                 s->radiance[3 * ((size_t)j * s->w + i) + (size_t)c] = (float)(l > 0 ? l * ibl->intensity : 0);
             }
         }

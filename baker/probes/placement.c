@@ -14,14 +14,11 @@
 #define AUTO_MAX_CELLS 4096   /* auto spacing: widened until the grid has at most this many cells (32,768 probes at most) */
 #define FAR_CELLS 3           /* a probe with no surface within this many cells is outside the level */
 
-/* The lightmapped geometry's bounds and surface area. */
-static void bounds_and_area(const lmb_scene *s, const lmb_layout *l, double lo[3], double hi[3], double *area)
+/* Calls fn for every lightmapped triangle, in world space. */
+typedef void (*triangle_fn)(void *user, const double q[9]);
+
+static void each_lightmapped_triangle(const lmb_scene *s, const lmb_layout *l, triangle_fn fn, void *user)
 {
-    *area = 0;
-    for (int k = 0; k < 3; k++) {
-        lo[k] = HUGE_VAL;
-        hi[k] = -HUGE_VAL;
-    }
     for (uint32_t i = 0; i < s->instance_count; i++) {
         if (!l->instances[i].lightmapped)
             continue;
@@ -29,14 +26,36 @@ static void bounds_and_area(const lmb_scene *s, const lmb_layout *l, double lo[3
         for (uint32_t f = 0; f < nt; f++) {
             double q[9];
             lmb_layout_world_triangle(s, l, i, f, q);
-            for (int c = 0; c < 3; c++)
-                for (int k = 0; k < 3; k++) {
-                    lo[k] = fmin(lo[k], q[3 * c + k]);
-                    hi[k] = fmax(hi[k], q[3 * c + k]);
-                }
-            *area += lmb_triangle_area(q);
+            fn(user, q);
         }
     }
+}
+
+typedef struct extent {
+    double lo[3], hi[3], area;
+} extent;
+
+static void grow_extent(void *user, const double q[9])
+{
+    extent *e = user;
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            e->lo[k] = fmin(e->lo[k], q[3 * c + k]);
+            e->hi[k] = fmax(e->hi[k], q[3 * c + k]);
+        }
+    e->area += lmb_triangle_area(q);
+}
+
+/* The lightmapped geometry's bounds and surface area. */
+static void bounds_and_area(const lmb_scene *s, const lmb_layout *l, double lo[3], double hi[3], double *area)
+{
+    extent e = {{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, 0};
+    each_lightmapped_triangle(s, l, grow_extent, &e);
+    for (int k = 0; k < 3; k++) {
+        lo[k] = e.lo[k];
+        hi[k] = e.hi[k];
+    }
+    *area = e.area;
 }
 
 /* Does triangle q touch the box centre c, half-size h? Its bounding box overlaps (the caller
@@ -67,36 +86,41 @@ static size_t cell_index(const grid *g, uint32_t x, uint32_t y, uint32_t z)
     return ((size_t)z * g->n[1] + y) * g->n[0] + x;
 }
 
+typedef struct marking {
+    const grid *g;
+    uint8_t *marked;
+} marking;
+
+/* Marks the cells triangle q passes through. */
+static void mark_triangle(void *user, const double q[9])
+{
+    const marking *m = user;
+    const grid *g = m->g;
+    double h[3] = {0.5 * g->cell[0], 0.5 * g->cell[1], 0.5 * g->cell[2]};
+    uint32_t a[3], b[3];
+    for (int k = 0; k < 3; k++) {
+        double mn = fmin(q[k], fmin(q[3 + k], q[6 + k])), mx = fmax(q[k], fmax(q[3 + k], q[6 + k]));
+        double u0 = floor((mn - g->lo[k]) / g->cell[k]), u1 = floor((mx - g->lo[k]) / g->cell[k]);
+        a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
+        b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
+    }
+    for (uint32_t z = a[2]; z <= b[2]; z++)
+        for (uint32_t y = a[1]; y <= b[1]; y++)
+            for (uint32_t x = a[0]; x <= b[0]; x++) {
+                size_t c = cell_index(g, x, y, z);
+                if (m->marked[c])
+                    continue;
+                double centre[3] = {g->lo[0] + (x + 0.5) * g->cell[0], g->lo[1] + (y + 0.5) * g->cell[1],
+                                    g->lo[2] + (z + 0.5) * g->cell[2]};
+                m->marked[c] = (uint8_t)plane_meets_box(q, centre, h);
+            }
+}
+
 /* Marks every cell some lightmapped triangle passes through. */
 static void mark_surface_cells(const lmb_scene *s, const lmb_layout *l, const grid *g, uint8_t *marked)
 {
-    double h[3] = {0.5 * g->cell[0], 0.5 * g->cell[1], 0.5 * g->cell[2]};
-    for (uint32_t i = 0; i < s->instance_count; i++) {
-        if (!l->instances[i].lightmapped)
-            continue;
-        uint32_t nt = s->meshes[s->instances[i].mesh].triangle_count;
-        for (uint32_t f = 0; f < nt; f++) {
-            double q[9];
-            lmb_layout_world_triangle(s, l, i, f, q);
-            uint32_t a[3], b[3];
-            for (int k = 0; k < 3; k++) {
-                double mn = fmin(q[k], fmin(q[3 + k], q[6 + k])), mx = fmax(q[k], fmax(q[3 + k], q[6 + k]));
-                double u0 = floor((mn - g->lo[k]) / g->cell[k]), u1 = floor((mx - g->lo[k]) / g->cell[k]);
-                a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
-                b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
-            }
-            for (uint32_t z = a[2]; z <= b[2]; z++)
-                for (uint32_t y = a[1]; y <= b[1]; y++)
-                    for (uint32_t x = a[0]; x <= b[0]; x++) {
-                        size_t c = cell_index(g, x, y, z);
-                        if (marked[c])
-                            continue;
-                        double centre[3] = {g->lo[0] + (x + 0.5) * g->cell[0], g->lo[1] + (y + 0.5) * g->cell[1],
-                                            g->lo[2] + (z + 0.5) * g->cell[2]};
-                        marked[c] = (uint8_t)plane_meets_box(q, centre, h);
-                    }
-        }
-    }
+    marking m = {g, marked};
+    each_lightmapped_triangle(s, l, mark_triangle, &m);
 }
 
 /* 0 keep, 1 inside geometry (most rays that hit something hit a back face), 2 outside the level

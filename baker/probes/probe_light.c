@@ -21,6 +21,7 @@
 
 #include "util/lmb_math.h"
 #include "util/rng.h"
+#include "util/sh.h"
 
 #include <omp.h>
 
@@ -32,35 +33,6 @@
 #define EMITTER_SAMPLES 256 /* points on emitters per probe for the SH (a small lamp is hit by few rays) */
 
 static const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-
-/* Real SH up to l = 2 (sky.c's sh9 order and constants). */
-static void sh9(const double w[3], double y[9])
-{
-    double x = w[0], yy = w[1], z = w[2];
-    y[0] = 0.282095;
-    y[1] = 0.488603 * yy;
-    y[2] = 0.488603 * z;
-    y[3] = 0.488603 * x;
-    y[4] = 1.092548 * x * yy;
-    y[5] = 1.092548 * yy * z;
-    y[6] = 0.315392 * (3 * z * z - 1);
-    y[7] = 1.092548 * x * z;
-    y[8] = 0.546274 * (x * x - yy * yy);
-}
-
-static const double band[9] = {LMB_PI,     2 * LMB_PI / 3, 2 * LMB_PI / 3, 2 * LMB_PI / 3, LMB_PI / 4,
-                               LMB_PI / 4, LMB_PI / 4,     LMB_PI / 4,     LMB_PI / 4};
-
-void lmb_probe_sh_irradiance(const float sh[LMB_PROBE_SH], const double n[3], double e[3])
-{
-    double y[9];
-    sh9(n, y);
-    for (int c = 0; c < 3; c++) {
-        e[c] = 0;
-        for (int k = 0; k < 9; k++)
-            e[c] += sh[3 * k + c] * y[k];
-    }
-}
 
 typedef struct probe_job {
     const lmb_probe_set *set;
@@ -78,7 +50,7 @@ static void add_delta(void *user, const double dir[3], const double e[3])
 {
     delta_sum *d = user;
     double y[9];
-    sh9(dir, y);
+    lmb_sh9(dir[0], dir[1], dir[2], y);
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++)
             d->l[k][c] += e[c] * y[k];
@@ -124,7 +96,7 @@ static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
                 l[c] = b[c];
         }
         double y[9];
-        sh9(w, y);
+        lmb_sh9(w[0], w[1], w[2], y);
         for (int k = 0; k < 9; k++)
             for (int c = 0; c < 3; c++)
                 sum.l[k][c] += 4 * LMB_PI / n * l[c] * y[k];
@@ -152,7 +124,7 @@ static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
     }
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++)
-            out[3 * k + c] = (float)(band[k] * sum.l[k][c]);
+            out[3 * k + c] = (float)(lmb_sh_cosine_band(k) * sum.l[k][c]);
     for (int a = 0; a < 6; a++)
         for (int c = 0; c < 3; c++)
             out[LMB_PROBE_SH + 3 * a + c] = (float)cube[a][c];

@@ -107,16 +107,7 @@ lmb_status lmb_probe_volume_write_ktx2(const lmb_probe_volume *v, double scale, 
                         q[c] = (float)(cube[3 * face + c] * scale);
                 }
             }
-    uint8_t *data;
-    size_t size;
-    lmb_status st = lmb_ktx2_encode_3d(rx, 2 * ry, 3 * rz, rgb, LMB_KTX2_E5B9G9R9, 0, &data, &size, err);
+    lmb_status st = lmb_ktx2_write_3d(path, rx, 2 * ry, 3 * rz, rgb, LMB_KTX2_E5B9G9R9, 0, err);
     free(rgb);
-    if (st != LMB_OK)
-        return st;
-    FILE *fp = fopen(path, "wb");
-    int ok = fp && fwrite(data, 1, size, fp) == size;
-    if (fp && fclose(fp) != 0)
-        ok = 0;
-    free(data);
-    return ok ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write the irradiance volume", path);
+    return st;
 }

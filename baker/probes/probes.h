@@ -88,9 +88,6 @@ lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb
                             const lmb_cache *cache, lmb_steps *steps, int dark, lmb_progress_fn progress, void *user,
                             lmb_error *err);
 
-/* The irradiance the probe's SH gives for unit normal n (RGB). */
-void lmb_probe_sh_irradiance(const float sh[LMB_PROBE_SH], const double n[3], double e[3]);
-
 void lmb_probe_set_free(lmb_probe_set *set);
 
 /* The set as the output holds it (probe_output.c): owned arrays, free with lmb_probes_output_free

@@ -314,9 +314,15 @@ lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *r
 lmb_status lmb_ktx2_write(const char *path, uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f,
                           int zstd_level, lmb_error *err)
 {
+    return lmb_ktx2_write_3d(path, w, h, 0, rgb, f, zstd_level, err);
+}
+
+lmb_status lmb_ktx2_write_3d(const char *path, uint32_t w, uint32_t h, uint32_t d, const float *rgb,
+                             lmb_ktx2_format f, int zstd_level, lmb_error *err)
+{
     uint8_t *data;
     size_t size;
-    lmb_status st = lmb_ktx2_encode(w, h, rgb, f, zstd_level, &data, &size, err);
+    lmb_status st = lmb_ktx2_encode_3d(w, h, d, rgb, f, zstd_level, &data, &size, err);
     if (st != LMB_OK)
         return st;
     FILE *fp = fopen(path, "wb");

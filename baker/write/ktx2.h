@@ -43,8 +43,10 @@ lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_fo
 lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *rgb, lmb_ktx2_format f, int zstd_level,
                               uint8_t **out, size_t *size, lmb_error *err);
 
-/* lmb_ktx2_encode written to path. */
+/* lmb_ktx2_encode (lmb_ktx2_encode_3d) written to path. */
 lmb_status lmb_ktx2_write(const char *path, uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f,
                           int zstd_level, lmb_error *err);
+lmb_status lmb_ktx2_write_3d(const char *path, uint32_t w, uint32_t h, uint32_t d, const float *rgb,
+                             lmb_ktx2_format f, int zstd_level, lmb_error *err);
 
 #endif
