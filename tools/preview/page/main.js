@@ -1,8 +1,9 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
 // the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
 // (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
-// directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr) and the page exposes hooks for
-// tests: window.lmbReady, lmbInfo, lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData.
+// directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr, sphere=x,y,z: the probe-lit
+// sphere there, probes=1: the probes as markers) and the page exposes hooks for tests: window.lmbReady, lmbInfo,
+// lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -12,6 +13,7 @@ import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
 import { startView } from './start-view.js';
 import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
+import { loadProbes, ProbesView, shIrradiance, SPHERE_ALBEDO } from './probes-view.js';
 
 const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
 // "none" is three's LinearToneMapping: clamp(colour x 2^EV) (three applies no exposure at all
@@ -27,6 +29,8 @@ const state = {
   at: q.get('at') ? q.get('at').split(',').map(Number) : null, ui: q.get('ui') !== '0',
   directional: q.get('directional') !== '0', // directional lightmaps in the lit view, when the bake has them
   lightmap: q.get('lightmap') || 'ktx2', // the lightmap files read: ktx2 (when the glTF names them, else .hdr) or hdr
+  sphere: q.get('sphere') ? q.get('sphere').split(',').map(Number) : null, // the probe-lit sphere's centre
+  probes: q.get('probes') === '1', // the probes as markers
 };
 const info = (window.lmbInfo = { error: null });
 window.lmbReady = false;
@@ -145,6 +149,18 @@ const size = box.getSize(new THREE.Vector3()), centre = box.getCenter(new THREE.
 const extent = Math.max(size.length(), 1e-3);
 const camera = new THREE.PerspectiveCamera(FOV, innerWidth / innerHeight, extent * 1e-3, extent * 100);
 const controls = new OrbitControls(camera, renderer.domElement);
+// Light probes (probes-view.js): the moving sphere (sphere=x,y,z, or P at the orbit target;
+// I/K, J/L, U/O move it) and the probes as markers (probes=1, or G)
+const probes = await loadProbes(gltf.parser);
+const probesView = probes ? new ProbesView(probes, 0.35 * (probes.spacing || extent * 0.1)) : null;
+if (probesView) {
+  scene.add(probesView.sphere, probesView.markers);
+  probesView.markers.visible = state.probes;
+  if (state.sphere) {
+    if (state.sphere.length !== 3 || state.sphere.some((v) => !Number.isFinite(v))) throw new Error('sphere wants x,y,z');
+    probesView.moveTo(state.sphere);
+  }
+} else if (state.sphere || state.probes) throw new Error('this bake has no light probes (probes.auto: false and no probes.volumes)');
 const fly = new Fly(camera, renderer.domElement, extent * 0.3);
 
 function frontView() {
@@ -221,6 +237,8 @@ function updateInfo() {
     directionalMaterials,
     records: records ? { count: records.count, reachMin: records.reachMin, reachMax: records.reachMax, uri: records.uri } : { count: 0 },
     atlasView: { atlas: atlasView.atlas, layer: atlasView.layer, zoom: atlasView.zoom, originX: atlasView.originX, originY: atlasView.originY },
+    probes: probesView ? { count: probes.count, spacing: probes.spacing, markers: probesView.markers.visible,
+      sphere: probesView.sphere.visible ? { at: probesView.at, radius: probesView.sphere.geometry.parameters.radius, probes: probesView.used } : null } : { count: 0 },
   });
 }
 
@@ -232,7 +250,8 @@ function render() {
 // UI
 $('panel').classList.toggle('hidden', !state.ui);
 $('hover').classList.toggle('hidden', !state.ui);
-$('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-6: views';
+$('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-6: views' +
+  (probesView ? ', P: probe-lit sphere (I/K J/L U/O move it), G: probes' : '');
 $('atlas').innerHTML = atlases.filter(Boolean).map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
 const sync = () => {
   $('mode').value = state.mode; $('ev').value = state.ev; $('evText').textContent = state.ev.toFixed(1);
@@ -263,7 +282,21 @@ addEventListener('keydown', (e) => {
   if (e.code === 'KeyF') setFly(!fly.enabled);
   else if (e.code === 'KeyR') $('reset').click();
   else if (/^Digit[1-6]$/.test(e.code)) { state.mode = MODES[Number(e.code[5]) - 1]; sync(); apply(); }
+  else if (probesView) moveSphereByKey(e.code);
 });
+// P: the sphere at the orbit target (or hidden again); I/K, J/L, U/O: -z/+z, -x/+x, +y/-y by half
+// the probe spacing; G: the probes' markers
+function moveSphereByKey(code) {
+  const step = 0.5 * (probes.spacing || extent * 0.05);
+  const moves = { KeyI: [0, 0, -step], KeyK: [0, 0, step], KeyJ: [-step, 0, 0], KeyL: [step, 0, 0], KeyU: [0, step, 0], KeyO: [0, -step, 0] };
+  if (code === 'KeyP') {
+    if (probesView.sphere.visible) probesView.sphere.visible = false;
+    else probesView.moveTo(controls.target.toArray());
+  } else if (code === 'KeyG') probesView.markers.visible = !probesView.markers.visible;
+  else if (moves[code] && probesView.sphere.visible) probesView.moveTo(probesView.at.map((v, k) => v + moves[code][k]));
+  else return;
+  updateInfo(); requestRender();
+}
 addEventListener('resize', () => {
   renderer.setSize(innerWidth, innerHeight);
   camera.aspect = innerWidth / innerHeight; camera.updateProjectionMatrix();
@@ -324,6 +357,22 @@ addEventListener('pointermove', (e) => {
 window.lmbRecord = (i) => records && i < records.count ? {
   point: Array.from(records.records.subarray(4 * i, 4 * i + 3)), reach: records.records[4 * i + 3], colour: RECORD_RAMP[records.rampIndex(i)],
 } : null;
+// The probe-lit sphere: where it is, the irradiance SH lighting it (E, lux), the E and the linear
+// colour (albedo / pi x E) it shows for normal n; and moving it.
+window.lmbProbeSphere = (n) => probesView && probesView.sphere.visible ? {
+  at: probesView.at, sh: Array.from(probesView.sh), probes: probesView.used, albedo: SPHERE_ALBEDO,
+  irradiance: n ? shIrradiance(probesView.sh, n) : null,
+  linear: n ? shIrradiance(probesView.sh, n).map((e) => Math.max(0, e) * SPHERE_ALBEDO / Math.PI) : null,
+} : null;
+// The camera (px,py,pz,tx,ty,tz as the cam parameter) and the exposure, without a reload.
+window.lmbSetView = (cam, ev) => {
+  const c = cam.split(',').map(Number);
+  camera.position.set(c[0], c[1], c[2]); controls.target.set(c[3], c[4], c[5]); camera.lookAt(controls.target);
+  controls.update();
+  if (ev !== undefined) state.ev = ev;
+  apply();
+};
+window.lmbMoveProbeSphere = (x, y, z) => { if (!probesView) return false; probesView.moveTo([x, y, z]); updateInfo(); requestRender(); return true; };
 window.lmbProject = (x, y, z) => {
   const v = new THREE.Vector3(x, y, z).project(camera);
   return { x: (v.x + 1) / 2 * innerWidth, y: (1 - v.y) / 2 * innerHeight, inFront: v.z < 1 };

@@ -1,0 +1,123 @@
+// Light probes in the preview (docs/probes.md): a diffuse sphere the artist moves through the
+// level, lit by the probes interpolated at its centre, and the probes themselves as small
+// spheres. The probes come from the bake's glTF (asset.extras.lightmap.probes: positions, SH L2
+// irradiance). The sphere's shader evaluates the interpolated irradiance SH at each normal and
+// shows albedo / pi x E, the same light a lightmapped surface shows; it gets no other light,
+// and nothing else gets the probes' light.
+// Interpolation: the probes within the 8 nearest, weighted by 1 / d^2 (a probe at the centre
+// itself is taken alone, so a test can read one probe's light exactly).
+import * as THREE from 'three';
+
+const SH_Y = [0.282095, 0.488603, 0.488603, 0.488603, 1.092548, 1.092548, 0.315392, 1.092548, 0.546274];
+
+// The bake's probes, or null when it has none: {count, positions (Float32Array xyz), sh
+// (Float32Array, 27 per probe, E in lux), spacing}.
+export async function loadProbes(parser) {
+  const p = parser.json.asset && parser.json.asset.extras && parser.json.asset.extras.lightmap &&
+    parser.json.asset.extras.lightmap.probes;
+  if (!p || !p.count) return null;
+  const positions = (await parser.getDependency('accessor', p.positions)).array;
+  const sh = new Float32Array(await parser.getDependency('bufferView', p.sh));
+  const toLux = p.scale === 'radiance' ? Math.PI : 1; // E / pi stored: back to E
+  if (toLux !== 1) for (let i = 0; i < sh.length; i++) sh[i] *= toLux;
+  return { count: p.count, positions, sh, spacing: p.spacing || 0 };
+}
+
+// The irradiance SH (27 floats) at point x: IDW over the 8 nearest probes.
+export function interpolateSH(probes, x) {
+  const near = [];
+  for (let i = 0; i < probes.count; i++) {
+    const dx = probes.positions[3 * i] - x[0], dy = probes.positions[3 * i + 1] - x[1], dz = probes.positions[3 * i + 2] - x[2];
+    const d2 = dx * dx + dy * dy + dz * dz;
+    if (near.length < 8 || d2 < near[near.length - 1].d2) {
+      near.push({ i, d2 });
+      near.sort((a, b) => a.d2 - b.d2);
+      if (near.length > 8) near.pop();
+    }
+  }
+  const out = new Float32Array(27);
+  if (!near.length) return { sh: out, probes: [] };
+  const exact = near[0].d2 <= 1e-12 * Math.max(1, probes.spacing * probes.spacing);
+  const used = exact ? [near[0]] : near;
+  let total = 0;
+  for (const n of used) {
+    const w = exact ? 1 : 1 / n.d2;
+    total += w;
+    for (let k = 0; k < 27; k++) out[k] += w * probes.sh[27 * n.i + k];
+  }
+  for (let k = 0; k < 27; k++) out[k] /= total;
+  return { sh: out, probes: used.map((n) => n.i) };
+}
+
+// E for unit normal n from an irradiance SH (RGB).
+export function shIrradiance(sh, n) {
+  const [x, y, z] = n;
+  const b = [SH_Y[0], SH_Y[1] * y, SH_Y[2] * z, SH_Y[3] * x, SH_Y[4] * x * y, SH_Y[5] * y * z, SH_Y[6] * (3 * z * z - 1),
+    SH_Y[7] * x * z, SH_Y[8] * (x * x - y * y)];
+  return [0, 1, 2].map((c) => b.reduce((s, v, k) => s + v * sh[3 * k + c], 0));
+}
+
+// A material showing albedo / pi x E(n) for the SH in its uniform (tone-mapped like the level).
+function shMaterial(albedo) {
+  return new THREE.ShaderMaterial({
+    uniforms: { sh: { value: Array.from({ length: 9 }, () => new THREE.Vector3()) }, albedo: { value: albedo } },
+    vertexShader: `
+      varying vec3 vNormal;
+      void main() {
+        vNormal = normalize(mat3(modelMatrix) * normal);
+        gl_Position = projectionMatrix * viewMatrix * modelMatrix * vec4(position, 1.0);
+      }`,
+    fragmentShader: `
+      uniform vec3 sh[9];
+      uniform float albedo;
+      varying vec3 vNormal;
+      void main() {
+        vec3 n = normalize(vNormal);
+        vec3 e = sh[0] * 0.282095 + sh[1] * 0.488603 * n.y + sh[2] * 0.488603 * n.z + sh[3] * 0.488603 * n.x
+          + sh[4] * 1.092548 * n.x * n.y + sh[5] * 1.092548 * n.y * n.z + sh[6] * 0.315392 * (3.0 * n.z * n.z - 1.0)
+          + sh[7] * 1.092548 * n.x * n.z + sh[8] * 0.546274 * (n.x * n.x - n.y * n.y);
+        gl_FragColor = vec4(max(e, vec3(0.0)) * albedo / 3.14159265358979, 1.0);
+        #include <tonemapping_fragment>
+        #include <colorspace_fragment>
+      }`,
+    toneMapped: true,
+  });
+}
+
+export const SPHERE_ALBEDO = 0.8;
+
+// The moving sphere and the probes' markers. radius: the sphere's, world units.
+export class ProbesView {
+  constructor(probes, radius) {
+    this.probes = probes;
+    this.material = shMaterial(SPHERE_ALBEDO);
+    this.sphere = new THREE.Mesh(new THREE.SphereGeometry(radius, 48, 24), this.material);
+    this.sphere.name = 'lmbake probe sphere';
+    this.sphere.visible = false;
+    const marker = new THREE.SphereGeometry(radius * 0.15, 8, 6);
+    this.markers = new THREE.InstancedMesh(marker, new THREE.MeshBasicMaterial({ toneMapped: true }), probes.count);
+    this.markers.name = 'lmbake probes';
+    this.markers.visible = false;
+    const m = new THREE.Matrix4(), c = new THREE.Color();
+    for (let i = 0; i < probes.count; i++) {
+      m.makeTranslation(probes.positions[3 * i], probes.positions[3 * i + 1], probes.positions[3 * i + 2]);
+      this.markers.setMatrixAt(i, m);
+      const e = 0.282095 / Math.PI * SPHERE_ALBEDO; // the mean irradiance's share: sh[0] x Y00 = mean E
+      c.setRGB(probes.sh[27 * i] * e, probes.sh[27 * i + 1] * e, probes.sh[27 * i + 2] * e);
+      this.markers.setColorAt(i, c);
+    }
+    this.at = null;
+    this.used = [];
+  }
+
+  // Puts the sphere at x (world) and lights it from the probes there.
+  moveTo(x) {
+    const { sh, probes } = interpolateSH(this.probes, x);
+    for (let k = 0; k < 9; k++) this.material.uniforms.sh.value[k].set(sh[3 * k], sh[3 * k + 1], sh[3 * k + 2]);
+    this.sphere.position.set(x[0], x[1], x[2]);
+    this.sphere.visible = true;
+    this.at = x.slice();
+    this.sh = sh;
+    this.used = probes;
+  }
+}
