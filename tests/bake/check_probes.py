@@ -16,7 +16,7 @@ usage: check_probes.py LMBAKE WORKDIR CASE
   sealed   the sealed room under a sky of 10^4 nits with a point light outside: every probe 0.
   solid    a plane with a closed 2 m cube on it: no probe inside the cube, probes around it.
   scale    output.scale radiance: the same probes' values divided by pi.
-  cornell  bevy's Cornell box at defaults with probes.volumes 1 to 2 units off its floor, walls and
+  cornell  bevy's Cornell box (atlas.texels 150,000) with probes.volumes 1 to 2 units off its floor, walls and
            ceiling: at each probe, for the axis facing a surface straight ahead (a ray along -n
            hits a triangle facing n within 8 units), the ambient cube's irradiance for n against
            the lightmap read there (bilinear, as an engine reads it): the mean ratio per surface
@@ -175,7 +175,8 @@ def scale(lmbake, work):
                   % (b["count"], worst, b["meta"]["scale"]))
 
 
-CORNELL_VOLUMES = """probes:
+CORNELL_VOLUMES = """atlas: {texels: 150000}
+probes:
   auto: false
   volumes:
     - {min: [-540, 0.5, -200], max: [-480, 1.5, -40], resolution: [3, 1, 4]}
