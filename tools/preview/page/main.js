@@ -11,7 +11,7 @@ import { lightmapPlugin, lightmapScaleOffset, applyDirectionalLightmaps, applyLi
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
-import { startView } from './start-view.js';
+import { startView, frontViewPose } from './start-view.js';
 import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
 import { loadProbes, ProbesView, shIrradiance, SPHERE_ALBEDO } from './probes-view.js';
 
@@ -164,11 +164,10 @@ if (probesView) {
 const fly = new Fly(camera, renderer.domElement, extent * 0.3);
 
 function frontView() {
-  const tanHalf = Math.tan(THREE.MathUtils.degToRad(FOV / 2));
-  const half = 1.1 * Math.max(size.y / 2, size.x / 2 / camera.aspect);
-  camera.position.set(centre.x, centre.y, centre.z + size.z / 2 + half / tanHalf);
-  controls.target.copy(centre);
-  camera.lookAt(centre);
+  const pose = frontViewPose(box, camera.aspect, FOV);
+  camera.position.copy(pose.position);
+  controls.target.copy(pose.target);
+  camera.lookAt(pose.target);
 }
 if (state.cam) {
   const c = state.cam.split(',').map(Number);
@@ -176,12 +175,13 @@ if (state.cam) {
   camera.position.set(c[0], c[1], c[2]); controls.target.set(c[3], c[4], c[5]); camera.lookAt(controls.target);
 } else if (state.view === 'front') frontView();
 else if (state.view === 'start') {
-  const start = startView(gltf, root, box);
+  const start = startView(gltf, root, box, camera.aspect, FOV);
   if (start) {
     camera.position.copy(start.position); controls.target.copy(start.target); camera.lookAt(start.target);
   } else frontView();
   info.startView = start ? start.from : 'front';
   info.startProbe = startView.last || null; // the candidates: eye, blocked, walls met of 16, median distance
+  info.startScores = startView.scores || null; // inside against front: what each view shows (viewScore)
 } else throw new Error(`unknown view '${state.view}' (start, front, or cam=px,py,pz,tx,ty,tz)`);
 controls.update();
 
