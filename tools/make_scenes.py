@@ -27,6 +27,9 @@ usage: make_scenes.py OUTDIR
   box-floor.gltf      plane with a closed 2 m cube on it, point light above the cube
   probe-point.gltf    black plane (albedo 0, 4 x 4) and a 100 cd point light 2 above it: a probe
                       above it sees the light alone
+  probe-node.gltf     the same with a node "Hall" asking for an irradiance volume (extras.lightmap_probes
+                      [4, 2, 3]; translation (0, 1, 0), 30 degrees about +y, scale (3, 2, 2.5));
+                      probe-node-bad.gltf: its resolution [0, 2, 3]
   furnace.gltf        closed 2 m box, every face albedo 0.5 and emitting 1 nit (the furnace test;
                       also the benchmark's "light from everywhere" scene)
   furnace-*.gltf      the same box with other materials (FURNACE_MATERIALS: spec-gloss, a
@@ -375,6 +378,13 @@ def analytic(out):
     s.mesh("plane", plane(4), s.material("black", (0.0, 0.0, 0.0)))
     s.light("point", "point", 100.0, translation=(0.3, 2, -0.2))
     s.write(os.path.join(out, "probe-point.gltf"))
+    half = math.radians(30) / 2
+    s.doc["nodes"].append({"name": "Hall", "translation": [0, 1, 0], "rotation": [0, math.sin(half), 0, math.cos(half)],
+                           "scale": [3, 2, 2.5], "extras": {"lightmap_probes": [4, 2, 3]}})
+    s.doc["scenes"][0]["nodes"].append(len(s.doc["nodes"]) - 1)
+    s.write(os.path.join(out, "probe-node.gltf"))
+    s.doc["nodes"][-1]["extras"]["lightmap_probes"] = [0, 2, 3]
+    s.write(os.path.join(out, "probe-node-bad.gltf"))
 
 
 PLATE_HEIGHT = 1.5  # sun-plate.gltf

@@ -185,6 +185,29 @@ const char *mode_string(const tinygltf::Value &extras)
     return v->IsString() ? v->Get<std::string>().c_str() : "?";
 }
 
+/* extras.lightmap_probes: [x, y, z], integers 1..256 (docs/probes.md); 0 absent, -1 malformed. */
+void probe_resolution(const tinygltf::Value &extras, int32_t out[3])
+{
+    out[0] = out[1] = out[2] = 0;
+    const tinygltf::Value *v = extras.IsObject() ? member(extras, "lightmap_probes") : nullptr;
+    if (!v)
+        return;
+    out[0] = out[1] = out[2] = -1;
+    if (!v->IsArray() || v->ArrayLen() != 3)
+        return;
+    int32_t r[3];
+    for (int k = 0; k < 3; k++) {
+        const tinygltf::Value &e = v->Get((int)k);
+        double x = e.IsNumber() ? e.GetNumberAsDouble() : -1;
+        if (!(x >= 1 && x <= 256 && x == (double)(int32_t)x))
+            return;
+        r[k] = (int32_t)x;
+    }
+    out[0] = r[0];
+    out[1] = r[1];
+    out[2] = r[2];
+}
+
 void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
 {
     c.name = n.name.c_str();
@@ -209,6 +232,7 @@ void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
             c.extras_lightmap = flag->GetNumberAsDouble() != 0.0;
     }
     c.lightmap_mode = mode_string(n.extras);
+    probe_resolution(n.extras, c.lightmap_probes);
     const tinygltf::Value *gpu = extension(n.extensions, "EXT_mesh_gpu_instancing");
     const tinygltf::Value *attrs = gpu ? member(*gpu, "attributes") : nullptr;
     c.has_gpu_instancing = attrs != nullptr;

@@ -64,6 +64,7 @@ typedef struct lmb_gltf_node {
     int32_t gpu_translation, gpu_rotation, gpu_scale; /* EXT_mesh_gpu_instancing accessors, -1 */
     int has_gpu_instancing;
     const char *lightmap_mode; /* extras.lightmap_mode as written ("" absent, "?" not a string): the mode of its light */
+    int32_t lightmap_probes[3]; /* extras.lightmap_probes: a volume's resolution; 0 0 0 absent, -1 -1 -1 malformed */
 } lmb_gltf_node;
 
 /* A glTF textureInfo with its KHR_texture_transform, as written (defaults filled in). */

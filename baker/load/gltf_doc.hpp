@@ -46,6 +46,8 @@ struct lmb_gltf_doc {
         std::string uri;
         double lo[3], hi[3];
         uint32_t res[3], config_entry;
+        std::string node_name; /* "" unless from a node's extras.lightmap_probes (then matrix places it) */
+        double matrix[16];
     };
     std::vector<volume> volumes;
     /* writer: materials.default.albedo for primitives with no material, if given */

@@ -18,7 +18,7 @@ typedef struct walk {
     const lmb_accessor_ctx *ctx;
     lmb_scene *scene;
     const lmb_log *log;
-    uint32_t instance_cap, light_cap;
+    uint32_t instance_cap, light_cap, volume_cap;
 } walk;
 
 static lmb_status check_graph(const lmb_accessor_ctx *ctx, lmb_error *err)
@@ -252,6 +252,43 @@ static lmb_status add_light(walk *w, uint32_t node, const double world[16], lmb_
 }
 
 /* Depth-first over a tree already checked acyclic; the depth is bounded by node_count. */
+/* A node's extras.lightmap_probes as a probe volume; a malformed one or a flat transform is an
+ * error naming the file and the node. */
+static lmb_status add_probe_volume(walk *w, uint32_t node, const double world[16], lmb_error *err)
+{
+    const lmb_gltf_node *n = &w->ctx->view->nodes[node];
+    char name[160];
+    snprintf(name, sizeof name, "%s", n->name && n->name[0] ? n->name : "");
+    if (!name[0])
+        snprintf(name, sizeof name, "node %u", node);
+    if (n->lightmap_probes[0] < 0)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: node '%s': extras.lightmap_probes must be [x, y, z], integers in "
+                             "1..256 (the volume's resolution)", w->scene->path, name);
+    if (!lmb_mat4_is_finite(world) || fabs(lmb_mat4_det3(world)) < 1e-30)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: node '%s': extras.lightmap_probes: its transform is flat or not "
+                             "finite, so it places no volume", w->scene->path, name);
+    lmb_scene *s = w->scene;
+    if (s->probe_volume_count == w->volume_cap) {
+        uint32_t cap = w->volume_cap ? 2 * w->volume_cap : 4;
+        lmb_node_probe_volume *v = realloc(s->probe_volumes, cap * sizeof *v);
+        if (!v)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory");
+        s->probe_volumes = v;
+        w->volume_cap = cap;
+    }
+    lmb_node_probe_volume *v = &s->probe_volumes[s->probe_volume_count];
+    v->name = malloc(strlen(name) + 1);
+    if (!v->name)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory");
+    memcpy(v->name, name, strlen(name) + 1);
+    v->node = node;
+    memcpy(v->world, world, sizeof v->world);
+    for (int k = 0; k < 3; k++)
+        v->resolution[k] = (uint32_t)n->lightmap_probes[k];
+    s->probe_volume_count++;
+    return LMB_OK;
+}
+
 static lmb_status visit(walk *w, uint32_t node, const double parent_world[16], lmb_error *err)
 {
     const lmb_gltf_node *n = &w->ctx->view->nodes[node];
@@ -266,6 +303,8 @@ static lmb_status visit(walk *w, uint32_t node, const double parent_world[16], l
         st = n->has_gpu_instancing ? add_gpu_instances(w, node, world, err) : add_instance(w, node, -1, world, err);
     if (st == LMB_OK && n->light >= 0)
         st = add_light(w, node, world, err);
+    if (st == LMB_OK && n->lightmap_probes[0])
+        st = add_probe_volume(w, node, world, err);
     for (uint32_t k = 0; k < n->child_count && st == LMB_OK; k++)
         st = visit(w, (uint32_t)w->ctx->view->children[n->first_child + k], world, err);
     return st;
@@ -276,7 +315,7 @@ lmb_status lmb_load_nodes(const lmb_accessor_ctx *ctx, lmb_scene *scene, const l
     lmb_status st = check_graph(ctx, err);
     if (st != LMB_OK)
         return st;
-    walk w = {ctx, scene, log, 0, 0};
+    walk w = {ctx, scene, log, 0, 0, 0};
     double identity[16];
     lmb_mat4_identity(identity);
     for (uint32_t r = 0; r < ctx->view->scene_root_count && st == LMB_OK; r++)

@@ -156,6 +156,9 @@ void lmb_scene_free(lmb_scene *s)
     free(s->instances);
     free(s->materials);
     free(s->lights);
+    for (uint32_t i = 0; i < s->probe_volume_count; i++)
+        free(s->probe_volumes[i].name);
+    free(s->probe_volumes);
     free(s->path);
     if (s->doc)
         lmb_gltf_close(s->doc);

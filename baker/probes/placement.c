@@ -3,6 +3,8 @@
 #include "probes.h"
 #include "sphere.h"
 
+#include "util/mat4.h"
+
 #include <omp.h>
 
 #include <math.h>
@@ -292,20 +294,65 @@ static lmb_status volume_grid(const lmb_config *cfg, uint32_t k, uint32_t first_
     return LMB_OK;
 }
 
+/* A node's extras.lightmap_probes: one probe at each cell's centre of the unit cube centred on
+ * the node's origin, through its world transform. */
+static lmb_status node_grid(const lmb_scene *s, uint32_t k, uint32_t first_voxel, lmb_probe_set *out, candidates *c,
+                            lmb_error *err)
+{
+    const lmb_node_probe_volume *v = &s->probe_volumes[k];
+    size_t cells = (size_t)v->resolution[0] * v->resolution[1] * v->resolution[2];
+    if (c->count + cells > LMB_PROBES_MAX || first_voxel + cells > UINT32_MAX)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: node '%s': extras.lightmap_probes (%ux%ux%u) brings the probes to "
+                             "%zu: more than the %u a bake holds (%d floats each, 200 MB of output)", s->path, v->name,
+                             v->resolution[0], v->resolution[1], v->resolution[2], c->count + cells, LMB_PROBES_MAX,
+                             LMB_PROBE_SH + LMB_PROBE_CUBE);
+    lmb_probe_grid *pg = &out->grids[out->grid_count++];
+    for (int a = 0; a < 3; a++) {
+        pg->lo[a] = -0.5;
+        pg->res[a] = v->resolution[a];
+        pg->cell[a] = 1.0 / v->resolution[a];
+    }
+    pg->first_voxel = first_voxel;
+    pg->from_node = 1;
+    memcpy(pg->world, v->world, sizeof pg->world);
+    pg->node = v->node;
+    pg->node_name = v->name;
+    for (uint32_t z = 0; z < pg->res[2]; z++)
+        for (uint32_t y = 0; y < pg->res[1]; y++)
+            for (uint32_t x = 0; x < pg->res[0]; x++) {
+                uint32_t cell[3] = {x, y, z};
+                double local[3], p[3];
+                for (int a = 0; a < 3; a++)
+                    local[a] = pg->lo[a] + (cell[a] + 0.5) * pg->cell[a];
+                lmb_mat4_point(pg->world, local, p);
+                if (!add_candidate(c, p, first_voxel + (uint32_t)(((size_t)z * pg->res[1] + y) * pg->res[0] + x), 0))
+                    return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu probes", c->count);
+            }
+    return LMB_OK;
+}
+
 lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
                             const lmb_log *log, lmb_probe_set *out, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
     out->rays = cfg->probe_rays;
     candidates c = {NULL, NULL, NULL, 0, 0};
+    out->grids = calloc(1 + (size_t)cfg->probe_volume_count + s->probe_volume_count, sizeof *out->grids);
+    if (!out->grids)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
     lmb_status st = cfg->probes_auto ? auto_grid(s, l, cfg, out, &c, err) : LMB_OK;
     uint32_t voxels = 0;
     if (out->grid_count)
         voxels = out->grids[0].res[0] * out->grids[0].res[1] * out->grids[0].res[2];
     for (uint32_t k = 0; st == LMB_OK && k < cfg->probe_volume_count; k++) {
         st = volume_grid(cfg, k, voxels, out, &c, err);
-        const lmb_probe_grid *pg = &out->grids[out->grid_count - 1];
-        voxels += pg->res[0] * pg->res[1] * pg->res[2];
+        const lmb_probe_grid *pg = &out->grids[out->grid_count ? out->grid_count - 1 : 0];
+        voxels += st == LMB_OK ? pg->res[0] * pg->res[1] * pg->res[2] : 0;
+    }
+    for (uint32_t k = 0; st == LMB_OK && k < s->probe_volume_count; k++) {
+        st = node_grid(s, k, voxels, out, &c, err);
+        const lmb_probe_grid *pg = &out->grids[out->grid_count ? out->grid_count - 1 : 0];
+        voxels += st == LMB_OK ? pg->res[0] * pg->res[1] * pg->res[2] : 0;
     }
     uint8_t *fate = st == LMB_OK ? malloc(c.count + 1) : NULL;
     if (st == LMB_OK && !fate)
@@ -355,14 +402,16 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
                  n[2], out->spacing, cfg->probe_spacing > 0 ? "probes.spacing" : "auto: from the lightmapped surface's area",
                  out->refined);
     }
-    lmb_info(log, "probes: %u (%u volume(s) from probes.volumes); %u inside geometry and %u outside the level dropped",
-             out->count, cfg->probe_volume_count, out->dropped_inside, out->dropped_outside);
+    lmb_info(log, "probes: %u (%u volume(s) from probes.volumes, %u from nodes' extras.lightmap_probes); %u inside "
+             "geometry and %u outside the level dropped", out->count, cfg->probe_volume_count, s->probe_volume_count,
+             out->dropped_inside, out->dropped_outside);
     return LMB_OK;
 }
 
 void lmb_probe_set_free(lmb_probe_set *set)
 {
     free(set->position);
+    free(set->grids);
     free(set->cell);
     free(set->sh);
     free(set->cube);

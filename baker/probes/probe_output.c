@@ -10,7 +10,8 @@
 #include <string.h>
 
 /* Each grid's volume file beside the glTF (STEM-irradiance-volume.ktx2 for the auto grid,
- * STEM-irradiance-volume-K.ktx2 for probes.volumes entry K); out->volumes owned. */
+ * STEM-irradiance-volume-K.ktx2 for probes.volumes entry K, STEM-irradiance-volume-node-N.ktx2
+ * for node N's extras.lightmap_probes); out->volumes owned (node names borrowed from the scene). */
 static lmb_status write_volumes(const lmb_probe_set *set, double scale, const char *dir, const char *stem,
                                 lmb_gltf_probes *out, lmb_error *err)
 {
@@ -23,7 +24,9 @@ static lmb_status write_volumes(const lmb_probe_set *set, double scale, const ch
         lmb_probe_volume v;
         st = lmb_probe_volume_make(set, g, &v, err);
         char name[512], path[4096 + 520];
-        if (set->grids[g].volume)
+        if (set->grids[g].from_node)
+            snprintf(name, sizeof name, "%s-irradiance-volume-node-%u.ktx2", stem, set->grids[g].node);
+        else if (set->grids[g].volume)
             snprintf(name, sizeof name, "%s-irradiance-volume-%u.ktx2", stem, set->grids[g].volume);
         else
             snprintf(name, sizeof name, "%s-irradiance-volume.ktx2", stem);
@@ -41,6 +44,8 @@ static lmb_status write_volumes(const lmb_probe_set *set, double scale, const ch
             memcpy(o->hi, v.hi, sizeof v.hi);
             memcpy(o->res, v.res, sizeof v.res);
             o->config_entry = set->grids[g].volume;
+            o->node_name = set->grids[g].from_node ? set->grids[g].node_name : NULL;
+            memcpy(o->matrix, set->grids[g].world, sizeof o->matrix);
         }
         lmb_probe_volume_free(&v);
     }

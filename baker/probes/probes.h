@@ -41,6 +41,11 @@ typedef struct lmb_probe_grid {
     uint32_t res[3];       /* cells per axis */
     uint32_t first_voxel;  /* its first voxel among all grids' */
     uint32_t volume;       /* 0: the auto grid; k: probes.volumes entry k (1-based) */
+    int from_node;         /* a node's extras.lightmap_probes: lo and cell span the unit cube centred
+                              on the origin, placed by world */
+    double world[16];
+    uint32_t node;         /* from_node: the glTF node, and its name */
+    const char *node_name;
 } lmb_probe_grid;
 
 typedef struct lmb_probe_set {
@@ -53,8 +58,9 @@ typedef struct lmb_probe_set {
     uint32_t dropped_inside, dropped_outside;
     uint32_t rays;     /* rays per probe (probes.rays) */
     uint32_t *cell;    /* per probe: its voxel among all grids' (lmb_probe_grid.first_voxel + x fastest) */
-    lmb_probe_grid grids[1 + LMB_MAX_PROBE_VOLUMES];
-    uint32_t grid_count; /* the auto grid (probes.auto) first, then each probes.volumes entry */
+    lmb_probe_grid *grids;
+    uint32_t grid_count; /* the auto grid (probes.auto) first, then each probes.volumes entry, then
+                            each node's extras.lightmap_probes */
 } lmb_probe_set;
 
 /* An irradiance volume as bevy reads one (IrradianceVolume: a unit cube centred on the origin,
@@ -77,8 +83,9 @@ void lmb_probe_volume_free(lmb_probe_volume *v);
  * (x, y + Ry, z + k Rz), k = 0, 1, 2 for A = X, Y, Z; values times `scale`. */
 lmb_status lmb_probe_volume_write_ktx2(const lmb_probe_volume *v, double scale, const char *path, lmb_error *err);
 
-/* Places the probes of the level (probes.auto, then probes.volumes: a probe at each cell's
- * centre, dropped inside geometry) into out. Empty (count 0) when there are none. */
+/* Places the probes of the level (probes.auto, then probes.volumes and the nodes whose
+ * extras.lightmap_probes asks for a volume: a probe at each cell's centre, dropped inside
+ * geometry) into out. Empty (count 0) when there are none. */
 lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, const lmb_rt *rt,
                             const lmb_log *log, lmb_probe_set *out, lmb_error *err);
 

@@ -523,11 +523,16 @@ namespace {
 void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, int radiance)
 {
     tinygltf::Node node;
-    node.name = v.config_entry ? "lightmap irradiance volume " + std::to_string(v.config_entry)
-                               : std::string("lightmap irradiance volume");
-    for (int k = 0; k < 3; k++) {
-        node.translation.push_back(0.5 * (v.lo[k] + v.hi[k]));
-        node.scale.push_back(v.hi[k] - v.lo[k]);
+    node.name = !v.node_name.empty() ? "lightmap irradiance volume of " + v.node_name
+                : v.config_entry      ? "lightmap irradiance volume " + std::to_string(v.config_entry)
+                                      : std::string("lightmap irradiance volume");
+    if (!v.node_name.empty()) {
+        node.matrix.assign(v.matrix, v.matrix + 16); /* the asking node's world transform */
+    } else {
+        for (int k = 0; k < 3; k++) {
+            node.translation.push_back(0.5 * (v.lo[k] + v.hi[k]));
+            node.scale.push_back(v.hi[k] - v.lo[k]);
+        }
     }
     Value::Object volume;
     volume["uri"] = Value(v.uri);
@@ -537,6 +542,8 @@ void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, int radi
     volume["scale"] = Value(std::string(radiance ? "radiance" : "irradiance"));
     volume["unit"] = Value(std::string(radiance ? "nits (E / pi)" : "lux (E)"));
     volume["configEntry"] = Value((int)v.config_entry);
+    if (!v.node_name.empty())
+        volume["node"] = Value(v.node_name);
     Value::Object node_lightmap;
     node_lightmap["irradianceVolume"] = Value(volume);
     Value::Object node_extras;
@@ -608,7 +615,8 @@ extern "C" lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_prob
         for (uint32_t i = 0; i < p->volume_count; i++) {
             const lmb_gltf_volume &v = p->volumes[i];
             lmb_gltf_doc::volume d{v.uri, {v.lo[0], v.lo[1], v.lo[2]}, {v.hi[0], v.hi[1], v.hi[2]},
-                                   {v.res[0], v.res[1], v.res[2]}, v.config_entry};
+                                   {v.res[0], v.res[1], v.res[2]}, v.config_entry, v.node_name ? v.node_name : "", {0}};
+            std::copy(v.matrix, v.matrix + 16, d.matrix);
             doc->volumes.push_back(d);
         }
         return LMB_OK;

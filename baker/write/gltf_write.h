@@ -113,6 +113,9 @@ typedef struct lmb_gltf_volume {
     double lo[3], hi[3];
     uint32_t res[3];
     uint32_t config_entry; /* 0: the auto grid; k: probes.volumes entry k */
+    const char *node_name; /* a node's extras.lightmap_probes: its name (NULL otherwise); matrix places
+                              the unit cube (lo, hi unused) */
+    double matrix[16];
 } lmb_gltf_volume;
 
 /* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes

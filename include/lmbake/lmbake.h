@@ -174,6 +174,16 @@ typedef struct lmb_light {
 
 typedef struct lmb_gltf_doc lmb_gltf_doc; /* opaque: the parsed glTF, kept for writing */
 
+/* A node whose extras.lightmap_probes = [x, y, z] asks for an irradiance volume: a grid of
+ * x x y x z probes over the unit cube centred on its origin, placed by its world transform
+ * (bevy's IrradianceVolume). */
+typedef struct lmb_node_probe_volume {
+    uint32_t node;
+    char *name;         /* the node's name or "node N" */
+    double world[16];   /* column-major */
+    uint32_t resolution[3];
+} lmb_node_probe_volume;
+
 typedef struct lmb_scene {
     char *path; /* the file it was loaded from */
     lmb_mesh *meshes;
@@ -186,6 +196,8 @@ typedef struct lmb_scene {
     uint32_t material_count;
     lmb_light *lights;
     uint32_t light_count;
+    lmb_node_probe_volume *probe_volumes; /* nodes whose extras.lightmap_probes asks for a volume */
+    uint32_t probe_volume_count;
     uint32_t node_count;
     uint32_t gpu_instanced_nodes; /* nodes expanded from EXT_mesh_gpu_instancing */
     double default_albedo[3];     /* diffuse albedo of primitives with no material (materials.default.albedo; glTF's

@@ -21,6 +21,10 @@ usage: check_probes.py LMBAKE WORKDIR CASE
            hits a triangle facing n within 8 units), the ambient cube's irradiance for n against
            the lightmap read there (bilinear, as an engine reads it): the mean ratio per surface
            within 3%; each probe's ratio and the SH's (its L2 truncation) printed.
+  node     a node "Hall" with extras.lightmap_probes [4, 2, 3] (rotated 30 degrees, scaled): its 24
+           probes at its world transform x the unit cube's cell centres (1e-4), the output's
+           volume node with that transform as its matrix, its KTX2 of (4, 4, 9) texels; a
+           resolution [0, 2, 3]: exit 2 naming the file and the node, nothing written.
   volume   the closed cube on a plane: the grid as bevy's irradiance volume, read back by an
            independent reader (tests/ktx2/read_ktx2.mjs, npm ktx-parse): vkFormat 123, (Rx, 2Ry,
            3Rz) texels for the node's resolution, every face of every voxel with probes equal to
@@ -270,6 +274,57 @@ def cornell(lmbake, work):
                   % (probes["count"], "\n  ".join(lines)))
 
 
+def quat_matrix(t, q, sc):
+    """Column-major 4 x 4 of translation t, rotation quaternion q (x, y, z, w), scale sc."""
+    x, y, z, w = q
+    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    m = [0.0] * 16
+    for c in range(3):
+        for row in range(3):
+            m[4 * c + row] = r[row][c] * sc[c]
+    m[12], m[13], m[14], m[15] = t[0], t[1], t[2], 1.0
+    return m
+
+
+def node(lmbake, work):
+    probes, log = bake(lmbake, work, "probe-node", "node", "probes: {auto: false}\n")
+    out = os.path.join(work, "out-node")
+    with open(os.path.join(out, "probe-node.gltf")) as f:
+        doc = json.load(f)
+    hall = [n for n in doc["nodes"] if n.get("name") == "Hall"][0]
+    m = quat_matrix(hall["translation"], hall["rotation"], hall["scale"])
+    want = []
+    for z in range(3):
+        for y in range(2):
+            for x in range(4):
+                lc = [(x + 0.5) / 4 - 0.5, (y + 0.5) / 2 - 0.5, (z + 0.5) / 3 - 0.5]
+                want.append([sum(m[4 * c + r] * lc[c] for c in range(3)) + m[12 + r] for r in range(3)])
+    got = probes["positions"]
+    worst = max(min(max(abs(a - b) for a, b in zip(w, g)) for g in got) for w in want) if got else 1e9
+    vol = [n for n in doc["nodes"] if n.get("name") == "lightmap irradiance volume of Hall"]
+    matrix_ok = bool(vol) and max(abs(a - b) for a, b in zip(vol[0].get("matrix", [0] * 16), m)) < 1e-9
+    head = None
+    if vol:
+        ktx = os.path.join(out, vol[0]["extras"]["lightmap"]["irradianceVolume"]["uri"])
+        p = subprocess.run(["node", os.path.join(ROOT, "tests", "ktx2", "read_ktx2.mjs"), ktx, os.path.join(work, "node.f32")],
+                           capture_output=True, text=True, cwd=ROOT)
+        head = json.loads(p.stdout) if p.returncode == 0 else None
+    dims_ok = head is not None and (head["pixelWidth"], head["pixelHeight"], head["pixelDepth"]) == (4, 4, 9)
+    scenes = os.path.join(work, "scenes")
+    bad_out = os.path.join(work, "out-node-bad")
+    b = subprocess.run([lmbake, "bake", os.path.join(scenes, "probe-node-bad.gltf"), "-o", bad_out], capture_output=True,
+                       text=True)
+    bad_ok = b.returncode == 2 and "probe-node-bad.gltf: node 'Hall': extras.lightmap_probes" in b.stderr \
+        and not os.path.exists(bad_out)
+    good = probes["count"] == 24 and worst < 1e-4 and matrix_ok and dims_ok and bad_ok
+    return report("node", good, "%d probes (want 24), farthest from its expected place %.2g; volume node with the Hall's "
+                  "matrix: %s; KTX2 %s; bad resolution: exit %d, %s"
+                  % (probes["count"], worst, matrix_ok, head and (head["pixelWidth"], head["pixelHeight"], head["pixelDepth"]),
+                     b.returncode, b.stderr.strip().splitlines()[-1] if b.stderr.strip() else "no message"))
+
+
 def volume(lmbake, work):
     probes, _ = bake(lmbake, work, "box-floor", "volume", "bounces: 2\n")
     out = os.path.join(work, "out-volume")
@@ -324,5 +379,5 @@ if __name__ == "__main__":
     lmbake, work, case = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
     cases = {"sky": sky, "point": point, "sealed": sealed, "solid": solid, "scale": scale, "volume": volume,
-             "cornell": cornell}
+             "cornell": cornell, "node": node}
     sys.exit(0 if cases[case](lmbake, work) else 1)
