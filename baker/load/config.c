@@ -231,7 +231,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->sky_samples = 64;
     cfg->probes_auto = 1;
     cfg->probe_spacing = 0; /* auto */
-    cfg->probe_rays = 1024;
+    cfg->probe_rays = 512;
     cfg->ktx2_format = 0; /* e5b9g9r9 */
     cfg->ktx2_zstd = 1;
     cfg->default_albedo[0] = cfg->default_albedo[1] = cfg->default_albedo[2] = -1; /* none: glTF's metal */

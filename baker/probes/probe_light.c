@@ -29,8 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CUBE_SAMPLES 64     /* direct-light samples per axis of the ambient cube (area lights, sky) */
-#define EMITTER_SAMPLES 256 /* points on emitters per probe for the SH (a small lamp is hit by few rays) */
+#define CUBE_SAMPLES 16     /* direct-light samples per axis of the ambient cube (area lights, sky): samples.direct's default */
+#define EMITTER_SAMPLES 64  /* points on emitters per probe for the SH (a small lamp is hit by few rays) */
 
 static const double axes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 

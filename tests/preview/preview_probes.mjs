@@ -5,7 +5,8 @@
 // probe's SH, computed here from the glTF's own buffer (not the page's code): tone mapping
 // "none" at an exposure that puts it near mid-grey, sRGB, within 2 levels (8-bit). Then moves the
 // sphere to a second probe without reloading and checks it again. Two probes: the brightest
-// upward-facing one (a lit spot) and a dim one (in shadow); their screenshots are saved.
+// toward +Z (a lit spot) and the dimmest with at least 2% of its light (in shadow); their
+// screenshots are saved.
 //   usage: node tests/preview/preview_probes.mjs GLTF SHOTS_DIR
 import fs from 'node:fs';
 import path from 'node:path';
@@ -50,7 +51,11 @@ try {
   };
   let done = 0;
   let page = null, context = null;
-  for (const [name, list] of [['lit', order], ['shadow', order.slice().reverse()]]) {
+  // in shadow: the dimmest with at least 2% of the brightest's light (dimmer, the SH's own
+  // rounding near 0 decides the pixel, not the light)
+  const floor = 0.02 * lum(eUpZ(probes, order[0]));
+  const dim = order.filter((i) => lum(eUpZ(probes, i)) >= floor).reverse();
+  for (const [name, list] of [['lit', order], ['shadow', dim]]) {
     for (const i of list.slice(0, 40)) {
       const t = target(i); // the camera 2.5 radii in front of it (+Z); a probe whose view is blocked is skipped
       const cam = [t.at[0], t.at[1], t.at[2] + 2.5 * radius, ...t.at].join(',');

@@ -590,7 +590,7 @@ static void test_probe_keys(void)
     lmb_config_default(&c);
     CHECK_INT(c.probes_auto, 1);
     CHECK_NEAR(c.probe_spacing, 0, 0);
-    CHECK_INT(c.probe_rays, 1024);
+    CHECK_INT(c.probe_rays, 512);
     CHECK_INT(c.probe_volume_count, 0);
     CHECK_INT(parse("probes:\n  auto: false\n  spacing: 2.5\n  rays: 256\n  volumes:\n"
                     "    - {min: [-1, 0, -2], max: [1, 2.5, 2], resolution: [4, 2, 8]}\n"
