@@ -30,6 +30,8 @@ static const char help[] =
     "                      invalid, atlases) headless to OUTDIR/preview-<view>.png\n"
     "      --reference     path-trace indirect light with no cache (ground truth for error\n"
     "                      measurement; --rays paths per texel: use many)\n"
+    "      --quick         a quick look: the same atlases lit with a quarter of the rays, the\n"
+    "                      irradiance cache sparser, no seam stitching or probes (docs/watch.md)\n"
     "      --plan PLAN     start from a plan written by 'lmbake plan' (same input and config,\n"
     "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
     "      --print-config  print the effective config (every key, after -c and the options\n"
@@ -53,7 +55,7 @@ typedef struct bake_args {
     const char *timings_csv; /* --timings=CSV */
     int timings;
     long long threads, seed, rays, method; /* -1: from the config */
-    int quiet, reference, preview, print_config;
+    int quiet, reference, preview, print_config, quick;
     long long step;               /* -1: not given */
     unsigned long long shard, shards; /* --shard K/N (K 1-based), --shards N */
     unsigned long long worker, workers, wait_timeout; /* --worker W/J (W 1-based), --wait-timeout S */
@@ -115,6 +117,8 @@ static int parse_args(int argc, char **argv, bake_args *a)
                 return cli_usage_error("bake", "--method needs cosine, amis or amis_defensive");
         } else if (cli_is_flag(argv[i], "--preview", NULL)) {
             a->preview = 1;
+        } else if (cli_is_flag(argv[i], "--quick", NULL)) {
+            a->quick = 1;
         } else if (cli_is_flag(argv[i], "--reference", NULL)) {
             a->reference = 1;
         } else if ((r = cli_opt_value(argc, argv, &i, "--plan", NULL, &v)) != 0) {
@@ -327,8 +331,8 @@ static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, siz
         return cli_usage_error(name, "--worker %llu/%llu: at most as many workers as shards (%llu)", a->worker,
                                a->workers, a->shards);
 
-    if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config))
-        return cli_usage_error(name, "--plan, --reference and --print-config are 'lmbake bake' options");
+    if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config || a->quick))
+        return cli_usage_error(name, "--plan, --quick, --reference and --print-config are 'lmbake bake' options");
     if (stage != STAGE_BAKE && stage != STAGE_FINISH && a->preview)
         return cli_usage_error(name, "--preview is an option of 'lmbake bake' and 'lmbake finish'");
     if (farm_stage && !a->farm)
@@ -381,6 +385,8 @@ static int run(int argc, char **argv, stage_kind stage)
     if (a.method >= 0)
         cfg.gather_method = (lmb_gather_method)a.method;
     cfg.reference = a.reference;
+    if (a.quick)
+        lmb_config_quick(&cfg);
     if (a.print_config) {
         size_t n = lmb_config_write(&cfg, NULL, 0);
         char *text = malloc(n + 1);

@@ -401,6 +401,10 @@ lmb_status lmb_config_lint(const lmb_config *cfg, const lmb_log *log, lmb_error 
  * length the whole text needs. Two configs that bake the same give the same text. */
 size_t lmb_config_write(const lmb_config *cfg, char *buf, size_t size);
 
+/* Turns cfg into its quick look (`bake --quick`, the watch's first picture; docs/watch.md): the
+ * same layout, lit with a fraction of the rays, no seam stitching or probes. */
+void lmb_config_quick(lmb_config *cfg);
+
 /* glob match with '*' and '?', used for node/mesh name patterns. */
 int lmb_glob_match(const char *pattern, const char *name);
 

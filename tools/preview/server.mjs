@@ -8,7 +8,7 @@ import { fileURLToPath } from 'node:url';
 
 export const projectRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 
-const TYPES = {
+export const TYPES = {
   '.html': 'text/html; charset=utf-8', '.js': 'text/javascript; charset=utf-8',
   '.mjs': 'text/javascript; charset=utf-8', '.json': 'application/json', '.css': 'text/css',
   '.gltf': 'model/gltf+json', '.glb': 'model/gltf-binary', '.bin': 'application/octet-stream',
@@ -37,7 +37,7 @@ export function checkGltf(file) {
 }
 
 // Maps a URL path to a file under one of the roots, or null. realpath defeats symlinks out.
-function resolveFile(roots, urlPath) {
+export function resolveFile(roots, urlPath) {
   let p;
   try { p = decodeURIComponent(urlPath); } catch { return null; }
   if (p.includes('\0')) return null;

@@ -3,7 +3,8 @@
 // (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
 // directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr, sphere=x,y,z: the probe-lit
 // sphere there, probes=1: the probes as markers) and the page exposes hooks for tests: window.lmbReady, lmbInfo,
-// lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView.
+// lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView, lmbCamera;
+// gen and kind: the bake of `preview --watch` to show (page/watch.js sets them).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -57,7 +58,8 @@ renderer.outputColorSpace = THREE.SRGBColorSpace;
 renderer.debug.onShaderError = (gl, program, vs, fs) => fail('shader error: ' + (gl.getShaderInfoLog(fs) || gl.getShaderInfoLog(vs) || gl.getProgramInfoLog(program)));
 document.body.prepend(renderer.domElement);
 
-const sceneInfo = await (await fetch('/scene.json')).json();
+// the bake to show: the server's one, or under `preview --watch` the one the frame's gen and kind name
+const sceneInfo = await (await fetch('/scene.json' + (q.has('gen') ? `?gen=${q.get('gen')}&kind=${q.get('kind')}` : ''))).json();
 document.title = `lmbake preview: ${sceneInfo.name}`;
 $('title').textContent = sceneInfo.name;
 const atlases = [];
@@ -372,6 +374,8 @@ window.lmbSetView = (cam, ev) => {
   if (ev !== undefined) state.ev = ev;
   apply();
 };
+// The camera now (the watch page carries it over to the next bake's frame).
+window.lmbCamera = () => ({ position: camera.position.toArray(), target: controls.target.toArray() });
 window.lmbMoveProbeSphere = (x, y, z) => { if (!probesView) return false; probesView.moveTo([x, y, z]); updateInfo(); requestRender(); return true; };
 window.lmbProject = (x, y, z) => {
   const v = new THREE.Vector3(x, y, z).project(camera);

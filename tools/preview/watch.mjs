@@ -1,0 +1,220 @@
+#!/usr/bin/env node
+// `lmbake preview --watch LEVEL [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]`
+// (docs/watch.md): bakes the level, serves the preview on 127.0.0.1 and bakes again whenever the
+// level, its buffers and images, the config or its sky image change. Each change is baked twice:
+// a quick look first (`lmbake bake --quick` into a private folder, never OUTDIR), then the real
+// bake into OUTDIR exactly as `lmbake bake` writes it. A change during a bake stops that bake
+// (SIGTERM; lmbake's output folder is swapped in whole or not at all) and the newest state is
+// baked; a save that does not bake (a parse error, a bad key) leaves the last good bake on
+// screen and the error on the page, in the log and at /status. The page (page/watch.html)
+// shows each new bake in place, from the same camera.
+// Exit 1: usage error; 2: the level is missing at the start; 3: the server could not start.
+import fs from 'node:fs';
+import http from 'node:http';
+import os from 'node:os';
+import path from 'node:path';
+import { spawn } from 'node:child_process';
+import { projectRoot, resolveFile, TYPES } from './server.mjs';
+import { watchedFiles, snapshot, configKeys, fingerprint, compare } from './watch-inputs.mjs';
+
+const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
+const POLL_MS = 200; // how often the files' sizes and times are looked at
+const SETTLE_MS = 300; // a change is baked once the files have stood still this long
+
+function parseArgs(args) {
+  const o = { level: null, config: null, outdir: 'lmbake-out', port: 0, lightmap: null, lmbake: process.env.LMBAKE || path.join(projectRoot, 'build', 'lmbake'), quick: true };
+  for (let i = 0; i < args.length; i++) {
+    const a = args[i], value = () => { if (i + 1 >= args.length) throw new Error(`${a} needs a value`); return args[++i]; };
+    if (a === '-h' || a === '--help') { console.log(usage); process.exit(0); }
+    else if (a === '-c' || a === '--config') o.config = path.resolve(value());
+    else if (a === '-o' || a === '--output') o.outdir = value();
+    else if (a === '--port') { o.port = Number(value()); if (!Number.isInteger(o.port) || o.port < 0 || o.port > 65535) throw new Error('--port wants 0..65535'); }
+    else if (a === '--lightmap') { o.lightmap = value(); if (!['ktx2', 'hdr'].includes(o.lightmap)) throw new Error('--lightmap wants ktx2 or hdr'); }
+    else if (a === '--lmbake') o.lmbake = value();
+    else if (a === '--no-quick') o.quick = false;
+    else if (a.startsWith('-')) throw new Error(`unknown option '${a}'`);
+    else if (o.level === null) o.level = path.resolve(a);
+    else throw new Error(`one level only ('${a}')`);
+  }
+  if (!o.level) throw new Error('no level given');
+  o.outdir = path.resolve(o.outdir);
+  return o;
+}
+
+let opts;
+try { opts = parseArgs(process.argv.slice(2)); } catch (e) { console.error(`preview: ${e.message}\n${usage}`); process.exit(1); }
+if (!fs.existsSync(opts.level)) { console.error(`preview: error: cannot open '${opts.level}' to watch`); process.exit(2); }
+const stem = path.basename(opts.level).replace(/\.(gltf|glb)$/i, '');
+const quickRoot = fs.mkdtempSync(path.join(os.tmpdir(), 'lmbake-watch-'));
+const say = (line) => console.log(`watch: ${line}`);
+
+// What the page and /status see.
+const status = {
+  state: 'starting', level: opts.level, config: opts.config, outdir: opts.outdir,
+  generation: 0, // the newest change taken up (1: the first bake)
+  shown: null, // {generation, kind: quick|final, readyAt (ms), seconds (from the change seen), changed, layout}
+  baking: null, // {generation, kind, stage, percent, startedAt}
+  changed: [], layout: false, error: null, cancelled: 0, history: [],
+};
+
+let files = [], lastSnapshot = null, movedAt = 0, dirty = true, child = null, goodPrint = null;
+let dying = 0; // stopped bakes not yet gone: the next one waits for them (one writer of OUTDIR at a time)
+
+function stopChild(why) {
+  if (!child) return;
+  say(`${status.baking.kind} bake ${status.baking.generation} stopped (${why})`);
+  status.cancelled++;
+  child.cancelled = true;
+  dying++;
+  child.once('close', () => { dying--; });
+  child.kill('SIGTERM');
+  child = null;
+  status.baking = null;
+}
+
+// One `lmbake bake` of the newest state: quick into QUICK/N, final into OUTDIR. Resolves to
+// {ok, seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
+function bake(kind, generation) {
+  const out = kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir;
+  const args = ['bake', opts.level, '-o', out, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
+  return new Promise((resolve) => {
+    const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+    child = p;
+    status.baking = { generation, kind, stage: 'load', percent: 0, startedAt: Date.now() };
+    let stderr = '', pending = '';
+    p.stdout.on('data', () => {});
+    p.stderr.on('data', (d) => {
+      stderr += d;
+      pending += d;
+      const lines = pending.split(/[\r\n]/);
+      pending = lines.pop();
+      for (const l of lines) {
+        const m = /^([a-zA-Z][^:]*): +(\d+)%/.exec(l);
+        if (m && child === p) Object.assign(status.baking, { stage: m[1], percent: Number(m[2]) });
+      }
+    });
+    p.on('error', (e) => resolve({ ok: false, error: `cannot run ${opts.lmbake}: ${e.message}` }));
+    p.on('close', (code) => {
+      if (p.cancelled) return resolve({ cancelled: true });
+      if (child === p) { child = null; status.baking = null; }
+      if (code === 0) return resolve({ ok: true, dir: out });
+      const errors = stderr.split('\n').filter((l) => /error:/.test(l));
+      resolve({ ok: false, error: (errors.length ? errors.join('\n') : stderr.trim().split('\n').slice(-3).join('\n')) || `lmbake exited ${code}` });
+    });
+  });
+}
+
+// The newest state of the files, baked: fingerprint, quick bake, final bake; any step may
+// find the files moved again (then it returns and the loop starts over).
+async function bakeNewest() {
+  dirty = false;
+  if (!fs.existsSync(opts.level)) { status.state = 'waiting'; status.error = `${opts.level}: missing; waiting for it`; say(status.error); return; }
+  if (opts.config && !fs.existsSync(opts.config)) { status.state = 'waiting'; status.error = `${opts.config}: missing; waiting for it`; say(status.error); return; }
+  let print, fp;
+  try {
+    print = configKeys(opts.lmbake, opts.config);
+    files = watchedFiles(opts.level, opts.config, print);
+    lastSnapshot = snapshot(files);
+    fp = fingerprint(opts.level, files, print);
+  } catch (e) {
+    files = watchedFiles(opts.level, opts.config, goodPrint);
+    lastSnapshot = snapshot(files);
+    return failed(`${e.message}`);
+  }
+  const change = compare(status.lastGood ? status.lastGood.fp : null, fp);
+  const generation = ++status.generation;
+  Object.assign(status, { state: 'baking', changed: change.what, layout: change.layout });
+  say(`bake ${generation}: ${change.what.join('; ')} (${change.layout ? 'layout and lighting' : 'lighting only'})`);
+  const seen = movedAt || Date.now();
+  for (const kind of opts.quick ? ['quick', 'final'] : ['final']) {
+    const r = await bake(kind, generation);
+    if (r.cancelled || dirty) return;
+    if (!r.ok) return failed(r.error);
+    const seconds = (Date.now() - seen) / 1000;
+    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout };
+    status.history.push({ generation, kind, seconds, changed: change.what });
+    if (status.history.length > 50) status.history.shift();
+    status.error = null;
+    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'})`);
+    tidyQuickDirs();
+  }
+  status.lastGood = { fp };
+  goodPrint = print;
+  status.state = 'idle';
+}
+
+function failed(message) {
+  status.state = 'error';
+  status.error = message;
+  say(`error: ${message.split('\n').join(' / ')}; ${status.shown ? `bake ${status.shown.generation} stays on screen` : 'nothing baked yet'}; waiting for the next save`);
+}
+
+// Quick folders no page can still want: all but the shown generation's and the newest.
+function tidyQuickDirs() {
+  for (const d of fs.readdirSync(quickRoot)) {
+    const g = Number(d);
+    if (g !== status.generation && !(status.shown && status.shown.generation === g && status.shown.kind === 'quick')) fs.rmSync(path.join(quickRoot, d), { recursive: true, force: true });
+  }
+}
+
+// The loop: poll sizes and times; a move stops the running bake at once and, once the files
+// have settled, bakes the newest state.
+let running = false;
+function tick() {
+  const now = snapshot(files.length ? files : [{ file: opts.level }]);
+  if (lastSnapshot !== null && now !== lastSnapshot) {
+    lastSnapshot = now;
+    movedAt = Date.now();
+    dirty = true;
+    stopChild('the files changed');
+  }
+  if (dirty && !running && !dying && Date.now() - movedAt >= SETTLE_MS) { // not awaited: the polling goes on during the bake
+    running = true;
+    bakeNewest().catch((e) => failed(String((e && e.stack) || e))).finally(() => { running = false; });
+  }
+}
+
+// HTTP: the watch page, the preview page in its frame, each bake's files, /status.
+const three = path.join(projectRoot, 'node_modules', 'three');
+const pageRoot = path.join(projectRoot, 'tools', 'preview', 'page');
+const staticRoots = [['/page/', pageRoot], ['/three/build/', path.join(three, 'build')], ['/three/examples/jsm/', path.join(three, 'examples', 'jsm')]];
+const server = http.createServer((req, res) => {
+  const send = (code, type, body) => {
+    res.writeHead(code, { 'Content-Type': type, 'Cache-Control': 'no-store', 'X-Content-Type-Options': 'nosniff' });
+    res.end(req.method === 'HEAD' ? undefined : body);
+  };
+  if (req.method !== 'GET' && req.method !== 'HEAD') return send(405, 'text/plain', 'read-only\n');
+  const url = new URL(req.url, 'http://127.0.0.1');
+  const file = (f) => fs.readFile(f, (err, data) => (err ? send(404, 'text/plain', 'not found\n') : send(200, TYPES[path.extname(f).toLowerCase()] || 'application/octet-stream', data)));
+  if (url.pathname === '/' || url.pathname === '/watch.html') return file(path.join(pageRoot, 'watch.html'));
+  if (url.pathname === '/index.html') return file(path.join(pageRoot, 'index.html'));
+  if (url.pathname === '/status') {
+    const { lastGood, ...view } = status; // eslint-disable-line no-unused-vars
+    return send(200, 'application/json', JSON.stringify({ ...view, now: Date.now(), watching: files.map((f) => f.file) }));
+  }
+  if (url.pathname === '/scene.json') {
+    const kind = url.searchParams.get('kind'), gen = url.searchParams.get('gen');
+    if (!['quick', 'final'].includes(kind) || !/^\d+$/.test(gen || '')) return send(404, 'text/plain', 'no such bake\n');
+    return send(200, 'application/json', JSON.stringify({ gltf: `/bake/${kind}/${gen}/${encodeURIComponent(stem)}.gltf`, name: `${stem}.gltf (${kind} bake ${gen})` }));
+  }
+  const m = /^\/bake\/(quick|final)\/(\d+)\//.exec(url.pathname);
+  const roots = m ? [[m[0], m[1] === 'quick' ? path.join(quickRoot, m[2]) : opts.outdir]] : staticRoots;
+  const f = resolveFile(roots, url.pathname);
+  return f ? file(f) : send(404, 'text/plain', 'not found\n');
+});
+server.once('error', (e) => { console.error(`preview: error: ${e.message}`); process.exit(3); });
+server.listen(opts.port, '127.0.0.1', () => {
+  console.log(`preview: http://127.0.0.1:${server.address().port}/${opts.lightmap ? '?lightmap=' + opts.lightmap : ''}`);
+  say(`watching ${opts.level}${opts.config ? ' and ' + opts.config : ''}; final bakes go to ${opts.outdir}; Ctrl-C stops`);
+  const loop = () => { try { tick(); } catch (e) { failed(String((e && e.stack) || e)); } setTimeout(loop, POLL_MS); };
+  loop();
+});
+const stop = () => {
+  if (child) { child.cancelled = true; child.kill('SIGTERM'); }
+  fs.rmSync(quickRoot, { recursive: true, force: true });
+  server.closeAllConnections();
+  server.close(() => process.exit(0));
+  setTimeout(() => process.exit(0), 1000).unref();
+};
+process.on('SIGINT', stop);
+process.on('SIGTERM', stop);
