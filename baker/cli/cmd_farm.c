@@ -182,6 +182,8 @@ static void script_head(FILE *f, const farm_args *a, const char *exe, const char
 static const char parallel_body[] =
     "command -v parallel >/dev/null || { echo \"lmbake farm parallel: GNU parallel is not installed (Debian: apt-get install parallel)\" >&2; exit 3; }\n"
     "mkdir -p \"$FARM/logs\"\n"
+    "# workers that share a machine's cores: OpenMP threads sleep at once instead of spinning (docs/threads.md)\n"
+    "[ \"$WORKERS\" -gt 1 ] && export OMP_WAIT_POLICY=\"${OMP_WAIT_POLICY:-passive}\"\n"
     "stamp() { printf '%s\\t%s\\n' \"$1\" \"$(date +%s.%N)\" >>\"$FARM/logs/times.tsv\"; }  # what each stage took\n"
     "stamp start\n"
     "[ -f \"$FARM/plan.lmbp\" ] || \"$LMBAKE\" plan \"$SCENE\" \"${CONFIG[@]}\" \"${THREADS[@]}\" --farm \"$FARM\" \"${QUIET[@]}\"\n"

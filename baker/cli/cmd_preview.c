@@ -16,7 +16,8 @@
 
 static const char help[] =
     "usage: lmbake preview OUT.gltf [--port N] [--lightmap ktx2|hdr]\n"
-    "       lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]\n"
+    "       lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--no-quick] [--port N]\n"
+    "                      [--lightmap ktx2|hdr]\n"
     "\n"
     "Serves a baked level (the .gltf `lmbake bake` wrote) on http://127.0.0.1:PORT/ and prints\n"
     "the address; open it in a browser. Views: lit, lightmap only, UV1 checker with texel grid,\n"
@@ -33,6 +34,7 @@ static const char help[] =
     "  --watch      bake LEVEL and follow its changes (see above)\n"
     "  -c, --config FILE, -o, --output DIR\n"
     "               with --watch: the bake's config and output folder (default ./lmbake-out)\n"
+    "  --no-quick   with --watch: no quick look, only the real bakes\n"
     "  --port N     port to listen on (default: a free one)\n"
     "  --lightmap ktx2|hdr\n"
     "               which file of each atlas the page reads: its KTX2 when the glTF names one\n"
@@ -42,7 +44,7 @@ static const char help[] =
 int cmd_preview(int argc, char **argv)
 {
     const char *gltf = NULL, *port = NULL, *source = NULL, *config = NULL, *outdir = NULL, *v;
-    int watch = 0;
+    int watch = 0, no_quick = 0;
     for (int i = 1; i < argc; i++) {
         int r;
         unsigned long long n;
@@ -55,6 +57,8 @@ int cmd_preview(int argc, char **argv)
             port = v;
         } else if (cli_is_flag(argv[i], "--watch", NULL)) {
             watch = 1;
+        } else if (cli_is_flag(argv[i], "--no-quick", NULL)) {
+            no_quick = 1;
         } else if ((r = cli_opt_value(argc, argv, &i, "--config", "-c", &v)) != 0) {
             if (r < 0)
                 return cli_usage_error("preview", "%s needs a file", argv[i]);
@@ -78,8 +82,9 @@ int cmd_preview(int argc, char **argv)
     if (!gltf)
         return cli_usage_error("preview", watch ? "no LEVEL given (the .gltf or .glb to bake and watch)"
                                                 : "no OUT.gltf given (the .gltf that `lmbake bake` wrote)");
-    if (!watch && (config || outdir))
-        return cli_usage_error("preview", "-c and -o go with --watch (which bakes); a baked .gltf is shown as it is");
+    if (!watch && (config || outdir || no_quick))
+        return cli_usage_error("preview", "-c, -o and --no-quick go with --watch (which bakes); a baked .gltf is shown "
+                                          "as it is");
     if (access(gltf, R_OK) != 0) {
         lmb_error err;
         lmb_error_set(&err, LMB_ERR_INPUT, "cannot open '%s' for the preview", gltf);
@@ -103,6 +108,8 @@ int cmd_preview(int argc, char **argv)
         args[n++] = "--lmbake";
         args[n++] = self;
     }
+    if (no_quick)
+        args[n++] = "--no-quick";
     if (config) {
         args[n++] = "-c";
         args[n++] = (char *)config;
