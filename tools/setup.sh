@@ -22,6 +22,7 @@ packages=(
   libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
   libopenmesh-dev                   # the unwrapper's half-edge mesh (OpenMesh, behind baker/unwrap/halfedge_adapter.cpp)
   libsuitesparse-dev                # CHOLMOD sparse Cholesky for the LSCM flattening
+  libqhull-dev                      # the light probes' Delaunay tetrahedra (qhull's reentrant C API)
   python3-matplotlib python3-openimageio  # benchmark plots, reading EXR in test scripts
   chromium                          # headless browser for the preview's shots and e2e test (playwright-core drives it)
   strace                            # the hostile-input test checks which files a bake opens

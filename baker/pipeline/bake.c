@@ -252,7 +252,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK)
         st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
     if (st == LMB_OK)
-        st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, err);
+        st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, shard ? NULL : log, err);
     if (st == LMB_OK && worker)
         st = lmb_steps_worker_end(steps, err);
     if (worker && !finishes) {
@@ -304,7 +304,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK) {
         lmb_copy_input_textures(s, &od, log);
         lmb_gltf_probes out_probes;
-        st = lmb_probes_output(&probes, cfg, od.staging, od.stem, &out_probes, err);
+        st = lmb_probes_output(&probes, cfg, od.staging, od.stem, log, &out_probes, err);
         if (st == LMB_OK)
             st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
                                             cache.shadowmask != NULL, &out_probes, err);

@@ -1,6 +1,6 @@
 /*
- * Probe light (see probes.h). At each probe, probes.rays directions of a spherical Fibonacci
- * lattice (sphere.h) see: the sky where they leave the level, and where they hit a lightmapped
+ * Probe light (see probes.h). At each probe, rounds of probes.rays directions of a spherical
+ * Fibonacci lattice (sphere.h; each round after the first rotated at random) see: the sky where they leave the level, and where they hit a lightmapped
  * surface its outgoing diffuse radiance B = albedo / pi x E from the finished bounce cache (a
  * surface without a lightmap: its direct light, one bounce, as the final gather does); back
  * faces are black. With L(w) so sampled,
@@ -13,8 +13,10 @@
  * light of every light and the sky at a point facing n, by the direct stage's own estimator
  * (lmb_direct_at_split: shadow rays, area-light and sky sampling with MIS; minus the `indirect`
  * lights' part), plus 4 pi / n sum_i B(w_i) max(0, n . w_i) over the rays that hit surfaces.
- * Random numbers (area lights, the sky's map) are keyed by (seed, probe, axis): a probe's values
- * do not depend on threads or on how a farm splits the probes.
+ * Rounds are added until the mean radiance's relative standard error is within samples.noise
+ * (ray_rounds), as texels sample adaptively. Random numbers (rotations, area lights, the sky's
+ * map) are keyed by (seed, probe, round or axis): a probe's values do not depend on threads or
+ * on how a farm splits the probes.
  */
 #include "probes.h"
 #include "sphere.h"
@@ -56,21 +58,43 @@ static void add_delta(void *user, const double dir[3], const double e[3])
             d->l[k][c] += e[c] * y[k];
 }
 
-/* One probe's 45 floats (SH then cube) into out; returns the rays traced. */
-static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
+/* A rotation taking the lattice to round r's own directions (round 0: none): Shoemake's uniform
+ * random unit quaternion, keyed by (seed, probe, round). */
+static void round_rotation(const probe_job *job, uint32_t i, uint32_t r, double m[9])
+{
+    if (r == 0) {
+        const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        memcpy(m, id, sizeof id);
+        return;
+    }
+    lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x524f544eull ^ i, r);
+    double u1 = lmb_rng_next(&rng), u2 = 2 * LMB_PI * lmb_rng_next(&rng), u3 = 2 * LMB_PI * lmb_rng_next(&rng);
+    double a = sqrt(1 - u1), b = sqrt(u1);
+    double x = a * sin(u2), y = a * cos(u2), z = b * sin(u3), w = b * cos(u3);
+    double r9[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
+                    2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                    2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y)};
+    memcpy(m, r9, sizeof r9);
+}
+
+/* One round: the n lattice directions (rotated by m) traced from probe i, their radiance's SH
+ * and the reflected light's cube added to sum and cube (each round weighted 4 pi / n), and the
+ * mean radiance of the even and the odd directions (two interleaved half lattices) into half.
+ * Returns the rays traced. */
+static uint64_t trace_round(const probe_job *job, uint32_t i, uint32_t r, const double m[9], delta_sum *sum,
+                            double cube[6][3], double half[2])
 {
     const lmb_rt *rt = job->cache->rt;
     const double *p = job->set->position + 3 * (size_t)i;
     const lmb_sky *sky = lmb_direct_sky(job->direct);
     uint32_t n = job->set->rays;
-    delta_sum sum;
-    double cube[6][3];
-    memset(&sum, 0, sizeof sum);
-    memset(cube, 0, sizeof cube);
     uint64_t rays = 0;
+    half[0] = half[1] = 0;
     for (uint32_t j = 0; j < n; j++) {
-        double w[3], l[3] = {0, 0, 0}, b[3] = {0, 0, 0};
-        lmb_sphere_direction(j, n, w);
+        double v[3], w[3], l[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+        lmb_sphere_direction(j, n, v);
+        for (int k = 0; k < 3; k++)
+            w[k] = m[3 * k] * v[0] + m[3 * k + 1] * v[1] + m[3 * k + 2] * v[2];
         lmb_rt_hit h;
         rays++;
         if (!lmb_rt_intersect(rt, p, w, rt->eps, 1e300, &h)) {
@@ -86,7 +110,7 @@ static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
                     y.n[k] = y.ng[k] = h.ng[k];
                 }
                 y.eps = 4 * rt->eps;
-                lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, j);
+                lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, (uint64_t)r * n + j);
                 rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);
             }
             if (kind != LMB_HIT_DARK)
@@ -99,13 +123,70 @@ static uint64_t light_probe(const probe_job *job, uint32_t i, float *out)
         lmb_sh9(w[0], w[1], w[2], y);
         for (int k = 0; k < 9; k++)
             for (int c = 0; c < 3; c++)
-                sum.l[k][c] += 4 * LMB_PI / n * l[c] * y[k];
+                sum->l[k][c] += 4 * LMB_PI / n * l[c] * y[k];
         for (int a = 0; a < 6; a++) {
             double cosang = axes[a][0] * w[0] + axes[a][1] * w[1] + axes[a][2] * w[2];
             for (int c = 0; cosang > 0 && c < 3; c++)
                 cube[a][c] += 4 * LMB_PI / n * b[c] * cosang;
         }
+        half[j & 1] += lmb_luminance(l) / (0.5 * n);
     }
+    return rays;
+}
+
+/* Rounds of probes.rays directions until the mean radiance's relative standard error is within
+ * samples.noise or samples.max_rays are spent (samples.adaptive; else one round). The error of
+ * one round: the difference of its two interleaved half lattices (two estimates of the mean,
+ * var(mean) ~ (h1 - h2)^2 / 4); of R > 1 rounds: the rounds' own spread, var / R. */
+static uint32_t ray_rounds(const probe_job *job, uint32_t i, delta_sum *sum, double cube[6][3], uint64_t *rays)
+{
+    const lmb_config *cfg = job->cfg;
+    uint32_t n = job->set->rays, most = cfg->adaptive ? (cfg->max_rays > n ? cfg->max_rays / n : 1) : 1;
+    double means[64], first_half[2] = {0, 0};
+    most = most > 64 ? 64 : most;
+    uint32_t r = 0;
+    while (r < most) {
+        double m[9], half[2];
+        round_rotation(job, i, r, m);
+        *rays += trace_round(job, i, r, m, sum, cube, half);
+        means[r] = 0.5 * (half[0] + half[1]);
+        if (r == 0)
+            memcpy(first_half, half, sizeof half);
+        r++;
+        double mean = 0, var = 0;
+        for (uint32_t k = 0; k < r; k++)
+            mean += means[k] / r;
+        if (r == 1) {
+            var = 0.25 * (first_half[0] - first_half[1]) * (first_half[0] - first_half[1]);
+        } else {
+            for (uint32_t k = 0; k < r; k++)
+                var += (means[k] - mean) * (means[k] - mean) / (r - 1);
+            var /= r;
+        }
+        if (mean <= 0 || sqrt(var) <= cfg->noise_target * mean)
+            break;
+    }
+    return r;
+}
+
+/* One probe's 45 floats (SH then cube) into out; returns the rays traced. */
+static uint64_t light_probe(const probe_job *job, uint32_t i, float *out, uint32_t *rounds)
+{
+    const lmb_rt *rt = job->cache->rt;
+    const double *p = job->set->position + 3 * (size_t)i;
+    delta_sum sum;
+    double cube[6][3];
+    memset(&sum, 0, sizeof sum);
+    memset(cube, 0, sizeof cube);
+    uint64_t rays = 0;
+    uint32_t r = ray_rounds(job, i, &sum, cube, &rays);
+    *rounds = r;
+    for (int k = 0; k < 9; k++) /* each round summed at weight 4 pi / n: their mean */
+        for (int c = 0; c < 3; c++)
+            sum.l[k][c] /= r;
+    for (int a = 0; a < 6; a++)
+        for (int c = 0; c < 3; c++)
+            cube[a][c] /= r;
     rays += lmb_direct_deltas_at(job->direct, p, add_delta, &sum);
     lmb_rng erng = lmb_rng_make(job->cfg->seed, 0x454d4954ull ^ i, 0);
     rays += lmb_direct_emitter_samples_at(job->direct, p, EMITTER_SAMPLES, &erng, add_delta, &sum);
@@ -140,25 +221,28 @@ static lmb_status probe_range(void *user, uint64_t first, uint64_t last, lmb_buf
     float *v = lmb_buf_extend(out, (size_t)(last - first) * PROBE_FLOATS * sizeof *v, err);
     if (!v)
         return err->status;
-    uint64_t rays = 0;
-#pragma omp parallel num_threads(job->threads) reduction(+ : rays)
+    uint64_t rays = 0, more = 0;
+#pragma omp parallel num_threads(job->threads) reduction(+ : rays, more)
     {
         lmb_rt_thread_init();
 #pragma omp for schedule(dynamic, 4)
         for (uint64_t i = first; i < last; i++) {
             float values[PROBE_FLOATS];
-            rays += light_probe(job, (uint32_t)i, values);
+            uint32_t rounds;
+            rays += light_probe(job, (uint32_t)i, values, &rounds);
+            more += rounds > 1;
             memcpy(v + (i - first) * PROBE_FLOATS, values, sizeof values);
         }
     }
     counters[0] += rays;
     counters[1] += last - first;
+    counters[2] += more;
     return LMB_OK;
 }
 
 lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb_direct *direct,
                             const lmb_cache *cache, lmb_steps *steps, int dark, lmb_progress_fn progress, void *user,
-                            lmb_error *err)
+                            const lmb_log *log, lmb_error *err)
 {
     if (!set->count || dark) /* nothing emits: every probe is 0 (the arrays are zeroed) */
         return LMB_OK;
@@ -178,6 +262,10 @@ lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb
         memcpy(set->cube + (size_t)i * LMB_PROBE_CUBE, v + LMB_PROBE_SH, LMB_PROBE_CUBE * sizeof *v);
     }
     lmb_buf_free(&bytes);
+    if (st == LMB_OK && cfg->adaptive)
+        lmb_info(log, "probes: %.0f rays per probe on average; %llu of %u probes took more than one round of %u "
+                 "(samples.noise %g, at most samples.max_rays %u)", (double)counters[0] / set->count,
+                 (unsigned long long)counters[2], set->count, set->rays, cfg->noise_target, cfg->max_rays);
     if (st == LMB_OK && progress)
         progress(user, "probes", set->count, set->count);
     return st;

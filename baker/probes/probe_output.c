@@ -1,6 +1,6 @@
 /* The probes as the output holds them (write/gltf_write.h's lmb_gltf_probes): float positions,
- * the values in the lightmaps' scale (output.scale radiance: E / pi), and each grid as bevy's
- * irradiance volume. */
+ * the values in the lightmaps' scale (output.scale radiance: E / pi), their Delaunay tetrahedra
+ * (tetrahedra.c), and each grid as bevy's irradiance volume. */
 #include "probes.h"
 
 #include "util/lmb_math.h"
@@ -53,7 +53,7 @@ static lmb_status write_volumes(const lmb_probe_set *set, double scale, const ch
 }
 
 lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
-                             lmb_gltf_probes *out, lmb_error *err)
+                             const lmb_log *log, lmb_gltf_probes *out, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
     if (!set->count)
@@ -81,6 +81,18 @@ lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, co
     out->cube = cube;
     out->spacing = set->spacing;
     out->radiance = radiance;
+    lmb_probe_tetrahedra_out tets;
+    lmb_status st = lmb_probe_tetrahedra(set, &tets, err);
+    if (st != LMB_OK)
+        return st;
+    out->tetrahedra = tets.tetrahedra; /* owned by out now */
+    out->tetrahedron_count = tets.count;
+    if (tets.count)
+        lmb_info(log, "probes: %u tetrahedra (Delaunay, qhull)%s", tets.count,
+                 tets.flat ? "; flat ones between grid cells dropped" : "");
+    else
+        lmb_warn(log, "probes: no tetrahedra: the %u probes %s%s", set->count,
+                 set->count < 4 ? "are fewer than 4" : "span no volume (qhull: ", set->count < 4 ? "" : tets.why);
     return write_volumes(set, scale, dir, stem, out, err);
 }
 
@@ -89,6 +101,7 @@ void lmb_probes_output_free(lmb_gltf_probes *out)
     free((void *)out->positions);
     free((void *)out->sh);
     free((void *)out->cube);
+    free((void *)out->tetrahedra);
     for (uint32_t i = 0; out->volumes && i < out->volume_count; i++)
         free((void *)out->volumes[i].uri);
     free((void *)out->volumes);

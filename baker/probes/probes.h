@@ -90,18 +90,30 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
                             const lmb_log *log, lmb_probe_set *out, lmb_error *err);
 
 /* Lights the placed probes as one step of the bake (steps/runner.h): direct light from
- * `direct`, reflected light from the finished cache. dark: nothing emits (all zero, no rays). */
+ * `direct`, reflected light from the finished cache, rounds of probes.rays directions until
+ * samples.noise (samples.adaptive). dark: nothing emits (all zero, no rays). */
 lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb_direct *direct,
                             const lmb_cache *cache, lmb_steps *steps, int dark, lmb_progress_fn progress, void *user,
-                            lmb_error *err);
+                            const lmb_log *log, lmb_error *err);
 
 void lmb_probe_set_free(lmb_probe_set *set);
 
+/* The Delaunay tetrahedra of the probe positions (tetrahedra.c, qhull): 4 probe indices each,
+ * positive volume, flat ones dropped. Fewer than 4 probes, or all in a plane: none, and `why`
+ * says what qhull said. */
+typedef struct lmb_probe_tetrahedra_out {
+    uint32_t *tetrahedra; /* 4 per tetrahedron */
+    uint32_t count;
+    uint32_t flat;        /* flat tetrahedra dropped */
+    char why[256];
+} lmb_probe_tetrahedra_out;
+lmb_status lmb_probe_tetrahedra(const lmb_probe_set *set, lmb_probe_tetrahedra_out *out, lmb_error *err);
+void lmb_probe_tetrahedra_free(lmb_probe_tetrahedra_out *out);
 /* The set as the output holds it (probe_output.c): owned arrays, free with lmb_probes_output_free
  * (also after an error); its grid as DIR/STEM-irradiance-volume.ktx2 (bevy's layout). Empty, no
  * file, when the set is. */
 lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
-                             lmb_gltf_probes *out, lmb_error *err);
+                             const lmb_log *log, lmb_gltf_probes *out, lmb_error *err);
 void lmb_probes_output_free(lmb_gltf_probes *out);
 
 #endif

@@ -9,6 +9,7 @@
 #include "gltf_write.h"
 
 #include "../load/gltf_doc.hpp"
+#include "gltf_buffers.hpp"
 #include "gltf_prune.hpp"
 #include "rgbm.h"
 
@@ -18,14 +19,7 @@
 #include <utility>
 #include <vector>
 
-namespace {
-
-using tinygltf::Value;
-
-struct writer {
-    tinygltf::Model &m;
-    int buffer; /* the new buffer */
-};
+namespace lmb_gltf_out {
 
 int new_buffer(tinygltf::Model &m)
 {
@@ -75,6 +69,13 @@ int add_float_accessor(writer &w, const float *data, uint32_t count, int comps, 
     w.m.accessors.push_back(a);
     return (int)w.m.accessors.size() - 1;
 }
+
+} // namespace lmb_gltf_out
+
+namespace {
+
+using tinygltf::Value;
+using namespace lmb_gltf_out;
 
 /* Gathers a plain accessor's elements through `source`; -1 if it cannot be copied. */
 int gather_accessor(writer &w, int index, const uint32_t *source, uint32_t count)
@@ -517,114 +518,6 @@ extern "C" lmb_status lmb_gltf_set_records(lmb_gltf_doc *doc, const char *uri, u
     }
 }
 
-namespace {
-
-/* One irradiance volume as a node of the default scene (see lmb_gltf_set_probes). */
-void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, int radiance)
-{
-    tinygltf::Node node;
-    node.name = !v.node_name.empty() ? "lightmap irradiance volume of " + v.node_name
-                : v.config_entry      ? "lightmap irradiance volume " + std::to_string(v.config_entry)
-                                      : std::string("lightmap irradiance volume");
-    if (!v.node_name.empty()) {
-        node.matrix.assign(v.matrix, v.matrix + 16); /* the asking node's world transform */
-    } else {
-        for (int k = 0; k < 3; k++) {
-            node.translation.push_back(0.5 * (v.lo[k] + v.hi[k]));
-            node.scale.push_back(v.hi[k] - v.lo[k]);
-        }
-    }
-    Value::Object volume;
-    volume["uri"] = Value(v.uri);
-    volume["resolution"] = Value(Value::Array{Value((int)v.res[0]), Value((int)v.res[1]), Value((int)v.res[2])});
-    volume["layout"] = Value(std::string("bevy IrradianceVolume: a unit cube centred on the origin, placed by this node; "
-                                         "KTX2 E5B9G9R9 of (Rx, 2Ry, 3Rz) texels, ambient cubes"));
-    volume["scale"] = Value(std::string(radiance ? "radiance" : "irradiance"));
-    volume["unit"] = Value(std::string(radiance ? "nits (E / pi)" : "lux (E)"));
-    volume["configEntry"] = Value((int)v.config_entry);
-    if (!v.node_name.empty())
-        volume["node"] = Value(v.node_name);
-    Value::Object node_lightmap;
-    node_lightmap["irradianceVolume"] = Value(volume);
-    Value::Object node_extras;
-    node_extras["lightmap"] = Value(node_lightmap);
-    node.extras = Value(node_extras);
-    m.nodes.push_back(node);
-    int index = (int)m.nodes.size() - 1;
-    if (m.scenes.empty()) {
-        m.scenes.push_back(tinygltf::Scene());
-        m.defaultScene = 0;
-    }
-    size_t scene = m.defaultScene >= 0 && (size_t)m.defaultScene < m.scenes.size() ? (size_t)m.defaultScene : 0;
-    m.scenes[scene].nodes.push_back(index);
-}
-
-/* The probes lmb_gltf_set_probes kept: into the new buffer and asset.extras.lightmap.probes. */
-void add_probes(lmb_gltf_doc *doc)
-{
-    uint32_t count = (uint32_t)(doc->probe_positions.size() / 3);
-    if (!count)
-        return;
-    const float *xyz = doc->probe_positions.data(), *sh_values = doc->probe_sh.data(),
-                *cube_values = doc->probe_cube.data();
-    tinygltf::Model &m = doc->model;
-    writer w{m, new_buffer(m)};
-    Value::Object probes;
-    probes["count"] = Value((int)count);
-    int positions = add_float_accessor(w, xyz, count, 3, true);
-    m.bufferViews[(size_t)m.accessors[(size_t)positions].bufferView].target = 0; /* points, not a vertex buffer */
-    probes["positions"] = Value(positions);
-    int sh = add_view(w, sh_values, sizeof(float) * 27 * (size_t)count, 0);
-    int cube = add_view(w, cube_values, sizeof(float) * 18 * (size_t)count, 0);
-    m.bufferViews[(size_t)sh].name = "lightmap probes SH L2";
-    m.bufferViews[(size_t)cube].name = "lightmap probes ambient cube";
-    probes["sh"] = Value(sh);
-    probes["ambientCube"] = Value(cube);
-    probes["shBasis"] = Value(std::string(
-        "float32 x 27 per probe, coefficient-major RGB: (l,m) = (0,0) (1,-1) (1,0) (1,1) (2,-2) (2,-1) (2,0) "
-        "(2,1) (2,2), real SH Y00 = 0.282095, Y1m = 0.488603 (y, z, x), Y2-2 = 1.092548 xy, Y2-1 = 1.092548 yz, "
-        "Y20 = 0.315392 (3z^2 - 1), Y21 = 1.092548 xz, Y22 = 0.546274 (x^2 - y^2), glTF axes; irradiance "
-        "E(n) = sum_k sh[k] Y_k(n) (the radiance's coefficients times pi, 2pi/3, pi/4)"));
-    probes["ambientCubeLayout"] = Value(std::string("float32 x 18 per probe: irradiance for normals +X, -X, +Y, -Y, "
-                                                    "+Z, -Z, RGB each"));
-    probes["scale"] = Value(std::string(doc->probe_radiance ? "radiance" : "irradiance"));
-    probes["unit"] = Value(std::string(doc->probe_radiance ? "nits (E / pi)" : "lux (E)"));
-    probes["spacing"] = Value(doc->probe_spacing);
-    tinygltf::Asset &asset = m.asset;
-    Value::Object extras = asset.extras.IsObject() ? asset.extras.Get<Value::Object>() : Value::Object();
-    Value::Object lightmap = extras.count("lightmap") && extras["lightmap"].IsObject()
-                                 ? extras["lightmap"].Get<Value::Object>() : Value::Object();
-    lightmap["probes"] = Value(probes);
-    extras["lightmap"] = Value(lightmap);
-    asset.extras = Value(extras);
-    for (const auto &v : doc->volumes)
-        add_volume_node(m, v, doc->probe_radiance);
-}
-
-} // namespace
-
-extern "C" lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_probes *p, lmb_error *err)
-{
-    try {
-        doc->probe_positions.assign(p->positions, p->positions + 3 * (size_t)p->count);
-        doc->probe_sh.assign(p->sh, p->sh + 27 * (size_t)p->count);
-        doc->probe_cube.assign(p->cube, p->cube + 18 * (size_t)p->count);
-        doc->probe_spacing = p->spacing;
-        doc->probe_radiance = p->radiance;
-        doc->volumes.clear();
-        for (uint32_t i = 0; i < p->volume_count; i++) {
-            const lmb_gltf_volume &v = p->volumes[i];
-            lmb_gltf_doc::volume d{v.uri, {v.lo[0], v.lo[1], v.lo[2]}, {v.hi[0], v.hi[1], v.hi[2]},
-                                   {v.res[0], v.res[1], v.res[2]}, v.config_entry, v.node_name ? v.node_name : "", {0}};
-            std::copy(v.matrix, v.matrix + 16, d.matrix);
-            doc->volumes.push_back(d);
-        }
-        return LMB_OK;
-    } catch (const std::exception &e) {
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "glTF output: cannot keep the light probes: %s", e.what());
-    }
-}
-
 lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_name, lmb_error *err)
 {
     try {
@@ -634,7 +527,7 @@ lmb_status lmb_gltf_save(lmb_gltf_doc *doc, const char *path, const char *bin_na
         if (dot != std::string::npos)
             stem = stem.substr(0, dot);
         lmb_gltf_prune_replaced(doc);
-        add_probes(doc);
+        lmb_gltf_add_probes(doc);
         for (size_t i = 0; i < m.buffers.size(); i++) {
             if (m.buffers[i].name == "lmbake")
                 m.buffers[i].uri = bin_name;

@@ -102,6 +102,8 @@ typedef struct lmb_gltf_probes {
     const float *positions; /* 3 per probe, world */
     const float *sh;        /* 27 per probe: SH L2 irradiance, coefficient-major RGB */
     const float *cube;      /* 18 per probe: irradiance for +X, -X, +Y, -Y, +Z, -Z, RGB */
+    const uint32_t *tetrahedra; /* 4 probe indices per tetrahedron (Delaunay), positive volume */
+    uint32_t tetrahedron_count;
     double spacing;         /* the grid's cell */
     int radiance;           /* output.scale radiance */
     uint32_t volume_count;  /* the grids as bevy's irradiance volumes (KTX2) */
@@ -119,8 +121,9 @@ typedef struct lmb_gltf_volume {
 } lmb_gltf_volume;
 
 /* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes
- * as buffer views of float32) and names them in asset.extras.lightmap.probes {count, positions,
- * sh, ambientCube, shBasis, scale, unit, spacing} (docs/probes.md); the asset's other extras
+ * as buffer views of float32, the tetrahedra as a SCALAR uint32 accessor) and names them in
+ * asset.extras.lightmap.probes {count, positions, sh, ambientCube, tetrahedra, shBasis, scale,
+ * unit, spacing} (docs/probes.md); the asset's other extras
  * are kept. Per volume a node "lightmap irradiance volume" (or "... K" for probes.volumes entry
  * K) in the default scene whose transform takes a unit cube centred on the origin to the
  * volume's box (bevy's IrradianceVolume), with extras.lightmap.irradianceVolume {uri,

@@ -31,6 +31,14 @@ usage: check_probes.py LMBAKE WORKDIR CASE
            the mean of its probes' ambient cubes within E5B9G9R9's precision (2^-9 of the texel's
            largest channel), and the voxels inside the cube (no probe) filled from their
            neighbours, not black (two bounces: every probe outside sees some light).
+  adaptive rounds of probes.rays directions to samples.noise (the sky plane): none with
+           samples.adaptive false; with a target no estimate meets most probes take more rounds
+           than at the default target, and the reflected light is within 1% as in `sky`.
+  tetrahedra bevy's Cornell box (atlas.texels 40,000): the probes' Delaunay tetrahedra in the
+           output (asset.extras.lightmap.probes.tetrahedra): every probe a vertex, every volume
+           positive, no probe inside a circumsphere (deeper than 1e-5 of r^2: float32 positions),
+           each face in at most two, the boundary faces enclose the tetrahedra's total volume;
+           and a volume of one layer of probes: no tetrahedra, a warning that says why.
 """
 import json
 import math
@@ -375,9 +383,107 @@ def volume(lmbake, work):
                      checked, worst, empty, black_inside))
 
 
+def adaptive(lmbake, work):
+    """Rounds of rays to samples.noise: none with samples.adaptive false; at a noise target no
+    estimate meets (samples.max_rays 2048: at most 4 rounds of 512) more than half the probes
+    take more rounds, more than at the default target; the reflected light of the sky case
+    (cube -Y) then still within 1% of pi B F."""
+    L = 1000.0
+    rounds = lambda log: [l for l in log.splitlines() if "rays per probe on average" in l]
+    _, off = bake(lmbake, work, "sky-plane", "fixed", "sky: {intensity: %g}\nsamples: {adaptive: false}\n" % L)
+    probes, most = bake(lmbake, work, "sky-plane", "most", "sky: {intensity: %g}\nsamples: {noise: 1e-9, max_rays: 2048}\n" % L)
+    _, default = bake(lmbake, work, "sky-plane", "default", "sky: {intensity: %g}\nsamples: {max_rays: 2048}\n" % L)
+    line, line_default = rounds(most), rounds(default)
+    n = probes["count"]
+    took = lambda l: int(l[0].split("; ")[1].split(" of ")[0]) if l else -1
+    # a probe whose two half lattices agree exactly (a step between sky and plane crossed by as
+    # many directions in each) shows no error and stops: most, not all, take more rounds
+    every = took(line) > n // 2 and took(line_default) < took(line)
+    rays = float(line[0].split("probes: ")[1].split(" rays")[0]) if line else 0
+    mid = [i for i, p in enumerate(probes["positions"]) if abs(p[0]) < 3 and abs(p[2]) < 3]
+    down = [probes["cube"][i][3 * 3] / (math.pi * 0.5 * L * plane_view_factor(probes["positions"][i], 5.0))
+            for i in mid]
+    good = not rounds(off) and every and max(abs(r - 1) for r in down) <= 0.01
+    return report("adaptive", good, "samples.adaptive false: %s; samples.noise 1e-9: %s; default noise: %d probes "
+                  "(fewer); reflected light at 1e-9, cube -Y / (pi B F) %.5f..%.5f (1 +- 1%%)"
+                  % ("no rounds" if not rounds(off) else rounds(off)[0], line[0].split("probes: ")[1] if line else "no line",
+                     took(line_default), min(down), max(down)))
+
+
+TETRA_CONFIG = "atlas: {texels: 40000}\nbounces: 1\n"
+FLAT_CONFIG = TETRA_CONFIG + """probes:
+  auto: false
+  volumes: [{min: [-500, 100, -500], max: [-100, 110, -100], resolution: [4, 1, 4]}]
+"""
+
+
+def tetrahedra(lmbake, work):
+    import numpy as np  # this case only
+    glb = os.path.join(ROOT, "assets", "scenes", "cornell-box-bevy", "CornellBox.glb")
+    good = True
+    for name, config in (("auto", TETRA_CONFIG), ("flat", FLAT_CONFIG)):
+        cfg = os.path.join(work, name + ".yaml")
+        with open(cfg, "w") as f:
+            f.write(config)
+        out = os.path.join(work, "out-" + name)
+        p = subprocess.run([lmbake, "bake", glb, "-c", cfg, "-o", out], capture_output=True, text=True)
+        if p.returncode != 0:
+            return report("tetrahedra", False, "%s: bake failed (%d): %s" % (name, p.returncode, p.stderr))
+        path = os.path.join(out, "CornellBox.gltf")
+        doc = json.load(open(path))
+        meta = doc["asset"]["extras"]["lightmap"]["probes"]
+        if name == "flat":
+            good &= report("tetrahedra flat", "tetrahedra" not in meta and "no tetrahedra" in p.stderr,
+                           "16 probes in one layer: %s; %s" % ("no tetrahedra key" if "tetrahedra" not in meta else
+                                                              "a tetrahedra key",
+                                                              [l for l in p.stderr.splitlines() if "tetrahedra" in l]))
+            continue
+        pos = np.array(load_probes(path)["positions"], dtype=np.float64)
+        acc = doc["accessors"][meta["tetrahedra"]]
+        view = doc["bufferViews"][acc["bufferView"]]
+        with open(os.path.join(out, doc["buffers"][view["buffer"]]["uri"]), "rb") as f:
+            f.seek(view.get("byteOffset", 0) + acc.get("byteOffset", 0))
+            tets = np.frombuffer(f.read(4 * acc["count"]), "<u4").reshape(-1, 4).astype(np.int64)
+        a, b, c, d = (pos[tets[:, k]] for k in range(4))
+        vol = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
+        # Delaunay: no probe inside a tetrahedron's circumsphere (deeper than float32 positions allow)
+        m = 2 * np.stack([b - a, c - a, d - a], 1)
+        rhs = np.stack([(q * q).sum(1) - (a * a).sum(1) for q in (b, c, d)], 1)
+        centre = np.linalg.solve(m, rhs[..., None])[..., 0]
+        r2 = ((centre - a) ** 2).sum(1)
+        deepest = 0.0
+        for i in range(0, len(tets), 1000):
+            d2 = ((centre[i:i + 1000, None, :] - pos[None, :, :]) ** 2).sum(2)
+            deepest = max(deepest, float(((r2[i:i + 1000, None] - d2) / r2[i:i + 1000, None]).max()))
+        # a conforming mesh: each face in at most 2 tetrahedra; the faces in one bound a closed
+        # surface whose enclosed volume (divergence theorem) is the tetrahedra's total
+        faces = {}
+        for t in tets:
+            for skip, sign in ((0, 1), (1, -1), (2, 1), (3, -1)):
+                f = [int(t[k]) for k in range(4) if k != skip]
+                key = tuple(sorted(f))
+                faces.setdefault(key, []).append((f, sign))
+        shared_ok = all(len(v) <= 2 for v in faces.values())
+        boundary = [v[0] for v in faces.values() if len(v) == 1]
+        enclosed = 0.0
+        for f, sign in boundary:  # outward: the face opposite vertex k, oriented by the tetrahedron
+            p0, p1, p2 = pos[f[0]], pos[f[1]], pos[f[2]]
+            enclosed += sign * np.dot(p0, np.cross(p1, p2)) / 6
+        total = float(vol.sum())
+        good &= report("tetrahedra", vol.min() > 0 and deepest < 1e-5 and shared_ok and len(np.unique(tets)) == len(pos)
+                       and abs(enclosed - total) <= 1e-9 * abs(total),
+                       "%d probes, %d tetrahedra, every probe a vertex: %s; smallest volume %.4g (> 0); deepest probe "
+                       "inside a circumsphere %.2g of r^2 (< 1e-5); faces in at most 2 tetrahedra: %s; the %d faces in one "
+                       "(the hull, and flat ones dropped between grid cells) enclose %.10g, the tetrahedra %.10g"
+                       % (len(pos), len(tets), len(np.unique(tets)) == len(pos), vol.min(), deepest, shared_ok,
+                          len(boundary), enclosed, total))
+    return good
+
+
 if __name__ == "__main__":
     lmbake, work, case = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
     cases = {"sky": sky, "point": point, "sealed": sealed, "solid": solid, "scale": scale, "volume": volume,
-             "cornell": cornell, "node": node}
+             "cornell": cornell, "node": node, "tetrahedra": tetrahedra,
+             "adaptive": adaptive}
     sys.exit(0 if cases[case](lmbake, work) else 1)

@@ -6,7 +6,8 @@
 // "none" at an exposure that puts it near mid-grey, sRGB, within 2 levels (8-bit). Then moves the
 // sphere to a second probe without reloading and checks it again. Two probes: the brightest
 // toward +Z (a lit spot) and the dimmest with at least 2% of its light (in shadow); their
-// screenshots are saved.
+// screenshots are saved. Last, the sphere at a tetrahedron's centroid: the mean of its four
+// probes' SH.
 //   usage: node tests/preview/preview_probes.mjs GLTF SHOTS_DIR
 import fs from 'node:fs';
 import path from 'node:path';
@@ -28,7 +29,12 @@ function readProbes(file) {
     return new Float32Array(b.buffer.slice(b.byteOffset + (v.byteOffset || 0), b.byteOffset + (v.byteOffset || 0) + v.byteLength));
   };
   const scale = p.scale === 'radiance' ? Math.PI : 1;
-  return { count: p.count, spacing: p.spacing, positions: view(doc.accessors[p.positions].bufferView), sh: view(p.sh).map((v) => v * scale) };
+  let tetrahedra = null;
+  if (p.tetrahedra !== undefined) {
+    const a = doc.accessors[p.tetrahedra], v = doc.bufferViews[a.bufferView], b = fs.readFileSync(path.join(path.dirname(file), doc.buffers[v.buffer].uri));
+    tetrahedra = new Uint32Array(b.buffer.slice(b.byteOffset + (v.byteOffset || 0), b.byteOffset + (v.byteOffset || 0) + 4 * a.count));
+  }
+  return { count: p.count, spacing: p.spacing, positions: view(doc.accessors[p.positions].bufferView), sh: view(p.sh).map((v) => v * scale), tetrahedra };
 }
 // E(+Z) of probe i: the SH at n = (0, 0, 1): Y00, Y10 = 0.488603 z, Y20 = 0.315392 (3z^2 - 1)
 const eUpZ = (pr, i) => [0, 1, 2].map((c) => 0.282095 * pr.sh[27 * i + c] + 0.488603 * pr.sh[27 * i + 6 + c] + 0.630784 * pr.sh[27 * i + 18 + c]);
@@ -84,6 +90,21 @@ try {
     }
   }
   if (done < 2) { console.log(`FAIL: ${done} of 2 probes could be looked at`); failures++; }
+  // between probes: the sphere at a tetrahedron's centroid takes the mean of its four probes' SH
+  // (barycentric weights 1/4 each), as Unity and Godot interpolate
+  if (!probes.tetrahedra || !probes.tetrahedra.length) { console.log('FAIL: the bake has no tetrahedra'); failures++; }
+  else if (page) {
+    const t = Array.from(probes.tetrahedra.subarray(0, 4));
+    const at = [0, 1, 2].map((c) => t.reduce((s, i) => s + probes.positions[3 * i + c], 0) / 4);
+    await page.evaluate((a) => window.lmbMoveProbeSphere(...a), at);
+    const got = await page.evaluate(() => window.lmbProbeSphere(null));
+    const want = Array.from({ length: 27 }, (_, k) => t.reduce((s, i) => s + probes.sh[27 * i + k], 0) / 4);
+    const scaleSh = Math.max(...want.map(Math.abs));
+    const off = Math.max(...want.map((w, k) => Math.abs(got.sh[k] - w))) / scaleSh;
+    const ok = got.interpolation === 'tetrahedron' && off <= 1e-4;
+    failures += !ok;
+    console.log(`${ok ? 'ok' : 'FAIL'}: the sphere at tetrahedron 0's centroid (probes ${t.join(', ')}): ${got.interpolation}, its SH the mean of theirs within ${off.toExponential(1)} of the largest coefficient (bound 1e-4)`);
+  }
   if (context) await context.close();
 } finally {
   await srv.close();

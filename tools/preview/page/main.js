@@ -362,7 +362,7 @@ window.lmbRecord = (i) => records && i < records.count ? {
 // The probe-lit sphere: where it is, the irradiance SH lighting it (E, lux), the E and the linear
 // colour (albedo / pi x E) it shows for normal n; and moving it.
 window.lmbProbeSphere = (n) => probesView && probesView.sphere.visible ? {
-  at: probesView.at, sh: Array.from(probesView.sh), probes: probesView.used, albedo: SPHERE_ALBEDO,
+  at: probesView.at, sh: Array.from(probesView.sh), probes: probesView.used, interpolation: probesView.how, albedo: SPHERE_ALBEDO,
   irradiance: n ? shIrradiance(probesView.sh, n) : null,
   linear: n ? shIrradiance(probesView.sh, n).map((e) => Math.max(0, e) * SPHERE_ALBEDO / Math.PI) : null,
 } : null;

@@ -4,8 +4,11 @@
 // irradiance). The sphere's shader evaluates the interpolated irradiance SH at each normal and
 // shows albedo / pi x E, the same light a lightmapped surface shows; it gets no other light,
 // and nothing else gets the probes' light.
-// Interpolation: the probes within the 8 nearest, weighted by 1 / d^2 (a probe at the centre
-// itself is taken alone, so a test can read one probe's light exactly).
+// Interpolation: as Unity and Godot do, over the probes' tetrahedra (the bake's Delaunay
+// tetrahedra): inside one, its four probes with the point's barycentric weights (a probe at the
+// centre itself has weight 1, so a test can read one probe's light exactly). Outside them all
+// (beyond the probes' hull) or with no tetrahedra in the file: the 8 nearest probes weighted by
+// 1 / d^2.
 import * as THREE from 'three';
 
 const SH_Y = [0.282095, 0.488603, 0.488603, 0.488603, 1.092548, 1.092548, 0.315392, 1.092548, 0.546274];
@@ -20,11 +23,37 @@ export async function loadProbes(parser) {
   const sh = new Float32Array(await parser.getDependency('bufferView', p.sh));
   const toLux = p.scale === 'radiance' ? Math.PI : 1; // E / pi stored: back to E
   if (toLux !== 1) for (let i = 0; i < sh.length; i++) sh[i] *= toLux;
-  return { count: p.count, positions, sh, spacing: p.spacing || 0 };
+  const tetrahedra = p.tetrahedra !== undefined ? (await parser.getDependency('accessor', p.tetrahedra)).array : null;
+  return { count: p.count, positions, sh, spacing: p.spacing || 0, tetrahedra };
 }
 
-// The irradiance SH (27 floats) at point x: IDW over the 8 nearest probes.
+// The tetrahedron holding x and x's barycentric weights in it, or null (outside them all).
+export function findTetrahedron(probes, x) {
+  const t = probes.tetrahedra, P = probes.positions;
+  if (!t) return null;
+  const eps = 1e-7;
+  for (let k = 0; k < t.length; k += 4) {
+    const a = 3 * t[k], v = [0, 1, 2].map((j) => [P[3 * t[k + j + 1]] - P[a], P[3 * t[k + j + 1] + 1] - P[a + 1], P[3 * t[k + j + 1] + 2] - P[a + 2]]);
+    const q = [x[0] - P[a], x[1] - P[a + 1], x[2] - P[a + 2]];
+    const det = (u, w, z) => u[0] * (w[1] * z[2] - w[2] * z[1]) - u[1] * (w[0] * z[2] - w[2] * z[0]) + u[2] * (w[0] * z[1] - w[1] * z[0]);
+    const d = det(v[0], v[1], v[2]);
+    if (!(d > 0)) continue;
+    const b1 = det(q, v[1], v[2]) / d, b2 = det(v[0], q, v[2]) / d, b3 = det(v[0], v[1], q) / d, b0 = 1 - b1 - b2 - b3;
+    if (b0 >= -eps && b1 >= -eps && b2 >= -eps && b3 >= -eps) return { probes: [t[k], t[k + 1], t[k + 2], t[k + 3]], weights: [b0, b1, b2, b3] };
+  }
+  return null;
+}
+
+// The irradiance SH (27 floats) at point x: barycentric in its tetrahedron, else IDW over the 8
+// nearest probes. {sh, probes (those used), how: 'tetrahedron' or 'nearest'}.
 export function interpolateSH(probes, x) {
+  const tet = findTetrahedron(probes, x);
+  if (tet) {
+    const out = new Float32Array(27);
+    tet.probes.forEach((i, j) => { for (let k = 0; k < 27; k++) out[k] += tet.weights[j] * probes.sh[27 * i + k]; });
+    const used = tet.probes.filter((_, j) => tet.weights[j] > 1e-6);
+    return { sh: out, probes: used, weights: tet.weights, how: 'tetrahedron' };
+  }
   const near = [];
   for (let i = 0; i < probes.count; i++) {
     const dx = probes.positions[3 * i] - x[0], dy = probes.positions[3 * i + 1] - x[1], dz = probes.positions[3 * i + 2] - x[2];
@@ -36,7 +65,7 @@ export function interpolateSH(probes, x) {
     }
   }
   const out = new Float32Array(27);
-  if (!near.length) return { sh: out, probes: [] };
+  if (!near.length) return { sh: out, probes: [], how: 'nearest' };
   const exact = near[0].d2 <= 1e-12 * Math.max(1, probes.spacing * probes.spacing);
   const used = exact ? [near[0]] : near;
   let total = 0;
@@ -46,7 +75,7 @@ export function interpolateSH(probes, x) {
     for (let k = 0; k < 27; k++) out[k] += w * probes.sh[27 * n.i + k];
   }
   for (let k = 0; k < 27; k++) out[k] /= total;
-  return { sh: out, probes: used.map((n) => n.i) };
+  return { sh: out, probes: used.map((n) => n.i), how: 'nearest' };
 }
 
 // E for unit normal n from an irradiance SH (RGB).
@@ -112,7 +141,8 @@ export class ProbesView {
 
   // Puts the sphere at x (world) and lights it from the probes there.
   moveTo(x) {
-    const { sh, probes } = interpolateSH(this.probes, x);
+    const { sh, probes, how } = interpolateSH(this.probes, x);
+    this.how = how;
     for (let k = 0; k < 9; k++) this.material.uniforms.sh.value[k].set(sh[3 * k], sh[3 * k + 1], sh[3 * k + 2]);
     this.sphere.position.set(x[0], x[1], x[2]);
     this.sphere.visible = true;

@@ -1,0 +1,122 @@
+/*
+ * The probe set's tetrahedra (docs/probes.md#tetrahedra): the 3D Delaunay tetrahedralization of
+ * the probe positions by qhull (libqhull_r, Debian's libqhull-dev: the Delaunay of a point set is
+ * the lower hull of the points lifted onto a paraboloid, "qhull d Qbb Qt"), the mesh Unity's
+ * light probe groups and Godot's LightmapGI interpolate over: a point inside a tetrahedron takes
+ * its four probes' SH with its barycentric weights. qhull triangulates the non-simplicial cells a
+ * regular grid makes (8 cospherical points, option Qt) and may leave flat tetrahedra between two
+ * cells triangulated differently; those hold no volume and are dropped (counted). Each
+ * tetrahedron is written with a positive volume: (p1 - p0) x (p2 - p0) . (p3 - p0) > 0.
+ * Deterministic: one thread, facets in qhull's own order for the same points.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "probes.h"
+
+#include <libqhull_r/qhull_ra.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static double signed_volume6(const double *p, const uint32_t v[4])
+{
+    const double *a = p + 3 * (size_t)v[0], *b = p + 3 * (size_t)v[1], *c = p + 3 * (size_t)v[2],
+                 *d = p + 3 * (size_t)v[3];
+    double u[3], w[3], x[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        w[k] = c[k] - a[k];
+        x[k] = d[k] - a[k];
+    }
+    return (u[1] * w[2] - u[2] * w[1]) * x[0] + (u[2] * w[0] - u[0] * w[2]) * x[1] + (u[0] * w[1] - u[1] * w[0]) * x[2];
+}
+
+lmb_status lmb_probe_tetrahedra(const lmb_probe_set *set, lmb_probe_tetrahedra_out *out, lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (set->count < 4)
+        return LMB_OK;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    coordT *points = malloc(3 * (size_t)set->count * sizeof *points);
+    if (!points)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for the tetrahedra");
+    for (size_t i = 0; i < 3 * (size_t)set->count; i++) {
+        points[i] = set->position[i];
+        lo[i % 3] = fmin(lo[i % 3], points[i]);
+        hi[i % 3] = fmax(hi[i % 3], points[i]);
+    }
+    double extent = fmax(hi[0] - lo[0], fmax(hi[1] - lo[1], hi[2] - lo[2]));
+    /* flatter than this (relative to the set's extent cubed, x 6) holds no volume */
+    double flat = 1e-9 * extent * extent * extent;
+    char *messages = NULL;
+    size_t message_size = 0;
+    FILE *errors = open_memstream(&messages, &message_size);
+    qhT qh_qh, *qh = &qh_qh;
+    QHULL_LIB_CHECK
+    qh_zero(qh, errors);
+    char options[] = "qhull d Qbb Qt";
+    int code = errors ? qh_new_qhull(qh, 3, (int)set->count, points, False, options, NULL, errors) : -1;
+    lmb_status st = LMB_OK;
+    if (code == 0) {
+        facetT *facet;
+        vertexT *vertex, **vertexp;
+        size_t cap = 0;
+        FORALLfacets {
+            if (!facet->upperdelaunay)
+                cap++;
+        }
+        out->tetrahedra = malloc((4 * cap + 1) * sizeof *out->tetrahedra);
+        if (!out->tetrahedra)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu tetrahedra", cap);
+        FORALLfacets {
+            if (st != LMB_OK || facet->upperdelaunay)
+                continue;
+            uint32_t v[4], k = 0;
+            FOREACHvertex_(facet->vertices) {
+                if (k < 4)
+                    v[k] = (uint32_t)qh_pointid(qh, vertex->point);
+                k++;
+            }
+            if (k != 4) /* Qt makes every cell a simplex */
+                continue;
+            double vol = signed_volume6(set->position, v);
+            if (fabs(vol) <= flat) {
+                out->flat++;
+                continue;
+            }
+            if (vol < 0) {
+                uint32_t t = v[2];
+                v[2] = v[3];
+                v[3] = t;
+            }
+            memcpy(out->tetrahedra + 4 * (size_t)out->count, v, sizeof v);
+            out->count++;
+        }
+    } else if (errors) {
+        fflush(errors);
+        /* a flat or tiny set (a one-layer volume): no tetrahedra, and why */
+        const char *m = messages ? messages : "";
+        const char *stop = strstr(m, ".  "); /* qhull's first sentence; its advice on options follows */
+        int len = (int)(stop ? (size_t)(stop - m) : strcspn(m, "\n"));
+        snprintf(out->why, sizeof out->why, "%.*s", len, m);
+    } else {
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: cannot start qhull (no memory stream)");
+    }
+    qh_freeqhull(qh, !qh_ALL);
+    int curlong, totlong;
+    qh_memfreeshort(qh, &curlong, &totlong);
+    if (errors)
+        fclose(errors);
+    free(messages);
+    free(points);
+    if (st != LMB_OK)
+        lmb_probe_tetrahedra_free(out);
+    return st;
+}
+
+void lmb_probe_tetrahedra_free(lmb_probe_tetrahedra_out *out)
+{
+    free(out->tetrahedra);
+    memset(out, 0, sizeof *out);
+}
