@@ -18,8 +18,8 @@ import { projectRoot, resolveFile, TYPES } from './server.mjs';
 import { watchedFiles, snapshot, configKeys, fingerprint, compare } from './watch-inputs.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
-const POLL_MS = 200; // how often the files' sizes and times are looked at
-const SETTLE_MS = 300; // a change is baked once the files have stood still this long
+const POLL_MS = 100; // how often the files' sizes and times are looked at
+const SETTLE_MS = 200; // a change is baked once the files have stood still this long
 
 function parseArgs(args) {
   const o = { level: null, config: null, outdir: 'lmbake-out', port: 0, lightmap: null, lmbake: process.env.LMBAKE || path.join(projectRoot, 'build', 'lmbake'), quick: true };
