@@ -22,6 +22,7 @@
 #include "sphere.h"
 
 #include "util/lmb_math.h"
+#include "util/mat4.h"
 #include "util/rng.h"
 #include "util/sh.h"
 
@@ -58,30 +59,26 @@ static void add_delta(void *user, const double dir[3], const double e[3])
             d->l[k][c] += e[c] * y[k];
 }
 
-/* A rotation taking the lattice to round r's own directions (round 0: none): Shoemake's uniform
- * random unit quaternion, keyed by (seed, probe, round). */
-static void round_rotation(const probe_job *job, uint32_t i, uint32_t r, double m[9])
+/* The transform taking the lattice to round r's own directions (round 0: none): Shoemake's
+ * uniform random unit quaternion, keyed by (seed, probe, round). */
+static void round_rotation(const probe_job *job, uint32_t i, uint32_t r, double m[16])
 {
     if (r == 0) {
-        const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-        memcpy(m, id, sizeof id);
+        lmb_mat4_identity(m);
         return;
     }
     lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x524f544eull ^ i, r);
     double u1 = lmb_rng_next(&rng), u2 = 2 * LMB_PI * lmb_rng_next(&rng), u3 = 2 * LMB_PI * lmb_rng_next(&rng);
     double a = sqrt(1 - u1), b = sqrt(u1);
-    double x = a * sin(u2), y = a * cos(u2), z = b * sin(u3), w = b * cos(u3);
-    double r9[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
-                    2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-                    2 * (x * z - y * w),     2 * (y * z + x * w),     1 - 2 * (x * x + y * y)};
-    memcpy(m, r9, sizeof r9);
+    const double q[4] = {a * sin(u2), a * cos(u2), b * sin(u3), b * cos(u3)}, zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
+    lmb_mat4_from_trs(zero, q, one, m);
 }
 
 /* One round: the n lattice directions (rotated by m) traced from probe i, their radiance's SH
  * and the reflected light's cube added to sum and cube (each round weighted 4 pi / n), and the
  * mean radiance of the even and the odd directions (two interleaved half lattices) into half.
  * Returns the rays traced. */
-static uint64_t trace_round(const probe_job *job, uint32_t i, uint32_t r, const double m[9], delta_sum *sum,
+static uint64_t trace_round(const probe_job *job, uint32_t i, uint32_t r, const double m[16], delta_sum *sum,
                             double cube[6][3], double half[2])
 {
     const lmb_rt *rt = job->cache->rt;
@@ -93,8 +90,7 @@ static uint64_t trace_round(const probe_job *job, uint32_t i, uint32_t r, const 
     for (uint32_t j = 0; j < n; j++) {
         double v[3], w[3], l[3] = {0, 0, 0}, b[3] = {0, 0, 0};
         lmb_sphere_direction(j, n, v);
-        for (int k = 0; k < 3; k++)
-            w[k] = m[3 * k] * v[0] + m[3 * k + 1] * v[1] + m[3 * k + 2] * v[2];
+        lmb_mat4_vector(m, v, w);
         lmb_rt_hit h;
         rays++;
         if (!lmb_rt_intersect(rt, p, w, rt->eps, 1e300, &h)) {
@@ -146,7 +142,7 @@ static uint32_t ray_rounds(const probe_job *job, uint32_t i, delta_sum *sum, dou
     most = most > 64 ? 64 : most;
     uint32_t r = 0;
     while (r < most) {
-        double m[9], half[2];
+        double m[16], half[2];
         round_rotation(job, i, r, m);
         *rays += trace_round(job, i, r, m, sum, cube, half);
         means[r] = 0.5 * (half[0] + half[1]);

@@ -12,6 +12,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "probes.h"
 
+#include "util/frame.h"
+
 #include <libqhull_r/qhull_ra.h>
 
 #include <math.h>
@@ -19,17 +21,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* 6 x the tetrahedron's signed volume: (b - a) x (c - a) . (d - a) */
 static double signed_volume6(const double *p, const uint32_t v[4])
 {
-    const double *a = p + 3 * (size_t)v[0], *b = p + 3 * (size_t)v[1], *c = p + 3 * (size_t)v[2],
-                 *d = p + 3 * (size_t)v[3];
-    double u[3], w[3], x[3];
-    for (int k = 0; k < 3; k++) {
-        u[k] = b[k] - a[k];
-        w[k] = c[k] - a[k];
-        x[k] = d[k] - a[k];
-    }
-    return (u[1] * w[2] - u[2] * w[1]) * x[0] + (u[2] * w[0] - u[0] * w[2]) * x[1] + (u[0] * w[1] - u[1] * w[0]) * x[2];
+    const double *a = p + 3 * (size_t)v[0];
+    double e[3][3], x[3];
+    for (int j = 0; j < 3; j++)
+        for (int k = 0; k < 3; k++)
+            e[j][k] = p[3 * (size_t)v[j + 1] + k] - a[k];
+    lmb_cross3(e[0], e[1], x);
+    return lmb_dot3(x, e[2]);
 }
 
 lmb_status lmb_probe_tetrahedra(const lmb_probe_set *set, lmb_probe_tetrahedra_out *out, lmb_error *err)

@@ -74,8 +74,20 @@ try {
 
   doc.extensions.KHR_lights_punctual.lights[0].intensity *= 3;
   save();
+  // hold the final bake (SIGSTOP) once it runs, so the quick picture is on screen to be read
+  // however fast the final would come; let it go on after
+  const status = async () => (await fetch(url + 'status')).json();
+  let held = null;
+  for (let k = 0; k < 2400 && !held; k++) {
+    const st = await status();
+    if (st.baking && st.baking.generation === 2 && st.baking.kind === 'final') { held = st.baking.pid; process.kill(held, 'SIGSTOP'); }
+    else if (st.shown && st.shown.generation === 2 && st.shown.kind === 'final') break;
+    else await new Promise((r) => setTimeout(r, 25));
+  }
+  check(held !== null, `bake 2's final bake held while the quick one is read (pid ${held})`);
   await shown(2, 'quick');
   const q2 = await pixels('bake2-quick'), camQ = await camera();
+  if (held) process.kill(held, 'SIGCONT');
   await shown(2, 'final');
   const f2 = await pixels('bake2-final'), cam2 = await camera();
   for (let i = 0; i < points.length; i++) {

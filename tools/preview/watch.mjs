@@ -80,7 +80,7 @@ function bake(kind, generation) {
   return new Promise((resolve) => {
     const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     child = p;
-    status.baking = { generation, kind, stage: 'load', percent: 0, startedAt: Date.now() };
+    status.baking = { generation, kind, stage: 'load', percent: 0, startedAt: Date.now(), pid: p.pid };
     let stderr = '', pending = '';
     p.stdout.on('data', () => {});
     p.stderr.on('data', (d) => {
