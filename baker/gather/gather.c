@@ -49,7 +49,7 @@ static double cached_radiance(void *user, const double w[3], uint32_t sample, do
         return INFINITY;
     double albedo[3], e[3];
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
-    if (kind == LMB_HIT_DARK)
+    if (kind == LMB_HIT_DARK || (kind == LMB_HIT_UNMAPPED && job->unmapped_dark))
         return h.t;
     if (kind == LMB_HIT_UNMAPPED || job->direct_at_hits) {
         lmb_shading_point y;

@@ -35,6 +35,9 @@ typedef struct lmb_gather_job {
     uint32_t guide_lobes;       /* lobes a pilot learns (gather.lobes) */
     int direct_at_hits;         /* the cache holds indirect light only; direct light is computed
                                    at each hit with shadow rays (gather.direct_at_hits) */
+    int unmapped_dark;          /* hits on surfaces without a lightmap bring nothing: a bounce pass after the
+                                   first gathers what the last pass added (D_b = K D_{b-1}), and such a
+                                   surface's only light, its direct light, was the first pass's */
     const char *stage;          /* progress stage name */
     lmb_progress_fn progress;
     void *progress_user;

@@ -86,6 +86,7 @@ lmb_status lmb_lighting_bounces(const pass_env *env, uint32_t *passes, lmb_error
         lmb_estimator_options e = {.method = LMB_GATHER_COSINE, .rays = pass_rays(cfg, b), .iterations = 1};
         job->estimator = e;
         job->pass = b;
+        job->unmapped_dark = b >= 2; /* surfaces without a lightmap: their direct light, in the first pass only */
         if (automatic)
             snprintf(stage, sizeof stage, "bounce pass %u (auto)", b);
         else
@@ -134,6 +135,7 @@ lmb_status lmb_lighting_bounces(const pass_env *env, uint32_t *passes, lmb_error
             break;
         st = lmb_lighting_store(w, cache, err); /* the cache := D_b, what the next pass gathers */
     }
+    job->unmapped_dark = 0; /* the gathers after the passes read all the light */
     /* result := E_b + the tail D_b r / (1 - r); the cache := result */
     for (uint32_t a = 0; a < n && st == LMB_OK; a++)
         for (size_t k = 0; k < 3 * (size_t)w[a].t.count; k++) {
