@@ -8,6 +8,7 @@
 #include "../util/clock.h"
 #include "layout.h"
 #include "coverage.h"
+#include "layout_internal.h"
 #include "density.h"
 #include "keep_uv1.h"
 #include "rect_instances.h"
@@ -320,8 +321,8 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
 /* One placement of the lightmapped instances list[0..n) (their charts unwrapped, measures
  * taken): densities for `budget` texels (quietly: lmb_layout_build said them for the whole
  * budget), then packing. log: the packer's messages, NULL to keep a trial quiet. */
-static lmb_status place(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *all, uint32_t n,
-                        const lmb_density_measures *measures, uint64_t budget, const lmb_log *log, lmb_error *err)
+lmb_status lmb_layout_place(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *all, uint32_t n,
+                            const lmb_density_measures *measures, uint64_t budget, const lmb_log *log, lmb_error *err)
 {
     uint32_t *list = malloc(((size_t)n + 1) * sizeof *list);
     if (!list)
@@ -384,7 +385,7 @@ static lmb_status place(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l
 }
 
 /* Undoes place(): the charts stay, every placement goes. */
-static void unplace(lmb_layout *l)
+void lmb_layout_unplace(lmb_layout *l)
 {
     for (uint32_t i = 0; i < l->instance_count; i++) {
         free(l->instances[i].uv1);
@@ -400,91 +401,13 @@ static void unplace(lmb_layout *l)
     l->block_count = l->atlas_count = l->chart_total = 0;
 }
 
-/* A bake may make at most this share of atlas.texels (padding, partly covered edge texels and
- * raised small props included); a layout over it is made again at a lower density. */
-#define BUDGET_SLACK 1.10
-#define BUDGET_AIM 0.97
-#define BUDGET_ROUNDS 6
-
-/* texel_density: auto: places for the budget and counts the texels the layout makes
- * (coverage.h). The density's estimate counts surface only; small charts also touch texels at
- * their edges and are padded, so a level of many small charts makes more. While a layout makes
- * more than BUDGET_SLACK x the budget, the budget asked of the density is lowered and the layout
- * made again: first by the ratio, then along the line through the last two layouts (texels =
- * a x asked + m: m is what the charts take at any density, their edges and padding). When m
- * alone is over the budget, no density keeps it: lowering would only take texels from the
- * surfaces that can use them, so the first layout stays and a warning gives the numbers. A
- * level within the budget keeps its first layout, unchanged. */
-static lmb_status place_within_budget(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
-                                      uint32_t n, const lmb_density_measures *measures, const lmb_log *log,
-                                      int retry_if_over, int *over, lmb_error *err)
+/* Charts the instances list[0..n) place: their meshes' charts, once per instance. */
+static uint64_t placed_charts(const lmb_scene *s, const lmb_layout *l, const uint32_t *list, uint32_t n)
 {
-    uint64_t budget = lmb_config_atlas_texels(cfg), made = 0, first_made = 0;
-    double asked = (double)budget, prev_asked = 0, prev_made = 0, floor_texels = 0;
-    uint32_t round = 0;
-    int impossible = 0;
-    lmb_status st = LMB_OK;
-    for (;;) {
-        round++;
-        st = place(s, cfg, l, list, n, measures, (uint64_t)asked, round == 1 ? log : NULL, err);
-        if (st != LMB_OK || !l->density.automatic)
-            break;
-        made = lmb_layout_count_texels(s, l, cfg->texel_samples, cfg->threads, err, &st);
-        first_made = round == 1 ? made : first_made;
-        if (st != LMB_OK || made <= BUDGET_SLACK * (double)budget || round >= BUDGET_ROUNDS)
-            break;
-        double next = asked * BUDGET_AIM * (double)budget / (double)made;
-        if (round >= 2) {
-            double a = ((double)prev_made - (double)made) / (prev_asked - asked);
-            floor_texels = (double)made - a * asked;
-            impossible = !(a > 0) || floor_texels >= BUDGET_AIM * (double)budget;
-            if (!impossible)
-                next = (BUDGET_AIM * (double)budget - floor_texels) / a;
-        }
-        unplace(l);
-        if (impossible) { /* the first layout again: the density for the whole budget */
-            st = place(s, cfg, l, list, n, measures, budget, NULL, err);
-            made = first_made;
-            break;
-        }
-        prev_asked = asked;
-        prev_made = (double)made;
-        asked = fmax(1.0, floor(next));
-    }
-    if (st != LMB_OK)
-        return st;
-    l->density.budget = budget;
-    l->density.texels = made;
-    l->density.rounds = round;
-    double share = 100.0 * (double)made / (double)budget;
-    *over = impossible;
-    if (impossible && retry_if_over)
-        return LMB_OK; /* the caller tries fewer charts first */
-    if (impossible)
-        lmb_warn(log,
-                 "texel budget: the layout makes %llu texels, %.0f%% of atlas.texels %llu, and no density keeps it: "
-                 "its %u charts take about %.0f texels whatever the density (every chart touches a few texels and "
-                 "is padded; instanced copies repeat their mesh's charts), so the density stays %.4g texels per unit. "
-                 "Raise atlas.texels, or give small props fewer charts or no lightmap",
-                 (unsigned long long)made, share, (unsigned long long)budget, l->chart_total, floor_texels,
-                 l->density.scene_density);
-    else if (made > BUDGET_SLACK * (double)budget)
-        lmb_warn(log, "texel budget: %llu texels made, %.0f%% of atlas.texels %llu, after %u layouts",
-                 (unsigned long long)made, share, (unsigned long long)budget, round);
-    else if (round > 1)
-        lmb_info(log,
-                 "texel budget: the layout at the budget's density made %.0f%% of atlas.texels %llu (small charts' "
-                 "edge texels and padding, raised props); made again at %.4g texels per unit: %llu texels (%.0f%%)",
-                 100.0 * (double)first_made / (double)budget, (unsigned long long)budget, l->density.scene_density,
-                 (unsigned long long)made, share);
-    if (l->density.short_of_floor)
-        lmb_warn(log,
-                 "atlas.min_chart_texels: %u small instance(s) fall short of charts %u texels wide to keep the texel "
-                 "budget: they get %.0f%% of that density at least (charts down to %.1f texels); raise atlas.texels "
-                 "to give them more",
-                 l->density.short_of_floor, cfg->min_chart_texels, 100 * l->density.floor_share_min,
-                 cfg->min_chart_texels * l->density.floor_share_min);
-    return LMB_OK;
+    uint64_t charts = 0;
+    for (uint32_t k = 0; k < n; k++)
+        charts += l->meshes[s->instances[list[k]].mesh].charts.chart_count;
+    return charts;
 }
 
 lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progress_fn progress, void *user,
@@ -521,22 +444,26 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     double t0 = lmb_seconds();
     int over = 0;
     if (st == LMB_OK)
-        st = place_within_budget(s, cfg, l, list, n, &measures, log, 1, &over, err);
+        st = lmb_layout_place_within_budget(s, cfg, l, list, n, &measures, log, 1, &over, err);
     if (st == LMB_OK && over) {
-        /* no density keeps the budget with these charts: glue every chart that can be, and again */
-        uint32_t before = l->chart_total;
-        unplace(l);
-        lmb_density_measures_free(&measures);
+        /* no density keeps the budget with these charts: glue every chart that can be, and again
+         * (unless gluing leaves every mesh's charts as they were) */
+        uint64_t before = placed_charts(s, l, list, n);
         st = unwrap_meshes(s, cfg, l, NULL, NULL, 1, err);
-        if (st == LMB_OK)
+        uint64_t after = st == LMB_OK ? placed_charts(s, l, list, n) : before;
+        if (st == LMB_OK && after != before) {
+            lmb_density_measures_free(&measures);
             st = lmb_density_measure(s, cfg, l, list, n, &measures, err);
-        if (st == LMB_OK)
-            st = place_within_budget(s, cfg, l, list, n, &measures, log, 0, &over, err);
+            if (st == LMB_OK)
+                st = lmb_layout_place_within_budget(s, cfg, l, list, n, &measures, log, 1, &over, err);
+        }
         if (st == LMB_OK)
             lmb_info(log, "texel budget: the charts could not keep it at any density; every chart that can be was "
-                     "glued onto a neighbour: %u charts, were %u (%.0f%% of atlas.texels made)", l->chart_total, before,
-                     100.0 * (double)l->density.texels / (double)l->density.budget);
+                     "glued onto a neighbour: %llu charts, were %llu%s", (unsigned long long)after,
+                     (unsigned long long)before, over ? ", and still no density keeps it" : "");
     }
+    if (st == LMB_OK && over) /* still none: the props whose charts cost the most go to the light probes */
+        st = lmb_layout_light_by_probes(s, cfg, l, list, n, &measures, log, err);
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);

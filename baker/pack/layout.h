@@ -26,6 +26,9 @@ typedef struct lmb_density_report {
     double floor_share_min;  /* of those, the lowest share of its floor density one got */
     uint64_t texels;         /* texels the layout makes (coverage.h); 0 when not counted (explicit density) */
     uint32_t rounds;         /* layouts made to keep the budget: 1 when the first kept it */
+    double floor_texels;     /* when no density kept the budget: what the charts take at any density */
+    uint32_t probe_lit;      /* instances the budget moved to the light probes (probe_lit.h) */
+    uint32_t probe_lit_meshes; /* their meshes */
 } lmb_density_report;
 
 /* One mesh's primitives as a single triangle list (vertex ids offset per primitive). */
@@ -48,6 +51,8 @@ typedef struct lmb_layout_mesh {
 
 typedef struct lmb_layout_instance {
     int lightmapped;
+    int probe_lit;        /* not lightmapped: its mesh's charts could not keep the texel budget at any density, so
+                             the light probes light it (probe_lit.h); the probes cover its box */
     uint32_t atlas;
     double texel_density; /* texels per world unit used for it */
     uint32_t triangle_count; /* its mesh's triangles */

@@ -60,6 +60,64 @@ static void bounds_and_area(const lmb_scene *s, const lmb_layout *l, double lo[3
     *area = e.area;
 }
 
+/* The world boxes of the probe-lit instances (layout.h: props whose charts the texel budget could
+ * not hold, lit by the probes instead): their mesh's object-space box through their transform.
+ * Returns how many (boxes: 6 doubles each, lo then hi; caller frees), or -1 when out of memory. */
+static long probe_lit_boxes(const lmb_scene *s, const lmb_layout *l, double **boxes)
+{
+    *boxes = NULL;
+    size_t n = 0;
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        n += l->instances[i].probe_lit != 0;
+    if (!n)
+        return 0;
+    double *mesh_box = malloc(6 * ((size_t)s->mesh_count + 1) * sizeof *mesh_box);
+    double *out = malloc(6 * n * sizeof *out);
+    if (!mesh_box || !out) {
+        free(mesh_box);
+        free(out);
+        return -1;
+    }
+    for (uint32_t m = 0; m < s->mesh_count; m++) {
+        double *b = mesh_box + 6 * (size_t)m;
+        b[0] = b[1] = b[2] = HUGE_VAL;
+        b[3] = b[4] = b[5] = -HUGE_VAL;
+    }
+    for (uint32_t i = 0; i < s->instance_count; i++) { /* only the meshes that need it, once each */
+        uint32_t m = s->instances[i].mesh;
+        double *b = mesh_box + 6 * (size_t)m;
+        if (!l->instances[i].probe_lit || b[3] >= b[0])
+            continue;
+        const lmb_mesh *me = &s->meshes[m];
+        for (uint32_t p = me->first_primitive; p < me->first_primitive + me->primitive_count; p++)
+            for (uint32_t v = 0; v < s->primitives[p].vertex_count; v++)
+                for (int k = 0; k < 3; k++) {
+                    b[k] = fmin(b[k], s->primitives[p].positions[3 * (size_t)v + k]);
+                    b[3 + k] = fmax(b[3 + k], s->primitives[p].positions[3 * (size_t)v + k]);
+                }
+    }
+    size_t j = 0;
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        const double *b = mesh_box + 6 * (size_t)s->instances[i].mesh;
+        if (!l->instances[i].probe_lit || !(b[3] >= b[0]))
+            continue;
+        double *o = out + 6 * j++;
+        o[0] = o[1] = o[2] = HUGE_VAL;
+        o[3] = o[4] = o[5] = -HUGE_VAL;
+        for (int c = 0; c < 8; c++) {
+            double p[3] = {b[c & 1 ? 3 : 0], b[c & 2 ? 4 : 1], b[c & 4 ? 5 : 2]}, w[3];
+            lmb_mat4_point(s->instances[i].world, p, w);
+            for (int k = 0; k < 3; k++) {
+                o[k] = fmin(o[k], w[k]);
+                o[3 + k] = fmax(o[3 + k], w[k]);
+            }
+        }
+    }
+    free(mesh_box);
+    *boxes = out;
+    return (long)j;
+}
+
 /* Does triangle q touch the box centre c, half-size h? Its bounding box overlaps (the caller
  * visits only those cells) and its plane passes within the box (a conservative test: a cell
  * near a triangle's edge may count, which only refines it). */
@@ -118,6 +176,21 @@ static void mark_triangle(void *user, const double q[9])
             }
 }
 
+/* Marks the cells box (lo, hi: 6 doubles) overlaps. */
+static void mark_box(const grid *g, const double box[6], uint8_t *marked)
+{
+    uint32_t a[3], b[3];
+    for (int k = 0; k < 3; k++) {
+        double u0 = floor((box[k] - g->lo[k]) / g->cell[k]), u1 = floor((box[3 + k] - g->lo[k]) / g->cell[k]);
+        a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
+        b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
+    }
+    for (uint32_t z = a[2]; z <= b[2]; z++)
+        for (uint32_t y = a[1]; y <= b[1]; y++)
+            for (uint32_t x = a[0]; x <= b[0]; x++)
+                marked[cell_index(g, x, y, z)] = 1;
+}
+
 /* Marks every cell some lightmapped triangle passes through. */
 static void mark_surface_cells(const lmb_scene *s, const lmb_layout *l, const grid *g, uint8_t *marked)
 {
@@ -147,7 +220,10 @@ static int probe_fate(const lmb_rt *rt, const double p[3], double far)
 }
 
 /* The grid: auto spacing from the surface area (a probe per AUTO_PROBES-th of it), widened to
- * AUTO_MAX_CELLS cells; a flat level's thin axis gets one cell of the spacing, centred. */
+ * AUTO_MAX_CELLS cells. An axis thinner than the spacing gets one cell: the bounds' own extent
+ * when that is at least an eighth of the spacing (a ground with props on it: the probes at a
+ * quarter and three quarters of their height, where things move, not half of them under the
+ * ground), else one cell of the spacing, centred (a flat level). */
 static void make_grid(const lmb_config *cfg, const double lo[3], const double hi[3], double area, grid *g,
                       double *spacing)
 {
@@ -156,9 +232,10 @@ static void make_grid(const lmb_config *cfg, const double lo[3], const double hi
         size_t cells = 1;
         for (int k = 0; k < 3; k++) {
             double ext = hi[k] - lo[k];
-            g->n[k] = ext > s ? (uint32_t)fmin(ceil(ext / s), 1e6) : 1;
-            g->cell[k] = ext > s ? ext / g->n[k] : s;
-            g->lo[k] = ext > s ? lo[k] : 0.5 * (lo[k] + hi[k]) - 0.5 * s;
+            int thin = !(ext > s), flat = thin && !(ext >= 0.125 * s);
+            g->n[k] = thin ? 1 : (uint32_t)fmin(ceil(ext / s), 1e6);
+            g->cell[k] = flat ? s : ext / g->n[k];
+            g->lo[k] = flat ? 0.5 * (lo[k] + hi[k]) - 0.5 * s : lo[k];
             cells *= g->n[k];
         }
         if (cfg->probe_spacing > 0 || cells <= AUTO_MAX_CELLS)
@@ -209,13 +286,25 @@ static const char *config_name(const lmb_config *cfg)
 static lmb_status auto_grid(const lmb_scene *s, const lmb_layout *l, const lmb_config *cfg, lmb_probe_set *out,
                             candidates *c, lmb_error *err)
 {
-    double lo[3], hi[3], area;
+    double lo[3], hi[3], area, *boxes;
     bounds_and_area(s, l, lo, hi, &area);
-    if (!(area > 0) || !(hi[0] >= lo[0]))
+    long nbox = probe_lit_boxes(s, l, &boxes);
+    if (nbox < 0)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for the probe-lit instances' boxes");
+    for (long b = 0; b < nbox; b++) /* the grid covers the probe-lit props too */
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], boxes[6 * b + k]);
+            hi[k] = fmax(hi[k], boxes[6 * b + 3 + k]);
+        }
+    if (!(area > 0) || !(hi[0] >= lo[0])) {
+        free(boxes);
         return LMB_OK;
+    }
     grid g;
     make_grid(cfg, lo, hi, area, &g, &out->spacing);
     size_t cells = (size_t)g.n[0] * g.n[1] * g.n[2];
+    if (cells > LMB_PROBES_MAX)
+        free(boxes);
     if (cells > LMB_PROBES_MAX)
         return lmb_error_set(err, LMB_ERR_INPUT,
                              "%s: probes.spacing %g makes a grid of %ux%ux%u = %zu cells over the level's %g x %g x %g "
@@ -223,9 +312,14 @@ static lmb_status auto_grid(const lmb_scene *s, const lmb_layout *l, const lmb_c
                              "probes.spacing", config_name(cfg), cfg->probe_spacing, g.n[0], g.n[1], g.n[2], cells,
                              hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], LMB_PROBES_MAX, LMB_PROBE_SH + LMB_PROBE_CUBE);
     uint8_t *marked = calloc(cells + 1, 1);
-    if (!marked)
+    if (!marked) {
+        free(boxes);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %zu cells", cells);
+    }
     mark_surface_cells(s, l, &g, marked);
+    for (long b = 0; b < nbox; b++) /* and refines the cells their boxes overlap */
+        mark_box(&g, boxes + 6 * b, marked);
+    free(boxes);
     size_t want = 0;
     for (size_t k = 0; k < cells; k++) {
         want += marked[k] ? 8 : 1;

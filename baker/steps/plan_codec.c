@@ -97,7 +97,7 @@ lmb_status lmb_plan_encode(const lmb_layout *l, uint8_t **out, size_t *size, lmb
     }
     for (uint32_t i = 0; i < l->instance_count; i++) {
         const lmb_layout_instance *in = &l->instances[i];
-        put_u32(&w, (uint32_t)in->lightmapped);
+        put_u32(&w, (uint32_t)(in->lightmapped ? 1 : 0) | (in->probe_lit ? 2u : 0u)); /* flags */
         put_u32(&w, in->atlas);
         put_f64(&w, in->texel_density);
         put_u32(&w, (uint32_t)in->shared_layout);
@@ -247,7 +247,11 @@ lmb_status lmb_plan_decode(const char *name, const uint8_t *bytes, size_t size, 
     for (uint32_t i = 0; i < l->instance_count && !r.failed; i++) {
         lmb_layout_instance *in = &l->instances[i];
         uint32_t mesh_triangles = l->meshes[scene->instances[i].mesh].soup.triangle_count;
-        in->lightmapped = (int)get_u32(&r);
+        uint32_t flags = get_u32(&r);
+        in->lightmapped = (int)(flags & 1u);
+        in->probe_lit = (int)(flags >> 1 & 1u);
+        r.failed |= flags > 3 || (in->lightmapped && in->probe_lit);
+        l->density.probe_lit += (uint32_t)in->probe_lit;
         in->atlas = get_u32(&r);
         in->texel_density = get_f64(&r);
         in->shared_layout = (int)get_u32(&r);

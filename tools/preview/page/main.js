@@ -14,7 +14,7 @@ import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';
 import { startView, frontViewPose } from './start-view.js';
 import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
-import { loadProbes, ProbesView, shIrradiance, SPHERE_ALBEDO } from './probes-view.js';
+import { loadProbes, ProbesView, shIrradiance, SPHERE_ALBEDO, probeLitCopies, probeLitMaterial } from './probes-view.js';
 
 const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
 // "none" is three's LinearToneMapping: clamp(colour x 2^EV) (three applies no exposure at all
@@ -163,6 +163,17 @@ if (probesView) {
     probesView.moveTo(state.sphere);
   }
 } else if (state.sphere || state.probes) throw new Error('this bake has no light probes (probes.auto: false and no probes.volumes)');
+// Meshes without a lightmap (props the bake lit by its probes, meshes the config excluded): lit by
+// the probes at each copy's centre in the lit view (their material's colour) and the lightmap view
+// (white), as an engine lights them (probes-view.js)
+if (probes) for (const e of entries) {
+  if (e.lit.lightMap) continue;
+  e.probeLit = probeLitCopies(probes, e.mesh);
+  e.probeLitAlbedo = e.lit.color ? e.lit.color.clone() : new THREE.Color(1, 1, 1);
+  const normals = !!e.geometry.attributes.normal;
+  e.probeLitLit = probeLitMaterial(e.probeLit, e.probeLitAlbedo, normals);
+  e.probeLitWhite = probeLitMaterial(e.probeLit, new THREE.Color(1, 1, 1), normals);
+}
 const fly = new Fly(camera, renderer.domElement, extent * 0.3);
 
 function frontView() {
@@ -195,8 +206,8 @@ controls.addEventListener('change', requestRender);
 function apply() {
   const m = state.mode;
   for (const e of entries) {
-    let mat = e.lit, geom = e.geometry;
-    if (m === 'lightmap') mat = e.lightmap || GREY;
+    let mat = e.probeLitLit || e.lit, geom = e.geometry;
+    if (m === 'lightmap') mat = e.lightmap || e.probeLitWhite || GREY;
     else if (m === 'records') mat = e.lightmap ? (e.recordsBase ||= recordsBaseMaterial(e.lightmap)) : GREY;
     else if (m === 'invalid') mat = e.invalid || GREY;
     else if (m === 'checker') { mat = e.checker || GREY; geom = e.checkerGeometry || e.geometry; }
@@ -239,6 +250,8 @@ function updateInfo() {
     directionalMaterials,
     records: records ? { count: records.count, reachMin: records.reachMin, reachMax: records.reachMax, uri: records.uri } : { count: 0 },
     atlasView: { atlas: atlasView.atlas, layer: atlasView.layer, zoom: atlasView.zoom, originX: atlasView.originX, originY: atlasView.originY },
+    // meshes without a lightmap lit by the probes: copies, and how each copy's SH was interpolated
+    probeLit: entries.filter((e) => e.probeLit).map((e) => ({ object: e.mesh.name, node: e.node, copies: e.probeLit.copies, interpolation: e.probeLit.how })),
     probes: probesView ? { count: probes.count, spacing: probes.spacing, markers: probesView.markers.visible,
       sphere: probesView.sphere.visible ? { at: probesView.at, radius: probesView.sphere.geometry.parameters.radius, probes: probesView.used } : null } : { count: 0 },
   });
@@ -327,6 +340,11 @@ function pick(px, py) {
   const r = { object: hit.object.name, point: hit.point.toArray(), distance: hit.distance, atlas: e ? e.atlas : -1 };
   if (e) r.node = e.node;
   if (hit.instanceId !== undefined) r.instance = hit.instanceId; // an InstancedMesh's copy
+  if (hit.face) { // the triangle's normal in world space (through the copy's matrix too)
+    const m = hit.object.matrixWorld.clone();
+    if (hit.instanceId !== undefined) m.multiply(hit.object.getMatrixAt(hit.instanceId, new THREE.Matrix4()));
+    r.faceNormal = hit.face.normal.clone().applyMatrix3(new THREE.Matrix3().getNormalMatrix(m)).normalize().toArray();
+  }
   if (hit.uv1) {
     // uv1: the mesh's TEXCOORD_1; lightmapUv: where the atlas is read, uv1 x scale + offset
     // (an InstancedMesh's copy: its own rectangle, scaleOffset)
@@ -366,6 +384,16 @@ window.lmbProbeSphere = (n) => probesView && probesView.sphere.visible ? {
   irradiance: n ? shIrradiance(probesView.sh, n) : null,
   linear: n ? shIrradiance(probesView.sh, n).map((e) => Math.max(0, e) * SPHERE_ALBEDO / Math.PI) : null,
 } : null;
+// A mesh without a lightmap lit by the probes (object: its name): copy k's centre, SH, albedo,
+// and for normal n the E and the linear colour (albedo / pi x E) the lit view shows.
+window.lmbProbeLit = (object, k, n) => {
+  const e = entries.find((x) => x.probeLit && x.mesh.name === object);
+  if (!e || !(k >= 0 && k < e.probeLit.copies)) return null;
+  const sh = e.probeLit.sh.subarray(27 * k, 27 * k + 27), albedo = e.probeLitAlbedo.toArray();
+  const E = n ? shIrradiance(sh, n) : null;
+  return { centre: e.probeLit.centres[k], sh: Array.from(sh), albedo, irradiance: E,
+    linear: E ? E.map((x, c) => Math.max(0, x) * albedo[c] / Math.PI) : null };
+};
 // The camera (px,py,pz,tx,ty,tz as the cam parameter) and the exposure, without a reload.
 window.lmbSetView = (cam, ev) => {
   const c = cam.split(',').map(Number);
