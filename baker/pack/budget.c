@@ -111,76 +111,112 @@ lmb_status lmb_layout_place_within_budget(const lmb_scene *s, const lmb_config *
     return LMB_OK;
 }
 
-/* No density keeps the budget with every chart (l placed with list[0..n), l->density.floor_texels
- * known): the meshes drawn many times whose charts cost the most are lit by the probes instead
- * (probe_lit.h) and the rest placed again, within the budget; measures become the kept list's.
- * With nothing to move the layout stays and the log says no density keeps it. */
-lmb_status lmb_layout_light_by_probes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
-                                  uint32_t n, lmb_density_measures *measures, const lmb_log *log, lmb_error *err)
+/* The moved meshes' names and copies, for the warning ("'Prop' (10000), ..."). */
+static void moved_names(const lmb_scene *s, const uint8_t *moved, char *names, size_t size)
 {
-    uint32_t *keep = malloc(((size_t)n + 1) * sizeof *keep);
-    uint8_t *moved = malloc((size_t)s->instance_count + 1);
-    lmb_probe_lit_choice choice;
-    if (!keep || !moved ||
-        lmb_probe_lit_choose(s, l, list, n, measures->area, l->density.floor_texels, l->density.budget, keep, moved,
-                             &choice) != 0) {
-        free(keep);
-        free(moved);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
-    }
-    if (!choice.moved) { /* the layout for the whole budget, over it */
-        free(keep);
-        free(moved);
-        uint64_t made = l->density.texels;
-        lmb_status st = lmb_layout_place(s, cfg, l, list, n, measures, l->density.budget, NULL, err);
-        l->density.texels = made;
-        if (st == LMB_OK)
-            report_budget(cfg, l, log, 1, 0);
-        return st;
-    }
-    double floor_texels = l->density.floor_texels;
-    uint64_t budget = l->density.budget;
-    char names[160] = "";
     size_t used = 0;
     uint32_t named = 0;
-    for (uint32_t m = 0; m < s->mesh_count && used + 1 < sizeof names; m++) { /* the moved meshes, by index */
+    names[0] = '\0';
+    for (uint32_t m = 0; m < s->mesh_count && used + 1 < size; m++) { /* by mesh index */
         uint32_t copies = 0;
         for (uint32_t i = 0; i < s->instance_count; i++)
             copies += moved[i] && s->instances[i].mesh == m;
         if (!copies)
             continue;
-        int w = named < 3 ? snprintf(names + used, sizeof names - used, "%s'%.40s' (%u)", named ? ", " : "",
-                                     s->meshes[m].name, copies)
-                          : snprintf(names + used, sizeof names - used, ", ...");
+        int w = named < 3 ? snprintf(names + used, size - used, "%s'%.40s' (%u)", named ? ", " : "", s->meshes[m].name,
+                                     copies)
+                          : snprintf(names + used, size - used, ", ...");
         used += w > 0 ? (size_t)w : 0;
         if (named++ >= 3)
             break;
     }
-    lmb_layout_unplace(l);
-    lmb_density_measures_free(measures);
-    lmb_status st = lmb_density_measure(s, cfg, l, keep, choice.kept, measures, err);
-    int over = 0;
-    if (st == LMB_OK)
-        st = lmb_layout_place_within_budget(s, cfg, l, keep, choice.kept, measures, log, 0, &over, err);
-    for (uint32_t i = 0; st == LMB_OK && i < s->instance_count; i++)
-        l->instances[i].probe_lit = moved[i];
-    l->density.probe_lit = choice.moved;
-    l->density.probe_lit_meshes = choice.moved_meshes;
-    int probes_off = !cfg->probes_auto && cfg->probe_volume_count == 0 && s->probe_volume_count == 0;
-    if (st == LMB_OK)
-        lmb_warn(log,
-                 "texel budget: %u instance(s) of %u mesh(es) drawn many times are lit by the light probes, not the "
-                 "lightmap: %s. With them every chart together takes about %.0f texels whatever the density, %.0f%% "
-                 "of atlas.texels %llu (each chart touches a few texels and is padded; every copy repeats its mesh's "
-                 "charts). They still cast shadows and bounce light%s. To lightmap them, raise atlas.texels above "
-                 "about %.0f or give those meshes fewer charts",
-                 choice.moved, choice.moved_meshes, names, floor_texels, 100.0 * floor_texels / (double)budget,
-                 (unsigned long long)budget,
-                 probes_off ? "; the probes are off (probes.auto false, no volumes), so they get no baked light"
-                            : ", and the probe grid covers them",
-                 2.0 * floor_texels);
-    free(keep);
-    free(moved);
-    return st;
 }
 
+/* No density keeps the budget with every chart: either the rounds found the charts' floor over it
+ * (failed == LMB_OK, l->density.floor_texels known) or a mesh's copies fit no atlas at any
+ * density (failed == LMB_ERR_INPUT, l->unfit_mesh; err holds that error). The meshes drawn many
+ * times whose charts cost the most (and any that fit no atlas, found again on each try) are lit by
+ * the probes instead (probe_lit.h) and the rest placed again within the budget; measures become
+ * the kept list's. With nothing to move: the layout for the whole budget and its warning, or the
+ * error as it was. */
+lmb_status lmb_layout_light_by_probes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
+                                      uint32_t n, lmb_density_measures *measures, const lmb_log *log,
+                                      lmb_status failed, lmb_error *err)
+{
+    uint32_t *keep = malloc(((size_t)n + 1) * sizeof *keep);
+    uint8_t *moved = malloc((size_t)s->instance_count + 1), *forced = calloc((size_t)s->mesh_count + 1, 1);
+    double *area = malloc(((size_t)n + 1) * sizeof *area);
+    if (!keep || !moved || !forced || !area) {
+        free(keep);
+        free(moved);
+        free(forced);
+        free(area);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+    }
+    memcpy(area, measures->area, (size_t)n * sizeof *area); /* the whole list's: measures become the kept one's */
+    double floor_texels = failed == LMB_OK ? l->density.floor_texels : 0;
+    uint64_t budget = lmb_config_atlas_texels(cfg);
+    int unfit = failed != LMB_OK;
+    if (unfit)
+        forced[l->unfit_mesh] = 1;
+    lmb_probe_lit_choice choice = {0};
+    lmb_status st = failed;
+    for (uint32_t tries = 0; tries <= s->mesh_count; tries++) {
+        if (lmb_probe_lit_choose(s, l, list, n, area, floor_texels, budget, forced, keep, moved, &choice) != 0) {
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
+            break;
+        }
+        if (!choice.moved)
+            break;
+        lmb_layout_unplace(l);
+        lmb_density_measures_free(measures);
+        st = lmb_density_measure(s, cfg, l, keep, choice.kept, measures, err);
+        int over = 0;
+        if (st == LMB_OK)
+            st = lmb_layout_place_within_budget(s, cfg, l, keep, choice.kept, measures, log, 0, &over, err);
+        if (st != LMB_ERR_INPUT || l->unfit_mesh == UINT32_MAX || forced[l->unfit_mesh])
+            break;
+        forced[l->unfit_mesh] = 1; /* another mesh's copies fit no atlas: it goes too */
+        unfit = 1;
+    }
+    if (!choice.moved && failed == LMB_OK && st == LMB_OK) { /* nothing can go: the whole budget's layout, over it */
+        uint64_t made = l->density.texels;
+        st = lmb_layout_place(s, cfg, l, list, n, measures, budget, NULL, err);
+        l->density.texels = made;
+        if (st == LMB_OK)
+            report_budget(cfg, l, log, 1, 0);
+    }
+    if (st == LMB_OK && choice.moved) {
+        for (uint32_t i = 0; i < s->instance_count; i++)
+            l->instances[i].probe_lit = moved[i];
+        l->density.probe_lit = choice.moved;
+        l->density.probe_lit_meshes = choice.moved_meshes;
+        char names[160];
+        moved_names(s, moved, names, sizeof names);
+        int probes_off = !cfg->probes_auto && cfg->probe_volume_count == 0 && s->probe_volume_count == 0;
+        const char *shadows = probes_off
+                                  ? "; the probes are off (probes.auto false, no volumes), so they get no baked light"
+                                  : ", and the probe grid covers them";
+        if (floor_texels > 0 && !unfit)
+            lmb_warn(log,
+                     "texel budget: %u instance(s) of %u mesh(es) drawn many times are lit by the light probes, not "
+                     "the lightmap: %s. With them every chart together takes about %.0f texels whatever the density, "
+                     "%.0f%% of atlas.texels %llu (each chart touches a few texels and is padded; every copy repeats "
+                     "its mesh's charts). They still cast shadows and bounce light%s. To lightmap them, raise "
+                     "atlas.texels above about %.0f or give those meshes fewer charts",
+                     choice.moved, choice.moved_meshes, names, floor_texels, 100.0 * floor_texels / (double)budget,
+                     (unsigned long long)budget, shadows, 2.0 * floor_texels);
+        else
+            lmb_warn(log,
+                     "texel budget: %u instance(s) of %u mesh(es) drawn many times are lit by the light probes, not "
+                     "the lightmap: %s. The copies of a node share one atlas, and theirs fit no %ux%u atlas at any "
+                     "density (each chart is padded; every copy repeats its mesh's charts). They still cast shadows "
+                     "and bounce light%s. To lightmap them, raise atlas.max_size or give those meshes fewer charts",
+                     choice.moved, choice.moved_meshes, names, cfg->max_atlas_size, cfg->max_atlas_size, shadows);
+    }
+    free(keep);
+    free(moved);
+    free(forced);
+    free(area);
+    return st;
+}

@@ -416,6 +416,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     memset(l, 0, sizeof *l);
     l->mesh_count = s->mesh_count;
     l->instance_count = s->instance_count;
+    l->unfit_mesh = UINT32_MAX;
     l->meshes = calloc((size_t)s->mesh_count + 1, sizeof *l->meshes);
     l->instances = calloc((size_t)s->instance_count + 1, sizeof *l->instances);
     uint32_t *list = malloc(((size_t)s->instance_count + 1) * sizeof *list), n = 0;
@@ -445,6 +446,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
     int over = 0;
     if (st == LMB_OK)
         st = lmb_layout_place_within_budget(s, cfg, l, list, n, &measures, log, 1, &over, err);
+    int unfit = st == LMB_ERR_INPUT && l->unfit_mesh != UINT32_MAX; /* copies that fit no atlas at any density */
     if (st == LMB_OK && over) {
         /* no density keeps the budget with these charts: glue every chart that can be, and again
          * (unless gluing leaves every mesh's charts as they were) */
@@ -462,8 +464,8 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
                      "glued onto a neighbour: %llu charts, were %llu%s", (unsigned long long)after,
                      (unsigned long long)before, over ? ", and still no density keeps it" : "");
     }
-    if (st == LMB_OK && over) /* still none: the props whose charts cost the most go to the light probes */
-        st = lmb_layout_light_by_probes(s, cfg, l, list, n, &measures, log, err);
+    if ((st == LMB_OK && over) || unfit) /* still none: the props whose charts cost the most go to the probes */
+        st = lmb_layout_light_by_probes(s, cfg, l, list, n, &measures, log, st, err);
     l->pack_seconds = lmb_seconds() - t0;
     if (progress && st == LMB_OK)
         progress(user, "pack", 1, 1);

@@ -85,6 +85,8 @@ typedef struct lmb_layout {
     uint32_t block_count;
     lmb_layout_block *blocks; /* layouts shared by rectangle-placed instances */
     uint32_t chart_total;  /* charts placed, over all instances */
+    uint32_t unfit_mesh;   /* after a placement failed with texel_density: auto because a mesh's copies fit no atlas at
+                              any density (rect_instances.c): that mesh, else UINT32_MAX */
     lmb_density_report density;    /* how densities were chosen */
     double pack_seconds;
 } lmb_layout;

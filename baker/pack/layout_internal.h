@@ -25,10 +25,13 @@ lmb_status lmb_layout_place_within_budget(const lmb_scene *s, const lmb_config *
                                           const uint32_t *list, uint32_t n, const lmb_density_measures *measures,
                                           const lmb_log *log, int retry_if_over, int *over, lmb_error *err);
 
-/* No density keeps the budget with every chart (l->density.floor_texels known): the props the
- * probes light instead (probe_lit.h) leave list, the rest is placed within the budget (measures
- * become the kept list's); with nothing to move, the layout for the whole budget and a warning. */
+/* No density keeps the budget with every chart: failed == LMB_OK when the rounds found the charts'
+ * floor over it (l->density.floor_texels), LMB_ERR_INPUT when a mesh's copies fit no atlas at any
+ * density (l->unfit_mesh, err set). The props the probes light instead (probe_lit.h) leave list,
+ * the rest is placed within the budget (measures become the kept list's); with nothing to move,
+ * the layout for the whole budget and a warning, or the error as it was. */
 lmb_status lmb_layout_light_by_probes(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, const uint32_t *list,
-                                      uint32_t n, lmb_density_measures *measures, const lmb_log *log, lmb_error *err);
+                                      uint32_t n, lmb_density_measures *measures, const lmb_log *log,
+                                      lmb_status failed, lmb_error *err);
 
 #endif

@@ -19,8 +19,8 @@ static int by_cost_desc(const void *pa, const void *pb)
 }
 
 int lmb_probe_lit_choose(const lmb_scene *s, const lmb_layout *l, const uint32_t *list, uint32_t n,
-                         const double *area, double floor_texels, uint64_t budget, uint32_t *keep, uint8_t *moved,
-                         lmb_probe_lit_choice *out)
+                         const double *area, double floor_texels, uint64_t budget, const uint8_t *forced,
+                         uint32_t *keep, uint8_t *moved, lmb_probe_lit_choice *out)
 {
     memset(out, 0, sizeof *out);
     memset(moved, 0, s->instance_count);
@@ -53,8 +53,16 @@ int lmb_probe_lit_choose(const lmb_scene *s, const lmb_layout *l, const uint32_t
     qsort(cost, used, sizeof *cost, by_cost_desc);
     double kept_floor = floor_texels, target = LMB_PROBE_LIT_FLOOR_SHARE * (double)budget;
     uint32_t lightmapped_meshes = used;
+    for (uint32_t j = 0; forced && j < used && lightmapped_meshes > 1; j++) { /* those that fit no atlas */
+        if (!forced[cost[j].mesh])
+            continue;
+        go[cost[j].mesh] = 1;
+        kept_floor -= all_charts > 0 ? floor_texels * cost[j].charts / all_charts : 0;
+        lightmapped_meshes--;
+        out->moved_meshes++;
+    }
     for (uint32_t j = 0; j < used && kept_floor > target && lightmapped_meshes > 1; j++) {
-        if (cost[j].copies < 2)
+        if (cost[j].copies < 2 || go[cost[j].mesh])
             continue;
         go[cost[j].mesh] = 1;
         kept_floor -= all_charts > 0 ? floor_texels * cost[j].charts / all_charts : 0;

@@ -32,11 +32,12 @@ typedef struct lmb_probe_lit_choice {
  * over `budget`. A mesh's share of the floor is estimated by its charts times its copies over
  * all charts placed; meshes drawn at least twice go, most floor texels per world area first
  * (mesh index breaks ties), until the kept floor is at most LMB_PROBE_LIT_FLOOR_SHARE of the
- * budget. The last lightmapped mesh always stays. keep: n entries; moved: instance_count
+ * budget. forced (per mesh, may be NULL): meshes that go first whatever their cost (copies that
+ * fit no atlas at any density). The last lightmapped mesh always stays. keep: n entries; moved: instance_count
  * bytes, zeroed here. Deterministic: it reads only the layout and the scene. Returns 0 with
  * out->moved == 0 when nothing can go; -1 when out of memory. */
 int lmb_probe_lit_choose(const lmb_scene *scene, const lmb_layout *l, const uint32_t *list, uint32_t n,
-                         const double *area, double floor_texels, uint64_t budget, uint32_t *keep, uint8_t *moved,
-                         lmb_probe_lit_choice *out);
+                         const double *area, double floor_texels, uint64_t budget, const uint8_t *forced,
+                         uint32_t *keep, uint8_t *moved, lmb_probe_lit_choice *out);
 
 #endif

@@ -261,6 +261,7 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
     double *area = malloc(((size_t)n + 1) * sizeof *area);
     lmb_rect_result r;
     memset(&r, 0, sizeof r);
+    l->unfit_mesh = UINT32_MAX;
     uint32_t ng = order && groups && items && area ? make_groups(s, cfg, l, list, n, order, groups) : UINT32_MAX;
     lmb_status st = ng != UINT32_MAX ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "layout: out of memory");
     for (uint32_t j = 0; st == LMB_OK && j < n; j++)
@@ -303,6 +304,8 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
         g->block = NULL;
         st = make_block(s, cfg, l, first, g, NULL, err);
     }
+    if (st == LMB_ERR_INPUT && r.failed_group < ng && l->density.automatic) /* the layout may light it by probes */
+        l->unfit_mesh = s->instances[order[groups[r.failed_group].first]].mesh;
     if (st == LMB_ERR_INPUT && r.failed_group < ng)
         st = lmb_error_set(err, LMB_ERR_INPUT,
                            "instance '%s' (mesh '%s') and the copies that share its layout do not fit in one %ux%u "

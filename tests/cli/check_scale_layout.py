@@ -8,7 +8,8 @@ over a ground, and single:2, the soup level):
   - with atlas.texels 20,000 the props' 18 charts each (5,401 in all) take more than the budget
     at any density (edges and padding): the props are lit by the light probes instead, a
     warning names the mesh, its 300 copies and what the charts take whatever the density (over
-    the budget), and the ground's layout keeps the budget;
+    the budget), and the ground's layout keeps the budget; with atlas.max_size 128 the copies
+    (one atlas for all) fit no atlas at any density: they go to the probes too, not an error;
   - 0 overlapping texels in every atlas of both levels at 1x and 4x the default budget;
   - a bake where nothing emits light (the sun made `realtime`) stops after the layout: the
     warning, no light stage, black lightmaps, and the same texels as the layout counted.
@@ -92,6 +93,15 @@ def main():
           "gpu:300 atlas.texels 20000: the props go to the probes, said with the numbers (%s); %d texels made"
           % (m.group(0) if m else p.stderr[-600:], made))
     check("no density keeps it" not in p.stderr, "gpu:300 atlas.texels 20000: no 'no density keeps it' warning")
+    # atlas.max_size 128: the 300 copies, which share one atlas, fit none at any density
+    p = unwrap(lmbake, gpu, work, "gpu:300 atlas.max_size 128", "atlas:\n  max_size: 128\n")
+    m = re.search(r"texel budget: 300 instance\(s\) of 1 mesh\(es\) drawn many times are lit by the light probes, "
+                  r"not the lightmap: 'Prop' \(300\)\. The copies of a node share one atlas, and theirs fit no "
+                  r"128x128 atlas at any density", p.stderr)
+    _, budget, made = budget_line(p.stdout) if p.returncode == 0 else (0, 1, -1)
+    check(p.returncode == 0 and m and 0 < made <= 1.10 * budget,
+          "gpu:300 atlas.max_size 128: the copies go to the probes instead of an error (%s); %d texels for %d"
+          % (m.group(0) if m else p.stderr[-600:], made, budget))
     n, overlaps = overlapping(p.stdout)
     check(n > 0 and overlaps == 0, "gpu:300 atlas.texels 20000: %d overlapping texels" % overlaps)
     check_layout(lmbake, gpu, work, "gpu:300 4x budget", 4 * DEFAULT_BUDGET)

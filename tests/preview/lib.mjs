@@ -168,3 +168,21 @@ export function gltfAccessors(gltfFile) {
   };
   return { json, dir, read };
 }
+
+// A bake's light probes from its glTF (asset.extras.lightmap.probes), read from the buffers here,
+// not by the page's code: {count, spacing, positions (Float32Array xyz), sh (27 per probe, E in
+// lux), tetrahedra (Uint32Array, 4 per tetrahedron) or null}.
+export function readProbes(file) {
+  const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
+  const p = doc.asset.extras.lightmap.probes;
+  const bytes = (viewIndex, length) => {
+    const v = doc.bufferViews[viewIndex], b = fs.readFileSync(path.join(path.dirname(file), doc.buffers[v.buffer].uri));
+    const start = b.byteOffset + (v.byteOffset || 0);
+    return b.buffer.slice(start, start + (length ?? v.byteLength));
+  };
+  const scale = p.scale === 'radiance' ? Math.PI : 1;
+  const tetrahedra = p.tetrahedra !== undefined
+    ? new Uint32Array(bytes(doc.accessors[p.tetrahedra].bufferView, 4 * doc.accessors[p.tetrahedra].count)) : null;
+  return { count: p.count, spacing: p.spacing, positions: new Float32Array(bytes(doc.accessors[p.positions].bufferView)),
+    sh: new Float32Array(bytes(p.sh)).map((v) => v * scale), tetrahedra };
+}

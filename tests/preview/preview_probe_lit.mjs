@@ -12,22 +12,12 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
 import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
-import { decodePng } from './lib.mjs';
+import { decodePng, readProbes } from './lib.mjs';
 
 const [gltfFile, shotsDir] = process.argv.slice(2);
 if (!shotsDir) { console.error('usage: node tests/preview/preview_probe_lit.mjs GLTF SHOTS_DIR'); process.exit(1); }
 const TOL = 0.02;
 
-function readProbes(file) {
-  const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
-  const p = doc.asset.extras.lightmap.probes;
-  const view = (i) => {
-    const v = doc.bufferViews[i], b = fs.readFileSync(path.join(path.dirname(file), doc.buffers[v.buffer].uri));
-    return new Float32Array(b.buffer.slice(b.byteOffset + (v.byteOffset || 0), b.byteOffset + (v.byteOffset || 0) + v.byteLength));
-  };
-  const scale = p.scale === 'radiance' ? Math.PI : 1;
-  return { count: p.count, spacing: p.spacing, positions: view(doc.accessors[p.positions].bufferView), sh: view(p.sh).map((v) => v * scale) };
-}
 // E(+Y) of an SH (27 floats, offset o): Y00, Y1-1 = 0.488603 y, Y20 = 0.315392 (3z^2 - 1) = -0.315392, Y22 = -0.546274
 const eUpY = (sh, o) => [0, 1, 2].map((c) => 0.282095 * sh[o + c] + 0.488603 * sh[o + 3 + c] - 0.315392 * sh[o + 18 + c] - 0.546274 * sh[o + 24 + c]);
 const lum = (e) => 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];

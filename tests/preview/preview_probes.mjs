@@ -13,29 +13,13 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
 import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
-import { decodePng, srgb } from './lib.mjs';
+import { decodePng, srgb, readProbes } from './lib.mjs';
 
 const [gltfFile, shotsDir] = process.argv.slice(2);
 if (!shotsDir) { console.error('usage: node tests/preview/preview_probes.mjs GLTF SHOTS_DIR'); process.exit(1); }
 const ALBEDO = 0.8; // probes-view.js's sphere
 const TOL = 2;
 
-// The probes from the glTF: positions and SH (E in lux), read from its buffers.
-function readProbes(file) {
-  const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
-  const p = doc.asset.extras.lightmap.probes;
-  const view = (i) => {
-    const v = doc.bufferViews[i], b = fs.readFileSync(path.join(path.dirname(file), doc.buffers[v.buffer].uri));
-    return new Float32Array(b.buffer.slice(b.byteOffset + (v.byteOffset || 0), b.byteOffset + (v.byteOffset || 0) + v.byteLength));
-  };
-  const scale = p.scale === 'radiance' ? Math.PI : 1;
-  let tetrahedra = null;
-  if (p.tetrahedra !== undefined) {
-    const a = doc.accessors[p.tetrahedra], v = doc.bufferViews[a.bufferView], b = fs.readFileSync(path.join(path.dirname(file), doc.buffers[v.buffer].uri));
-    tetrahedra = new Uint32Array(b.buffer.slice(b.byteOffset + (v.byteOffset || 0), b.byteOffset + (v.byteOffset || 0) + 4 * a.count));
-  }
-  return { count: p.count, spacing: p.spacing, positions: view(doc.accessors[p.positions].bufferView), sh: view(p.sh).map((v) => v * scale), tetrahedra };
-}
 // E(+Z) of probe i: the SH at n = (0, 0, 1): Y00, Y10 = 0.488603 z, Y20 = 0.315392 (3z^2 - 1)
 const eUpZ = (pr, i) => [0, 1, 2].map((c) => 0.282095 * pr.sh[27 * i + c] + 0.488603 * pr.sh[27 * i + 6 + c] + 0.630784 * pr.sh[27 * i + 18 + c]);
 const lum = (e) => 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];

@@ -86,6 +86,14 @@ export function shIrradiance(sh, n) {
   return [0, 1, 2].map((c) => b.reduce((s, v, k) => s + v * sh[3 * k + c], 0));
 }
 
+// E(n) from an irradiance SH in GLSL (the basis of SH_Y above), for the materials below.
+const SH_GLSL = /* glsl */`
+  vec3 shIrradiance(vec3 sh[9], vec3 n) {
+    return sh[0] * 0.282095 + sh[1] * 0.488603 * n.y + sh[2] * 0.488603 * n.z + sh[3] * 0.488603 * n.x
+      + sh[4] * 1.092548 * n.x * n.y + sh[5] * 1.092548 * n.y * n.z + sh[6] * 0.315392 * (3.0 * n.z * n.z - 1.0)
+      + sh[7] * 1.092548 * n.x * n.z + sh[8] * 0.546274 * (n.x * n.x - n.y * n.y);
+  }`;
+
 // A material showing albedo / pi x E(n) for the SH in its uniform (tone-mapped like the level).
 function shMaterial(albedo) {
   return new THREE.ShaderMaterial({
@@ -100,12 +108,10 @@ function shMaterial(albedo) {
       uniform vec3 sh[9];
       uniform float albedo;
       varying vec3 vNormal;
+      ${SH_GLSL}
       void main() {
         vec3 n = normalize(vNormal);
-        vec3 e = sh[0] * 0.282095 + sh[1] * 0.488603 * n.y + sh[2] * 0.488603 * n.z + sh[3] * 0.488603 * n.x
-          + sh[4] * 1.092548 * n.x * n.y + sh[5] * 1.092548 * n.y * n.z + sh[6] * 0.315392 * (3.0 * n.z * n.z - 1.0)
-          + sh[7] * 1.092548 * n.x * n.z + sh[8] * 0.546274 * (n.x * n.x - n.y * n.y);
-        gl_FragColor = vec4(max(e, vec3(0.0)) * albedo / 3.14159265358979, 1.0);
+        gl_FragColor = vec4(max(shIrradiance(sh, n), vec3(0.0)) * albedo / 3.14159265358979, 1.0);
         #include <tonemapping_fragment>
         #include <colorspace_fragment>
       }`,
@@ -222,6 +228,7 @@ export function probeLitMaterial(copies, albedo, normals) {
       varying vec3 vWorld;
       varying vec3 vNormal;
       flat varying int vCopy;
+      ${SH_GLSL}
       void main() {
         #ifdef LMB_VERTEX_NORMALS
           vec3 n = normalize(vNormal) * (gl_FrontFacing ? 1.0 : -1.0);
@@ -231,10 +238,7 @@ export function probeLitMaterial(copies, albedo, normals) {
         ivec2 at = ivec2(9 * (vCopy % ${PER_ROW}), vCopy / ${PER_ROW});
         vec3 sh[9];
         for (int k = 0; k < 9; k++) sh[k] = texelFetch(shTex, at + ivec2(k, 0), 0).rgb;
-        vec3 e = sh[0] * 0.282095 + sh[1] * 0.488603 * n.y + sh[2] * 0.488603 * n.z + sh[3] * 0.488603 * n.x
-          + sh[4] * 1.092548 * n.x * n.y + sh[5] * 1.092548 * n.y * n.z + sh[6] * 0.315392 * (3.0 * n.z * n.z - 1.0)
-          + sh[7] * 1.092548 * n.x * n.z + sh[8] * 0.546274 * (n.x * n.x - n.y * n.y);
-        gl_FragColor = vec4(max(e, vec3(0.0)) * albedo / 3.14159265358979, 1.0);
+        gl_FragColor = vec4(max(shIrradiance(sh, n), vec3(0.0)) * albedo / 3.14159265358979, 1.0);
         #include <tonemapping_fragment>
         #include <colorspace_fragment>
       }`,
