@@ -125,10 +125,11 @@ async function bakeNewest() {
   const generation = ++status.generation;
   Object.assign(status, { state: 'baking', changed: change.what, layout: change.layout });
   say(`bake ${generation}: ${change.what.join('; ')} (${change.layout ? 'layout and lighting' : 'lighting only'})`);
-  const seen = movedAt || Date.now();
+  const seen = movedAt || Date.now(), started = lastSnapshot;
   for (const kind of opts.quick ? ['quick', 'final'] : ['final']) {
     const r = await bake(kind, generation);
     if (r.cancelled || dirty) return;
+    if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
     const seconds = (Date.now() - seen) / 1000;
     status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout };
@@ -141,6 +142,16 @@ async function bakeNewest() {
   status.lastGood = { fp };
   goodPrint = print;
   status.state = 'idle';
+}
+
+// A bake that failed while the files moved under it (a save it read half-way, before the poll
+// saw the save) is a stopped bake, not an error: the newest state is baked once it settles.
+function superseded(kind, generation) {
+  say(`${kind} bake ${generation} stopped (the files changed while it read them)`);
+  status.cancelled++;
+  lastSnapshot = snapshot(files);
+  movedAt = Date.now();
+  dirty = true;
 }
 
 function failed(message) {
