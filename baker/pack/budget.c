@@ -114,22 +114,24 @@ lmb_status lmb_layout_place_within_budget(const lmb_scene *s, const lmb_config *
 /* The moved meshes' names and copies, for the warning ("'Prop' (10000), ..."). */
 static void moved_names(const lmb_scene *s, const uint8_t *moved, char *names, size_t size)
 {
+    names[0] = '\0';
+    uint32_t *copies = calloc((size_t)s->mesh_count + 1, sizeof *copies);
+    if (!copies)
+        return; /* the warning goes out without names */
+    for (uint32_t i = 0; i < s->instance_count; i++) /* one pass: copies per mesh */
+        copies[s->instances[i].mesh] += moved[i];
     size_t used = 0;
     uint32_t named = 0;
-    names[0] = '\0';
-    for (uint32_t m = 0; m < s->mesh_count && used + 1 < size; m++) { /* by mesh index */
-        uint32_t copies = 0;
-        for (uint32_t i = 0; i < s->instance_count; i++)
-            copies += moved[i] && s->instances[i].mesh == m;
-        if (!copies)
+    for (uint32_t m = 0; m < s->mesh_count && used + 1 < size && named <= 3; m++) { /* by mesh index */
+        if (!copies[m])
             continue;
         int w = named < 3 ? snprintf(names + used, size - used, "%s'%.40s' (%u)", named ? ", " : "", s->meshes[m].name,
-                                     copies)
+                                     copies[m])
                           : snprintf(names + used, size - used, ", ...");
         used += w > 0 ? (size_t)w : 0;
-        if (named++ >= 3)
-            break;
+        named++;
     }
+    free(copies);
 }
 
 /* No density keeps the budget with every chart: either the rounds found the charts' floor over it

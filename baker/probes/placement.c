@@ -146,6 +146,16 @@ static size_t cell_index(const grid *g, uint32_t x, uint32_t y, uint32_t z)
     return ((size_t)z * g->n[1] + y) * g->n[0] + x;
 }
 
+/* The cells box (lo, hi: 6 doubles) overlaps, clamped to the grid: a[k]..b[k] per axis. */
+static void cells_of_box(const grid *g, const double box[6], uint32_t a[3], uint32_t b[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double u0 = floor((box[k] - g->lo[k]) / g->cell[k]), u1 = floor((box[3 + k] - g->lo[k]) / g->cell[k]);
+        a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
+        b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
+    }
+}
+
 typedef struct marking {
     const grid *g;
     uint8_t *marked;
@@ -157,13 +167,13 @@ static void mark_triangle(void *user, const double q[9])
     const marking *m = user;
     const grid *g = m->g;
     double h[3] = {0.5 * g->cell[0], 0.5 * g->cell[1], 0.5 * g->cell[2]};
-    uint32_t a[3], b[3];
+    double box[6];
     for (int k = 0; k < 3; k++) {
-        double mn = fmin(q[k], fmin(q[3 + k], q[6 + k])), mx = fmax(q[k], fmax(q[3 + k], q[6 + k]));
-        double u0 = floor((mn - g->lo[k]) / g->cell[k]), u1 = floor((mx - g->lo[k]) / g->cell[k]);
-        a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
-        b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
+        box[k] = fmin(q[k], fmin(q[3 + k], q[6 + k]));
+        box[3 + k] = fmax(q[k], fmax(q[3 + k], q[6 + k]));
     }
+    uint32_t a[3], b[3];
+    cells_of_box(g, box, a, b);
     for (uint32_t z = a[2]; z <= b[2]; z++)
         for (uint32_t y = a[1]; y <= b[1]; y++)
             for (uint32_t x = a[0]; x <= b[0]; x++) {
@@ -180,11 +190,7 @@ static void mark_triangle(void *user, const double q[9])
 static void mark_box(const grid *g, const double box[6], uint8_t *marked)
 {
     uint32_t a[3], b[3];
-    for (int k = 0; k < 3; k++) {
-        double u0 = floor((box[k] - g->lo[k]) / g->cell[k]), u1 = floor((box[3 + k] - g->lo[k]) / g->cell[k]);
-        a[k] = u0 < 0 ? 0 : u0 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u0;
-        b[k] = u1 < 0 ? 0 : u1 >= g->n[k] ? g->n[k] - 1 : (uint32_t)u1;
-    }
+    cells_of_box(g, box, a, b);
     for (uint32_t z = a[2]; z <= b[2]; z++)
         for (uint32_t y = a[1]; y <= b[1]; y++)
             for (uint32_t x = a[0]; x <= b[0]; x++)
