@@ -514,7 +514,7 @@ static int run(int argc, char **argv, stage_kind stage)
         printf("%s: %.3f s, %llu rays, %.4g rays/s, ", cfg.reference ? "reference" : "final gather", bs.gather_seconds,
                (unsigned long long)bs.gather_rays, bs.gather_seconds > 0 ? (double)bs.gather_rays / bs.gather_seconds : 0.0);
         if (bs.gather_records)
-            printf("%llu records of %u rays (irradiance_cache.error %g)", (unsigned long long)bs.gather_records,
+            printf("%llu records of at most %u rays (irradiance_cache.error %g)", (unsigned long long)bs.gather_records,
                    cfg.gather_rays * cfg.ic_ray_scale, cfg.ic_error);
         else
             printf("%u rays per texel", cfg.gather_rays);

@@ -187,8 +187,9 @@ static lmb_status gather_texel(const lmb_gather_job *job, uint32_t atlas, const 
  * ray-weighted mean of both gathers (each unbiased).
  */
 static lmb_status more_rays(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
-                            const lmb_estimator_options *opt, const lmb_estimate *est, int guided, point_rays *pr,
-                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st)
+                            const lmb_estimator_options *opt, double max_rays, const lmb_estimate *est, int guided,
+                            point_rays *pr, lmb_estimator_scratch *scratch, lmb_gather_point_result *out,
+                            lmb_gather_stats *st)
 {
     if (!(job->noise_target > 0) || !(est->var > 0) || !job->cache || job->reference)
         return LMB_OK;
@@ -198,8 +199,8 @@ static lmb_status more_rays(const lmb_gather_job *job, uint32_t atlas, const lmb
         return LMB_OK;
     double want = ceil(opt->rays * est->var / (target * target));
     st->extended++;
-    if (want > job->max_rays) {
-        want = job->max_rays;
+    if (want > max_rays) {
+        want = max_rays;
         st->capped++;
     }
     if (want <= opt->rays)
@@ -223,12 +224,18 @@ static lmb_status more_rays(const lmb_gather_job *job, uint32_t atlas, const lmb
 }
 
 lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
-                            const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
-                            lmb_gather_point_result *out, lmb_gather_stats *st)
+                            const lmb_mixture *guide, uint32_t learn_lobes, double ray_share,
+                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st)
 {
     point_rays pr;
     point_setup(job, atlas, t, i, &pr);
     lmb_estimator_options opt = job->estimator;
+    double max_rays = job->max_rays;
+    if (ray_share < 1) {
+        double rays = floor(opt.rays * ray_share + 0.5);
+        opt.rays = rays < 1 ? 1 : (uint32_t)rays;
+        max_rays = floor(max_rays * ray_share + 0.5);
+    }
     opt.gradient = 1;
     opt.guide = guide;
     int guided = lmb_estimator_guided(&opt);
@@ -247,7 +254,7 @@ lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lm
     else
         out->harmonic = pr.inverse_distances > 0 ? pr.distances / pr.inverse_distances : HUGE_VAL;
     out->learned = est.learned;
-    if (more_rays(job, atlas, t, i, &opt, &est, guided, &pr, scratch, out, st) != LMB_OK)
+    if (more_rays(job, atlas, t, i, &opt, max_rays, &est, guided, &pr, scratch, out, st) != LMB_OK)
         return LMB_ERR_INTERNAL;
     st->rays += pr.rays;
     st->texels++;

@@ -70,10 +70,11 @@ typedef struct lmb_gather_point_result {
 } lmb_gather_point_result;
 
 /* guide: a mixture to gather by (lmb_estimator_guided; NULL: none); learn_lobes > 0: fit one
- * (out->learned) when not guided. */
+ * (out->learned) when not guided. ray_share in (0, 1]: this share of the job's rays and of its
+ * max_rays (1: the job's). */
 lmb_status lmb_gather_record(const lmb_gather_job *job, uint32_t atlas, const lmb_texels *t, uint32_t i,
-                            const lmb_mixture *guide, uint32_t learn_lobes, lmb_estimator_scratch *scratch,
-                            lmb_gather_point_result *out, lmb_gather_stats *st);
+                            const lmb_mixture *guide, uint32_t learn_lobes, double ray_share,
+                            lmb_estimator_scratch *scratch, lmb_gather_point_result *out, lmb_gather_stats *st);
 
 /* The indirect part of every listed texel's light direction (directional lightmaps): the
  * irradiance-weighted sum of incoming directions, sum lum(L) w cos over the hemisphere (lux),

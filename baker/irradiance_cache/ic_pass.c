@@ -84,8 +84,48 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, uint32_t
     return LMB_OK;
 }
 
+/* records.serves: how many texels each record serves, from its shares of every valid texel's
+ * interpolation (lmb_ic_add_shares), rounded up and kept within [1, ray_scale]. A record that
+ * gathers ray_scale x a texel's rays for fewer texels than that costs more than gathering at
+ * those texels would: records crowd where charts are small or normals turn (instanced props
+ * of a few hundred texels each), and there a record serves one or two texels. Positions and
+ * reaches fixed, the shares are too: counted by the first pass that gathers again and kept
+ * with the records; the same at any thread count. */
+static lmb_status count_served(pass_ctx *c, lmb_error *err)
+{
+    uint32_t m = c->records.count, scale = c->opt->ray_scale;
+    if (scale <= 1 || !m || c->records.serves)
+        return LMB_OK;
+    uint64_t *share = calloc(m, sizeof *share);
+    uint32_t *serves = malloc((size_t)m * sizeof *serves);
+    if (!share || !serves) {
+        free(serves);
+        free(share);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", m);
+    }
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        const lmb_texels *t = c->t[a];
+#pragma omp parallel for num_threads(c->threads) schedule(dynamic, 1024)
+        for (uint32_t i = 0; i < t->count; i++) {
+            double p[3], n[3];
+            if (!t->valid[i])
+                continue;
+            lmb_ic_texel_point(c, (texel_at){a, i}, p, n);
+            lmb_ic_add_shares(&c->records, p, n, share);
+        }
+    }
+    for (uint32_t k = 0; k < m; k++) {
+        uint64_t texels = (share[k] + LMB_IC_SHARE_ONE - 1) / LMB_IC_SHARE_ONE;
+        serves[k] = texels < 1 ? 1 : texels > scale ? scale : (uint32_t)texels;
+    }
+    free(share);
+    c->records.serves = serves;
+    return LMB_OK;
+}
+
 /* The records of an earlier pass, gathered again with this pass's light, group by group in
- * placement order (guided gathering reads earlier groups' mixtures). */
+ * placement order (guided gathering reads earlier groups' mixtures); a record that serves
+ * fewer texels than ray_scale gathers that many texels' rays (count_served). */
 static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
 {
     uint32_t m = c->records.count, groups = 0;
@@ -101,7 +141,7 @@ static lmb_status regather(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
         groups = c->records.rec[k].group + 1 > groups ? c->records.rec[k].group + 1 : groups;
     }
     c->level = c->levels - 1;
-    lmb_status st = LMB_OK;
+    lmb_status st = count_served(c, err);
     uint64_t done = 0;
     /* unguided, a record's gather reads no other record: all groups in one step */
     uint32_t step_groups = c->guided ? groups : 1;

@@ -178,7 +178,9 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                     }
                 }
                 lmb_gather_point_result g;
-                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, &scratch, &g, &gs) !=
+                double share = rs->slots && c->records.serves ? (double)c->records.serves[rs->slots[k]] / c->opt->ray_scale : 1;
+                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, share, &scratch, &g,
+                                      &gs) !=
                     LMB_OK) {
                     failed = 1;
                     continue;
@@ -272,7 +274,10 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, co
     char name[160];
     snprintf(name, sizeof name, "%s: %s %u", c->stage, slots ? "records gathered again, group" : "records placed, level",
              slots ? c->regather_group : c->group);
-    lmb_step_desc d = {name, m, NULL, (double)m * c->job->estimator.rays, gather_records_range, &rs};
+    double rays = 0;
+    for (uint64_t k = 0; k < m; k++)
+        rays += slots && c->records.serves ? (double)c->records.serves[slots[k]] / c->opt->ray_scale : 1;
+    lmb_step_desc d = {name, m, NULL, rays * c->job->estimator.rays, gather_records_range, &rs};
     uint64_t counters[LMB_STEP_COUNTERS];
     records_taken rt = {c, slots, candidates, rec, 0, 0};
     /* records gathered again overwrite records their own group reads: taken once all are gathered */

@@ -27,6 +27,7 @@ void lmb_ic_records_free(lmb_ic_records *s)
     free(s->order);
     free(s->box);
     free(s->reach);
+    free(s->serves);
     memset(s, 0, sizeof *s);
 }
 
@@ -34,6 +35,8 @@ lmb_status lmb_ic_records_append(lmb_ic_records *s, const lmb_ic_record *r, uint
 {
     if ((uint64_t)s->count + n > UINT32_MAX - 1)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: more than 4 billion records");
+    free(s->serves);
+    s->serves = NULL;
     if (s->count + n > s->cap) {
         uint32_t cap = s->cap ? s->cap : 1024;
         while (cap < s->count + n)
@@ -311,6 +314,31 @@ double lmb_ic_interpolate(const lmb_ic_records *s, const double p[3], const doub
     return c.sum;
 }
 
+typedef struct share_ctx {
+    const lmb_ic_records *s;
+    const double *p, *n;
+    double sum;
+    uint64_t *share;
+} share_ctx;
+
+static void share_visit(void *user, uint32_t k)
+{
+    share_ctx *c = user;
+    double w = lmb_ic_weight(c->s, &c->s->rec[k], c->p, c->n);
+    if (!(w > 0))
+        return;
+    uint64_t part = (uint64_t)llround(w / c->sum * LMB_IC_SHARE_ONE);
+#pragma omp atomic
+    c->share[k] += part;
+}
+
+void lmb_ic_add_shares(const lmb_ic_records *s, const double p[3], const double n[3], uint64_t *share)
+{
+    share_ctx c = {s, p, n, lmb_ic_interpolate(s, p, n, NULL), share};
+    if (c.sum > 0)
+        walk(s, p, -1, share_visit, &c);
+}
+
 /* ---- neighbour clamping ------------------------------------------------------------------ */
 
 typedef struct clamp_ctx {
@@ -340,6 +368,8 @@ lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *
     double *h = malloc(((size_t)s->count + 1) * sizeof *h);
     if (!h)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory clamping %u records", s->count);
+    free(s->serves);
+    s->serves = NULL;
     int nt = threads ? (int)threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(nt) schedule(dynamic, 256)
     for (uint32_t i = 0; i < s->count; i++) {

@@ -51,6 +51,9 @@ typedef struct lmb_ic_records {
     uint32_t nodes;
     float (*box)[6];       /* per node: min xyz, max xyz of its records' positions */
     float *reach;          /* per node: the largest r below it */
+    /* per record, the texels it serves within [1, ray_scale] (ic_pass.c, count_served): set by
+     * the first pass that gathers at the records again, dropped when records are added or clamped */
+    uint32_t *serves;
 } lmb_ic_records;
 
 /* An empty set for error setting a (> 0). Free with lmb_ic_records_free. */
@@ -73,6 +76,15 @@ double lmb_ic_weight(const lmb_ic_records *s, const lmb_ic_record *r, const doub
 /* Sum of the weights at (p, n); with e != NULL also the interpolated irradiance (0 when the
  * sum is 0). Reads the index: call lmb_ic_records_index first. */
 double lmb_ic_interpolate(const lmb_ic_records *s, const double p[3], const double n[3], double e[3]);
+
+/* Fixed point of lmb_ic_add_shares: a whole texel. */
+#define LMB_IC_SHARE_ONE 65536
+
+/* Adds to share[k] record k's part of the interpolation at (p, n), w_k / sum of the weights, in
+ * units of 1 / LMB_IC_SHARE_ONE (rounded): summed over every valid texel, how many texels a
+ * record serves. The additions are atomic integers, so a parallel sweep gives the same sums
+ * at any thread count. Reads the index. */
+void lmb_ic_add_shares(const lmb_ic_records *s, const double p[3], const double n[3], uint64_t *share);
 
 /* The nearest record k with eligible[k] set whose shading normal is within acos(min_cos) of n
  * and that lies within twice its reach of p; -1 when there is none. Reads the index. */

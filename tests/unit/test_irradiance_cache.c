@@ -12,7 +12,11 @@
  *   - the two facts that let later placement rounds skip candidates (ic_pass.c,
  *     uncovered_again): on random record sets, clamping never grows a reach, and a record's
  *     weight at any point never grows when its reach shrinks, so a weight sum falls only
- *     where a reach shrank.
+ *     where a reach shrank;
+ *   - the texels a record serves (lmb_ic_add_shares, what sets its rays when gathered again):
+ *     a lone record that reaches only its own point serves exactly 1; on a floor grid every
+ *     point gives out 1 in all (to the rounding), an inner record serves the points per record,
+ *     and a parallel sweep gives the same integers as a serial one.
  */
 #include "check.h"
 
@@ -224,6 +228,48 @@ static void test_reach_only_shrinks(void)
     CHECK(fell > 100);             /* some of which the shrinking lowered */
 }
 
+static void test_shares(void)
+{
+    lmb_ic_records s;
+    lmb_error err;
+    lmb_ic_records_init(&s, 0.3);
+    floor_grid(&s, 0.1, 20, constant);                     /* records 0..399, reach 0.15 */
+    lmb_ic_record lone = rec(10, 10, 0, 0, 0, 1, 1, 0.05); /* record 400, far from the grid */
+    CHECK(lmb_ic_records_append(&s, &lone, 1, &err) == LMB_OK);
+    CHECK(lmb_ic_records_index(&s, 0, &err) == LMB_OK);
+    enum { SIDE = 76, POINTS = SIDE * SIDE };
+    uint64_t serial[401] = {0}, parallel[401] = {0};
+    double n[3] = {0, 0, 1};
+    /* points every 0.025 over [0, 1.9]: 16 per record of the grid */
+    for (int k = 0; k < POINTS; k++) {
+        double p[3] = {0.0125 + 0.025 * (k % SIDE), 0.0125 + 0.025 * (k / SIDE), 0};
+        lmb_ic_add_shares(&s, p, n, serial);
+    }
+#pragma omp parallel for schedule(dynamic, 7)
+    for (int k = 0; k < POINTS; k++) {
+        double p[3] = {0.0125 + 0.025 * (k % SIDE), 0.0125 + 0.025 * (k / SIDE), 0};
+        lmb_ic_add_shares(&s, p, n, parallel);
+    }
+    double lone_p[3] = {10, 10, 0};
+    lmb_ic_add_shares(&s, lone_p, n, serial);
+    lmb_ic_add_shares(&s, lone_p, n, parallel);
+    CHECK(serial[400] == LMB_IC_SHARE_ONE);
+    uint64_t total = 0;
+    int same = 1;
+    for (int k = 0; k < 401; k++) {
+        total += serial[k];
+        same &= serial[k] == parallel[k];
+    }
+    CHECK(same);
+    /* each point's parts are rounded once per record that weighs there (at most ~9) */
+    double points = (double)total / LMB_IC_SHARE_ONE;
+    CHECK(fabs(points - (POINTS + 1)) < (POINTS + 1) * 9.0 / LMB_IC_SHARE_ONE);
+    /* an inner record (row 10, column 10) serves about the 16 points of its cell */
+    double inner = (double)serial[10 * 20 + 10] / LMB_IC_SHARE_ONE;
+    CHECK(inner > 14 && inner < 18);
+    lmb_ic_records_free(&s);
+}
+
 int main(void)
 {
     test_constant_plane();
@@ -231,5 +277,6 @@ int main(void)
     test_gradients();
     test_neighbour_clamp();
     test_reach_only_shrinks();
+    test_shares();
     return check_failed_count != 0;
 }
