@@ -280,8 +280,10 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, co
     lmb_step_desc d = {name, m, NULL, rays * c->job->estimator.rays, gather_records_range, &rs};
     uint64_t counters[LMB_STEP_COUNTERS];
     records_taken rt = {c, slots, candidates, rec, 0, 0};
-    /* records gathered again overwrite records their own group reads: taken once all are gathered */
-    lmb_status st = lmb_steps_run_streamed(c->job->steps, &d, slots ? 0 : RECORD_CHUNK, take_records, &rt, counters, err);
+    /* taken as they come, records gathered again too: a take writes the irradiance, rotation
+     * gradient and mixture of records of the group being gathered, which no gather of the
+     * group reads (they read positions, reaches and earlier groups' mixtures only) */
+    lmb_status st = lmb_steps_run_streamed(c->job->steps, &d, RECORD_CHUNK, take_records, &rt, counters, err);
     stats->rays += counters[0];
     stats->texels += counters[1];
     stats->adapted += counters[2];
