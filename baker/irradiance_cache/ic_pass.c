@@ -251,6 +251,7 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint
                              (unsigned long long)n);
     }
     uint64_t m = 0;
+    c->spacing = spacing;
     st = lmb_ic_gather_records(c, cand, n, NULL, round == 0, fresh, &m, 0, n, stats, err);
     for (uint64_t k = 0; st == LMB_OK && k < m; k++) {
         c->is_record[fresh[k].atlas][fresh[k].texel] = 1;

@@ -33,7 +33,8 @@ typedef struct lmb_ic_options {
     double error;          /* Ward's a (> 0) */
     double min_spacing;    /* texels: the smallest reach */
     double max_spacing;    /* texels: the largest reach, and the first level's grid */
-    uint32_t ray_scale;    /* a record gathers with ray_scale x the pass's rays per texel */
+    uint32_t ray_scale;    /* a record gathers with ray_scale x the pass's rays per texel, or fewer
+                              where it stands for fewer texels (ic_record_step.c, ray_share) */
 } lmb_ic_options;
 
 /* A pass's records as the preview draws them: x, y, z (world) and reach per record. */

@@ -31,6 +31,7 @@ typedef struct pass_ctx {
     char stage[96];
     uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
     uint32_t regather_group;      /* the group being gathered again (step names) */
+    uint32_t spacing;             /* the placement level's grid spacing (texels) being gathered */
     /* guided gathering (gather/guide.h): per record, the mixture it gathered by or learned in
      * this pass; has_mix[k] is set once record k's whole group is gathered, so a record is
      * guided only by records of earlier groups (deterministic at any thread count) */

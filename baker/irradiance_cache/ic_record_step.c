@@ -123,6 +123,19 @@ static int take_mixture(lmb_buf *in, lmb_mixture *m)
     return 1;
 }
 
+/* The share of the record rays (ray_scale x a texel's) a record gathers with: placed on a grid of
+ * spacing s, it stands for at most s x s texels, so min(s^2, ray_scale) texels' rays; gathered
+ * again, the texels it serves (ic_pass.c, count_served). Never more than a record costs without
+ * the cache at the texels it stands for. */
+static double ray_share(const pass_ctx *c, const uint32_t *slots, uint64_t k)
+{
+    double scale = c->opt->ray_scale;
+    if (slots)
+        return c->records.serves ? c->records.serves[slots[k]] / scale : 1;
+    double cell = (double)c->spacing * c->spacing;
+    return cell < scale ? cell / scale : 1;
+}
+
 /* A gather_records call as a step: its items are the texels at[]. */
 typedef struct records_step {
     pass_ctx *c;
@@ -178,9 +191,8 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                     }
                 }
                 lmb_gather_point_result g;
-                double share = rs->slots && c->records.serves ? (double)c->records.serves[rs->slots[k]] / c->opt->ray_scale : 1;
-                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, share, &scratch, &g,
-                                      &gs) !=
+                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, ray_share(c, rs->slots, k),
+                                      &scratch, &g, &gs) !=
                     LMB_OK) {
                     failed = 1;
                     continue;
@@ -276,7 +288,7 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, co
              slots ? c->regather_group : c->group);
     double rays = 0;
     for (uint64_t k = 0; k < m; k++)
-        rays += slots && c->records.serves ? (double)c->records.serves[slots[k]] / c->opt->ray_scale : 1;
+        rays += ray_share(c, slots, k);
     lmb_step_desc d = {name, m, NULL, rays * c->job->estimator.rays, gather_records_range, &rs};
     uint64_t counters[LMB_STEP_COUNTERS];
     records_taken rt = {c, slots, candidates, rec, 0, 0};
