@@ -8,6 +8,7 @@
 #include "commands.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char help[] =
@@ -69,6 +70,28 @@ static void print_material(uint32_t m, const lmb_material *mat)
                mat->emissive_texture.texture >= 0 ? " x texture" : "");
 }
 
+/* "lightmapped" below is the selection (lightmap.include/exclude); the layout may still send a
+ * mesh drawn more than once to the light probes when the texel budget cannot hold its charts
+ * (pack/probe_lit.c), which only the bake knows: say which meshes could go. */
+static void print_probe_candidates(const lmb_scene *s)
+{
+    uint32_t *drawn = calloc((size_t)s->mesh_count + 1, sizeof *drawn), meshes = 0, copies = 0;
+    if (!drawn)
+        return;
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        drawn[s->instances[i].mesh] += s->instances[i].lightmapped != 0;
+    for (uint32_t m = 0; m < s->mesh_count; m++)
+        if (drawn[m] >= 2) {
+            meshes++;
+            copies += drawn[m];
+        }
+    free(drawn);
+    if (meshes)
+        printf("  (%u lightmapped mesh(es) drawn more than once, %u copies: if the texel budget cannot hold their "
+               "charts, the bake lights them by the light probes instead and its warning names them)\n",
+               meshes, copies);
+}
+
 static void print_text(const lmb_scene *s, const lmb_scene_stats *st)
 {
     printf("scene: %s\n", s->path);
@@ -103,6 +126,7 @@ static void print_text(const lmb_scene *s, const lmb_scene_stats *st)
                in->flips_winding ? " (mirrored)" : "", in->lightmapped ? "lightmapped" : "skipped: ",
                in->skip_reason);
     }
+    print_probe_candidates(s);
     printf("materials:\n");
     for (uint32_t m = 0; m < s->material_count; m++) {
         const lmb_material *mat = &s->materials[m];

@@ -13,7 +13,8 @@ alone take about 7,000 texels at any density. Asserted:
     some above the ground);
   - the props still cast shadows: over 5% of the ground's texels get under half its median
     light;
-  - `lmbake farm parallel` in 2 shards writes the same files, byte for byte.
+  - `lmbake farm parallel` in 2 shards writes the same files, byte for byte;
+  - `lmbake inspect` (before any layout) says that the mesh drawn 60 times may go to the probes.
 
 usage: check_probe_lit.py LMBAKE WORKDIR
 """
@@ -57,6 +58,11 @@ def main():
     config = os.path.join(work, "budget.yaml")
     with open(config, "w") as f:
         f.write("atlas:\n  texels: 4000\noutput:\n  formats: [exr, mask]\n")
+    p = subprocess.run([lmbake, "inspect", level, "-c", config], capture_output=True, text=True, timeout=120)
+    check(p.returncode == 0
+          and "1 lightmapped mesh(es) drawn more than once, 60 copies: if the texel budget cannot hold their charts, "
+              "the bake lights them by the light probes" in p.stdout,
+          "inspect says the prop's 60 copies may be lit by the probes")
     out = os.path.join(work, "out")
     shutil.rmtree(out, ignore_errors=True)
     p = subprocess.run([lmbake, "bake", level, "-c", config, "-o", out], capture_output=True, text=True, timeout=600)
