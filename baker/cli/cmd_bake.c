@@ -30,10 +30,15 @@ static const char help[] =
     "                      invalid, atlases) headless to OUTDIR/preview-<view>.png\n"
     "      --reference     path-trace indirect light with no cache (ground truth for error\n"
     "                      measurement; --rays paths per texel: use many)\n"
-    "      --quick         a quick look: the same atlases lit with a quarter of the rays, the\n"
-    "                      irradiance cache sparser, no seam stitching or probes (docs/watch.md)\n"
+    "      --quick         a quick look: half the texel density (its own atlases), a quarter\n"
+    "                      of the rays, the irradiance cache sparser, no seam stitching or\n"
+    "                      probes (docs/watch.md)\n"
     "      --plan PLAN     start from a plan written by 'lmbake plan' (same input and config,\n"
     "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
+    "      --layout-cache DIR\n"
+    "                      keep the layout (unwrap, pack) in DIR and read it back when only\n"
+    "                      lights, materials, sky or sampling changed (what preview --watch\n"
+    "                      does between bakes): the same files, byte for byte\n"
     "      --print-config  print the effective config (every key, after -c and the options\n"
     "                      above) as YAML that -c reads back, and exit; SCENE may be left out\n"
     "      --timings[=CSV] at the end, per stage: wall time, CPU time over all threads and the\n"
@@ -52,6 +57,7 @@ static const char help[] =
 
 typedef struct bake_args {
     const char *scene, *config, *outdir, *plan, *farm;
+    const char *layout_cache; /* --layout-cache DIR */
     const char *timings_csv; /* --timings=CSV */
     int timings;
     long long threads, seed, rays, method; /* -1: from the config */
@@ -125,6 +131,10 @@ static int parse_args(int argc, char **argv, bake_args *a)
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a file", argv[i]);
             a->plan = v;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--layout-cache", NULL, &v)) != 0) {
+            if (r < 0)
+                return cli_usage_error("bake", "%s needs a folder", argv[i]);
+            a->layout_cache = v;
         } else if ((r = cli_opt_value(argc, argv, &i, "--farm", NULL, &v)) != 0) {
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
@@ -331,8 +341,11 @@ static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, siz
         return cli_usage_error(name, "--worker %llu/%llu: at most as many workers as shards (%llu)", a->worker,
                                a->workers, a->shards);
 
-    if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config || a->quick))
-        return cli_usage_error(name, "--plan, --quick, --reference and --print-config are 'lmbake bake' options");
+    if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config || a->quick || a->layout_cache))
+        return cli_usage_error(name, "--plan, --layout-cache, --quick, --reference and --print-config are 'lmbake "
+                               "bake' options");
+    if (a->plan && a->layout_cache)
+        return cli_usage_error(name, "--plan and --layout-cache both give the layout: one or the other");
     if (stage != STAGE_BAKE && stage != STAGE_FINISH && a->preview)
         return cli_usage_error(name, "--preview is an option of 'lmbake bake' and 'lmbake finish'");
     if (farm_stage && !a->farm)
@@ -465,7 +478,7 @@ static int run(int argc, char **argv, stage_kind stage)
                        a.farm, (uint32_t)(a.step > 0 ? a.step : 0), (uint32_t)(a.shard ? a.shard - 1 : 0),
                        (uint32_t)(a.shards ? a.shards : 1), 0, 0,
                        (uint32_t)(a.worker ? a.worker - 1 : 0), (uint32_t)(a.workers ? a.workers : 1),
-                       (double)a.wait_timeout};
+                       (double)a.wait_timeout, a.layout_cache, 0};
     int writes_bake = stage != STAGE_STEP && (stage != STAGE_WORKER || (a.outdir_given && a.worker == 1));
     lmb_bake_stats bs;
     double ts = cli_now();

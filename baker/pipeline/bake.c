@@ -13,6 +13,7 @@
 #include "util/memory.h"
 #include "steps/plan.h"
 #include "steps/runner.h"
+#include "watch/layout_cache.h"
 #include "pipeline/lighting.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
@@ -157,7 +158,7 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err)
 {
-    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0};
+    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, NULL, 0};
     return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
 }
 
@@ -175,6 +176,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (shard && (run->shards == 0 || run->shard >= run->shards))
         return lmb_error_set(err, LMB_ERR_USAGE, "shard %u of %u: out of range", run->shard + 1, run->shards);
     run->ended = 0;
+    run->layout_reused = 0;
     double t0 = lmb_seconds();
     memset(stats, 0, sizeof *stats);
     lmb_scene_set_light_modes(s, cfg, shard ? NULL : log); /* mixed lighting: which lights the bake holds */
@@ -205,9 +207,11 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = texels_fit_memory(cfg, cfg->texel_density > 0 ? 0 : lmb_config_atlas_texels(cfg), err);
     if (st == LMB_OK && plan_path) /* the plan stage's layout (steps/plan.h), checked against this scene and config */
         st = lmb_plan_read(plan_path, s, cfg, &l, &id, err);
+    else if (st == LMB_OK && run->layout_cache && run->mode == LMB_FARM_LOCAL)
+        st = lmb_layout_cached(s, cfg, run->layout_cache, progress, user, log, &l, &run->layout_reused, err);
     else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
-    if (st == LMB_OK && !plan_path && cfg->texel_density > 0) { /* an explicit density: the texels it made */
+    if (st == LMB_OK && !plan_path && !run->layout_reused && cfg->texel_density > 0) { /* an explicit density: the texels it made */
         uint64_t made = lmb_layout_count_texels(s, &l, cfg->texel_samples, cfg->threads, err, &st);
         if (st == LMB_OK)
             st = texels_fit_memory(cfg, made, err);

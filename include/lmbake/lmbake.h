@@ -539,6 +539,9 @@ typedef struct lmb_farm_run {
     uint32_t steps;           /* out: steps met */
     uint32_t worker, workers; /* LMB_FARM_WORKER: 0-based worker of workers (workers <= shards) */
     double wait_timeout;      /* LMB_FARM_WORKER: seconds to wait for another worker's part (0: for ever) */
+    const char *layout_cache; /* LMB_FARM_LOCAL with no plan: a folder of layouts kept between bakes
+                                 (lmbake bake --layout-cache, docs/watch.md); NULL: none */
+    int layout_reused;        /* out: the layout was read back from layout_cache, not built */
 } lmb_farm_run;
 
 /* lmb_bake_planned through the farm: plan_path is required unless mode is LMB_FARM_LOCAL.

@@ -4,9 +4,11 @@
 1. identical   the watch bakes a copy of tools/make_scenes.py's cornell-point.gltf (quick, then
                final); the light's intensity is changed in the file: bake 2 is a change of
                "lights", lighting only; its final files in OUTDIR equal `lmbake bake` of the
-               changed level byte for byte; the quick bake never wrote into OUTDIR; then the light
+               changed level byte for byte, its layout read back (--layout-cache); the quick bake
+               never wrote into OUTDIR; then the light
                is moved (a node's translation: "lights" again) and a config sampling key changed
-               ("config samples.gather", lighting only), then an atlas key ("layout and lighting").
+               ("config samples.gather", lighting only), then an atlas key ("layout and lighting":
+               laid out again).
 2. errors      a half-written level (JSON cut short) and a config with an unknown key: state
                "error", the message names the file (and the key), the last good bake stays shown,
                nothing new in OUTDIR; the next good save bakes. The level removed: "waiting", then
@@ -139,7 +141,9 @@ def identical(lmbake, work):
         s = w.shown(2, "quick")
         ok &= check(s["changed"] == ["lights"] and not s["layout"], "intensity changed: bake 2 is %s, layout %s"
                     % (s["changed"], s["layout"]))
-        w.shown(2, "final")
+        s = w.shown(2, "final")
+        ok &= check(s["shown"].get("layoutKept") is True, "intensity changed: bake 2's final read its layout back (layoutKept "
+                    "%s)" % s["shown"].get("layoutKept"))
         plain = os.path.join(work, "plain")
         shutil.rmtree(plain, ignore_errors=True)
         subprocess.run([lmbake, "bake", level, "-c", cfg, "-o", plain, "-q"], check=True)
@@ -160,6 +164,8 @@ def identical(lmbake, work):
         s = w.shown(5, "final")
         ok &= check(s["changed"] == ["config atlas.padding"] and s["layout"], "atlas.padding: bake 5 is %s, layout %s"
                     % (s["changed"], s["layout"]))
+        ok &= check(s["shown"].get("layoutKept") is False, "atlas.padding: bake 5 laid the level out again (layoutKept %s)"
+                    % s["shown"].get("layoutKept"))
         lines = [l for l in w.log() if re.match(r"watch: (quick|final) bake \d+ ready in [0-9.]+ s \(", l)]
         ok &= check(len(lines) == 10, "one line per bake ready (%d): %s" % (len(lines), lines[-1] if lines else ""))
     finally:

@@ -46,6 +46,9 @@ try { opts = parseArgs(process.argv.slice(2)); } catch (e) { console.error(`prev
 if (!fs.existsSync(opts.level)) { console.error(`preview: error: cannot open '${opts.level}' to watch`); process.exit(2); }
 const stem = path.basename(opts.level).replace(/\.(gltf|glb)$/i, '');
 const quickRoot = fs.mkdtempSync(path.join(os.tmpdir(), 'lmbake-watch-'));
+// Layouts kept between bakes (lmbake bake --layout-cache): a change of lights, materials, sky or
+// sampling keys reads the layout back instead of unwrapping and packing again.
+const layoutRoot = path.join(quickRoot, 'layouts');
 const say = (line) => console.log(`watch: ${line}`);
 
 // What the page and /status see.
@@ -76,13 +79,13 @@ function stopChild(why) {
 // {ok, seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
 function bake(kind, generation) {
   const out = kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir;
-  const args = ['bake', opts.level, '-o', out, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
+  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
   return new Promise((resolve) => {
     const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     child = p;
     status.baking = { generation, kind, stage: 'load', percent: 0, startedAt: Date.now(), pid: p.pid };
-    let stderr = '', pending = '';
-    p.stdout.on('data', () => {});
+    let stderr = '', pending = '', stdout = '';
+    p.stdout.on('data', (d) => { if (stdout.length < 65536) stdout += d; });
     p.stderr.on('data', (d) => {
       stderr += d;
       pending += d;
@@ -97,7 +100,7 @@ function bake(kind, generation) {
     p.on('close', (code) => {
       if (p.cancelled) return resolve({ cancelled: true });
       if (child === p) { child = null; status.baking = null; }
-      if (code === 0) return resolve({ ok: true, dir: out });
+      if (code === 0) return resolve({ ok: true, dir: out, layoutKept: /^layout: read back/m.test(stdout) });
       const errors = stderr.split('\n').filter((l) => /error:/.test(l));
       resolve({ ok: false, error: (errors.length ? errors.join('\n') : stderr.trim().split('\n').slice(-3).join('\n')) || `lmbake exited ${code}` });
     });
@@ -132,12 +135,13 @@ async function bakeNewest() {
     if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
     const seconds = (Date.now() - seen) / 1000;
-    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout };
+    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept: r.layoutKept };
     status.history.push({ generation, kind, seconds, changed: change.what });
     if (status.history.length > 50) status.history.shift();
     status.error = null;
-    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'})`);
+    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${r.layoutKept ? '; layout kept' : ''})`);
     tidyQuickDirs();
+    tidyLayouts();
   }
   status.lastGood = { fp };
   goodPrint = print;
@@ -163,9 +167,19 @@ function failed(message) {
 // Quick folders no page can still want: all but the shown generation's and the newest.
 function tidyQuickDirs() {
   for (const d of fs.readdirSync(quickRoot)) {
+    if (!/^\d+$/.test(d)) continue; // the layouts
     const g = Number(d);
     if (g !== status.generation && !(status.shown && status.shown.generation === g && status.shown.kind === 'quick')) fs.rmSync(path.join(quickRoot, d), { recursive: true, force: true });
   }
+}
+
+// Layouts: the four used last (a quick and a final one, before and after a change of layout);
+// lmbake touches a layout it reads back.
+function tidyLayouts() {
+  let kept = [];
+  try { kept = fs.readdirSync(layoutRoot).filter((f) => f.endsWith('.lmbp')).map((f) => ({ f, t: fs.statSync(path.join(layoutRoot, f)).mtimeMs })); } catch { return; }
+  kept.sort((a, b) => b.t - a.t);
+  for (const { f } of kept.slice(4)) fs.rmSync(path.join(layoutRoot, f), { force: true });
 }
 
 // The loop: poll sizes and times; a move stops the running bake at once and, once the files
