@@ -8,11 +8,13 @@ other in one run. The quick picture's error against the final: both atlases box-
 
 level-single-10: its lamp 'Lamp 0' (KHR_lights_punctual: a change of lights). bevy's Cornell
 box: its light is an emissive quad: emissiveFactor x 2 (materials), then the node moved
-(geometry: the layout is made again).
+(geometry: the layout is made again). A level with no point light and no emissive material
+(tools/make_levels.py's gpu levels): its sun x 2, then turned 10 degrees about the vertical.
 
 usage: bench_watch.py LMBAKE OUT_CSV LEVEL...
 """
 import json
+import math
 import os
 import re
 import shutil
@@ -64,6 +66,19 @@ def light_edits(doc):
             n = next(n for n in d["nodes"] if n.get("extensions", {}).get("KHR_lights_punctual", {}).get("light") == k)
             n["translation"] = [n.get("translation", [0, 0, 0])[0] + 2.0] + n.get("translation", [0, 0, 0])[1:]
         return [("light %s x 2" % lights[k].get("name", k), brighter), ("light %s moved" % lights[k].get("name", k), moved)], node
+    if lights:  # a sun: brighter, then turned 10 degrees about the vertical
+        node = next(n for n in doc["nodes"] if "KHR_lights_punctual" in n.get("extensions", {}))
+
+        def sun_brighter(d):
+            d["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] *= 2
+
+        def sun_turned(d):
+            n = next(n for n in d["nodes"] if "KHR_lights_punctual" in n.get("extensions", {}))
+            x, y, z, w = n.get("rotation", [0, 0, 0, 1])
+            c, s = math.cos(math.radians(5)), math.sin(math.radians(5))  # q_y(10 deg) * q
+            n["rotation"] = [c * x + s * z, c * y + s * w, c * z - s * x, c * w - s * y]
+        name = lights[0].get("name", 0)
+        return [("light %s x 2" % name, sun_brighter), ("light %s turned 10 deg" % name, sun_turned)], node
     m = next(i for i, mat in enumerate(doc["materials"]) if any(mat.get("emissiveFactor", [0, 0, 0])))
     node_index = next(i for i, n in enumerate(doc["nodes"]) if "mesh" in n and any(
         p.get("material") == m for p in doc["meshes"][n["mesh"]]["primitives"]))
