@@ -9,6 +9,7 @@
 #include "progress.h"
 
 #include "pack/layout.h"
+#include "write/output_dir.h"
 #include "unwrap/metrics.h"
 #include "write/image_adapter.h"
 
@@ -318,7 +319,10 @@ int cmd_unwrap(int argc, char **argv)
     cli_progress progress;
     cli_progress_init(&progress, stderr, quiet);
     lmb_layout layout;
-    lmb_status st = lmb_layout_build(scene, &cfg, cli_progress_update, &progress, &log, &layout, &err);
+    int made = 0;
+    lmb_status st = png_dir ? lmb_make_folders(png_dir, &made, &err) : LMB_OK;
+    if (st == LMB_OK)
+        st = lmb_layout_build(scene, &cfg, cli_progress_update, &progress, &log, &layout, &err);
     double texels = 0;
     if (st == LMB_OK) {
         print_report(scene, &layout);

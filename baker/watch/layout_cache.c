@@ -5,8 +5,8 @@
 #include "steps/part_file.h"
 #include "steps/plan_codec.h"
 #include "util/clock.h"
+#include "write/output_dir.h"
 
-#include <errno.h>
 #include <nettle/sha2.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -209,9 +209,10 @@ lmb_status lmb_layout_cached(const lmb_scene *scene, const lmb_config *cfg, cons
     lmb_error e = {LMB_OK, ""};
     lmb_part_place place = {LMB_PART_PLAN, 0, 0, 1};
     if (st == LMB_OK) {
-        lmb_status kept = mkdir(dir, 0777) == 0 || errno == EEXIST
-                              ? lmb_plan_encode(l, &body, &size, &e)
-                              : lmb_error_set(&e, LMB_ERR_INTERNAL, "cannot make '%s': %s", dir, strerror(errno));
+        int made = 0;
+        lmb_status kept = lmb_make_folders(dir, &made, &e);
+        if (kept == LMB_OK)
+            kept = lmb_plan_encode(l, &body, &size, &e);
         if (kept == LMB_OK)
             kept = lmb_part_write(path, &id, &place, body, size, &e);
         if (kept == LMB_OK)

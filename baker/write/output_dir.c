@@ -106,7 +106,7 @@ static void sibling_prefix(const char *name, char *out, size_t size)
 
 /* Creates dir and any missing parents, as mkdir -p, counting them in *made; names the part
  * that cannot be made. */
-static lmb_status make_folders(const char *dir, int *made, lmb_error *err)
+lmb_status lmb_make_folders(const char *dir, int *made, lmb_error *err)
 {
     *made = 0;
     char path[4096];
@@ -155,7 +155,7 @@ lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *
         if (!S_ISDIR(sb.st_mode))
             return lmb_error_set(err, LMB_ERR_INPUT, "output '%s' exists and is not a folder", dir);
     } else {
-        lmb_status st = make_folders(dir, &od->created_dir, err);
+        lmb_status st = lmb_make_folders(dir, &od->created_dir, err);
         if (st != LMB_OK) {
             lmb_output_dir_abort(od);
             return st;

@@ -33,6 +33,10 @@ typedef struct lmb_output_dir {
     const lmb_log *log; /* for the fallbacks' warnings */
 } lmb_output_dir;
 
+/* Creates dir and any missing parents, as mkdir -p, counting them in *made; names the part
+ * that cannot be made (LMB_ERR_INPUT). */
+lmb_status lmb_make_folders(const char *dir, int *made, lmb_error *err);
+
 lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, const lmb_log *log,
                                lmb_error *err);
 
