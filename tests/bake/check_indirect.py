@@ -24,7 +24,8 @@ usage: check_indirect.py LMBAKE WORKDIR CHECK
   identity     AMIS and defensive AMIS (the default, guided) with one iteration and classic
                gathering: byte-identical EXR for the same seed.
   determinism  AMIS and guided defensive AMIS bakes at --threads 1 and --threads 2: byte-identical EXR.
-  unbiased     bright-spot Cornell box (point light 3 cm under the ceiling), one bounce, 512 rays:
+  unbiased     bright-spot Cornell box (point light 3 cm under the ceiling), one bounce, 512 rays,
+               8 texels per unit (the estimators are per texel: more texels add time, not power):
                at 8 texels spread over the atlas (each 2 texels from any chart border), the mean of
                AMIS, of defensive AMIS guided (the default: texels sampling from a pilot's mixture)
                and of defensive AMIS unguided, each over 32 seeds, lie within 3 standard errors
@@ -186,7 +187,7 @@ def unbiased(lmbake, work):
     variants = {"cosine": ("cosine", ""), "amis": ("amis", ""), "amis_defensive": ("amis_defensive", ""),
                 "unguided": ("amis_defensive", "gather: {guide_stride: 0}\n")}
     for name, (method, extra) in variants.items():
-        runs[name] = np.array([read(bake(lmbake, work, s, "%s-%d" % (name, seed), PER_TEXEL % (16, 4) + extra,
+        runs[name] = np.array([read(bake(lmbake, work, s, "%s-%d" % (name, seed), PER_TEXEL % (8, 4) + extra,
                                          "--method", method, "--rays", "512", "--seed", str(seed))).mean(axis=2)
                                for seed in range(1, 33)])
     ref = runs["cosine"]
