@@ -82,7 +82,7 @@ def lightmapped_nodes(doc):
 
 
 def rects(lmbake, work):
-    common = "atlas: {texels: 131072, keep_uv1: %s}\noutput: {formats: [exr, hdr, png, mask, ktx2], ktx2_format: b10g11r11}\n"
+    common = "atlas: {texels: 65536, keep_uv1: %s}\noutput: {formats: [exr, hdr, png, mask, ktx2], ktx2_format: b10g11r11}\n"
     out, doc, _ = bake(lmbake, work, MIXED, "rects", common % "true")
     src = json.load(open(MIXED))
     src_bins = [open(os.path.join(os.path.dirname(MIXED), b["uri"]), "rb").read() for b in src["buffers"]]
