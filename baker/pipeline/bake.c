@@ -211,7 +211,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_layout_cached(s, cfg, run->layout_cache, progress, user, log, &l, &run->layout_reused, err);
     else if (st == LMB_OK)
         st = lmb_layout_build(s, cfg, progress, user, log, &l, err);
-    if (st == LMB_OK && !plan_path && !run->layout_reused && cfg->texel_density > 0) { /* an explicit density: the texels it made */
+    /* an explicit density: the texels it made (a layout read back passed this when it was built) */
+    if (st == LMB_OK && !plan_path && !run->layout_reused && cfg->texel_density > 0) {
         uint64_t made = lmb_layout_count_texels(s, &l, cfg->texel_samples, cfg->threads, err, &st);
         if (st == LMB_OK)
             st = texels_fit_memory(cfg, made, err);
