@@ -57,6 +57,36 @@ static lmb_status instanced_node(const lmb_scene *s, const lmb_layout *l, uint32
 }
 
 /* One instance's new primitives (instance_primitives) and the arrays they point into. */
+/* Instances whose vertices are built at once before they go into the document. */
+#define WRITE_BATCH 256
+
+/* Instance i into the document: its node's lightmapped mesh, a shared mesh's rectangle, or
+ * (EXT_mesh_gpu_instancing) every copy of its node, once per node; node_done and shared_by
+ * say what earlier instances did. */
+static lmb_status write_instance(lmb_scene *s, const lmb_layout *l, uint32_t i, const lmb_gltf_prim_out *pr,
+                                 uint32_t n, const int32_t *tex, const int32_t *dir_tex, uint8_t *node_done,
+                                 int64_t *shared_by, lmb_error *err)
+{
+    const lmb_instance *in = &s->instances[i];
+    const lmb_layout_instance *li = &l->instances[i];
+    if (!li->lightmapped || (in->gpu_instance >= 0 && node_done[in->node]))
+        return LMB_OK;
+    if (in->gpu_instance < 0 && li->shared_layout && shared_by[in->mesh] >= 0) /* atlas.share_meshes */
+        return lmb_gltf_share_lightmapped_mesh(s->doc, in->node, (uint32_t)shared_by[in->mesh], tex[li->atlas],
+                                               li->scale_offset, err);
+    int32_t t = tex[li->atlas], d = dir_tex[li->atlas];
+    lmb_status st;
+    if (in->gpu_instance >= 0) /* every copy of the node: one mesh, a rectangle each */
+        st = instanced_node(s, l, in->node, pr, n, t, d, err);
+    else if (li->shared_layout) { /* the first node of a shared mesh */
+        st = lmb_gltf_lightmap_shared_mesh(s->doc, in->node, pr, n, t, d, li->scale_offset, err);
+        shared_by[in->mesh] = (int64_t)in->node;
+    } else
+        st = lmb_gltf_lightmap_node(s->doc, in->node, pr, n, t, d, li->scale_offset, err);
+    node_done[in->node] = 1;
+    return st;
+}
+
 typedef struct instance_prims {
     int needed;
     lmb_gltf_prim_out *prims;
@@ -127,51 +157,39 @@ lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const
             shared_by[in->mesh] = in->node;
         node_done[in->node] = 1;
     }
-    /* their vertices in parallel (the work); the glTF document is written on one thread */
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads(), failed = 0;
-    uint32_t to_build = st == LMB_OK ? s->instance_count : 0;
-#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) reduction(| : failed)
-    for (uint32_t i = 0; i < to_build; i++)
-        if (prims[i].needed)
-            failed |= instance_primitives(s, l, i, &prims[i].prims, &prims[i].n, &prims[i].owned, &prims[i].owned_n,
-                                          &prims[i].err) != LMB_OK;
-    for (uint32_t i = 0; failed && i < s->instance_count; i++) /* the first instance's error */
-        if (prims[i].needed && prims[i].err.status != LMB_OK) {
-            *err = prims[i].err;
-            st = err->status;
-            break;
-        }
     if (node_done)
         memset(node_done, 0, (size_t)s->node_count + 1);
     for (uint32_t m = 0; shared_by && m < s->mesh_count; m++)
         shared_by[m] = -1;
-    for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
-        const lmb_instance *in = &s->instances[i];
-        const lmb_layout_instance *li = &l->instances[i];
-        if (!li->lightmapped || (in->gpu_instance >= 0 && node_done[in->node]))
-            continue;
-        if (in->gpu_instance < 0 && li->shared_layout && shared_by[in->mesh] >= 0) { /* atlas.share_meshes */
-            st = lmb_gltf_share_lightmapped_mesh(s->doc, in->node, (uint32_t)shared_by[in->mesh], tex[li->atlas],
-                                                 li->scale_offset, err);
-            continue;
+    /* a batch of instances at a time: their vertices in parallel (the work), then added to the
+     * glTF document on one thread in instance order and freed, so only a batch's arrays are held
+     * beside the document (all of them at once were 170 MB on a 2,000-node level) */
+    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    for (uint32_t b0 = 0; st == LMB_OK && b0 < s->instance_count; b0 += WRITE_BATCH) {
+        uint32_t b1 = s->instance_count - b0 < WRITE_BATCH ? s->instance_count : b0 + WRITE_BATCH;
+        int failed = 0;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1) reduction(| : failed)
+        for (uint32_t i = b0; i < b1; i++)
+            if (prims[i].needed)
+                failed |= instance_primitives(s, l, i, &prims[i].prims, &prims[i].n, &prims[i].owned,
+                                              &prims[i].owned_n, &prims[i].err) != LMB_OK;
+        for (uint32_t i = b0; failed && i < b1; i++) /* the first instance's error */
+            if (prims[i].needed && prims[i].err.status != LMB_OK) {
+                *err = prims[i].err;
+                st = err->status;
+                break;
+            }
+        for (uint32_t i = b0; i < b1 && st == LMB_OK; i++)
+            st = write_instance(s, l, i, prims[i].prims, prims[i].n, tex, dir_tex, node_done, shared_by, err);
+        for (uint32_t i = b0; i < b1; i++) {
+            for (uint32_t k = 0; k < prims[i].owned_n; k++)
+                free(prims[i].owned[k]);
+            free(prims[i].owned);
+            free(prims[i].prims);
+            prims[i].owned = NULL;
+            prims[i].prims = NULL;
+            prims[i].owned_n = 0;
         }
-        const lmb_gltf_prim_out *pr = prims[i].prims;
-        uint32_t n = prims[i].n;
-        int32_t t = tex[l->instances[i].atlas], d = dir_tex[l->instances[i].atlas];
-        if (in->gpu_instance >= 0) /* every copy of the node: one mesh, a rectangle each */
-            st = instanced_node(s, l, in->node, pr, n, t, d, err);
-        else if (li->shared_layout) { /* the first node of a shared mesh */
-            st = lmb_gltf_lightmap_shared_mesh(s->doc, in->node, pr, n, t, d, li->scale_offset, err);
-            shared_by[in->mesh] = in->node;
-        } else
-            st = lmb_gltf_lightmap_node(s->doc, in->node, pr, n, t, d, l->instances[i].scale_offset, err);
-        node_done[in->node] = 1;
-    }
-    for (uint32_t i = 0; prims && i < s->instance_count; i++) {
-        for (uint32_t k = 0; k < prims[i].owned_n; k++)
-            free(prims[i].owned[k]);
-        free(prims[i].owned);
-        free(prims[i].prims);
     }
     free(prims);
     free(node_done);
