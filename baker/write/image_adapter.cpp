@@ -214,3 +214,17 @@ extern "C" void lmb_image_rows_close(lmb_image_rows *r)
 {
     delete r;
 }
+
+#ifdef LMB_IMAGES_AS_MODULE
+/* Built as liblmbake-images.so (image_module.h): the table is the module's one exported symbol. */
+#include "image_module.h"
+
+extern "C" __attribute__((visibility("default"))) const lmb_image_api *lmb_images_module_api(void)
+{
+    static const lmb_image_api api = {LMB_IMAGE_API_VERSION, lmb_image_write_u8,   lmb_image_write_f32,
+                                      lmb_image_size,        lmb_image_read_rgb,   lmb_image_rows_open,
+                                      lmb_image_rows_read,   lmb_image_rows_is_u8, lmb_image_rows_read_u8,
+                                      lmb_image_rows_close};
+    return &api;
+}
+#endif
