@@ -9,9 +9,10 @@
 2. Workers by hand (lmbake worker): one killed mid-bake while the other waits, started
    again: the same bytes; one left alone times out naming the part and the worker it waits
    for; one with another config refuses to start, naming the key.
-3. Faults, driving the stages by hand (plan, step, merge, finish): at every step one shard is
-   killed (SIGKILL) half-way through its run and leaves no part, then is rerun; another
-   shard runs twice and writes the same bytes; finish refuses while a step is not merged and
+3. Faults, driving the stages by hand (plan, step, merge, finish): at the first step of each
+   kind (direct, records placed, ..., denoise level) one shard is killed (SIGKILL) half-way
+   through its run and leaves no part, then is rerun; another shard runs twice and writes the
+   same bytes; finish refuses while a step is not merged and
    nothing appears in the output folder before it; the output equals `lmbake bake`.
 4. Refusals by merge: a part from a farm with another config (named: the part file and the
    config key with both values), a damaged part, a missing part (the shard to rerun named).
@@ -20,6 +21,7 @@ usage: check_farm.py LMBAKE WORKDIR SCENE [quick]
 """
 import filecmp
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -141,11 +143,29 @@ def faults(lmbake, work, scene, cfg):
     run([lmbake, "plan"] + common + ["-q"])
     killed = late = twice = 0
     step = 0
+    kinds = set()
     while not os.path.exists(os.path.join(farm, "end")):
         # shard 1 as it should run, timed: the kill of shard 2 comes at half that time
         t0 = time.time()
-        run([lmbake, "step"] + common + ["--step", str(step), "--shard", "1/%d" % SHARDS, "-q", "--threads", "1"])
+        r = run([lmbake, "step"] + common + ["--step", str(step), "--shard", "1/%d" % SHARDS, "--threads", "1"])
         took = time.time() - t0
+        # the drill (a kill half-way, a shard run twice) on the first step of each kind (direct,
+        # records placed, gathered again, gradients, interpolation, refinement, denoise level,
+        # directions; a pass's or a level's number aside): later steps of a kind run the same code
+        # on other items, and are only run
+        said = r.stdout + r.stderr
+        m = re.search(r"^step %d \((.*?)\): shard" % step, said, re.M)
+        if not m and not re.search(r"^step %d: the bake has %d steps: nothing to do" % (step, step), said, re.M):
+            fail("step %d: shard 1 said neither the step's kind nor the end: %r" % (step, said[-300:]))
+        kind = re.sub(r"[0-9]+", "#", m.group(1)) if m else "the end"
+        if kind in kinds:
+            for k in range(2, SHARDS + 1):
+                run([lmbake, "step"] + common + ["--step", str(step), "--shard", "%d/%d" % (k, SHARDS), "-q",
+                                                 "--threads", "1"])
+            run([lmbake, "merge"] + common + ["--step", str(step), "--shards", str(SHARDS), "-q"])
+            step += 1
+            continue
+        kinds.add(kind)
         p = subprocess.Popen([lmbake, "step"] + common + ["--step", str(step), "--shard", "2/%d" % SHARDS, "-q",
                               "--threads", "1"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(took / 2)
@@ -187,9 +207,10 @@ def faults(lmbake, work, scene, cfg):
         fail("no shard was still running at half its time: the kill test did not kill")
     run([lmbake, "finish"] + common + ["-o", out, "-q"])
     names = same_files(ref, out, "faults")
-    print("faults: %d steps; %d shards killed half-way (no part left) and rerun, %d killed while exiting "
-          "(whole part, = rerun); %d shards run twice (same bytes); finish before the last merge refused; "
-          "output = lmbake bake in all %d files" % (steps_of(farm), killed, late, twice, len(names)))
+    print("faults: %d steps of %d kinds (%s); on the first of each kind: %d shards killed half-way (no part left) "
+          "and rerun, %d killed while exiting (whole part, = rerun), %d shards run twice (same bytes); finish "
+          "before the last merge refused; output = lmbake bake in all %d files" %
+          (steps_of(farm), len(kinds), "; ".join(sorted(kinds)), killed, late, twice, len(names)))
     return farm
 
 

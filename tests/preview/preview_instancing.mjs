@@ -111,7 +111,7 @@ async function instanced(gltfPath) {
       `${JSON.stringify(im)}; meshes other than InstancedMeshes with the patch: ${lm.info.patchedOthers}`);
 
     // probes: a grid of pixels on the copies, away from edges (the 4 neighbours see the same copy within 1.5 texels)
-    const probes = await gridProbes(lm.page, [nodeIndex], 6);
+    const probes = await gridProbes(lm.page, [nodeIndex], 8);
     let n = 0, bad = 0, worst = 0, texelOff = 0, instanceOff = 0, invalidOff = 0, ignoring = 0, neighbour = 0, first = null;
     const skipped = { clip: 0, edge: 0 }, cats = new Map(), copies = new Map(), probed = [];
     for (const p of probes) {
@@ -419,7 +419,7 @@ async function checkerAgrees(url, c3Png, probed, what, prefix, atlasSize) {
   });
   let onScreen = 0, differ = 0, background = 0, border = 0, shots = 0, first = null;
   const left = new Set(todo);
-  while (left.size && shots < 8) {
+  while (left.size && shots < 4) {
     // centre on the probe with the most others left within the view (120 x 90 texels at zoom 8)
     const rest = [...left], cand = rest.filter((_, i) => i % Math.max(1, Math.floor(rest.length / 400)) === 0);
     const near = (c) => rest.reduce((k, p) => k + (Math.abs(p.texel[0] - c.texel[0]) < VIEW[0] / ZOOM / 2 - 1 && Math.abs(p.texel[1] - c.texel[1]) < VIEW[1] / ZOOM / 2 - 1), 0);
