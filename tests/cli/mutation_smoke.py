@@ -3,7 +3,7 @@
 lmbake. Every run must exit 0 (still loadable) or 2 (bad input, with an "error:" line),
 never 3 or a signal, and print no sanitizer report (the ASan build runs this too).
 
-usage: mutation_smoke.py LMBAKE SCENES_DIR WORKDIR
+usage: mutation_smoke.py LMBAKE SCENES_DIR WORKDIR [PER_SOURCE]   (mutants per source file, default 40)
 """
 import os
 import random
@@ -16,20 +16,20 @@ SOURCES = [
     "khr-MeshPrimitiveModes/glTF-Embedded/MeshPrimitiveModes.gltf",
     "cornell-box-bevy/CornellBox.glb",
 ]
-PER_SOURCE = 40
 
 
 def main():
     lmbake, scenes, work = sys.argv[1:4]
+    per_source = int(sys.argv[4]) if len(sys.argv) > 4 else 40
     os.makedirs(work, exist_ok=True)
     rng = random.Random(20261122)  # fixed: the same files every run
     failures, runs = [], 0
     for rel in SOURCES:
         data = open(os.path.join(scenes, rel), "rb").read()
         ext = os.path.splitext(rel)[1]
-        for i in range(PER_SOURCE):
+        for i in range(per_source):
             d = bytearray(data)
-            if i < PER_SOURCE // 3:
+            if i < per_source // 3:
                 d = d[: rng.randrange(len(d))]
             else:
                 for _ in range(rng.randint(1, 8)):
