@@ -57,39 +57,49 @@ async function measure(browser, gltf, name) {
     const L = (x, y) => [-1, 0, 1].reduce((s, o) => s + luma(png.at(Math.round(x + o * ex), Math.round(y + o * ey))), 0) / 3;
     const worst = {};
     let points = 0;
-    for (const e of seamEdges(gltf)) {
+    // 7 points along every seam edge; projected, then picked, in one round trip each
+    const samples = [];
+    for (const e of seamEdges(gltf))
       for (let k = 1; k < 8; k++) {
         const t = k / 8, p = [0, 1, 2].map((c) => e.a.p[c] + t * (e.b.p[c] - e.a.p[c]));
         const q = [0, 1, 2].map((c) => e.a.p[c] + (t + 0.01) * (e.b.p[c] - e.a.p[c]));
-        const [s, s2] = await v.page.evaluate(([p, q]) => [window.lmbProject(...p), window.lmbProject(...q)], [p, q]);
-        let dx = s2.x - s.x, dy = s2.y - s.y;
-        const len = Math.hypot(dx, dy);
-        if (!s.inFront || len < 1e-3) continue;
-        const nx = -dy / len, ny = dx / len; // across the edge on screen
-        ex = dx / len; ey = dy / len;
-        // every sample must see this object close to the edge point (not occluded, not the background)
-        // and so must the pixels 3 px around each (away from the silhouette, whose pixels blend
-        // with the background)
-        const [picks, around] = await v.page.evaluate(([x, y, nx, ny]) => {
-          const at = [-3, -1, 1, 3].map((o) => [Math.round(x + o * nx), Math.round(y + o * ny)]);
-          return [at.map(([px, py]) => window.lmbPick(px, py)),
-            at.flatMap(([px, py]) => [[-3, -3], [3, -3], [-3, 3], [3, 3]].map(([i, j]) => window.lmbPick(px + i, py + j)))];
-        }, [s.x, s.y, nx, ny]);
-        if (picks.concat(around).some((h) => !h || h.object !== e.node)) continue;
-        // seen face-on enough: 6 px across the edge span under twice the surface a face-on view
-        // would show (near the silhouette a few pixels cross much of the surface and its shading)
-        const faceOn = 6 * 2 * picks[1].distance * Math.tan(Math.PI / 8) / VIEW_HEIGHT;
-        if (Math.hypot(...[0, 1, 2].map((c) => picks[3].point[c] - picks[0].point[c])) > 2 * faceOn) continue;
-        const l = OFFSETS.map((o) => L(s.x + o * nx, s.y + o * ny));
-        // a line: the 2 px step across the edge beyond the 2 px steps beside it (0 for a smooth
-        // gradient, at most 0 for a crease where facets meet or a flattened gradient; a seam line's
-        // height for a step in value)
-        const excess = Math.abs(l[2] - l[1]) - Math.max(Math.abs(l[1] - l[0]), Math.abs(l[3] - l[2]));
-        if (process.env.LMB_SEAMS_VERBOSE && excess > 2) console.log(`  ${name} ${e.node} (${s.x.toFixed(0)}, ${s.y.toFixed(0)}): ${l.map((v) => v.toFixed(1)).join(' ')}; edge ${JSON.stringify([e.a, e.b])} at ${t}`);
-        worst[e.node] = Math.max(worst[e.node] ?? -Infinity, excess);
-        points++;
+        samples.push({ e, t, p, q });
       }
-    }
+    const projected = await v.page.evaluate((pq) => pq.map(([p, q]) => [window.lmbProject(...p), window.lmbProject(...q)]),
+      samples.map((x) => [x.p, x.q]));
+    const across = [];
+    samples.forEach((x, i) => {
+      const [s, s2] = projected[i];
+      const dx = s2.x - s.x, dy = s2.y - s.y, len = Math.hypot(dx, dy);
+      if (!s.inFront || len < 1e-3) return;
+      across.push({ ...x, s, dx: dx / len, dy: dy / len, nx: -dy / len, ny: dx / len }); // (nx, ny): across the edge on screen
+    });
+    // every sample must see this object close to the edge point (not occluded, not the background)
+    // and so must the pixels 3 px around each (away from the silhouette, whose pixels blend
+    // with the background)
+    const picked = await v.page.evaluate((pts) => pts.map(([x, y, nx, ny]) => {
+      const at = [-3, -1, 1, 3].map((o) => [Math.round(x + o * nx), Math.round(y + o * ny)]);
+      return [at.map(([px, py]) => window.lmbPick(px, py)),
+        at.flatMap(([px, py]) => [[-3, -3], [3, -3], [-3, 3], [3, 3]].map(([i, j]) => window.lmbPick(px + i, py + j)))];
+    }), across.map((x) => [x.s.x, x.s.y, x.nx, x.ny]));
+    across.forEach((x, i) => {
+      const { e, t, s, nx, ny } = x;
+      const [picks, around] = picked[i];
+      ex = x.dx; ey = x.dy;
+      if (picks.concat(around).some((h) => !h || h.object !== e.node)) return;
+      // seen face-on enough: 6 px across the edge span under twice the surface a face-on view
+      // would show (near the silhouette a few pixels cross much of the surface and its shading)
+      const faceOn = 6 * 2 * picks[1].distance * Math.tan(Math.PI / 8) / VIEW_HEIGHT;
+      if (Math.hypot(...[0, 1, 2].map((c) => picks[3].point[c] - picks[0].point[c])) > 2 * faceOn) return;
+      const l = OFFSETS.map((o) => L(s.x + o * nx, s.y + o * ny));
+      // a line: the 2 px step across the edge beyond the 2 px steps beside it (0 for a smooth
+      // gradient, at most 0 for a crease where facets meet or a flattened gradient; a seam line's
+      // height for a step in value)
+      const excess = Math.abs(l[2] - l[1]) - Math.max(Math.abs(l[1] - l[0]), Math.abs(l[3] - l[2]));
+      if (process.env.LMB_SEAMS_VERBOSE && excess > 2) console.log(`  ${name} ${e.node} (${s.x.toFixed(0)}, ${s.y.toFixed(0)}): ${l.map((v) => v.toFixed(1)).join(' ')}; edge ${JSON.stringify([e.a, e.b])} at ${t}`);
+      worst[e.node] = Math.max(worst[e.node] ?? -Infinity, excess);
+      points++;
+    });
     await v.context.close();
     return { worst, points };
   } finally {
