@@ -16,7 +16,8 @@ usage: make_scenes.py OUTDIR
   sky-bare-wall.gltf  the open plane and a wall on it with no material (materials.default)
   sun-plate.gltf      4 x 4 ground, a sun straight down, a plate 1.5 above the x < 0 half: the
                       shadow edge's penumbra (lights.sun_angle)
-  many-lights.gltf    10 x 10 plane under 20 point lights (sampled by power, not looped)
+  many-lights.gltf    10 x 10 plane under 20 point lights (more than are looped: drawn by
+                      their unshadowed irradiance at each point)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
   disk-transform.gltf the same disk with a 2 x 1 emissive texture (black | white, NEAREST,
                       CLAMP_TO_EDGE) whose KHR_texture_transform (offset, rotation, scale and a

@@ -187,21 +187,71 @@ static void sun_disc(point_ctx *c, const lmb_light *l, uint32_t which, double e[
     }
 }
 
-/* Point and spot lights: all of them when few, else power-proportional samples. */
+/* A point or spot light's irradiance at c's point were nothing in the way (luminance, lux): what
+ * the many-light sampler draws in proportion to. 0 exactly where the light cannot reach the
+ * point (behind it, outside its range or cone), so drawing by it is unbiased. */
+static double unshadowed_luminance(const point_ctx *c, const lmb_light *l)
+{
+    double d[3], dist;
+    if (!lmb_light_direction(c, l, d, &dist))
+        return 0;
+    double cosang = lmb_dot3(c->n, d);
+    if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
+        return 0;
+    return l->intensity * lmb_luminance_f(l->color) * cosang * lmb_punctual_falloff(l, d, dist);
+}
+
+/* Point and spot lights: all of them when few (EXACT_LOCAL_LIGHTS), else the lights that can
+ * reach the point, each with its unshadowed irradiance there (the shadow ray is then the only
+ * noise left: Shirley, Wang and Zimmerman 1996, "Monte Carlo techniques for direct lighting
+ * calculations", sec. 4): every one of them exactly when they are no more than the samples, else
+ * c->samples drawn in proportion to it along a scrambled Sobol sequence (stratified picks). A
+ * lamp's hot spot is then lit by that lamp in nearly every sample; drawn by power alone, a level
+ * of ten lamps gave each hot spot a tenth of the samples and the quick look's texels 13% rms
+ * noise after 9 x 9 averaging. Beyond MANY_LIGHTS_BY_CONTRIBUTION lights, the per-point pass
+ * would cost more than the rays: the draws are by power. */
+#define MANY_LIGHTS_BY_CONTRIBUTION 256
+
 static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
 {
     const light_set *ls = &c->d->lights;
     const lmb_light *all = c->d->scene->lights;
+    uint32_t n = c->samples;
     if (ls->local_count <= EXACT_LOCAL_LIGHTS) {
         for (uint32_t i = 0; i < ls->local_count; i++)
             punctual(c, &all[ls->local[i]], 1.0, e);
         return;
     }
-    uint32_t n = c->samples;
+    if (ls->local_count > MANY_LIGHTS_BY_CONTRIBUTION) {
+        for (uint32_t s = 0; s < n; s++) {
+            double p;
+            uint32_t k = lmb_cdf_pick(ls->cdf, ls->local_count, lmb_rng_next(rng), &p);
+            punctual(c, &all[ls->local[k]], 1.0 / (p * n), e);
+        }
+        return;
+    }
+    double cdf[MANY_LIGHTS_BY_CONTRIBUTION + 1];
+    uint32_t reach[MANY_LIGHTS_BY_CONTRIBUTION], m = 0;
+    cdf[0] = 0;
+    for (uint32_t i = 0; i < ls->local_count; i++) {
+        double u = unshadowed_luminance(c, &all[ls->local[i]]);
+        if (u > 0) {
+            reach[m] = ls->local[i];
+            cdf[m + 1] = cdf[m] + u;
+            m++;
+        }
+    }
+    if (m <= n) {
+        for (uint32_t i = 0; i < m; i++)
+            punctual(c, &all[reach[i]], 1.0, e);
+        return;
+    }
+    uint64_t key = lmb_mix64(c->sequence ^ 0x4c4f43414cull);
     for (uint32_t s = 0; s < n; s++) {
-        double p;
-        uint32_t k = lmb_cdf_pick(ls->cdf, ls->local_count, lmb_rng_next(rng), &p);
-        punctual(c, &all[ls->local[k]], 1.0 / (p * n), e);
+        double u[2], p;
+        lmb_qmc_2d(key, c->first + s, u);
+        uint32_t k = lmb_cdf_pick(cdf, m, u[0], &p);
+        punctual(c, &all[reach[k]], 1.0 / (p * n), e);
     }
 }
 

@@ -184,10 +184,13 @@ def many_lights(charts, images):
                      for p in pts])
         ratios.append(v[0] / e)
     r = np.array(ratios)
-    mean, within = float(np.mean(r)), float(np.mean(np.abs(r - 1) < 0.1))
-    print("many-lights: 20 point lights sampled by power (256 per point): mean ratio to the exact sum %.4f over %d "
-          "texels (bound 1 +- 1%%), %.1f%% of texels within 10%% (bound 95%%)" % (mean, len(r), 100 * within))
-    return abs(mean - 1) < 0.01 and within >= 0.95
+    mean, worst = float(np.mean(r)), float(np.max(np.abs(r - 1)))
+    # drawn in proportion to each light's unshadowed irradiance at the point, with nothing in the
+    # way every draw weighs the exact sum: only float rounding is left (drawn by power, the
+    # texels spread by several percent)
+    print("many-lights: 20 point lights drawn by their unshadowed irradiance (256 per point): mean ratio to the exact "
+          "sum %.5f over %d texels (bound 1 +- 0.1%%), worst %.4f%% off (bound 0.5%%)" % (mean, len(r), 100 * worst))
+    return len(r) > 5000 and abs(mean - 1) < 0.001 and worst <= 0.005
 
 
 def in_cube_shadow(p, d):
