@@ -398,6 +398,8 @@ static int run(int argc, char **argv, stage_kind stage)
     if (a.method >= 0)
         cfg.gather_method = (lmb_gather_method)a.method;
     cfg.reference = a.reference;
+    /* keys are linted as the user set them, not as --quick changes them */
+    lmb_config user_cfg = cfg;
     if (a.quick)
         lmb_config_quick(&cfg);
     if (a.print_config) {
@@ -413,7 +415,7 @@ static int run(int argc, char **argv, stage_kind stage)
     cli_warnings warnings = {0, a.quiet};
     lmb_log log = cli_log(&warnings);
     /* once per bake: not in every farm shard */
-    if ((stage == STAGE_BAKE || stage == STAGE_PLAN) && lmb_config_lint(&cfg, &log, &err) != LMB_OK)
+    if ((stage == STAGE_BAKE || stage == STAGE_PLAN) && lmb_config_lint(&user_cfg, &log, &err) != LMB_OK)
         return cli_fail(&err);
     double t0 = cli_now();
     cli_timings *timings = a.timings ? cli_timings_start("load") : NULL;
