@@ -3,6 +3,7 @@
 # decoding and the farm's plan decoder (tests/fuzz/fuzz_*.c), built with Debian's clang-14,
 # ASan and UBSan.
 #   usage: tools/fuzz.sh [SECONDS] [TARGET...]   (default: 60 s; targets gltf config image plan)
+#   LMB_FUZZ_BUILD_ONLY=1: build and stop
 # All targets run at once, each for SECONDS of wall time, one process each (the machine's cores
 # are shared). Seeds come from assets/ and tests/data (tests/fuzz/CMakeLists.txt has the same
 # patterns); what a run adds stays in build-fuzz/corpus/<target> for the next run. First every
@@ -25,6 +26,8 @@ export LMB_FUZZ_PLAN_SCENE="$PWD/assets/scenes/cornell-box-bevy/CornellBox.glb" 
 LMB_SETUP_PACKAGES="clang-14 libclang-rt-14-dev libomp-14-dev" \
 LMB_BUILD_TARGETS="${targets[*]/#/fuzz_}" CC=clang-14 CXX=clang++-14 \
   tools/setup.sh build-fuzz -DLMB_FUZZ=ON -DBUILD_TESTING=OFF
+# LMB_FUZZ_BUILD_ONLY=1: the build alone (tools/test.sh builds it beside the sanitizer tests)
+[ "${LMB_FUZZ_BUILD_ONLY:-0}" = 1 ] && exit 0
 
 out=build-fuzz
 # Per-input limit. Measured by the replay below on this machine (2 cores, fuzz build): the
