@@ -277,6 +277,16 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     run->steps = lmb_steps_count(steps);
     if (st == LMB_OK && !dark)
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
+    /* The light is done: what only lighting read goes before the images, where OpenImageIO's
+     * libraries are loaded (the lights before the ray-tracing scene they point into). */
+    lmb_direct_free(direct);
+    direct = NULL;
+    lmb_sky_free(sky);
+    sky = NULL;
+    lmb_emitters_free(em);
+    em = NULL;
+    lmb_textures_free(&tx);
+    lmb_rt_free(&rt);
     lmb_atlas_output *outputs = calloc((size_t)l.atlas_count + 1, sizeof *outputs);
     if (st == LMB_OK && !outputs)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "output: out of memory");
