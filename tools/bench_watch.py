@@ -6,12 +6,14 @@ the moment each bake was ready), then a plain `lmbake bake` of the same file, on
 other in one run. The quick picture's error against the final: both atlases box-averaged over
 9 x 9 texels (valid texels only), rms of the difference over the final's mean, luminance.
 
-level-single-10: its lamp 'Lamp 0' (KHR_lights_punctual: a change of lights). bevy's Cornell
+level-single-10: its lamp 'Lamp 1' (KHR_lights_punctual: a change of lights; LEVEL:NAME picks a
+point light by name, the first by default: level-single-10's 'Lamp 0', like every even lamp of
+tools/make_levels.py's single level, sits between two wall pieces and lights nothing). bevy's Cornell
 box: its light is an emissive quad: emissiveFactor x 2 (materials), then the node moved
 (geometry: the layout is made again). A level with no point light and no emissive material
 (tools/make_levels.py's gpu levels): its sun x 2, then turned 10 degrees about the vertical.
 
-usage: bench_watch.py LMBAKE OUT_CSV LEVEL...
+usage: bench_watch.py LMBAKE OUT_CSV LEVEL[:LIGHT]...
 """
 import json
 import math
@@ -51,10 +53,12 @@ def write_level(path, doc, rest):
     os.replace(path + ".tmp", path)
 
 
-def light_edits(doc):
-    """[(what, edit(doc))]: the light brighter, then moved."""
+def light_edits(doc, light=None):
+    """[(what, edit(doc))]: the light brighter, then moved (the point light named `light`, else the first)."""
     lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
-    point = [i for i, l in enumerate(lights) if l.get("type") == "point"]
+    point = [i for i, l in enumerate(lights) if l.get("type") == "point" and light in (None, l.get("name"))]
+    if light and not point:
+        sys.exit("bench_watch: no point light named '%s'" % light)
     if point:
         k = point[0]
         node = next(n for n in doc["nodes"] if n.get("extensions", {}).get("KHR_lights_punctual", {}).get("light") == k)
@@ -175,11 +179,11 @@ def quick_in_final_atlas(quick_gltf, quick_img, final_gltf, shape):
     return out, hit
 
 
-def quick_error(quick_gltf, quick_exr, final_gltf, final_exr):
+def quick_error(quick_gltf, quick_img, final_gltf, final_exr):
     """rms over the final's valid texels of (quick - final), both 9 x 9-averaged in the final's
     atlas, luminance, over the final's mean."""
     f = oiio.ImageBuf(final_exr).get_pixels(oiio.FLOAT)[..., :3].astype(np.float64)
-    q = oiio.ImageBuf(quick_exr).get_pixels(oiio.FLOAT)[..., :3].astype(np.float64)
+    q = oiio.ImageBuf(quick_img).get_pixels(oiio.FLOAT)[..., :3].astype(np.float64)
     qf, hit = quick_in_final_atlas(quick_gltf, q, final_gltf, f.shape[:2])
     valid = (f.max(axis=2) > 0) & hit
     lum = lambda a: a @ np.array([0.2126, 0.7152, 0.0722])
@@ -204,12 +208,12 @@ def wait_shown(url, generation, kind, timeout=1800):
     sys.exit("timed out waiting for %s bake %d" % (kind, generation))
 
 
-def bench(lmbake, level_src, rows):
+def bench(lmbake, level_src, rows, light=None):
     work = tempfile.mkdtemp(prefix="bench-watch-")
     level = os.path.join(work, os.path.basename(level_src))
     shutil.copy(level_src, level)
     doc, rest = read_level(level)
-    edits, _ = light_edits(doc)
+    edits, _ = light_edits(doc, light)
     out = os.path.join(work, "out")
     p = subprocess.Popen([lmbake, "preview", "--watch", level, "-o", out], stdout=subprocess.PIPE, text=True)
     url = re.search(r"(http://127\.0\.0\.1:\d+/)", p.stdout.readline()).group(1)
@@ -228,11 +232,11 @@ def bench(lmbake, level_src, rows):
             os.makedirs(quick)
             get = lambda f: urllib.request.urlretrieve("%sbake/quick/%d/%s" % (url, g, f), os.path.join(quick, f))
             get("%s.gltf" % stem)
-            for f in ["%s-lightmap-0.exr" % stem] + [b["uri"] for b in json.load(open(os.path.join(quick, "%s.gltf" % stem)))["buffers"]]:
+            for f in ["%s-lightmap-0.hdr" % stem] + [b["uri"] for b in json.load(open(os.path.join(quick, "%s.gltf" % stem)))["buffers"]]:
                 get(f)
             s = wait_shown(url, g, "final")
             final_at = s["shown"]["readyAt"] / 1000
-            err = quick_error(os.path.join(quick, "%s.gltf" % stem), os.path.join(quick, "%s-lightmap-0.exr" % stem),
+            err = quick_error(os.path.join(quick, "%s.gltf" % stem), os.path.join(quick, "%s-lightmap-0.hdr" % stem),
                               os.path.join(out, "%s.gltf" % stem), os.path.join(out, "%s-lightmap-0.exr" % stem))
             t0 = time.time()
             subprocess.run([lmbake, "bake", level, "-o", os.path.join(work, "plain"), "-q"], check=True)
@@ -251,8 +255,9 @@ def bench(lmbake, level_src, rows):
 def main():
     lmbake, csv = sys.argv[1], sys.argv[2]
     rows = []
-    for level in sys.argv[3:]:
-        bench(lmbake, level, rows)
+    for arg in sys.argv[3:]:
+        m = re.match(r"(.*\.gl(?:b|tf)):(.+)$", arg)  # LEVEL:LIGHT
+        bench(lmbake, m.group(1) if m else arg, rows, m.group(2) if m else None)
     with open(csv, "w") as f:
         f.write("level,edit,changed,redone,save_to_quick_s,save_to_final_s,plain_bake_s,quick_error_9x9_rms\n")
         for r in rows:

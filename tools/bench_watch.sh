@@ -5,7 +5,7 @@
 # run right after, and the quick picture's 9 x 9-averaged error against the final. Writes
 # bench/watch.csv (or bench/watch-NAME.csv for levels given). About 10 minutes on 2 cores with
 # the default levels. Not part of the tests.
-#   usage: tools/bench_watch.sh [LEVEL ...]
+#   usage: tools/bench_watch.sh [LEVEL[:LIGHT] ...]   (LIGHT: the point light to edit, by name)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh build
@@ -16,7 +16,7 @@ if [ $# -gt 0 ]; then
   /usr/bin/python3 tools/bench_watch.py build/lmbake "$csv" "$@"
 else
   csv=bench/watch.csv
-  /usr/bin/python3 tools/bench_watch.py build/lmbake "$csv" bench/levels/level-single-10.glb \
+  /usr/bin/python3 tools/bench_watch.py build/lmbake "$csv" "bench/levels/level-single-10.glb:Lamp 1" \
     assets/scenes/cornell-box-bevy/CornellBox.glb
 fi
 column -s, -t "$csv"

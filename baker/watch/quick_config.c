@@ -3,10 +3,12 @@
  * quarter of the texels (half the texel density each way: its own, coarser layout, which the
  * preview loads whole) lit with a quarter of the direct light's, the final gather's and the
  * bounce passes' rays, adaptive sampling capped at 256 samples, the irradiance cache twice as
- * sparse, no seam stitching and no probes. What would bias the picture stays: the gather points
- * per texel (one instead of four made cornell-point 7% darker near its lamp) and the bounce
- * count (3 of 4 bounces: 3.7% darker). The denoiser stays on: it is what makes a few rays look
- * like the final picture.
+ * sparse, no seam stitching and no probes, at most two bounce passes (with bounces auto: the
+ * tail extrapolated from them covers the rest), and no EXR, KTX2, RGBM or direction maps (the
+ * .hdr the page reads and the .png beside it are always written). What would
+ * bias the picture stays: the gather points per texel (one instead of four made cornell-point
+ * 7% darker near its lamp) and a fixed bounce count (3 of 4 bounces: 3.7% darker). The denoiser
+ * stays on: it is what makes a few rays look like the final picture.
  */
 #include <lmbake/lmbake.h>
 
@@ -42,4 +44,11 @@ void lmb_config_quick(lmb_config *cfg)
     cfg->seam_stitch = 0;
     cfg->probes_auto = 0;
     cfg->probe_volume_count = 0;
+    /* at most two bounce passes before the final gather; the auto tail extrapolates the rest
+     * from their ratio (a fixed count is kept) */
+    if (cfg->bounces == LMB_AUTO && cfg->bounces_max > 3)
+        cfg->bounces_max = 3;
+    /* what the page reads: the .hdr (written with the .png whatever the formats), no direction maps */
+    cfg->output_formats = LMB_OUTPUT_HDR;
+    cfg->directional = 0;
 }
