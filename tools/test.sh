@@ -7,7 +7,9 @@
 # Each next build runs beside the tests before it, at the lowest CPU priority (nice 19): it
 # takes the cores the tests leave idle (a browser loading a page, a watch polling, the last
 # test of a pass running alone) and gets about 1.5% of a core while the tests want both, so
-# the tests' timings barely move. Its log is printed if it fails.
+# the tests' timings barely move. Its log is printed when it is waited for. The fuzz build
+# runs beside only when its packages (clang-14, libFuzzer) are installed: installing asks for
+# sudo, which a background job cannot (tools/fuzz.sh then builds it in the foreground).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -22,7 +24,7 @@ trap 'for p in "${beside_pid[@]}"; do kill -- -"$p" 2>/dev/null || true; done' E
 start_beside() {
   local name=$1
   shift
-  setsid nice -n 19 "$@" >"build/$name-beside.log" 2>&1 &
+  setsid -w nice -n 19 "$@" >"build/$name-beside.log" 2>&1 &
   beside_pid[$name]=$!
 }
 wait_beside() {
@@ -43,13 +45,18 @@ echo "test: Release build"
 
 if [ "$sanitize" != 0 ]; then
   wait_beside build-asan
-  [ "$fuzz_seconds" != 0 ] && start_beside build-fuzz env LMB_FUZZ_BUILD_ONLY=1 tools/fuzz.sh
+  fuzz_beside=0
+  if [ "$fuzz_seconds" != 0 ] && dpkg-query -W -f='${Status}\n' clang-14 libclang-rt-14-dev libomp-14-dev 2>/dev/null |
+       grep -c "install ok installed" | grep -qx 3; then
+    fuzz_beside=1
+    start_beside build-fuzz env LMB_FUZZ_BUILD_ONLY=1 tools/fuzz.sh
+  fi
   echo "test: ASan+UBSan build"
   (cd build-asan && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
      ctest --output-on-failure -j"$jobs")
 fi
 if [ "$fuzz_seconds" != 0 ]; then
-  [ "$sanitize" != 0 ] && wait_beside build-fuzz
+  [ "${fuzz_beside:-0}" = 1 ] && wait_beside build-fuzz
   echo "test: fuzzing, ${fuzz_seconds} s"
   tools/fuzz.sh "$fuzz_seconds"
 fi

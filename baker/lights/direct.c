@@ -33,8 +33,9 @@
 
 #define VALIDITY_RAYS 16
 /* Up to this many point/spot lights are all evaluated at every point (exact, no noise);
- * beyond it, samples.direct lights are drawn per point in proportion to power, so the
- * cost does not grow with the light count. Directional lights are always evaluated. */
+ * beyond it, per point the lights that can reach it are evaluated, or samples.direct of them
+ * drawn by their unshadowed irradiance there (local_lights), so the shadow rays do not grow
+ * with the light count. Directional lights are always evaluated. */
 #define EXACT_LOCAL_LIGHTS 8
 
 const lmb_config *lmb_direct_config(const lmb_direct *d)

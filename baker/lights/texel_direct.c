@@ -81,7 +81,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         p->sequence = lmb_mix64(p->rng.key ^ 0x51u);
         lmb_direct_draw exact = {LMB_DIRECT_EXACT, 0, 0, p->sequence, 0};
         r += lmb_direct_eval(job->direct, &p->sp, &exact, &p->rng, p->e, p->dir, p->deferred);
-        if (first) /* the refinement's own stream for the sky and many lights */
+        if (first) /* the refinement's own stream for the sky and many lights (drawn by power past 256) */
             p->rng = lmb_rng_make(cfg->seed, key, 0x6000u + k);
         if (job->shadowmask) { /* a stream of its own: the lightmap does not change with output.shadowmask */
             lmb_rng mask_rng = lmb_rng_make(cfg->seed, key, 0x5000u + k);

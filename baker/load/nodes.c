@@ -206,6 +206,13 @@ static lmb_status add_light(walk *w, uint32_t node, const double world[16], lmb_
     if (!(gl->intensity >= 0.0) || !isfinite(gl->intensity))
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s has intensity %g; it must be a finite number >= 0",
                              w->ctx->path, label, gl->intensity);
+    /* KHR_lights_punctual's colour is linear RGB in [0, 1] (its schema); a negative channel would
+     * be negative light, which the direct light's sampling cannot draw */
+    for (int c = 0; c < 3; c++)
+        if (!(gl->color[c] >= 0.0) || !isfinite(gl->color[c]))
+            return lmb_error_set(err, LMB_ERR_INPUT,
+                                 "%s: %s has colour (%g, %g, %g); each channel must be a finite number >= 0",
+                                 w->ctx->path, label, gl->color[0], gl->color[1], gl->color[2]);
     if (l.type == LMB_LIGHT_SPOT &&
         !(gl->inner_cone >= 0.0 && gl->inner_cone < gl->outer_cone && gl->outer_cone <= LMB_PI_2 + 1e-9))
         return lmb_error_set(err, LMB_ERR_INPUT,

@@ -4,7 +4,7 @@
  * preview loads whole) lit with a quarter of the direct light's, the final gather's and the
  * bounce passes' rays, adaptive sampling capped at 256 samples, the irradiance cache twice as
  * sparse, no seam stitching and no probes, at most two bounce passes (with bounces auto: the
- * tail extrapolated from them covers the rest), and no EXR, KTX2, RGBM or direction maps (the
+ * tail extrapolated from them covers the rest), and no EXR, KTX2, RGBM, mask or direction maps (the
  * .hdr the page reads and the .png beside it are always written). What would
  * bias the picture stays: the gather points per texel (one instead of four made cornell-point
  * 7% darker near its lamp) and a fixed bounce count (3 of 4 bounces: 3.7% darker). The denoiser

@@ -114,6 +114,14 @@ def cases():
     d["scenes"][0]["nodes"].append(1)
     yield "negative-intensity", d
 
+    d = copy.deepcopy(ok)
+    d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d["extensions"] = {"KHR_lights_punctual": {"lights": [{"name": "Odd", "type": "point", "intensity": 5,
+                                                           "color": [1, -0.3, 0]}]}}
+    d["nodes"].append({"name": "Lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    d["scenes"][0]["nodes"].append(1)
+    yield "negative-colour", d
+
     # borderline but valid: half the triangles have zero area (warning, exit 0)
     yield "degenerate-triangles", base_doc(QUAD + [(2, 0, 0)], QUAD_IDX + [1, 4, 1, 0, 1, 4])
 

@@ -58,7 +58,7 @@ def main():
         with open(cfg, "w") as f:
             # the light is checked elsewhere: one bounce and few rays (the texels are compared
             # with the same bake's EXR, noise and all)
-            f.write("texel_density: 64\nbounces: 1\nsamples: {gather: 32, bounce: 16, adaptive: false}\n"
+            f.write("texel_density: 64\nbounces: 1\nsamples: {gather: 32, adaptive: false}\n"
                     "output: {formats: [exr, ktx2], directional: false, ktx2_format: %s, "
                     "ktx2_supercompression: %s}\n" % (fmt, sc))
         out = os.path.join(work, name)
