@@ -132,15 +132,23 @@ double lmb_punctual_falloff(const lmb_light *l, const double d[3], double dist)
     return w;
 }
 
+/* Whether light l can reach c's point were nothing in the way: its unit direction d, distance,
+ * cosine at the point and falloff (lmb_punctual_falloff), each > 0 when it can. */
+static int punctual_reaches(const point_ctx *c, const lmb_light *l, double d[3], double *dist, double *cosang,
+                            double *w)
+{
+    if (!lmb_light_direction(c, l, d, dist))
+        return 0;
+    *w = lmb_punctual_falloff(l, d, *dist);
+    *cosang = lmb_dot3(c->n, d);
+    return *w > 0 && *cosang > 0 && lmb_dot3(c->ng, d) > 0;
+}
+
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
     double scale = c->d->cfg->light_intensity_scale, d[3], dist, cosang, w;
-    if (!lmb_light_direction(c, l, d, &dist))
-        return;
-    w = lmb_punctual_falloff(l, d, dist);
-    cosang = lmb_dot3(c->n, d);
-    if (w <= 0 || cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
+    if (!punctual_reaches(c, l, d, &dist, &cosang, &w))
         return;
     c->rays++;
     if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
@@ -193,13 +201,10 @@ static void sun_disc(point_ctx *c, const lmb_light *l, uint32_t which, double e[
  * point (behind it, outside its range or cone), so drawing by it is unbiased. */
 static double unshadowed_luminance(const point_ctx *c, const lmb_light *l)
 {
-    double d[3], dist;
-    if (!lmb_light_direction(c, l, d, &dist))
+    double d[3], dist, cosang, w;
+    if (!punctual_reaches(c, l, d, &dist, &cosang, &w))
         return 0;
-    double cosang = lmb_dot3(c->n, d);
-    if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
-        return 0;
-    return l->intensity * lmb_luminance_f(l->color) * cosang * lmb_punctual_falloff(l, d, dist);
+    return l->intensity * lmb_luminance_f(l->color) * cosang * w;
 }
 
 /* Point and spot lights: all of them when few (EXACT_LOCAL_LIGHTS), else the lights that can
