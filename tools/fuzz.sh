@@ -3,7 +3,7 @@
 # decoding and the farm's plan decoder (tests/fuzz/fuzz_*.c), built with Debian's clang-14,
 # ASan and UBSan.
 #   usage: tools/fuzz.sh [SECONDS] [TARGET...]   (default: 60 s; targets gltf config image plan)
-#   LMB_FUZZ_BUILD_ONLY=1: build and stop
+#   LMB_FUZZ_BUILD_ONLY=1: build and stop; LMB_FUZZ_PACKAGES_INSTALLED=1: whether its packages are there
 # All targets run at once, each for SECONDS of wall time, one process each (the machine's cores
 # are shared). Seeds come from assets/ and tests/data (tests/fuzz/CMakeLists.txt has the same
 # patterns); what a run adds stays in build-fuzz/corpus/<target> for the next run. First every
@@ -23,7 +23,15 @@ targets=("$@")
 export LMB_FUZZ_PLAN_SCENE="$PWD/assets/scenes/cornell-box-bevy/CornellBox.glb" # fuzz_plan's scene
 
 # clang-14 with libFuzzer's runtime; libomp for clang's OpenMP
-LMB_SETUP_PACKAGES="clang-14 libclang-rt-14-dev libomp-14-dev" \
+fuzz_packages="clang-14 libclang-rt-14-dev libomp-14-dev"
+# LMB_FUZZ_PACKAGES_INSTALLED=1: exit 0 when they are all installed, 1 otherwise (tools/test.sh)
+if [ "${LMB_FUZZ_PACKAGES_INSTALLED:-0}" = 1 ]; then
+  for p in $fuzz_packages; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || exit 1
+  done
+  exit 0
+fi
+LMB_SETUP_PACKAGES="$fuzz_packages" \
 LMB_BUILD_TARGETS="${targets[*]/#/fuzz_}" CC=clang-14 CXX=clang++-14 \
   tools/setup.sh build-fuzz -DLMB_FUZZ=ON -DBUILD_TESTING=OFF
 # LMB_FUZZ_BUILD_ONLY=1: the build alone (tools/test.sh builds it beside the sanitizer tests)
