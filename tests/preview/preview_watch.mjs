@@ -6,7 +6,8 @@
 // quick values, then to its final ones, without a reload (a marker on the page's window
 // survives) and with the camera unchanged. Bake 2's final pixels are 3x bake 1's in linear light
 // (the bake is linear in the light; 3% and 2 levels allowed for the 8-bit screenshot), its quick
-// ones are those of `lmbake bake --quick` of the same file shown by the plain preview. Then a half-written level: the page shows the error and keeps bake
+// ones are those the plain preview shows of bake 1's final composed with the two files' quick
+// looks (`lmbake bake --quick`; tools/preview/compose.mjs). Then a half-written level: the page shows the error and keeps bake
 // 2's pixels exactly. Screenshots in SHOTS_DIR (preview-watch-*.png).
 //   usage: node tests/preview/preview_watch.mjs LMBAKE WORKDIR SHOTS_DIR
 import fs from 'node:fs';
@@ -14,6 +15,7 @@ import path from 'node:path';
 import { spawn, execFileSync } from 'node:child_process';
 import { launchBrowser, openPreview, VIEWPORT } from '../../tools/preview/browser.mjs';
 import { startServer } from '../../tools/preview/server.mjs';
+import { compose } from '../../tools/preview/compose.mjs';
 import { decodePng, srgb } from './lib.mjs';
 
 const [lmbake, work, shots] = process.argv.slice(2);
@@ -71,6 +73,11 @@ try {
   const camera = async () => (await page.frames().filter((x) => x !== page.mainFrame()).pop().evaluate(() => window.lmbCamera()));
   const b1 = await pixels('bake1'), cam1 = await camera();
   check(b1.every((px) => Math.max(...px) > 8 && Math.max(...px) < 150), `bake 1 shown; pixels ${JSON.stringify(b1)}`);
+  // what bake 2's quick picture is composed from: bake 1's final (OUTDIR, copied now) and the
+  // quick look of bake 1's file (baked here as the watch did)
+  const final1 = path.join(work, 'final1'), quick1 = path.join(work, 'quick1');
+  fs.cpSync(path.join(work, 'out'), final1, { recursive: true });
+  execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quick1, '--quick', '-q']);
 
   doc.extensions.KHR_lights_punctual.lights[0].intensity *= 3;
   save();
@@ -86,7 +93,7 @@ try {
   }
   check(held !== null, `bake 2's final bake held while the quick one is read (pid ${held})`);
   await shown(2, 'quick');
-  const q2 = await pixels('bake2-quick'), camQ = await camera();
+  const q2 = await pixels('bake2-quick'), camQ = await camera(), statusQ = await status();
   if (held) process.kill(held, 'SIGCONT');
   await shown(2, 'final');
   const f2 = await pixels('bake2-final'), cam2 = await camera();
@@ -97,11 +104,14 @@ try {
       if (!okFinal) check(false, `point ${i} channel ${c}: final ${f2[i][c]}, want sRGB ${srgb(want).toFixed(1)} (3 x bake 1's ${b1[i][c]})`);
     }
   }
-  // the quick look (its own coarser atlas, fewer rays): what the plain preview shows of
-  // `lmbake bake --quick` of the same file from the same camera, within a level
-  const quickDir = path.join(work, 'quick2');
+  // the quick picture: bake 1's final plus the change at the quick look's resolution (bake 2's
+  // quick look less bake 1's, compose.mjs; its values are checked in watch_compose): what the
+  // plain preview shows of that composed from the same camera, within a level
+  const quickDir = path.join(work, 'quick2'), composedDir = path.join(work, 'composed2');
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quickDir, '--quick', '-q']);
-  const srv = await startServer(path.join(quickDir, 'cornell-point.gltf'));
+  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: composedDir, stem: 'cornell-point' });
+  check(composed.ok && statusQ.shown.composedOn === 1, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}; here: ${composed.ok || composed.why})`);
+  const srv = await startServer(path.join(composedDir, 'cornell-point.gltf'));
   const v = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: '-7', cam: '0.5,0.5,2.2,0.5,0.45,0' });
   const png = decodePng(await v.page.screenshot());
   const wantQuick = [];
@@ -109,7 +119,7 @@ try {
   await v.context.close();
   await srv.close();
   const quickOff = Math.max(...q2.flatMap((px, i) => px.map((x, c) => Math.abs(x - wantQuick[i][c]))));
-  check(quickOff <= 1, `bake 2's quick picture is \`lmbake bake --quick\`'s: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)} (largest difference ${quickOff})`);
+  check(quickOff <= 1, `bake 2's quick picture is the composed one: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)} (largest difference ${quickOff})`);
   check(true, `bake 2 (light x 3): quick ${JSON.stringify(q2)} then final ${JSON.stringify(f2)} against bake 1 ${JSON.stringify(b1)}`);
   const same = (a, b) => a.position.every((v, k) => Math.abs(v - b.position[k]) < 1e-9) && a.target.every((v, k) => Math.abs(v - b.target[k]) < 1e-9);
   check(same(cam1, camQ) && same(cam1, cam2), `the camera stayed where it was (${cam2.position.map((v) => v.toFixed(3))})`);

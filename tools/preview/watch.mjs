@@ -16,6 +16,7 @@ import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { projectRoot, resolveFile, TYPES } from './server.mjs';
 import { watchedFiles, snapshot, configKeys, fingerprint, compare } from './watch-inputs.mjs';
+import { compose } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
 const POLL_MS = 100; // how often the files' sizes and times are looked at
@@ -134,18 +135,39 @@ async function bakeNewest() {
     if (r.cancelled || dirty) return;
     if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
+    const composed = kind === 'quick' ? composeQuick(generation, change) : null;
     const seconds = (Date.now() - seen) / 1000;
-    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept: r.layoutKept };
+    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept: r.layoutKept, composedOn: composed };
     status.history.push({ generation, kind, seconds, changed: change.what });
     if (status.history.length > 50) status.history.shift();
     status.error = null;
-    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${r.layoutKept ? '; layout kept' : ''})`);
+    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${r.layoutKept ? '; layout kept' : ''}${composed ? `; composed on final bake ${composed}` : ''})`);
     tidyQuickDirs();
     tidyLayouts();
   }
-  status.lastGood = { fp };
+  status.lastGood = { fp, generation, outdir: outdirStamp(), quick: opts.quick ? path.join(quickRoot, String(generation)) : null };
   goodPrint = print;
   status.state = 'idle';
+}
+
+// OUTDIR's glTF as it stands (inode and time): the composed picture's base must be the final
+// bake lastGood names, not one a stopped bake swapped in as it was stopped.
+function outdirStamp() {
+  try { const st = fs.statSync(path.join(opts.outdir, `${stem}.gltf`)); return `${st.ino}:${st.mtimeMs}`; } catch { return null; }
+}
+
+// After quick bake N of a change that keeps the layout (and the output's units): the picture
+// shown is the last final bake plus the difference of the two quick looks, in the final's atlas
+// (compose.mjs), written to QUICK/N/composed. Returns the final bake's generation it was composed
+// on, or null (then the quick look is shown as baked, and the log says why).
+function composeQuick(generation, change) {
+  const base = status.lastGood;
+  if (!base || !base.quick || change.layout || change.what.some((w) => /^config .*\boutput\./.test(w))) return null;
+  if (!fs.existsSync(base.quick) || outdirStamp() !== base.outdir) return null;
+  const dir = path.join(quickRoot, String(generation));
+  const r = compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out: path.join(dir, 'composed'), stem });
+  if (!r.ok) { say(`quick bake ${generation}: shown as baked, not composed on final bake ${base.generation} (${r.why})`); return null; }
+  return base.generation;
 }
 
 // A bake that failed while the files moved under it (a save it read half-way, before the poll
@@ -169,7 +191,8 @@ function tidyQuickDirs() {
   for (const d of fs.readdirSync(quickRoot)) {
     if (!/^\d+$/.test(d)) continue; // the layouts
     const g = Number(d);
-    if (g !== status.generation && !(status.shown && status.shown.generation === g && status.shown.kind === 'quick')) fs.rmSync(path.join(quickRoot, d), { recursive: true, force: true });
+    const base = status.lastGood && status.lastGood.generation === g; // the next composed picture's quick(before)
+    if (g !== status.generation && !base && !(status.shown && status.shown.generation === g && status.shown.kind === 'quick')) fs.rmSync(path.join(quickRoot, d), { recursive: true, force: true });
   }
 }
 
@@ -220,7 +243,8 @@ const server = http.createServer((req, res) => {
   if (url.pathname === '/scene.json') {
     const kind = url.searchParams.get('kind'), gen = url.searchParams.get('gen');
     if (!['quick', 'final'].includes(kind) || !/^\d+$/.test(gen || '')) return send(404, 'text/plain', 'no such bake\n');
-    return send(200, 'application/json', JSON.stringify({ gltf: `/bake/${kind}/${gen}/${encodeURIComponent(stem)}.gltf`, name: `${stem}.gltf (${kind} bake ${gen})` }));
+    const composed = kind === 'quick' && fs.existsSync(path.join(quickRoot, gen, 'composed', `${stem}.gltf`)) ? 'composed/' : '';
+    return send(200, 'application/json', JSON.stringify({ gltf: `/bake/${kind}/${gen}/${composed}${encodeURIComponent(stem)}.gltf`, name: `${stem}.gltf (${kind} bake ${gen}${composed ? ', composed on the last final' : ''})` }));
   }
   const m = /^\/bake\/(quick|final)\/(\d+)\//.exec(url.pathname);
   const roots = m ? [[m[0], m[1] === 'quick' ? path.join(quickRoot, m[2]) : opts.outdir]] : staticRoots;

@@ -1,0 +1,331 @@
+// The watch's composed quick picture (docs/watch.md#the-composed-quick-picture): after a change
+// that keeps the layout, the quick look is shown as
+//
+//     final(before) + quick(after) - quick(before)
+//
+// in the final bake's atlas. Light is linear in what emits it, so where the change does not
+// reach, the difference of the two quick looks (same layout, same seed) is close to zero and the
+// picture is the last final bake, at its resolution and noise; where it does, the change is
+// added at the quick look's resolution. The quick looks are read at each final texel through the
+// triangles both bakes share (the unwrap keeps the input's triangles in order): the texel
+// centre's barycentric coordinates in its final TEXCOORD_1 triangle, the same point in the
+// quick bake's triangle, read bilinearly (tools/bench_watch.py's mapping). Copies that share one
+// TEXCOORD_1 in both bakes map rectangle to rectangle instead. Texels no triangle covers (the
+// atlas's padding) take the difference of a covered neighbour.
+//
+// compose(...) writes OUT: the final's glTF with its lightmap textures naming only the composed
+// .hdr (no KTX2 or EXR: those are the old final's), the final's other files hard-linked (or
+// copied), and the composed .hdr. It returns {ok: true, ms} or {ok: false, why} (then the quick
+// look is shown as baked).
+import fs from 'node:fs';
+import path from 'node:path';
+import { HDRLoader } from 'three/examples/jsm/loaders/HDRLoader.js';
+
+const FLOAT_TYPE = 1015; // three's FloatType: HDRLoader decodes to float32 RGBA
+const MAX_TRIANGLES = 5e6; // placed triangles mapped one by one at most (about 2 s here)
+const PAD_PASSES = 8; // texels beyond the triangles filled from a neighbour, at most this far out
+
+function readGltf(dir, stem) {
+  const file = path.join(dir, `${stem}.gltf`);
+  const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
+  const buffers = new Map();
+  const buffer = (i) => {
+    if (!buffers.has(i)) buffers.set(i, fs.readFileSync(path.join(dir, doc.buffers[i].uri)));
+    return buffers.get(i);
+  };
+  return { dir, stem, doc, buffer };
+}
+
+const COMPONENTS = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4 };
+const TYPES = { 5126: Float32Array, 5125: Uint32Array, 5123: Uint16Array, 5121: Uint8Array };
+
+// An accessor's values, flat (count x components), as numbers (no sparse, no normalisation).
+function accessor(g, index) {
+  const a = g.doc.accessors[index];
+  const v = g.doc.bufferViews[a.bufferView];
+  const Type = TYPES[a.componentType];
+  if (!Type || a.sparse) throw new Error(`accessor ${index}: type ${a.componentType} not read here`);
+  const n = COMPONENTS[a.type], size = Type.BYTES_PER_ELEMENT;
+  const stride = v.byteStride || n * size;
+  const data = g.buffer(v.buffer), start = data.byteOffset + (v.byteOffset || 0) + (a.byteOffset || 0);
+  const view = new DataView(data.buffer);
+  const get = { 5126: (o) => view.getFloat32(o, true), 5125: (o) => view.getUint32(o, true), 5123: (o) => view.getUint16(o, true), 5121: (o) => view.getUint8(o) }[a.componentType];
+  const out = new Float64Array(a.count * n);
+  for (let i = 0; i < a.count; i++) for (let c = 0; c < n; c++) out[i * n + c] = get(start + i * stride + c * size);
+  return out;
+}
+
+// A Radiance .hdr as three's HDRLoader reads it for the page: {width, height, data (RGBA float32)}.
+export function readHdr(file) {
+  const bytes = fs.readFileSync(file);
+  const loader = new HDRLoader();
+  loader.setDataType(FLOAT_TYPE);
+  return loader.parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
+}
+
+// Atlas index -> {width, height, data (RGBA float32, row 0 on top), hdr (the file's name), texture}
+function readAtlases(g) {
+  const atlases = new Map();
+  (g.doc.textures || []).forEach((t, ti) => {
+    const lm = t.extras && t.extras.lightmap;
+    if (!lm || !lm.files || !lm.files.hdr) return;
+    const img = readHdr(path.join(g.dir, lm.files.hdr));
+    atlases.set(lm.atlas, { width: img.width, height: img.height, data: img.data, hdr: lm.files.hdr, texture: ti });
+  });
+  return atlases;
+}
+
+// Every lightmapped node: {node, mesh, atlas, rects: [[sx, sy, ox, oy], ...] (one per copy)}.
+function lightmappedNodes(g) {
+  const out = [];
+  (g.doc.nodes || []).forEach((n, i) => {
+    const lm = n.extras && n.extras.lightmap;
+    if (!lm || n.mesh === undefined) return;
+    let rects;
+    if (lm.scaleOffset) rects = [lm.scaleOffset];
+    else {
+      const inst = n.extensions && n.extensions.EXT_mesh_gpu_instancing;
+      if (!inst || !inst.attributes._LIGHTMAP_SCALE) throw new Error(`node ${i}: no lightmap rectangle`);
+      const s = accessor(g, inst.attributes._LIGHTMAP_SCALE), o = accessor(g, inst.attributes._LIGHTMAP_OFFSET);
+      rects = [];
+      for (let k = 0; k < s.length / 2; k++) rects.push([s[2 * k], s[2 * k + 1], o[2 * k], o[2 * k + 1]]);
+    }
+    out.push({ node: i, mesh: n.mesh, atlas: lm.atlas, rects });
+  });
+  return out;
+}
+
+// A mesh's lightmapped primitives: [{uv (TEXCOORD_1, flat), index (flat)}].
+function meshUv1(g, mesh, cache) {
+  if (!cache.has(mesh)) {
+    cache.set(mesh, g.doc.meshes[mesh].primitives.filter((p) => p.attributes.TEXCOORD_1 !== undefined).map((p) => {
+      const uv = accessor(g, p.attributes.TEXCOORD_1);
+      const index = p.indices !== undefined ? accessor(g, p.indices) : Float64Array.from({ length: uv.length / 2 }, (_, k) => k);
+      return { uv, index };
+    }));
+  }
+  return cache.get(mesh);
+}
+
+const sameArray = (a, b) => a.length === b.length && a.every((x, i) => x === b[i]);
+
+// The weighted sum of quick images (sources: [{img, weight}], one atlas each, same size) at
+// quick atlas position (u, v), bilinear, into out[0..2].
+function sampleQuick(sources, u, v, out) {
+  const w = sources[0].img.width, h = sources[0].img.height;
+  const x = Math.min(Math.max(u * w - 0.5, 0), w - 1), y = Math.min(Math.max(v * h - 0.5, 0), h - 1);
+  const x0 = Math.floor(x), y0 = Math.floor(y), x1 = Math.min(x0 + 1, w - 1), y1 = Math.min(y0 + 1, h - 1);
+  const fx = x - x0, fy = y - y0;
+  const wts = [(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy];
+  const at = [(y0 * w + x0) * 4, (y0 * w + x1) * 4, (y1 * w + x0) * 4, (y1 * w + x1) * 4];
+  for (let c = 0; c < 3; c++) {
+    let s = 0;
+    for (const { img, weight } of sources) for (let k = 0; k < 4; k++) s += weight * wts[k] * img.data[at[k] + c];
+    out[c] = s;
+  }
+}
+
+// Rasterises final triangle f (atlas uv, 6 numbers) into the final atlas; each covered texel
+// centre gets the quick images' sum at the same barycentric point of quick triangle q.
+function mapTriangle(f, q, fa, sources, delta, covered) {
+  const W = fa.width, H = fa.height;
+  const ax = f[0] * W, ay = f[1] * H, bx = f[2] * W, by = f[3] * H, cx = f[4] * W, cy = f[5] * H;
+  const det = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay);
+  if (Math.abs(det) < 1e-12) return;
+  const x0 = Math.max(Math.floor(Math.min(ax, bx, cx) - 0.5), 0), x1 = Math.min(Math.ceil(Math.max(ax, bx, cx) - 0.5), W - 1);
+  const y0 = Math.max(Math.floor(Math.min(ay, by, cy) - 0.5), 0), y1 = Math.min(Math.ceil(Math.max(ay, by, cy) - 0.5), H - 1);
+  const d = [0, 0, 0], eps = 1e-9;
+  for (let y = y0; y <= y1; y++) {
+    for (let x = x0; x <= x1; x++) {
+      const px = x + 0.5 - ax, py = y + 0.5 - ay;
+      const l1 = (px * (cy - ay) - (cx - ax) * py) / det, l2 = ((bx - ax) * py - px * (by - ay)) / det;
+      if (l1 < -eps || l2 < -eps || l1 + l2 > 1 + eps) continue;
+      sampleQuick(sources, q[0] + l1 * (q[2] - q[0]) + l2 * (q[4] - q[0]), q[1] + l1 * (q[3] - q[1]) + l2 * (q[5] - q[1]), d);
+      const t = y * W + x;
+      delta[3 * t] = d[0]; delta[3 * t + 1] = d[1]; delta[3 * t + 2] = d[2];
+      covered[t] = 1;
+    }
+  }
+}
+
+// Every texel of a copy's final rectangle from the same point of its quick rectangle (both bakes
+// share the copy's TEXCOORD_1, so the map is the rectangles' affine map).
+function mapRect(rf, rq, fa, sources, delta, covered) {
+  const W = fa.width, H = fa.height, d = [0, 0, 0];
+  const x0 = Math.max(Math.floor(rf[2] * W), 0), x1 = Math.min(Math.ceil((rf[2] + rf[0]) * W) - 1, W - 1);
+  const y0 = Math.max(Math.floor(rf[3] * H), 0), y1 = Math.min(Math.ceil((rf[3] + rf[1]) * H) - 1, H - 1);
+  for (let y = y0; y <= y1; y++) {
+    for (let x = x0; x <= x1; x++) {
+      const s = ((x + 0.5) / W - rf[2]) / rf[0], t = ((y + 0.5) / H - rf[3]) / rf[1];
+      sampleQuick(sources, s * rq[0] + rq[2], t * rq[1] + rq[3], d);
+      const i = y * W + x;
+      delta[3 * i] = d[0]; delta[3 * i + 1] = d[1]; delta[3 * i + 2] = d[2];
+      covered[i] = 1;
+    }
+  }
+}
+
+// Uncovered texels next to covered ones take their neighbours' mean difference, pass by pass.
+function padDelta(W, H, delta, covered) {
+  for (let pass = 0; pass < PAD_PASSES; pass++) {
+    const next = [];
+    for (let y = 0; y < H; y++) {
+      for (let x = 0; x < W; x++) {
+        if (covered[y * W + x]) continue;
+        let n = 0, r = 0, g = 0, b = 0;
+        for (let dy = -1; dy <= 1; dy++) {
+          for (let dx = -1; dx <= 1; dx++) {
+            const xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= W || yy >= H || !covered[yy * W + xx]) continue;
+            const j = yy * W + xx;
+            n++; r += delta[3 * j]; g += delta[3 * j + 1]; b += delta[3 * j + 2];
+          }
+        }
+        if (n) next.push(y * W + x, r / n, g / n, b / n);
+      }
+    }
+    if (!next.length) return;
+    for (let k = 0; k < next.length; k += 4) {
+      const i = next[k];
+      delta[3 * i] = next[k + 1]; delta[3 * i + 1] = next[k + 2]; delta[3 * i + 2] = next[k + 3];
+      covered[i] = 1;
+    }
+  }
+}
+
+// A Radiance .hdr (RGBE, each scanline run-length framed with literal runs only: what three's
+// HDRLoader and OIIO read). Mantissas are rounded for three's decoding, byte x 2^(e-128) / 255
+// (the page's reader), so an .hdr read by HDRLoader and written again keeps its bytes.
+export function encodeHdr(width, height, rgba) {
+  const head = Buffer.from(`#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y ${height} +X ${width}\n`, 'ascii');
+  const rle = width >= 8 && width < 32768;
+  const perLine = rle ? 4 + 4 * (width + Math.ceil(width / 128)) : 4 * width;
+  const out = Buffer.alloc(head.length + height * perLine);
+  head.copy(out);
+  let o = head.length;
+  const line = new Uint8Array(4 * width);
+  for (let y = 0; y < height; y++) {
+    for (let x = 0; x < width; x++) {
+      const i = (y * width + x) * 4;
+      const r = Math.max(rgba[i], 0), g = Math.max(rgba[i + 1], 0), b = Math.max(rgba[i + 2], 0);
+      const m = Math.max(r, g, b);
+      if (!(m > 1e-32) || !Number.isFinite(m)) { line.fill(0, 4 * x, 4 * x + 4); continue; }
+      let e = Math.ceil(Math.log2(m)); // the smallest e with m <= 2^e
+      while (m > 2 ** e) e++;
+      while (e > -127 && m <= 2 ** (e - 1)) e--;
+      if (e > 127) e = 127;
+      const scale = 255 / 2 ** e;
+      line[4 * x] = Math.min(Math.round(r * scale), 255);
+      line[4 * x + 1] = Math.min(Math.round(g * scale), 255);
+      line[4 * x + 2] = Math.min(Math.round(b * scale), 255);
+      line[4 * x + 3] = e + 128;
+    }
+    if (!rle) { out.set(line, o); o += 4 * width; continue; }
+    out[o++] = 2; out[o++] = 2; out[o++] = width >> 8; out[o++] = width & 255;
+    for (let c = 0; c < 4; c++) {
+      for (let x = 0; x < width; x += 128) {
+        const n = Math.min(128, width - x);
+        out[o++] = n;
+        for (let k = 0; k < n; k++) out[o++] = line[4 * (x + k) + c];
+      }
+    }
+  }
+  return out.subarray(0, o);
+}
+
+function linkOrCopy(from, to) {
+  try { fs.linkSync(from, to); } catch { fs.copyFileSync(from, to); }
+}
+
+// The weighted sum of quick bakes, read at each texel of the final bake's atlases. f: the final
+// (readGltf); quicks: [{g (readGltf), weight}] sharing one layout. Returns {atlases (the
+// final's, readAtlases), mapped: atlas -> {value (3 floats a texel), covered (1: a triangle's or
+// copy's texel)}} or {why} when the bakes do not correspond.
+export function mapQuicks(f, quicks) {
+  const nf = lightmappedNodes(f), nq = quicks.map((q) => lightmappedNodes(q.g));
+  const sameNodes = (a, b) => a.length === b.length && a.every((x, i) => x.node === b[i].node && x.mesh === b[i].mesh && x.rects.length === b[i].rects.length);
+  if (!nq.every((n) => sameNodes(nf, n))) return { why: 'the bakes light different nodes' };
+  const sameLayout = (a, b) => a.every((x, i) => x.atlas === b[i].atlas && x.rects.every((r, k) => sameArray(r, b[i].rects[k])));
+  if (!nq.every((n) => sameLayout(nq[0], n))) return { why: 'the quick looks have different layouts' };
+  const atlases = readAtlases(f), qAtlases = quicks.map((q) => readAtlases(q.g));
+  for (const [a, img] of qAtlases[0]) {
+    if (!qAtlases.every((m) => m.has(a) && m.get(a).width === img.width && m.get(a).height === img.height)) return { why: 'the quick looks have different atlases' };
+  }
+  const mapped = new Map();
+  for (const [a, img] of atlases) mapped.set(a, { value: new Float32Array(3 * img.width * img.height), covered: new Uint8Array(img.width * img.height) });
+  const fMeshes = new Map(), qMeshes = quicks.map(() => new Map());
+  let triangles = 0;
+  for (let k = 0; k < nf.length; k++) {
+    const fn = nf[k], qn = nq[0][k];
+    const fa = atlases.get(fn.atlas), dst = mapped.get(fn.atlas);
+    const sources = quicks.map((q, i) => ({ img: qAtlases[i].get(qn.atlas), weight: q.weight }));
+    if (!fa || sources.some((x) => !x.img)) return { why: `node ${fn.node}: an atlas has no .hdr` };
+    const fp = meshUv1(f, fn.mesh, fMeshes), qps = quicks.map((q, i) => meshUv1(q.g, qn.mesh, qMeshes[i])), qp = qps[0];
+    if (fp.length !== qp.length) return { why: `mesh ${fn.mesh}: the bakes' primitives differ` };
+    if (!qps.every((x) => x.length === qp.length && x.every((p, i) => sameArray(p.uv, qp[i].uv)))) return { why: 'the quick looks have different layouts' };
+    const shared = fp.every((p, i) => sameArray(p.uv, qp[i].uv) && sameArray(p.index, qp[i].index));
+    const identity = fn.rects.length === 1 && sameArray(fn.rects[0], [1, 1, 0, 0]) && sameArray(qn.rects[0], [1, 1, 0, 0]);
+    if (shared && !identity) {
+      fn.rects.forEach((r, c) => mapRect(r, qn.rects[c], fa, sources, dst.value, dst.covered));
+      continue;
+    }
+    for (let p = 0; p < fp.length; p++) {
+      const { uv: fu, index: fi } = fp[p], { uv: qu, index: qi } = qp[p];
+      if (fi.length !== qi.length) return { why: `mesh ${fn.mesh}: the bakes' triangles differ` };
+      triangles += (fi.length / 3) * fn.rects.length;
+      if (triangles > MAX_TRIANGLES) return { why: `more than ${MAX_TRIANGLES} placed triangles to map` };
+      const tf = new Float64Array(6), tq = new Float64Array(6);
+      for (let c = 0; c < fn.rects.length; c++) {
+        const rf = fn.rects[c], rq = qn.rects[c];
+        for (let t = 0; t < fi.length; t += 3) {
+          for (let v = 0; v < 3; v++) {
+            tf[2 * v] = fu[2 * fi[t + v]] * rf[0] + rf[2]; tf[2 * v + 1] = fu[2 * fi[t + v] + 1] * rf[1] + rf[3];
+            tq[2 * v] = qu[2 * qi[t + v]] * rq[0] + rq[2]; tq[2 * v + 1] = qu[2 * qi[t + v] + 1] * rq[1] + rq[3];
+          }
+          mapTriangle(tf, tq, fa, sources, dst.value, dst.covered);
+        }
+      }
+    }
+  }
+  return { atlases, mapped };
+}
+
+export function readBake(dir, stem) { return readGltf(dir, stem); }
+
+// final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
+// look's; out: the folder to write (made here). stem: the level's file name without extension.
+export function compose({ final, quickBefore, quickAfter, out, stem }) {
+  const t0 = Date.now();
+  let f, qb, qa;
+  try {
+    [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readGltf(d, stem));
+  } catch (e) {
+    return { ok: false, why: `cannot read a bake (${e.message})` };
+  }
+  const m = mapQuicks(f, [{ g: qa, weight: 1 }, { g: qb, weight: -1 }]);
+  if (m.why) return { ok: false, why: m.why };
+  fs.rmSync(out, { recursive: true, force: true });
+  fs.mkdirSync(out, { recursive: true });
+  const hdrs = new Set([...m.atlases.values()].map((a) => a.hdr));
+  for (const [a, img] of m.atlases) {
+    const { value: delta, covered } = m.mapped.get(a);
+    padDelta(img.width, img.height, delta, covered);
+    const rgba = new Float32Array(img.data.length);
+    for (let i = 0, n = img.width * img.height; i < n; i++) {
+      for (let c = 0; c < 3; c++) rgba[4 * i + c] = Math.max(img.data[4 * i + c] + delta[3 * i + c], 0);
+      rgba[4 * i + 3] = 1;
+    }
+    fs.writeFileSync(path.join(out, img.hdr), encodeHdr(img.width, img.height, rgba));
+  }
+  // The glTF: lightmap files reduced to the composed .hdr and the PNG it carries beside.
+  const doc = f.doc;
+  const keep = (files) => Object.fromEntries(Object.entries(files).filter(([k]) => k === 'hdr' || k === 'png'));
+  for (const t of doc.textures || []) if (t.extras && t.extras.lightmap && t.extras.lightmap.files) t.extras.lightmap.files = keep(t.extras.lightmap.files);
+  for (const n of doc.nodes || []) if (n.extras && n.extras.lightmap && n.extras.lightmap.files) n.extras.lightmap.files = keep(n.extras.lightmap.files);
+  fs.writeFileSync(path.join(out, `${stem}.gltf`), JSON.stringify(doc));
+  for (const name of fs.readdirSync(final)) {
+    if (name === `${stem}.gltf` || hdrs.has(name) || /\.(ktx2|exr)$/i.test(name)) continue;
+    if (fs.statSync(path.join(final, name)).isFile()) linkOrCopy(path.join(final, name), path.join(out, name));
+  }
+  return { ok: true, ms: Date.now() - t0 };
+}
