@@ -163,11 +163,21 @@ function outdirStamp() {
 function composeQuick(generation, change) {
   const base = status.lastGood;
   if (!base || !base.quick || change.layout || change.what.some((w) => /^config .*\boutput\./.test(w))) return null;
-  if (!fs.existsSync(base.quick) || outdirStamp() !== base.outdir) return null;
-  const dir = path.join(quickRoot, String(generation));
-  const r = compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out: path.join(dir, 'composed'), stem });
-  if (!r.ok) { say(`quick bake ${generation}: shown as baked, not composed on final bake ${base.generation} (${r.why})`); return null; }
-  return base.generation;
+  const dir = path.join(quickRoot, String(generation)), out = path.join(dir, 'composed');
+  let r;
+  if (!fs.existsSync(base.quick)) r = { ok: false, why: `its quick look is gone` };
+  else if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
+  else {
+    try {
+      r = compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem });
+    } catch (e) {
+      r = { ok: false, why: e.message };
+    }
+  }
+  if (r.ok) return base.generation;
+  fs.rmSync(out, { recursive: true, force: true }); // a half-written one is never served
+  say(`quick bake ${generation}: shown as baked, not composed on final bake ${base.generation} (${r.why})`);
+  return null;
 }
 
 // A bake that failed while the files moved under it (a save it read half-way, before the poll
