@@ -19,7 +19,9 @@ packages=(
   nettle-dev                        # SHA-256 of the staged bake's plan and part files
   libzstd-dev                       # Zstandard supercompression of KTX2 lightmaps
   libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
-  libopenimageio-dev openimageio-tools  # EXR/HDR/PNG output (OIIO's CMake config wants the tools)
+  libopenimageio-dev openimageio-tools  # reading textures and sky images, other formats (OIIO's CMake config wants the tools)
+  libopenexr-dev libimath-dev       # .exr lightmaps through OpenEXRCore (C), half floats (Imath's C half.h)
+  libpng-dev libstb-dev             # .png (libpng) and .hdr (stb_image_write) lightmaps, without loading OIIO
   libopenmesh-dev                   # the unwrapper's half-edge mesh (OpenMesh, behind baker/unwrap/halfedge_adapter.cpp)
   libsuitesparse-dev                # CHOLMOD sparse Cholesky for the LSCM flattening
   libqhull-dev                      # the light probes' Delaunay tetrahedra (qhull's reentrant C API)

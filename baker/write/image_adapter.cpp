@@ -2,6 +2,11 @@
  * OpenImageIO adapter (see image_adapter.h): the only place lmbake touches OIIO's C++ API.
  */
 #include "image_adapter.h"
+#ifndef LMB_IMAGES_AS_MODULE
+extern "C" {
+#include "image_native.h"
+}
+#endif
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -74,6 +79,10 @@ lmb_status write_image(const char *path, uint32_t w, uint32_t h, uint32_t ch, OI
 extern "C" lmb_status lmb_image_write_u8(const char *path, uint32_t w, uint32_t h, uint32_t ch, const uint8_t *pixels,
                                          lmb_error *err)
 {
+#ifndef LMB_IMAGES_AS_MODULE /* linked in (sanitizer, fuzz builds): the same writers as the module build's */
+    if (lmb_image_native_writes(path, 0))
+        return lmb_image_native_write_u8(path, w, h, ch, pixels, err);
+#endif
     try {
         return write_image(path, w, h, ch, OIIO::TypeDesc::UINT8, pixels, err);
     } catch (const std::exception &e) {
@@ -84,6 +93,10 @@ extern "C" lmb_status lmb_image_write_u8(const char *path, uint32_t w, uint32_t 
 extern "C" lmb_status lmb_image_write_f32(const char *path, uint32_t w, uint32_t h, uint32_t ch, const float *pixels,
                                           lmb_error *err)
 {
+#ifndef LMB_IMAGES_AS_MODULE
+    if (lmb_image_native_writes(path, 1))
+        return lmb_image_native_write_f32(path, w, h, ch, pixels, err);
+#endif
     try {
         return write_image(path, w, h, ch, OIIO::TypeDesc::FLOAT, pixels, err);
     } catch (const std::exception &e) {

@@ -8,6 +8,7 @@
  */
 #define _GNU_SOURCE
 #include "image_module.h"
+#include "image_native.h"
 
 #include <dlfcn.h>
 #include <limits.h>
@@ -79,9 +80,13 @@ static const lmb_image_api *api_or_error(lmb_error *err)
     return module_api;
 }
 
+/* .exr, .hdr and .png are written without the module (image_native.c): a bake that reads no
+ * texture or sky image never loads it. */
 lmb_status lmb_image_write_u8(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                               const uint8_t *pixels, lmb_error *err)
 {
+    if (lmb_image_native_writes(path, 0))
+        return lmb_image_native_write_u8(path, width, height, channels, pixels, err);
     const lmb_image_api *api = api_or_error(err);
     return api ? api->write_u8(path, width, height, channels, pixels, err) : LMB_ERR_INTERNAL;
 }
@@ -89,6 +94,8 @@ lmb_status lmb_image_write_u8(const char *path, uint32_t width, uint32_t height,
 lmb_status lmb_image_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                                const float *pixels, lmb_error *err)
 {
+    if (lmb_image_native_writes(path, 1))
+        return lmb_image_native_write_f32(path, width, height, channels, pixels, err);
     const lmb_image_api *api = api_or_error(err);
     return api ? api->write_f32(path, width, height, channels, pixels, err) : LMB_ERR_INTERNAL;
 }

@@ -1,0 +1,194 @@
+/*
+ * The bake's own image formats written without OpenImageIO (image_native.h): .exr through
+ * OpenEXR's C library (OpenEXRCore), .png through libpng's simplified API, .hdr through stb's
+ * image writer. Loading the OpenImageIO module makes the dynamic loader bind Debian's build of
+ * it with its 261 shared libraries (FFmpeg, GStreamer, OpenCV, ...): about 0.38 s of a bake
+ * that only writes its lightmaps (docs/testing.md); these three libraries load in milliseconds.
+ * The files are what the module wrote: .exr as half float with ZIP compression (32-bit float
+ * when a value is beyond half's range), channels R, G, B; no time stamp anywhere (the same bake
+ * gives byte-identical files). Each file is written to a temporary name beside the target
+ * (NAME.part.EXT) and renamed into place: a failed write never leaves a partial file.
+ */
+#include "image_native.h"
+
+#include <OpenEXR/openexr.h>
+#include <Imath/half.h>
+#include <png.h>
+#include <stb_image_write.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *extension(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    return dot && (!slash || dot > slash) ? dot : "";
+}
+
+int lmb_image_native_writes(const char *path, int f32)
+{
+    const char *ext = extension(path);
+    return f32 ? strcmp(ext, ".exr") == 0 || strcmp(ext, ".hdr") == 0 : strcmp(ext, ".png") == 0;
+}
+
+/* NAME.part.EXT beside NAME.EXT: the extension stays last, as the module's names did. */
+static int part_name(const char *path, char *out, size_t size)
+{
+    const char *ext = extension(path);
+    int n = snprintf(out, size, "%.*s.part%s", (int)(ext - path), path, ext);
+    return n > 0 && (size_t)n < size;
+}
+
+static lmb_status move_into_place(const char *tmp, const char *path, lmb_error *err)
+{
+    if (rename(tmp, path) != 0) {
+        int e = errno;
+        remove(tmp);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot move the finished image into place: %s", path,
+                             strerror(e));
+    }
+    return LMB_OK;
+}
+
+static lmb_status write_png(const char *tmp, const char *path, uint32_t w, uint32_t h, uint32_t channels,
+                            const uint8_t *pixels, lmb_error *err)
+{
+    static const png_uint_32 formats[] = {0, PNG_FORMAT_GRAY, PNG_FORMAT_GA, PNG_FORMAT_RGB, PNG_FORMAT_RGBA};
+    if (channels < 1 || channels > 4)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: %u channels cannot be a PNG", path, channels);
+    png_image image;
+    memset(&image, 0, sizeof image);
+    image.version = PNG_IMAGE_VERSION;
+    image.width = w;
+    image.height = h;
+    image.format = formats[channels]; /* RGBM's 4th channel is data: stored as given, not premultiplied */
+    if (!png_image_write_to_file(&image, tmp, 0, pixels, (png_int_32)(w * channels), NULL)) {
+        remove(tmp);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write image: %s", path, image.message);
+    }
+    return LMB_OK;
+}
+
+static lmb_status write_hdr(const char *tmp, const char *path, uint32_t w, uint32_t h, uint32_t channels,
+                            const float *pixels, lmb_error *err)
+{
+    errno = 0;
+    if (!stbi_write_hdr(tmp, (int)w, (int)h, (int)channels, pixels)) {
+        int e = errno;
+        remove(tmp);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write image: %s", path,
+                             e ? strerror(e) : "the Radiance writer failed");
+    }
+    return LMB_OK;
+}
+
+/* One OpenEXR scanline image: channels B, G, R (the file's sorted order) from interleaved RGB. */
+static exr_result_t exr_write_rgb(exr_context_t ctx, uint32_t w, uint32_t h, const void *rgb, exr_pixel_type_t type)
+{
+    int part = 0;
+    size_t bytes = type == EXR_PIXEL_HALF ? 2 : 4;
+    exr_result_t rv = exr_add_part(ctx, "", EXR_STORAGE_SCANLINE, &part);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_initialize_required_attr_simple(ctx, part, (int32_t)w, (int32_t)h, EXR_COMPRESSION_ZIP);
+    static const char *names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3 && rv == EXR_ERR_SUCCESS; c++)
+        rv = exr_add_channel(ctx, part, names[c], type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_write_header(ctx);
+    int32_t lines = 1;
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
+    exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+    int started = 0;
+    for (int32_t y = 0; rv == EXR_ERR_SUCCESS && y < (int32_t)h; y += lines) {
+        exr_chunk_info_t chunk;
+        rv = exr_write_scanline_chunk_info(ctx, part, y, &chunk);
+        if (rv != EXR_ERR_SUCCESS)
+            break;
+        rv = started ? exr_encoding_update(ctx, part, &chunk, &enc) : exr_encoding_initialize(ctx, part, &chunk, &enc);
+        if (rv != EXR_ERR_SUCCESS)
+            break;
+        for (int16_t c = 0; c < enc.channel_count; c++) {
+            exr_coding_channel_info_t *ch = &enc.channels[c];
+            int offset = ch->channel_name[0] == 'R' ? 0 : ch->channel_name[0] == 'G' ? 1 : 2;
+            ch->encode_from_ptr = (const uint8_t *)rgb + ((size_t)chunk.start_y * w * 3 + (size_t)offset) * bytes;
+            ch->user_pixel_stride = (int32_t)(3 * bytes);
+            ch->user_line_stride = (int32_t)((size_t)w * 3 * bytes);
+            ch->user_data_type = (uint16_t)type;
+            ch->user_bytes_per_element = (int8_t)bytes;
+        }
+        if (!started)
+            rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+        started = 1;
+        if (rv == EXR_ERR_SUCCESS)
+            rv = exr_encoding_run(ctx, part, &enc);
+    }
+    if (started) {
+        exr_result_t d = exr_encoding_destroy(ctx, &enc);
+        if (rv == EXR_ERR_SUCCESS)
+            rv = d;
+    }
+    return rv;
+}
+
+static lmb_status write_exr(const char *tmp, const char *path, uint32_t w, uint32_t h, uint32_t channels,
+                            const float *pixels, lmb_error *err)
+{
+    if (channels != 3)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: the EXR writer takes RGB, not %u channels", path, channels);
+    size_t n = (size_t)w * h * 3;
+    /* half float holds up to 65504: sunlight (up to ~120,000 lux) would turn to Inf, so an atlas
+     * with a larger value is stored in 32-bit float */
+    int fits_half = 1;
+    for (size_t i = 0; i < n && fits_half; i++)
+        fits_half = fabsf(pixels[i]) <= 65504.0f;
+    uint16_t *half = NULL;
+    if (fits_half) {
+        half = malloc(n * sizeof *half + 1);
+        if (!half)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory for the image", path);
+        for (size_t i = 0; i < n; i++)
+            half[i] = imath_float_to_half(pixels[i]);
+    }
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.zip_level = 6; /* zlib's default level, deterministic */
+    exr_context_t ctx = NULL;
+    exr_result_t rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_write_rgb(ctx, w, h, fits_half ? (const void *)half : (const void *)pixels,
+                           fits_half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT);
+    exr_result_t done = ctx ? exr_finish(&ctx) : EXR_ERR_SUCCESS;
+    free(half);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = done;
+    if (rv != EXR_ERR_SUCCESS) {
+        remove(tmp);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write image: %s", path,
+                             exr_get_default_error_message(rv));
+    }
+    return LMB_OK;
+}
+
+lmb_status lmb_image_native_write_u8(const char *path, uint32_t width, uint32_t height, uint32_t channels,
+                                     const uint8_t *pixels, lmb_error *err)
+{
+    char tmp[4096];
+    if (!part_name(path, tmp, sizeof tmp))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: path too long", path);
+    lmb_status st = write_png(tmp, path, width, height, channels, pixels, err);
+    return st == LMB_OK ? move_into_place(tmp, path, err) : st;
+}
+
+lmb_status lmb_image_native_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
+                                      const float *pixels, lmb_error *err)
+{
+    char tmp[4096];
+    if (!part_name(path, tmp, sizeof tmp))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: path too long", path);
+    lmb_status st = strcmp(extension(path), ".exr") == 0 ? write_exr(tmp, path, width, height, channels, pixels, err)
+                                                         : write_hdr(tmp, path, width, height, channels, pixels, err);
+    return st == LMB_OK ? move_into_place(tmp, path, err) : st;
+}
