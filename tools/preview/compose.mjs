@@ -25,7 +25,8 @@ const FLOAT_TYPE = 1015; // three's FloatType: HDRLoader decodes to float32 RGBA
 const MAX_TRIANGLES = 5e6; // placed triangles mapped one by one at most (about 2 s here)
 const PAD_PASSES = 8; // texels beyond the triangles filled from a neighbour, at most this far out
 
-function readGltf(dir, stem) {
+// A bake's folder: {dir, stem, doc (the glTF's JSON), buffer(i) (read once)}.
+export function readBake(dir, stem) {
   const file = path.join(dir, `${stem}.gltf`);
   const doc = JSON.parse(fs.readFileSync(file, 'utf8'));
   const buffers = new Map();
@@ -238,7 +239,7 @@ function linkOrCopy(from, to) {
 }
 
 // The weighted sum of quick bakes, read at each texel of the final bake's atlases. f: the final
-// (readGltf); quicks: [{g (readGltf), weight}] sharing one layout. Returns {atlases (the
+// (readBake); quicks: [{g (readBake), weight}] sharing one layout. Returns {atlases (the
 // final's, readAtlases), mapped: atlas -> {value (3 floats a texel), covered (1: a triangle's or
 // copy's texel)}} or {why} when the bakes do not correspond.
 export function mapQuicks(f, quicks) {
@@ -253,17 +254,21 @@ export function mapQuicks(f, quicks) {
   }
   const mapped = new Map();
   for (const [a, img] of atlases) mapped.set(a, { value: new Float32Array(3 * img.width * img.height), covered: new Uint8Array(img.width * img.height) });
-  const fMeshes = new Map(), qMeshes = quicks.map(() => new Map());
+  const fMeshes = new Map(), qMeshes = quicks.map(() => new Map()), meshChecked = new Map();
   let triangles = 0;
   for (let k = 0; k < nf.length; k++) {
     const fn = nf[k], qn = nq[0][k];
     const fa = atlases.get(fn.atlas), dst = mapped.get(fn.atlas);
     const sources = quicks.map((q, i) => ({ img: qAtlases[i].get(qn.atlas), weight: q.weight }));
     if (!fa || sources.some((x) => !x.img)) return { why: `node ${fn.node}: an atlas has no .hdr` };
-    const fp = meshUv1(f, fn.mesh, fMeshes), qps = quicks.map((q, i) => meshUv1(q.g, qn.mesh, qMeshes[i])), qp = qps[0];
-    if (fp.length !== qp.length) return { why: `mesh ${fn.mesh}: the bakes' primitives differ` };
-    if (!qps.every((x) => x.length === qp.length && x.every((p, i) => sameArray(p.uv, qp[i].uv)))) return { why: 'the quick looks have different layouts' };
-    const shared = fp.every((p, i) => sameArray(p.uv, qp[i].uv) && sameArray(p.index, qp[i].index));
+    const fp = meshUv1(f, fn.mesh, fMeshes), qp = meshUv1(quicks[0].g, qn.mesh, qMeshes[0]);
+    if (!meshChecked.has(fn.mesh)) { // once per mesh: the nodes that share it share its answers
+      if (fp.length !== qp.length) return { why: `mesh ${fn.mesh}: the bakes' primitives differ` };
+      const qps = quicks.map((q, i) => meshUv1(q.g, qn.mesh, qMeshes[i]));
+      if (!qps.every((x) => x.length === qp.length && x.every((p, i) => sameArray(p.uv, qp[i].uv)))) return { why: 'the quick looks have different layouts' };
+      meshChecked.set(fn.mesh, fp.every((p, i) => sameArray(p.uv, qp[i].uv) && sameArray(p.index, qp[i].index)));
+    }
+    const shared = meshChecked.get(fn.mesh); // the same TEXCOORD_1 in the final and quick bakes
     const identity = fn.rects.length === 1 && sameArray(fn.rects[0], [1, 1, 0, 0]) && sameArray(qn.rects[0], [1, 1, 0, 0]);
     if (shared && !identity) {
       fn.rects.forEach((r, c) => mapRect(r, qn.rects[c], fa, sources, dst.value, dst.covered));
@@ -290,15 +295,13 @@ export function mapQuicks(f, quicks) {
   return { atlases, mapped };
 }
 
-export function readBake(dir, stem) { return readGltf(dir, stem); }
-
 // final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
 // look's; out: the folder to write (made here). stem: the level's file name without extension.
 export function compose({ final, quickBefore, quickAfter, out, stem }) {
   const t0 = Date.now();
   let f, qb, qa;
   try {
-    [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readGltf(d, stem));
+    [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readBake(d, stem));
   } catch (e) {
     return { ok: false, why: `cannot read a bake (${e.message})` };
   }
