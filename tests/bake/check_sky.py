@@ -106,7 +106,8 @@ def opening_view_factor(r, R, H):
 
 def well(lmbake, work):
     L = 1000.0
-    charts, images = bake(lmbake, work, "sky-well", "well", "sky: {intensity: %g, samples: 2048}\n" % L, density=64)
+    charts, images = bake(lmbake, work, "sky-well", "well", "sky: {intensity: %g, samples: 2048}\n"
+                            "density_overrides: [{match: wall, texel_density: 8}]\n" % L, density=64)
     R, H = WELL
     ratios, centre = [], []
     for node, v, pts, x, y, t in ca.texels(charts, images):
