@@ -448,15 +448,32 @@ uint32_t lmb_direct_eval(const lmb_direct *d, const lmb_shading_point *sp, const
     return (uint32_t)c.rays;
 }
 
-int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays,
-                              int *sees_back)
+int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, uint32_t atlas, uint32_t texel,
+                              uint32_t k, lmb_rng *rng, uint32_t *rays, int *sees_back)
 {
+    const lmb_point_validity *v = d->validity;
+    uint8_t *memo = NULL;
+    if (v && atlas < v->atlas_count && k < v->samples && ((uint64_t)texel + 1) * v->samples <= v->size[atlas])
+        memo = &v->entry[atlas][(uint64_t)texel * v->samples + k];
+    if (memo && *memo != LMB_VALIDITY_UNKNOWN) {
+        rng->counter += 2 * VALIDITY_RAYS; /* the draws back_face_hits takes */
+        *sees_back = *memo != LMB_VALIDITY_CLEAR;
+        return *memo == LMB_VALIDITY_INSIDE;
+    }
     point_ctx c;
     lmb_point_init(&c, d, sp);
     int back = back_face_hits(&c, rng);
     *rays += (uint32_t)c.rays;
     *sees_back = back > 0;
-    return 2 * back > VALIDITY_RAYS;
+    int inside = 2 * back > VALIDITY_RAYS;
+    if (memo) /* one thread owns a texel's points */
+        *memo = inside ? LMB_VALIDITY_INSIDE : back ? LMB_VALIDITY_NEAR_BACK : LMB_VALIDITY_CLEAR;
+    return inside;
+}
+
+void lmb_direct_set_validity(lmb_direct *d, struct lmb_point_validity *validity)
+{
+    d->validity = validity;
 }
 
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp)

@@ -86,10 +86,18 @@ uint32_t lmb_direct_shadowmask_channels(const lmb_direct *d);
 uint32_t lmb_shadowmask_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng,
                            double vis[LMB_SHADOWMASK_CHANNELS]);
 
-/* 1 when sp lies inside geometry (most of its hemisphere rays hit back faces); adds to *rays;
- * *sees_back: any of them hit a back face (sp is near geometry's inside: in a gap, at a contact). */
-int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng, uint32_t *rays,
-                              int *sees_back);
+/* 1 when sp, gather point k of texel `texel` (y x width + x) of atlas `atlas`, lies inside
+ * geometry (most of its hemisphere rays hit back faces); adds to *rays; *sees_back: any of them
+ * hit a back face (sp is near geometry's inside: in a gap, at a contact). With a validity memo
+ * (lmb_direct_set_validity) a point tested before is read from it, and rng moves past the draws
+ * the test takes, so what follows draws the same numbers either way. */
+int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, uint32_t atlas, uint32_t texel,
+                              uint32_t k, lmb_rng *rng, uint32_t *rays, int *sees_back);
+
+/* Gives d a gather points' validity memo (point_validity.h; borrowed, NULL: none) for the
+ * layout its texels come from. */
+struct lmb_point_validity;
+void lmb_direct_set_validity(lmb_direct *d, struct lmb_point_validity *validity);
 
 /* The config the lights were made with (borrowed). */
 const lmb_config *lmb_direct_config(const lmb_direct *d);

@@ -7,6 +7,7 @@
 #define LMBAKE_DIRECT_INTERNAL_H
 
 #include "direct.h"
+#include "point_validity.h"
 
 typedef struct light_set {
     uint32_t *local, local_count;       /* point and spot lights */
@@ -42,6 +43,7 @@ struct lmb_direct {
     const lmb_sky *sky;
     light_set lights;
     uint32_t **emitter_of; /* per Embree geometry: per triangle the emitter index + 1 (0: none), or NULL */
+    lmb_point_validity *validity; /* NULL, or the gather points' validity memo (borrowed; filled as points are tested) */
 };
 
 

@@ -73,7 +73,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         lmb_texel_shading_point(job->direct, t, i, k, &p->sp);
         p->rng = lmb_rng_make(cfg->seed, key, k);
         int sees_back;
-        if (lmb_point_inside_geometry(job->direct, &p->sp, &p->rng, &r, &sees_back))
+        if (lmb_point_inside_geometry(job->direct, &p->sp, job->atlas, t->texel[i], k, &p->rng, &r, &sees_back))
             continue;
         near_back |= sees_back;
         if (!used)

@@ -14,6 +14,7 @@
 #include "steps/plan.h"
 #include "steps/runner.h"
 #include "watch/layout_cache.h"
+#include "watch/validity_cache.h"
 #include "pipeline/lighting.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
@@ -198,6 +199,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_ic_points records = {NULL, 0};
     lmb_probe_set probes;
     memset(&probes, 0, sizeof probes);
+    lmb_point_validity validity; /* with a layout cache: the gather points' validity kept between bakes */
+    memset(&validity, 0, sizeof validity);
+    uint64_t validity_read = 0;
     memset(&l, 0, sizeof l);
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
@@ -249,6 +253,13 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (dark && !shard)
         lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material, no sky): the "
                  "lightmaps are black; no light is computed", s->path);
+    if (st == LMB_OK && !dark && run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path) {
+        st = lmb_point_validity_init(&validity, &l, cfg->texel_samples, err);
+        if (st == LMB_OK && lmb_validity_cache_read(s, cfg, run->layout_cache, &validity, log))
+            validity_read = lmb_point_validity_known(&validity);
+        if (st == LMB_OK)
+            lmb_direct_set_validity(direct, &validity);
+    }
     if (st == LMB_OK && dark)
         st = dark_atlases(s, cfg, &l, &cache, stats, err);
     else if (st == LMB_OK)
@@ -258,6 +269,14 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
     if (st == LMB_OK)
         st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, shard ? NULL : log, err);
+    if (st == LMB_OK && validity.entry) {
+        if (validity_read)
+            lmb_info(log, "gather points: the validity of %llu read back with the layout (their rays not traced again)",
+                     (unsigned long long)validity_read);
+        if (lmb_point_validity_known(&validity) > validity_read)
+            lmb_validity_cache_write(s, cfg, run->layout_cache, &validity, log);
+    }
+    lmb_point_validity_free(&validity);
     if (st == LMB_OK && worker)
         st = lmb_steps_worker_end(steps, err);
     if (worker && !finishes) {
@@ -335,6 +354,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
 done:
+    lmb_point_validity_free(&validity);
     lmb_steps_free(steps);
     lmb_part_identity_free(&id);
     lmb_cache_free(&cache);

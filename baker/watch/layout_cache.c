@@ -161,6 +161,15 @@ static lmb_status cache_identity(const lmb_scene *scene, const lmb_config *cfg, 
     return LMB_OK;
 }
 
+lmb_status lmb_layout_cache_path(const lmb_scene *scene, const lmb_config *cfg, const char *dir, char *path, size_t size,
+                                 lmb_error *err)
+{
+    lmb_part_identity id;
+    lmb_status st = cache_identity(scene, cfg, dir, &id, path, size, err);
+    lmb_part_identity_free(&id);
+    return st;
+}
+
 /* The layout in path, when it is there and whole; 0 otherwise (a damaged file is said). */
 static int read_back(const char *path, const lmb_part_identity *id, const lmb_scene *scene, const lmb_log *log,
                      lmb_layout *l)

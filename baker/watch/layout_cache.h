@@ -31,4 +31,9 @@ lmb_status lmb_layout_key(const lmb_scene *scene, const lmb_config *cfg, uint8_t
 lmb_status lmb_layout_cached(const lmb_scene *scene, const lmb_config *cfg, const char *dir, lmb_progress_fn progress,
                              void *user, const lmb_log *log, lmb_layout *l, int *reused, lmb_error *err);
 
+/* The file in dir that holds the layout of scene with cfg (whether or not it is there yet):
+ * DIR/layout-KEY.lmbp. Other files kept with that layout take its name as their stem. */
+lmb_status lmb_layout_cache_path(const lmb_scene *scene, const lmb_config *cfg, const char *dir, char *path, size_t size,
+                                 lmb_error *err);
+
 #endif

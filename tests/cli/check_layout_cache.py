@@ -4,11 +4,12 @@ cornell-point.gltf at a small density:
 
 1. the first bake builds the layout and keeps it in DIR ("layout: built ... kept");
 2. a lighting-only change (the lamp 3x brighter in the file, and a config sampling key) reads it
-   back ("layout: read back"), and the files equal a plain `lmbake bake` of the changed level
-   and config, byte for byte;
+   back ("layout: read back") with the gather points' validity the first bake tested (none of
+   their rays traced again: fewer rays), and the files equal a plain `lmbake bake` of the
+   changed level and config, byte for byte;
 3. a layout change (a mesh node moved; then atlas.padding) builds it again;
-4. a damaged cache file is said in a warning, the layout is built, and the files are still those
-   of a plain bake;
+4. damaged cache files (the layout, the validity) are said in a warning, the layout is built and
+   the points tested again, and the files are still those of a plain bake;
 5. --layout-cache with --plan is a usage error.
 
 usage: check_layout_cache.py LMBAKE WORKDIR
@@ -16,6 +17,7 @@ usage: check_layout_cache.py LMBAKE WORKDIR
 import filecmp
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -32,6 +34,11 @@ def run(args):
 def check(ok, message):
     print(("ok: " if ok else "FAIL: ") + message)
     return ok
+
+
+def rays(log):
+    m = re.search(r"\d+ texels \(\d+ valid\), (\d+) rays", log)
+    return int(m.group(1)) if m else -1
 
 
 def differing(a, b):
@@ -63,6 +70,10 @@ def main():
                 "first bake: layout built and kept (exit %d)" % code)
     kept = [f for f in os.listdir(cache) if f.endswith(".lmbp")] if os.path.isdir(cache) else []
     ok &= check(len(kept) == 1, "one layout file in the cache: %s" % kept)
+    memo = [f for f in os.listdir(cache) if f.endswith("-seed1.lmbv")] if os.path.isdir(cache) else []
+    ok &= check(len(memo) == 1 and memo[0].startswith(kept[0][:-5] if kept else "?"),
+                "the gather points' validity kept beside it: %s" % memo)
+    rays_first = rays(log)
 
     doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] *= 3
     json.dump(doc, open(level, "w"), indent=1)
@@ -70,6 +81,10 @@ def main():
     code, log = bake("cached", lighting, "--layout-cache", cache)
     ok &= check(code == 0 and "layout: read back" in log, "lamp x 3 and samples.gather: layout read back (exit %d)"
                 % code)
+    m = re.search(r"gather points: the validity of (\d+) read back", log)
+    ok &= check(m is not None and int(m.group(1)) > 1000 and rays(log) < rays_first,
+                "and the gather points' validity: %s points, %s rays against %s in the first bake"
+                % (m.group(1) if m else None, rays(log), rays_first))
     code, _ = bake("plain", lighting)
     diff = differing(os.path.join(work, "cached"), os.path.join(work, "plain"))
     ok &= check(code == 0 and not diff, "files from the layout read back equal a plain bake's, byte for byte%s"
@@ -89,8 +104,9 @@ def main():
         data[len(data) // 2] ^= 0xFF
         open(path, "wb").write(data)
     code, log = bake("damaged", lighting, "--layout-cache", cache)
-    ok &= check(code == 0 and "layout cache:" in log and "layout: built" in log,
-                "a damaged cache file: warned, layout built (exit %d)" % code)
+    ok &= check(code == 0 and "layout cache:" in log and "layout: built" in log and "is damaged" in log and
+                "validity of" not in log, "damaged cache files: warned, layout built, points tested again (exit %d)"
+                % code)
     code, _ = bake("plain2", lighting)
     diff = differing(os.path.join(work, "damaged"), os.path.join(work, "plain2"))
     ok &= check(not diff, "and the files equal a plain bake's%s" % (": differ " + ", ".join(diff) if diff else ""))

@@ -207,12 +207,17 @@ function tidyQuickDirs() {
 }
 
 // Layouts: the four used last (a quick and a final one, before and after a change of layout);
-// lmbake touches a layout it reads back.
+// lmbake touches a layout it reads back. The gather points' validity kept with a layout
+// (layout-KEY-seedN.lmbv) goes with it.
 function tidyLayouts() {
-  let kept = [];
-  try { kept = fs.readdirSync(layoutRoot).filter((f) => f.endsWith('.lmbp')).map((f) => ({ f, t: fs.statSync(path.join(layoutRoot, f)).mtimeMs })); } catch { return; }
+  let names = [];
+  try { names = fs.readdirSync(layoutRoot); } catch { return; }
+  const kept = names.filter((f) => f.endsWith('.lmbp')).map((f) => ({ f, t: fs.statSync(path.join(layoutRoot, f)).mtimeMs }));
   kept.sort((a, b) => b.t - a.t);
-  for (const { f } of kept.slice(4)) fs.rmSync(path.join(layoutRoot, f), { force: true });
+  for (const { f } of kept.slice(4)) {
+    const key = f.slice(0, -'.lmbp'.length);
+    for (const g of names) if (g === f || g.startsWith(`${key}-`)) fs.rmSync(path.join(layoutRoot, g), { force: true });
+  }
 }
 
 // The loop: poll sizes and times; a move stops the running bake at once and, once the files
