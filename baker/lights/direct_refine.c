@@ -347,9 +347,9 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     }
     lmb_status st = LMB_OK;
     if (noise->refined) {
-        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first, {NULL, NULL},
+        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first, {0},
                         progress, progress_user};
-        st = lmb_instance_rows_make(scene, layout, a, &c.instance_rows, err);
+        st = lmb_instance_rows_make(scene, layout, a, rows, &c.instance_rows, err);
         char name[64];
         snprintf(name, sizeof name, "direct, atlas %u: more samples", a);
         lmb_step_desc d = {name, bands, cost, step_rays, refine_bands, &c};

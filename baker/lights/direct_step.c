@@ -318,7 +318,7 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
 {
     memset(out, 0, sizeof *out);
     band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user,
-                  {NULL, NULL}};
+                  {0}};
     c.rows = c.width ? (LMB_DIRECT_BAND_TEXELS + c.width - 1) / c.width : c.height;
     if (!c.rows)
         c.rows = 1;
@@ -326,7 +326,7 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     double *cost = malloc((bands + 1) * sizeof *cost);
     if (!cost)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
-    lmb_status st = lmb_instance_rows_make(scene, layout, a, &c.instance_rows, err);
+    lmb_status st = lmb_instance_rows_make(scene, layout, a, c.rows, &c.instance_rows, err);
     if (st != LMB_OK) {
         free(cost);
         return st;

@@ -89,16 +89,66 @@ static void triangle_rows(const double *uv, long *y0, long *y1)
     *y1 = (long)floor(fmax(uv[1], fmax(uv[3], uv[5]))) + 1;
 }
 
-lmb_status lmb_instance_rows_make(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, lmb_instance_rows *out,
-                                  lmb_error *err)
+/* Triangles at least this many in an instance with its own layout get per-band lists. */
+#define BAND_LIST_TRIANGLES 1024
+
+/* Instance i's per-band triangle lists (counted, then filled in triangle order). */
+static int band_lists(const lmb_layout *l, uint32_t i, const lmb_charts *c, uint32_t height, uint32_t band_rows,
+                      uint32_t **start_out, uint32_t **list_out)
 {
+    uint32_t bands = (height + band_rows - 1) / band_rows;
+    uint32_t *start = calloc((size_t)bands + 2, sizeof *start);
+    if (!start)
+        return 0;
+    for (int pass = 0; pass < 2; pass++) {
+        uint32_t *fill = NULL;
+        if (pass == 1) {
+            for (uint32_t b = 0; b < bands; b++) /* counts to starts */
+                start[b + 1] += start[b];
+            *list_out = malloc(((size_t)start[bands] + 1) * sizeof **list_out);
+            fill = calloc((size_t)bands + 1, sizeof *fill);
+            if (!*list_out || !fill) {
+                free(*list_out);
+                free(fill);
+                free(start);
+                *list_out = NULL;
+                return 0;
+            }
+        }
+        for (uint32_t f = 0; f < c->triangle_count; f++) {
+            if (c->chart_of[f] == UINT32_MAX)
+                continue;
+            long y0, y1;
+            double uv[6];
+            lmb_layout_uv(l, i, f, uv);
+            triangle_rows(uv, &y0, &y1);
+            y0 = y0 < 0 ? 0 : y0;
+            y1 = y1 >= (long)height ? (long)height - 1 : y1;
+            for (long b = y0 / (long)band_rows; y0 <= y1 && b <= y1 / (long)band_rows; b++) {
+                if (pass == 0)
+                    start[b + 1]++;
+                else
+                    (*list_out)[start[b] + fill[b]++] = f;
+            }
+        }
+        free(fill);
+    }
+    *start_out = start;
+    return 1;
+}
+
+lmb_status lmb_instance_rows_make(const lmb_scene *s, const lmb_layout *l, uint32_t atlas, uint32_t band_rows,
+                                  lmb_instance_rows *out, lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->band_rows = band_rows;
+    out->instance_count = l->instance_count;
     out->lo = malloc(((size_t)l->instance_count + 1) * sizeof *out->lo);
     out->hi = malloc(((size_t)l->instance_count + 1) * sizeof *out->hi);
-    if (!out->lo || !out->hi) {
-        lmb_instance_rows_free(out);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u instances", l->instance_count);
-    }
-    for (uint32_t i = 0; i < l->instance_count; i++) {
+    out->band_start = calloc((size_t)l->instance_count + 1, sizeof *out->band_start);
+    out->band_triangles = calloc((size_t)l->instance_count + 1, sizeof *out->band_triangles);
+    int ok = out->lo && out->hi && out->band_start && out->band_triangles;
+    for (uint32_t i = 0; ok && i < l->instance_count; i++) {
         const lmb_layout_instance *li = &l->instances[i];
         out->lo[i] = INT64_MAX;
         out->hi[i] = INT64_MIN;
@@ -115,15 +165,30 @@ lmb_status lmb_instance_rows_make(const lmb_scene *s, const lmb_layout *l, uint3
             out->lo[i] = y0 < out->lo[i] ? y0 : out->lo[i];
             out->hi[i] = y1 > out->hi[i] ? y1 : out->hi[i];
         }
+        /* copies placed as rectangles span a few rows each: the instance's reach is enough */
+        if (band_rows && li->uv1 && c->triangle_count >= BAND_LIST_TRIANGLES)
+            ok = band_lists(l, i, c, l->height[atlas], band_rows, &out->band_start[i], &out->band_triangles[i]);
+    }
+    if (!ok) {
+        lmb_instance_rows_free(out);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u instances", l->instance_count);
     }
     return LMB_OK;
 }
 
 void lmb_instance_rows_free(lmb_instance_rows *r)
 {
+    for (uint32_t i = 0; i < r->instance_count; i++) {
+        if (r->band_start)
+            free(r->band_start[i]);
+        if (r->band_triangles)
+            free(r->band_triangles[i]);
+    }
     free(r->lo);
     free(r->hi);
-    r->lo = r->hi = NULL;
+    free(r->band_start);
+    free(r->band_triangles);
+    memset(r, 0, sizeof *r);
 }
 
 /* Sub-samples of rows [y0, y1) only: b holds (y1 - y0) rows. */
@@ -131,6 +196,9 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
                       uint32_t y1_band, const lmb_instance_rows *rows, best *b)
 {
     uint32_t w = l->width[atlas];
+    double offset[2 * 256]; /* the sub-samples' places in a texel (samples.texel <= 256) */
+    for (uint32_t k = 0; k < samples && k < 256; k++)
+        lmb_texel_subsample(k, samples, &offset[2 * k]);
     for (uint32_t i = 0; i < l->instance_count; i++) {
         const lmb_layout_instance *li = &l->instances[i];
         if (!li->lightmapped || li->atlas != atlas)
@@ -138,7 +206,17 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
         if (rows && (rows->hi[i] < (int64_t)y0_band || rows->lo[i] >= (int64_t)y1_band))
             continue; /* none of its triangles reaches the band */
         const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
-        for (uint32_t f = 0; f < c->triangle_count; f++) {
+        /* the band's own list when the band is one of those the lists were made for */
+        const uint32_t *list = NULL;
+        uint32_t count = c->triangle_count;
+        if (rows && rows->band_triangles && rows->band_triangles[i] && rows->band_rows &&
+            y0_band % rows->band_rows == 0 && y1_band - y0_band <= rows->band_rows) {
+            uint32_t band = y0_band / rows->band_rows;
+            list = rows->band_triangles[i] + rows->band_start[i][band];
+            count = rows->band_start[i][band + 1] - rows->band_start[i][band];
+        }
+        for (uint32_t n = 0; n < count; n++) {
+            uint32_t f = list ? list[n] : n;
             if (c->chart_of[f] == UINT32_MAX)
                 continue;
             double uv[6];
@@ -153,12 +231,11 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
             for (long y = y0; y <= y1; y++)
                 for (long x = x0; x <= x1; x++)
                     for (uint32_t k = 0; k < samples; k++) {
-                        double sp[2], b1 = 0, b2 = 0;
-                        lmb_texel_subsample(k, samples, sp);
-                        sp[0] += (double)x;
-                        sp[1] += (double)y;
-                        double d = lmb_closest_on_triangle_2d(uv, sp, &b1, &b2);
                         best *bb = &b[((size_t)(y - (long)y0_band) * w + (size_t)x) * samples + k];
+                        if (bb->dist == 0.0f)
+                            continue; /* inside an earlier triangle: nothing is closer, and ties keep the first */
+                        double sp[2] = {offset[2 * k] + (double)x, offset[2 * k + 1] + (double)y}, b1 = 0, b2 = 0;
+                        double d = lmb_closest_on_triangle_2d(uv, sp, &b1, &b2);
                         if (d <= 1.0 && d < bb->dist) {
                             bb->dist = (float)d;
                             bb->b1 = (float)b1;

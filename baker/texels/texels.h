@@ -54,13 +54,19 @@ lmb_status lmb_texels_build(const lmb_scene *scene, const lmb_layout *l, uint32_
 /* Each instance's reach in atlas rows (its triangles' texels and their neighbours), so that a
  * band of rows visits only the instances that cross it: a level of many small instances (the
  * copies of an instancing node) is banded in time that grows with the band, not with the level.
- * Owned: lmb_instance_rows_free. */
+ * An instance with its own layout and many triangles (a level's one big mesh) also lists, per
+ * band of `band_rows` rows, the triangles that reach it (in triangle order), so that a band
+ * visits those only. Owned: lmb_instance_rows_free. */
 typedef struct lmb_instance_rows {
-    int64_t *lo, *hi; /* per instance; lo > hi: no row (not in the atlas) */
+    uint32_t instance_count;
+    int64_t *lo, *hi;     /* per instance; lo > hi: no row (not in the atlas) */
+    uint32_t band_rows;   /* the bands the lists are made for: band b is rows [b band_rows, (b + 1) band_rows) */
+    uint32_t **band_start; /* per instance NULL, or per band b its list's start in band_triangles (bands + 1) */
+    uint32_t **band_triangles; /* per instance NULL, or the lists, one after the other */
 } lmb_instance_rows;
 
-lmb_status lmb_instance_rows_make(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, lmb_instance_rows *out,
-                                  lmb_error *err);
+lmb_status lmb_instance_rows_make(const lmb_scene *scene, const lmb_layout *l, uint32_t atlas, uint32_t band_rows,
+                                  lmb_instance_rows *out, lmb_error *err);
 void lmb_instance_rows_free(lmb_instance_rows *r);
 
 /* The same for atlas rows [y0, y1) only (texel indices stay y * width + x of the atlas):
