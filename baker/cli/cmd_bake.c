@@ -34,6 +34,11 @@ static const char help[] =
     "                      of the rays, the irradiance cache sparser, at most two bounce\n"
     "                      passes, no seam stitching or probes, only the .hdr and .png\n"
     "                      (docs/watch.md)\n"
+    "      --direct-of LIGHT\n"
+    "                      bake only the direct light of LIGHT (a glob over light and light\n"
+    "                      node names; repeatable, at most 16): no bounces, sky or emissive\n"
+    "                      surfaces, only the .hdr and .png (the watch's correction of a\n"
+    "                      changed light, docs/watch.md)\n"
     "      --plan PLAN     start from a plan written by 'lmbake plan' (same input and config,\n"
     "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
     "      --layout-cache DIR\n"
@@ -63,6 +68,8 @@ typedef struct bake_args {
     int timings;
     long long threads, seed, rays, method; /* -1: from the config */
     int quiet, reference, preview, print_config, quick;
+    const char *direct_of[LMB_MAX_DIRECT_OF + 1]; /* --direct-of LIGHT, repeatable */
+    uint32_t direct_of_count;
     long long step;               /* -1: not given */
     unsigned long long shard, shards; /* --shard K/N (K 1-based), --shards N */
     unsigned long long worker, workers, wait_timeout; /* --worker W/J (W 1-based), --wait-timeout S */
@@ -126,6 +133,12 @@ static int parse_args(int argc, char **argv, bake_args *a)
             a->preview = 1;
         } else if (cli_is_flag(argv[i], "--quick", NULL)) {
             a->quick = 1;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--direct-of", NULL, &v)) != 0) {
+            if (r < 0 || !*v)
+                return cli_usage_error("bake", "--direct-of needs a light's name");
+            if (a->direct_of_count == LMB_MAX_DIRECT_OF)
+                return cli_usage_error("bake", "--direct-of: at most %d lights", LMB_MAX_DIRECT_OF);
+            a->direct_of[a->direct_of_count++] = v;
         } else if (cli_is_flag(argv[i], "--reference", NULL)) {
             a->reference = 1;
         } else if ((r = cli_opt_value(argc, argv, &i, "--plan", NULL, &v)) != 0) {
@@ -342,9 +355,10 @@ static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, siz
         return cli_usage_error(name, "--worker %llu/%llu: at most as many workers as shards (%llu)", a->worker,
                                a->workers, a->shards);
 
-    if (stage != STAGE_BAKE && (a->plan || a->reference || a->print_config || a->quick || a->layout_cache))
-        return cli_usage_error(name, "--plan, --layout-cache, --quick, --reference and --print-config are 'lmbake "
-                               "bake' options");
+    if (stage != STAGE_BAKE &&
+        (a->plan || a->reference || a->print_config || a->quick || a->layout_cache || a->direct_of_count))
+        return cli_usage_error(name, "--plan, --layout-cache, --quick, --direct-of, --reference and --print-config are "
+                               "'lmbake bake' options");
     if (a->plan && a->layout_cache)
         return cli_usage_error(name, "--plan and --layout-cache both give the layout: one or the other");
     if (stage != STAGE_BAKE && stage != STAGE_FINISH && a->preview)
@@ -403,6 +417,8 @@ static int run(int argc, char **argv, stage_kind stage)
     lmb_config user_cfg = cfg;
     if (a.quick)
         lmb_config_quick(&cfg);
+    if (a.direct_of_count && lmb_config_direct_of(&cfg, a.direct_of, a.direct_of_count, &err) != LMB_OK)
+        return cli_fail(&err);
     if (a.print_config) {
         size_t n = lmb_config_write(&cfg, NULL, 0);
         char *text = malloc(n + 1);

@@ -63,7 +63,8 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const l
     lmb_emitters *es = calloc(1, sizeof *es);
     uint32_t cap = 0;
     lmb_status st = es ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "emitters: out of memory");
-    for (uint32_t i = 0; st == LMB_OK && i < s->instance_count; i++) {
+    /* lights.emissive_scale 0 (or bake --direct-of): no surface emits */
+    for (uint32_t i = 0; st == LMB_OK && cfg->emissive_scale > 0 && i < s->instance_count; i++) {
         const lmb_instance *in = &s->instances[i];
         const lmb_mesh *m = &s->meshes[in->mesh];
         for (uint32_t p = 0; st == LMB_OK && p < m->primitive_count; p++) {

@@ -41,6 +41,11 @@ void lmb_scene_set_light_modes(lmb_scene *s, const lmb_config *cfg, const lmb_lo
                 used[k]++;
                 break;
             }
+        int named = !cfg->direct_of_count; /* bake --direct-of: only the named lights */
+        for (uint32_t k = 0; !named && k < cfg->direct_of_count; k++)
+            named = lmb_glob_match(cfg->direct_of[k], l->name) || lmb_glob_match(cfg->direct_of[k], l->node_name);
+        if (!named)
+            l->mode = LMB_LIGHT_REALTIME;
         l->shadowmask_channel = -1;
         mixed += l->mode != LMB_LIGHT_BAKED;
     }

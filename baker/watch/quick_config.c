@@ -1,4 +1,7 @@
 /*
+ * The watch's variants of a bake's config: the quick look, and the direct light of changed
+ * lights (lmb_config_direct_of, at the end).
+ *
  * The quick look of `lmbake preview --watch` and `lmbake bake --quick` (docs/watch.md): a
  * quarter of the texels (half the texel density each way: its own, coarser layout, which the
  * preview loads whole) lit with a quarter of the direct light's, the final gather's and the
@@ -11,6 +14,9 @@
  * stays on: it is what makes a few rays look like the final picture.
  */
 #include <lmbake/lmbake.h>
+
+#include <stdio.h>
+#include <string.h>
 
 static uint32_t at_most(uint32_t value, uint32_t cap)
 {
@@ -51,4 +57,35 @@ void lmb_config_quick(lmb_config *cfg)
     /* what the page reads: the .hdr (written with the .png whatever the formats), no direction maps */
     cfg->output_formats = LMB_OUTPUT_HDR;
     cfg->directional = 0;
+}
+
+/*
+ * The watch's correction of a changed light (docs/watch.md#the-composed-quick-picture): the
+ * direct light of the named lights alone, at the final bake's layout and sampling, so that the
+ * composed picture can take that light's change at the final's resolution. Everything else that
+ * lights the level is left out (other lights realtime through lmb_scene_set_light_modes, no sky,
+ * no emission, no bounces); the lights' own modes stay (an `indirect` light has no direct light in
+ * the lightmap here either). The layout keys are untouched: the layout and the gather points'
+ * validity are the final's (read back from the layout cache).
+ */
+lmb_status lmb_config_direct_of(lmb_config *cfg, const char *const *names, uint32_t count, lmb_error *err)
+{
+    if (count > LMB_MAX_DIRECT_OF)
+        return lmb_error_set(err, LMB_ERR_USAGE, "--direct-of: at most %d lights", LMB_MAX_DIRECT_OF);
+    for (uint32_t i = 0; i < count; i++) {
+        if (strlen(names[i]) >= LMB_PATTERN_LEN)
+            return lmb_error_set(err, LMB_ERR_USAGE, "--direct-of: '%.40s...' is longer than %d characters", names[i],
+                                 LMB_PATTERN_LEN - 1);
+        snprintf(cfg->direct_of[i], LMB_PATTERN_LEN, "%s", names[i]);
+    }
+    cfg->direct_of_count = count;
+    cfg->bounces = 0;
+    cfg->sky_intensity = 0;
+    cfg->sky_image[0] = '\0';
+    cfg->emissive_scale = 0;
+    cfg->seam_stitch = 0;
+    cfg->output_formats = LMB_OUTPUT_HDR;
+    cfg->directional = 0;
+    cfg->shadowmask = 0;
+    return LMB_OK;
 }

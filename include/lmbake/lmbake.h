@@ -252,6 +252,7 @@ typedef enum lmb_output_scale {
 #define LMB_AUTO UINT32_MAX
 
 #define LMB_MAX_PATTERNS 64
+#define LMB_MAX_DIRECT_OF 16 /* lights named by --direct-of */
 #define LMB_PATTERN_LEN 128
 
 typedef struct lmb_density_override {
@@ -361,6 +362,10 @@ typedef struct lmb_config {
     double sun_angle;              /* degrees: a directional light is a disc of this angular diameter; 0 = a point */
     lmb_light_mode_rule light_modes[LMB_MAX_PATTERNS]; /* lights.modes: first match wins, over the file's extras */
     uint32_t light_mode_count;
+    /* not a config key: `lmbake bake --direct-of GLOB` (lmb_config_direct_of): the lights whose
+     * name or node name matches one of these are the only ones the bake holds (others realtime) */
+    char direct_of[LMB_MAX_DIRECT_OF][LMB_PATTERN_LEN];
+    uint32_t direct_of_count;
     int shadowmask;                /* output.shadowmask: the visibility of up to 4 `indirect` lights per texel */
     /* materials the file did not set, or set wrongly for a bake */
     double default_albedo[3];      /* materials.default.albedo: primitives with no material; [0] < 0: none (glTF's metal) */
@@ -404,6 +409,13 @@ size_t lmb_config_write(const lmb_config *cfg, char *buf, size_t size);
 /* Turns cfg into its quick look (`bake --quick`, the watch's first picture; docs/watch.md): the
  * same layout, lit with a fraction of the rays, no seam stitching or probes. */
 void lmb_config_quick(lmb_config *cfg);
+
+/* Turns cfg into the direct light of the lights whose name or node name matches one of the
+ * `count` globs in names (`bake --direct-of`, the watch's correction of a changed light; docs/
+ * watch.md): the same layout and the same direct light as cfg's bake holds of those lights, and
+ * nothing else: no bounces, sky, emissive surfaces, seam stitching or probes; only the .hdr and
+ * .png. LMB_ERR_USAGE for more than LMB_MAX_DIRECT_OF names or one too long. */
+lmb_status lmb_config_direct_of(lmb_config *cfg, const char *const *names, uint32_t count, lmb_error *err);
 
 /* glob match with '*' and '?', used for node/mesh name patterns. */
 int lmb_glob_match(const char *pattern, const char *name);

@@ -10,7 +10,10 @@ cornell-point.gltf at a small density:
 3. a layout change (a mesh node moved; then atlas.padding) builds it again;
 4. damaged cache files (the layout, the validity) are said in a warning, the layout is built and
    the points tested again, and the files are still those of a plain bake;
-5. --layout-cache with --plan is a usage error.
+5. --direct-of (the watch's correction of a changed light) reads the layout back and equals a
+   plain bake with no bounces, byte for byte; a name no light has gives black lightmaps, said;
+   on `lmbake plan` it is a usage error;
+6. --layout-cache with --plan is a usage error.
 
 usage: check_layout_cache.py LMBAKE WORKDIR
 """
@@ -110,6 +113,20 @@ def main():
     code, _ = bake("plain2", lighting)
     diff = differing(os.path.join(work, "damaged"), os.path.join(work, "plain2"))
     ok &= check(not diff, "and the files equal a plain bake's%s" % (": differ " + ", ".join(diff) if diff else ""))
+
+    # --direct-of (the watch's correction of a changed light): the named light's direct light
+    # alone, in the layout kept: the files of a plain bake with no bounces, byte for byte
+    code, log = bake("direct-of", lighting, "--layout-cache", cache, "--direct-of", "ceiling_*")
+    ok &= check(code == 0 and "layout: read back" in log, "--direct-of reads the layout back (exit %d)" % code)
+    code, _ = bake("direct-plain", lighting + "bounces: 0\nseams: {stitch: false}\noutput: {formats: [hdr], directional: false}\n")
+    diff = differing(os.path.join(work, "direct-of"), os.path.join(work, "direct-plain"))
+    ok &= check(code == 0 and not diff, "--direct-of 'ceiling_*' equals a plain bake with bounces: 0, byte for byte%s"
+                % (": differ " + ", ".join(diff) if diff else ""))
+    code, log = bake("direct-none", lighting, "--direct-of", "no such light")
+    ok &= check(code == 0 and "nothing emits light" in log, "--direct-of a name no light has: black lightmaps, said "
+                "(exit %d)" % code)
+    code, log = run([lmbake, "plan", level, "--direct-of", "x", "-o", os.path.join(work, "x")])
+    ok &= check(code == 1 and "--direct-of" in log, "--direct-of with plan: usage error (exit %d)" % code)
 
     code, log = run([lmbake, "bake", level, "--plan", "x.lmbp", "--layout-cache", cache, "-o", os.path.join(work, "x")])
     ok &= check(code == 1 and "--layout-cache" in log, "--plan with --layout-cache: usage error (exit %d)" % code)

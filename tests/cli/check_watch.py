@@ -234,7 +234,7 @@ def cancel(lmbake, work):
         s = w.shown(3, "final")
         finals = [h["generation"] for h in s["history"] if h["kind"] == "final"]
         ok &= check(finals == [1, 3], "only the newest state was baked to the end: final bakes %s" % finals)
-        ok &= check(any(re.match(r"watch: (quick|final) bake 2 stopped", l) for l in w.log()), "the log says bake 2 "
+        ok &= check(any(re.match(r"watch: (quick|correction|final) bake 2 stopped", l) for l in w.log()), "the log says bake 2 "
                     "was stopped")
     finally:
         w.stop()

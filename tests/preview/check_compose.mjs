@@ -6,6 +6,9 @@
 //   - F1 + Q2 - Q1 is closer to F2 than the quick look Q2 alone (both read in F2's atlas, 9 x 9
 //     texel box averages over the texels a triangle covers, rms of the luminance difference over
 //     F2's mean), and within 5%;
+//   - with the moved lamp's direct light alone (`bake --direct-of`) before and after, in both
+//     layouts, F1 + Q2 - Q1 - (QD2 - QD1) + (D2 - D1) is closer to F2 still; a correction of
+//     nothing (D1 - D1) leaves F1 texel for texel;
 //   - a quick look of another layout (the texel density changed) is refused with a reason.
 //   usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR
 import fs from 'node:fs';
@@ -30,18 +33,20 @@ doc.scenes[doc.scene || 0].nodes.push(doc.nodes.length - 1);
 const cfg = path.join(work, 'bake.yaml');
 fs.writeFileSync(cfg, 'texel_density: 16\nsamples: {gather: 256}\n');
 
-function bakeState(tag, { quick = false, config = cfg } = {}) {
+function bakeState(tag, { quick = false, config = cfg, extra = [] } = {}) {
   const dir = path.join(work, tag);
   fs.mkdirSync(dir, { recursive: true });
   for (const b of doc.buffers) if (!b.uri.startsWith('data:')) fs.copyFileSync(path.join(work, 'scenes', b.uri), path.join(dir, b.uri));
   fs.writeFileSync(path.join(dir, `${stem}.gltf`), JSON.stringify(doc));
   const out = path.join(dir, 'out');
-  execFileSync(lmbake, ['bake', path.join(dir, `${stem}.gltf`), '-c', config, '-o', out, '-q', ...(quick ? ['--quick'] : [])]);
+  execFileSync(lmbake, ['bake', path.join(dir, `${stem}.gltf`), '-c', config, '-o', out, '-q', ...(quick ? ['--quick'] : []), ...extra]);
   return out;
 }
-const F1 = bakeState('f1'), Q1 = bakeState('q1', { quick: true }), Q1again = bakeState('q1-again', { quick: true });
+// the corner lamp's direct light alone (`--direct-of`), in the final's layout and the quick look's
+const direct = (tag) => ({ final: bakeState(`d${tag}`, { extra: ['--direct-of', 'corner'] }), quick: bakeState(`qd${tag}`, { quick: true, extra: ['--direct-of', 'corner'] }) });
+const F1 = bakeState('f1'), Q1 = bakeState('q1', { quick: true }), Q1again = bakeState('q1-again', { quick: true }), D1 = direct(1);
 doc.nodes[doc.nodes.length - 1].translation = [0.8, 0.15, 0.75];
-const F2 = bakeState('f2'), Q2 = bakeState('q2', { quick: true });
+const F2 = bakeState('f2'), Q2 = bakeState('q2', { quick: true }), D2 = direct(2);
 
 // a change of nothing: the final's .hdr back
 const same = compose({ final: F1, quickBefore: Q1, quickAfter: Q1again, out: path.join(work, 'same'), stem });
@@ -49,6 +54,9 @@ const hdr = `${stem}-lightmap-0.hdr`;
 const a = same.ok ? readHdr(path.join(work, 'same', hdr)) : null, b = readHdr(path.join(F1, hdr));
 check(same.ok && a.width === b.width && a.height === b.height && a.data.every((x, i) => x === b.data[i]),
   `F1 + Q1 - Q1 is F1's .hdr texel for texel, as the page reads it (${same.ok ? `${same.ms} ms` : same.why})`);
+const sameCorrected = compose({ final: F1, quickBefore: Q1, quickAfter: Q1again, out: path.join(work, 'same-corrected'), stem, correction: { directBefore: D1.final, directAfter: D1.final, quickDirectBefore: D1.quick, quickDirectAfter: D1.quick } });
+const c = sameCorrected.ok ? readHdr(path.join(work, 'same-corrected', hdr)) : null;
+check(sameCorrected.ok && c.data.every((x, i) => x === b.data[i]), `and with the lamp's direct light taken off and put back: F1 again (${sameCorrected.ok ? `${sameCorrected.ms} ms` : sameCorrected.why})`);
 const gltf = JSON.parse(fs.readFileSync(path.join(work, 'same', `${stem}.gltf`), 'utf8'));
 const files = gltf.textures.filter((t) => t.extras && t.extras.lightmap).map((t) => Object.keys(t.extras.lightmap.files).sort().join(','));
 check(files.every((f) => f === 'hdr,png'), `the composed glTF names only its .hdr and .png (${files.join('; ')})`);
@@ -86,6 +94,10 @@ const error = (values) => {
 };
 const eQuick = error(quickAlone.mapped.get(0).value), eComposed = error(composed.mapped.get(0).value);
 check(eComposed < eQuick && eComposed <= 0.05, `the corner lamp moved: F1 + Q2 - Q1 is ${(100 * eComposed).toFixed(2)}% from F2, the quick look alone ${(100 * eQuick).toFixed(2)}% (9 x 9 rms; want below the quick look's and at most 5%)`);
+// with the lamp's direct light at the final's resolution: F1 + Q2 - Q1 - (QD2 - QD1) + (D2 - D1)
+const corrected = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'corrected'), stem, correction: { directBefore: D1.final, directAfter: D2.final, quickDirectBefore: D1.quick, quickDirectAfter: D2.quick } });
+const eCorrected = corrected.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'corrected'), stem), weight: 1 }]).mapped.get(0).value) : 1;
+check(corrected.ok && eCorrected < eComposed, `and with the lamp's direct light at the final's resolution: ${(100 * eCorrected).toFixed(2)}% from F2 (want below ${(100 * eComposed).toFixed(2)}%; ${corrected.ok ? `${corrected.ms} ms` : corrected.why})`);
 
 // another layout: refused, with the reason
 const cfg32 = path.join(work, 'bake32.yaml');

@@ -7,7 +7,8 @@
 // survives) and with the camera unchanged. Bake 2's final pixels are 3x bake 1's in linear light
 // (the bake is linear in the light; 3% and 2 levels allowed for the 8-bit screenshot), its quick
 // ones are those the plain preview shows of bake 1's final composed with the two files' quick
-// looks (`lmbake bake --quick`; tools/preview/compose.mjs). Then a half-written level: the page shows the error and keeps bake
+// looks (`lmbake bake --quick`) and the light's direct light alone (`--direct-of`, in both
+// layouts; tools/preview/compose.mjs). Then a half-written level: the page shows the error and keeps bake
 // 2's pixels exactly. Screenshots in SHOTS_DIR (preview-watch-*.png).
 //   usage: node tests/preview/preview_watch.mjs LMBAKE WORKDIR SHOTS_DIR
 import fs from 'node:fs';
@@ -78,6 +79,13 @@ try {
   const final1 = path.join(work, 'final1'), quick1 = path.join(work, 'quick1');
   fs.cpSync(path.join(work, 'out'), final1, { recursive: true });
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quick1, '--quick', '-q']);
+  // and the changed light's direct light alone, in the final's layout and the quick look's
+  const directOf = (tag) => ['direct', 'qdirect'].map((k) => {
+    const out = path.join(work, `${k}${tag}`);
+    execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', out, '--direct-of', 'ceiling_point', ...(k === 'qdirect' ? ['--quick'] : []), '-q']);
+    return out;
+  });
+  const [direct1, qdirect1] = directOf(1);
 
   doc.extensions.KHR_lights_punctual.lights[0].intensity *= 3;
   save();
@@ -109,8 +117,11 @@ try {
   // plain preview shows of that composed from the same camera, within a level
   const quickDir = path.join(work, 'quick2'), composedDir = path.join(work, 'composed2');
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quickDir, '--quick', '-q']);
-  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: composedDir, stem: 'cornell-point' });
+  const [direct2, qdirect2] = directOf(2);
+  const correction = { directBefore: direct1, directAfter: direct2, quickDirectBefore: qdirect1, quickDirectAfter: qdirect2 };
+  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: composedDir, stem: 'cornell-point', correction });
   check(composed.ok && statusQ.shown.composedOn === 1, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}; here: ${composed.ok || composed.why})`);
+  check(JSON.stringify(statusQ.shown.directOf) === '["ceiling_point"]', `with the changed light's direct light at the final's resolution (/status directOf: ${JSON.stringify(statusQ.shown.directOf)})`);
   const srv = await startServer(path.join(composedDir, 'cornell-point.gltf'));
   const v = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: '-7', cam: '0.5,0.5,2.2,0.5,0.45,0' });
   const png = decodePng(await v.page.screenshot());

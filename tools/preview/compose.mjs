@@ -13,6 +13,16 @@
 // TEXCOORD_1 in both bakes map rectangle to rectangle instead. Texels no triangle covers (the
 // atlas's padding) take the difference of a covered neighbour.
 //
+// A change of punctual lights can add a correction (the watch's `lmbake bake --direct-of` bakes of
+// the changed lights alone, before and after, in the final's layout and in the quick look's):
+//
+//     final(before) + [quick(after) - quick(before)] - [qdirect(after) - qdirect(before)]
+//                   + [direct(after) - direct(before)]
+//
+// the changed lights' direct light is then taken at the final's resolution (texel for texel:
+// the same layout), and only the rest of the change (their bounced light) at the quick look's.
+// A moved lamp's hot spot, a few texels wide, is what the quick look's resolution blurs.
+//
 // compose(...) writes OUT: the final's glTF with its lightmap textures naming only the composed
 // .hdr (no KTX2 or EXR: those are the old final's), the final's other files hard-linked (or
 // copied), and the composed .hdr. It returns {ok: true, ms} or {ok: false, why} (then the quick
@@ -295,24 +305,53 @@ export function mapQuicks(f, quicks) {
   return { atlases, mapped };
 }
 
+// The correction's final-layout part: direct(after) - direct(before), per final atlas (3 floats
+// a texel), or {why} when those bakes are not of the final's layout.
+function directChange(f, atlases, da, db) {
+  const nf = lightmappedNodes(f);
+  const change = new Map();
+  for (const g of [da, db]) {
+    const n = lightmappedNodes(g);
+    if (n.length !== nf.length || !n.every((x, i) => x.node === nf[i].node && x.atlas === nf[i].atlas && x.rects.length === nf[i].rects.length && x.rects.every((r, k) => sameArray(r, nf[i].rects[k])))) return { why: 'the direct-light bakes are of another layout' };
+  }
+  const [ia, ib] = [readAtlases(da), readAtlases(db)];
+  for (const [a, img] of atlases) {
+    const A = ia.get(a), B = ib.get(a);
+    if (!A || !B || A.width !== img.width || A.height !== img.height || B.width !== img.width || B.height !== img.height) return { why: 'the direct-light bakes have other atlases' };
+    const d = new Float32Array(3 * img.width * img.height);
+    for (let i = 0, n = img.width * img.height; i < n; i++) for (let c = 0; c < 3; c++) d[3 * i + c] = A.data[4 * i + c] - B.data[4 * i + c];
+    change.set(a, d);
+  }
+  return { change };
+}
+
 // final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
 // look's; out: the folder to write (made here). stem: the level's file name without extension.
-export function compose({ final, quickBefore, quickAfter, out, stem }) {
+// correction (optional): {directBefore, directAfter, quickDirectBefore, quickDirectAfter}, the
+// folders of the changed lights' --direct-of bakes (final's layout, quick look's layout).
+export function compose({ final, quickBefore, quickAfter, out, stem, correction = null }) {
   const t0 = Date.now();
-  let f, qb, qa;
+  let f, qb, qa, c = null;
   try {
     [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readBake(d, stem));
+    if (correction) c = Object.fromEntries(Object.entries(correction).map(([k, d]) => [k, readBake(d, stem)]));
   } catch (e) {
     return { ok: false, why: `cannot read a bake (${e.message})` };
   }
-  const m = mapQuicks(f, [{ g: qa, weight: 1 }, { g: qb, weight: -1 }]);
+  const quicks = [{ g: qa, weight: 1 }, { g: qb, weight: -1 }];
+  if (c) quicks.push({ g: c.quickDirectAfter, weight: -1 }, { g: c.quickDirectBefore, weight: 1 });
+  const m = mapQuicks(f, quicks);
   if (m.why) return { ok: false, why: m.why };
+  const direct = c ? directChange(f, m.atlases, c.directAfter, c.directBefore) : { change: null };
+  if (direct.why) return { ok: false, why: direct.why };
   fs.rmSync(out, { recursive: true, force: true });
   fs.mkdirSync(out, { recursive: true });
   const hdrs = new Set([...m.atlases.values()].map((a) => a.hdr));
   for (const [a, img] of m.atlases) {
     const { value: delta, covered } = m.mapped.get(a);
     padDelta(img.width, img.height, delta, covered);
+    const exact = direct.change && direct.change.get(a); // the changed lights' direct light, texel for texel
+    if (exact) for (let i = 0; i < delta.length; i++) delta[i] += exact[i];
     const rgba = new Float32Array(img.data.length);
     for (let i = 0, n = img.width * img.height; i < n; i++) {
       for (let c = 0; c < 3; c++) rgba[4 * i + c] = Math.max(img.data[4 * i + c] + delta[3 * i + c], 0);

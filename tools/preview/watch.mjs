@@ -15,7 +15,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { projectRoot, resolveFile, TYPES } from './server.mjs';
-import { watchedFiles, snapshot, configKeys, fingerprint, compare } from './watch-inputs.mjs';
+import { watchedFiles, snapshot, configKeys, fingerprint, compare, changedLights } from './watch-inputs.mjs';
 import { compose } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
@@ -76,11 +76,12 @@ function stopChild(why) {
   status.baking = null;
 }
 
-// One `lmbake bake` of the newest state: quick into QUICK/N, final into OUTDIR. Resolves to
-// {ok, seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
-function bake(kind, generation) {
-  const out = kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir;
-  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
+// One `lmbake bake` of the newest state: quick into QUICK/N, final into OUTDIR, a correction
+// (the changed lights' direct light) wherever `to` says ({level, out, extra: more arguments}).
+// Resolves to {ok, seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
+function bake(kind, generation, to = {}) {
+  const out = to.out || (kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir);
+  const args = ['bake', to.level || opts.level, '-o', out, '--layout-cache', layoutRoot, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : []), ...(to.extra || [])];
   return new Promise((resolve) => {
     const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     child = p;
@@ -135,13 +136,16 @@ async function bakeNewest() {
     if (r.cancelled || dirty) return;
     if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
-    const composed = kind === 'quick' ? composeQuick(generation, change) : null;
+    const correction = kind === 'quick' ? await correctionBakes(generation, change, fp) : null;
+    if ((correction && correction.cancelled) || dirty) return;
+    const composed = kind === 'quick' ? composeQuick(generation, change, correction) : null;
     const seconds = (Date.now() - seen) / 1000;
-    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept: r.layoutKept, composedOn: composed };
+    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept: r.layoutKept, composedOn: composed, directOf: composed && correction ? correction.names : null };
     status.history.push({ generation, kind, seconds, changed: change.what });
     if (status.history.length > 50) status.history.shift();
     status.error = null;
-    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${r.layoutKept ? '; layout kept' : ''}${composed ? `; composed on final bake ${composed}` : ''})`);
+    const exact = composed && correction ? `, the direct light of ${correction.names.map((n) => `'${n}'`).join(', ')} at its resolution` : '';
+    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${r.layoutKept ? '; layout kept' : ''}${composed ? `; composed on final bake ${composed}${exact}` : ''})`);
     tidyQuickDirs();
     tidyLayouts();
   }
@@ -156,11 +160,69 @@ function outdirStamp() {
   try { const st = fs.statSync(path.join(opts.outdir, `${stem}.gltf`)); return `${st.ino}:${st.mtimeMs}`; } catch { return null; }
 }
 
+// The correction of a change of punctual lights alone (compose.mjs): `lmbake bake --direct-of`
+// of the changed lights, in the final's layout and in the quick look's, after the change and
+// before it (the last final's level, rebuilt in a private folder), each state's two bakes in
+// QUICK/corrections/KEY. A state baked for the change before is reused: the lamp an artist moves
+// again was this change's "after". Resolves to {names, directBefore, directAfter,
+// quickDirectBefore, quickDirectAfter}, null (no correction; the log says why when it is not
+// obvious) or {cancelled: true}.
+async function correctionBakes(generation, change, fp) {
+  const base = status.lastGood;
+  if (!base || !base.quick || change.layout || change.what.length !== 1 || change.what[0] !== 'lights') return null;
+  const lights = changedLights(base.fp, fp);
+  const skip = (why) => { say(`quick bake ${generation}: composed without the changed lights' direct light (${why})`); return null; };
+  if (lights.why) return skip(lights.why);
+  const root = path.join(quickRoot, 'corrections');
+  const stateDir = (key) => path.join(root, key.slice(0, 24));
+  const extra = lights.names.flatMap((n) => ['--direct-of', n]);
+  for (const [key, level] of [[lights.after, opts.level], [lights.before, null]]) {
+    const dir = stateDir(key);
+    if (fs.existsSync(path.join(dir, 'done'))) continue;
+    fs.rmSync(dir, { recursive: true, force: true });
+    let from = level;
+    if (!from) {
+      try { from = writeLevelCopy(base.fp.level, path.join(quickRoot, 'before-level')); } catch (e) { return skip(`the level as it was: ${e.message}`); }
+    }
+    for (const [sub, more] of [['direct', []], ['quick', ['--quick']]]) {
+      const r = await bake('correction', generation, { level: from, out: path.join(dir, sub), extra: [...extra, ...more] });
+      if (r.cancelled || dirty) return { cancelled: true };
+      if (!r.ok) return skip(`lmbake bake --direct-of: ${r.error.split('\n')[0]}`);
+    }
+    fs.writeFileSync(path.join(dir, 'done'), '');
+  }
+  for (const d of fs.readdirSync(root)) if (![lights.after, lights.before].some((k) => k.startsWith(d))) fs.rmSync(path.join(root, d), { recursive: true, force: true });
+  const [after, before] = [stateDir(lights.after), stateDir(lights.before)];
+  return { names: lights.names, directAfter: path.join(after, 'direct'), quickDirectAfter: path.join(after, 'quick'), directBefore: path.join(before, 'direct'), quickDirectBefore: path.join(before, 'quick') };
+}
+
+// The level as a fingerprint read it ({file, bytes, json}), written into dir (emptied) with the
+// buffers and images its relative URIs name linked (or copied) beside it, so that lmbake, which
+// reads files only inside the level's folder, bakes it there. Returns the copy's path.
+function writeLevelCopy(level, dir) {
+  fs.rmSync(dir, { recursive: true, force: true });
+  fs.mkdirSync(dir, { recursive: true });
+  const copy = path.join(dir, path.basename(level.file));
+  fs.writeFileSync(copy, level.bytes);
+  const from = path.dirname(level.file);
+  for (const x of [...(level.json.buffers || []), ...(level.json.images || [])]) {
+    if (typeof x.uri !== 'string' || /^[a-z][a-z0-9+.-]*:/i.test(x.uri)) continue; // embedded (data:) or not a file
+    const rel = path.normalize(decodeURIComponent(x.uri));
+    if (path.isAbsolute(rel) || rel.startsWith('..')) throw new Error(`'${x.uri}' is outside the level's folder`);
+    fs.mkdirSync(path.dirname(path.join(dir, rel)), { recursive: true });
+    if (!fs.existsSync(path.join(dir, rel))) {
+      try { fs.linkSync(path.join(from, rel), path.join(dir, rel)); } catch { fs.copyFileSync(path.join(from, rel), path.join(dir, rel)); }
+    }
+  }
+  return copy;
+}
+
 // After quick bake N of a change that keeps the layout (and the output's units): the picture
 // shown is the last final bake plus the difference of the two quick looks, in the final's atlas
-// (compose.mjs), written to QUICK/N/composed. Returns the final bake's generation it was composed
-// on, or null (then the quick look is shown as baked, and the log says why).
-function composeQuick(generation, change) {
+// (compose.mjs), with the changed lights' direct light at the final's resolution when
+// correctionBakes made it, written to QUICK/N/composed. Returns the final bake's generation it
+// was composed on, or null (then the quick look is shown as baked, and the log says why).
+function composeQuick(generation, change, correction) {
   const base = status.lastGood;
   if (!base || !base.quick || change.layout || change.what.some((w) => /^config .*\boutput\./.test(w))) return null;
   const dir = path.join(quickRoot, String(generation)), out = path.join(dir, 'composed');
@@ -169,7 +231,8 @@ function composeQuick(generation, change) {
   else if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
   else {
     try {
-      r = compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem });
+      const { names, ...dirs } = correction || {}; // eslint-disable-line no-unused-vars
+      r = compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, correction: correction ? dirs : null });
     } catch (e) {
       r = { ok: false, why: e.message };
     }
@@ -199,7 +262,7 @@ function failed(message) {
 // Quick folders no page can still want: all but the shown generation's and the newest.
 function tidyQuickDirs() {
   for (const d of fs.readdirSync(quickRoot)) {
-    if (!/^\d+$/.test(d)) continue; // the layouts
+    if (!/^\d+$/.test(d)) continue; // the layouts, the corrections, the level as it was
     const g = Number(d);
     const base = status.lastGood && status.lastGood.generation === g; // the next composed picture's quick(before)
     if (g !== status.generation && !base && !(status.shown && status.shown.generation === g && status.shown.kind === 'quick')) fs.rmSync(path.join(quickRoot, d), { recursive: true, force: true });
