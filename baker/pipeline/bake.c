@@ -264,8 +264,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = dark_atlases(s, cfg, &l, &cache, stats, err);
     else if (st == LMB_OK)
         st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
-    /* light probes: placed in every process alike, lit as a step from the finished cache */
-    if (st == LMB_OK)
+    /* light probes: placed in every process alike, lit as a step from the finished cache (not
+     * for bake --direct-of: the watch reads only its lightmaps) */
+    if (st == LMB_OK && !cfg->direct_of_count)
         st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
     if (st == LMB_OK)
         st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, shard ? NULL : log, err);
