@@ -277,6 +277,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         if (lmb_point_validity_known(&validity) > validity_read)
             lmb_validity_cache_write(s, cfg, run->layout_cache, &validity, log);
     }
+    if (direct)
+        lmb_direct_set_validity(direct, NULL);
     lmb_point_validity_free(&validity);
     if (st == LMB_OK && worker)
         st = lmb_steps_worker_end(steps, err);

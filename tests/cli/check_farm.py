@@ -254,7 +254,7 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     # quick (sanitizer builds): a quarter of the texels; the farm's mechanics do not depend on them
-    base = "atlas: {texels: %d}\nbounces: 2\nsamples: {gather: 64, bounce: 16}\n" % (10000 if quick else 40000)
+    base = "atlas: {texels: %d}\nbounces: 2\nsamples: {gather: 64, bounce: 16}\n" % (10000 if quick else 20000)
     cache_amis = write(os.path.join(work, "cache-amis.yaml"),
                        base + "gather: {method: amis_defensive}\nirradiance_cache: {error: 0.3}\n"
                        "output: {directional: true}\nfarm: {min_step_rays: 0}\n")

@@ -60,7 +60,7 @@ function show(s) {
 const age = (ms) => (ms < 60000 ? `${Math.round(ms / 1000)} s` : `${Math.round(ms / 60000)} min`);
 function bar(s) {
   const sh = s.shown;
-  $('shown').innerHTML = sh ? `<b class="${sh.kind}">${sh.kind} bake ${sh.generation}</b>, ${age(s.now - sh.readyAt)} old (${sh.changed.join('; ')}; ready ${sh.seconds.toFixed(1)} s after the change${sh.layoutKept ? ', layout kept' : ''}${sh.composedOn ? `; the last final bake ${sh.composedOn} plus the change at the quick look's resolution` : ''})` : 'waiting for the first bake';
+  $('shown').innerHTML = sh ? `<b class="${sh.kind}">${sh.kind} bake ${sh.generation}</b>, ${age(s.now - sh.readyAt)} old (${sh.changed.join('; ')}; ready ${sh.seconds.toFixed(1)} s after the change${sh.layoutKept ? ', layout kept' : ''}${sh.composedOn ? `; the last final bake ${sh.composedOn} plus the change at the quick look's resolution${sh.directOf ? ` (${sh.directOf.join(', ')}: direct light at full resolution)` : ''}` : ''})` : 'waiting for the first bake';
   const b = s.baking;
   $('next').textContent = b ? `baking: ${b.kind} bake ${b.generation}, ${b.stage} ${b.percent}%` : s.state === 'idle' ? 'up to date' : s.state;
   $('werror').textContent = s.error ? `lmbake: ${s.error}\n${sh ? `(bake ${sh.generation} stays on screen until the next good save)` : ''}` : '';
