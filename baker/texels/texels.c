@@ -89,6 +89,17 @@ static void triangle_rows(const double *uv, long *y0, long *y1)
     *y1 = (long)floor(fmax(uv[1], fmax(uv[3], uv[5]))) + 1;
 }
 
+/* The rows instance i's triangle f reaches (triangle_rows); 0 for a triangle in no chart. */
+static int placed_triangle_rows(const lmb_layout *l, uint32_t i, const lmb_charts *c, uint32_t f, long *y0, long *y1)
+{
+    if (c->chart_of[f] == UINT32_MAX)
+        return 0;
+    double uv[6];
+    lmb_layout_uv(l, i, f, uv);
+    triangle_rows(uv, y0, y1);
+    return 1;
+}
+
 /* Triangles at least this many in an instance with its own layout get per-band lists. */
 #define BAND_LIST_TRIANGLES 1024
 
@@ -116,12 +127,9 @@ static int band_lists(const lmb_layout *l, uint32_t i, const lmb_charts *c, uint
             }
         }
         for (uint32_t f = 0; f < c->triangle_count; f++) {
-            if (c->chart_of[f] == UINT32_MAX)
-                continue;
             long y0, y1;
-            double uv[6];
-            lmb_layout_uv(l, i, f, uv);
-            triangle_rows(uv, &y0, &y1);
+            if (!placed_triangle_rows(l, i, c, f, &y0, &y1))
+                continue;
             y0 = y0 < 0 ? 0 : y0;
             y1 = y1 >= (long)height ? (long)height - 1 : y1;
             for (long b = y0 / (long)band_rows; y0 <= y1 && b <= y1 / (long)band_rows; b++) {
@@ -156,12 +164,9 @@ lmb_status lmb_instance_rows_make(const lmb_scene *s, const lmb_layout *l, uint3
             continue;
         const lmb_charts *c = &l->meshes[s->instances[i].mesh].charts;
         for (uint32_t f = 0; f < c->triangle_count; f++) {
-            if (c->chart_of[f] == UINT32_MAX)
-                continue;
             long y0, y1;
-            double uv[6];
-            lmb_layout_uv(l, i, f, uv);
-            triangle_rows(uv, &y0, &y1);
+            if (!placed_triangle_rows(l, i, c, f, &y0, &y1))
+                continue;
             out->lo[i] = y0 < out->lo[i] ? y0 : out->lo[i];
             out->hi[i] = y1 > out->hi[i] ? y1 : out->hi[i];
         }
