@@ -205,50 +205,31 @@ static void set_targets(lmb_mixture *out, const uint32_t *index, const float *w,
     }
 }
 
-/* The fields a kept mixture holds: where each lies in lmb_mixture and in lmb_mixture_kept. */
-static const struct {
-    size_t full, kept, size;
-} KEPT_FIELDS[] = {
-    {offsetof(lmb_mixture, count), offsetof(lmb_mixture_kept, count), sizeof(uint32_t)},
-    {offsetof(lmb_mixture, diffuse), offsetof(lmb_mixture_kept, diffuse), sizeof(double)},
-    {offsetof(lmb_mixture, aimed), offsetof(lmb_mixture_kept, aimed), sizeof(int) * LMB_MIXTURE_MAX_LOBES},
-    {offsetof(lmb_mixture, lobe), offsetof(lmb_mixture_kept, lobe), sizeof(lmb_lobe) * LMB_MIXTURE_MAX_LOBES},
-    {offsetof(lmb_mixture, weight), offsetof(lmb_mixture_kept, weight), sizeof(double) * LMB_MIXTURE_MAX_LOBES},
-    {offsetof(lmb_mixture, target), offsetof(lmb_mixture_kept, target), 3 * sizeof(double) * LMB_MIXTURE_MAX_LOBES},
-};
-
-/* Copies the kept fields from src to dst, one a mixture and the other a kept one (to_kept:
- * dst is the kept one, of dst_size bytes); the rest of dst is zeroed. */
-static void copy_kept_fields(void *dst, size_t dst_size, const void *src, int to_kept)
+void lmb_mixture_keep(const lmb_mixture *m, lmb_mixture_kept *out)
 {
-    memset(dst, 0, dst_size);
-    for (size_t f = 0; f < sizeof KEPT_FIELDS / sizeof KEPT_FIELDS[0]; f++) {
-        size_t at_full = KEPT_FIELDS[f].full, at_kept = KEPT_FIELDS[f].kept;
-        memcpy((char *)dst + (to_kept ? at_kept : at_full), (const char *)src + (to_kept ? at_full : at_kept),
-               KEPT_FIELDS[f].size);
+    memset(out, 0, sizeof *out);
+    out->count = m->count;
+    out->diffuse = (float)m->diffuse;
+    for (uint32_t k = 0; k < m->count && k < LMB_MIXTURE_MAX_LOBES; k++) {
+        out->aimed[k] = (uint8_t)(m->aimed[k] != 0);
+        out->exponent[k] = (float)m->lobe[k].a;
+        out->weight[k] = (float)m->weight[k];
+        for (int j = 0; j < 3; j++) {
+            out->axis[k][j] = (float)m->lobe[k].axis[j];
+            out->target[k][j] = (float)m->target[k][j];
+        }
     }
 }
 
-void lmb_mixture_keep(const lmb_mixture *m, lmb_mixture_kept *out)
+/* Turns every aimed lobe of out (fitted at `from`) towards its target as seen from `to` and
+ * sets every lobe's frame. */
+static void reaim_in_place(lmb_mixture *out, const double from[3], const double to[3])
 {
-    copy_kept_fields(out, sizeof *out, m, 1);
-}
-
-void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double to[3], lmb_mixture *out)
-{
-    lmb_mixture_kept kept;
-    lmb_mixture_keep(m, &kept);
-    lmb_mixture_reaim_kept(&kept, from, to, out);
-}
-
-void lmb_mixture_reaim_kept(const lmb_mixture_kept *m, const double from[3], const double to[3], lmb_mixture *out)
-{
-    copy_kept_fields(out, sizeof *out, m, 0);
-    for (uint32_t k = 0; k < m->count; k++) {
-        if (m->aimed[k]) {
+    for (uint32_t k = 0; k < out->count; k++) {
+        if (out->aimed[k]) {
             double v[3];
             for (int j = 0; j < 3; j++)
-                v[j] = from[j] + m->target[k][j] - to[j];
+                v[j] = from[j] + out->target[k][j] - to[j];
             double len = sqrt(lmb_dot3(v, v));
             if (len > 0) {
                 for (int j = 0; j < 3; j++) {
@@ -259,6 +240,42 @@ void lmb_mixture_reaim_kept(const lmb_mixture_kept *m, const double from[3], con
         }
         lmb_frame(out->lobe[k].axis, out->tangent[k], out->bitangent[k]);
     }
+}
+
+void lmb_mixture_reaim(const lmb_mixture *m, const double from[3], const double to[3], lmb_mixture *out)
+{
+    memset(out, 0, sizeof *out);
+    out->count = m->count;
+    out->diffuse = m->diffuse;
+    for (uint32_t k = 0; k < m->count && k < LMB_MIXTURE_MAX_LOBES; k++) {
+        out->lobe[k] = m->lobe[k];
+        out->weight[k] = m->weight[k];
+        out->aimed[k] = m->aimed[k];
+        memcpy(out->target[k], m->target[k], sizeof out->target[k]);
+    }
+    reaim_in_place(out, from, to);
+}
+
+void lmb_mixture_reaim_kept(const lmb_mixture_kept *m, const double from[3], const double to[3], lmb_mixture *out)
+{
+    memset(out, 0, sizeof *out);
+    out->count = m->count;
+    out->diffuse = m->diffuse;
+    for (uint32_t k = 0; k < m->count && k < LMB_MIXTURE_MAX_LOBES; k++) {
+        double len = 0;
+        for (int j = 0; j < 3; j++) {
+            out->lobe[k].axis[j] = m->axis[k][j];
+            out->target[k][j] = m->target[k][j];
+            len += out->lobe[k].axis[j] * out->lobe[k].axis[j];
+        }
+        len = sqrt(len); /* a unit axis rounded to floats: unit again */
+        for (int j = 0; len > 0 && j < 3; j++)
+            out->lobe[k].axis[j] /= len;
+        out->lobe[k].a = m->exponent[k];
+        out->weight[k] = m->weight[k];
+        out->aimed[k] = m->aimed[k];
+    }
+    reaim_in_place(out, from, to);
 }
 
 /* Copies the samples to fit into the scratch (see lmb_mixture_fit): every step-th, standing for

@@ -270,7 +270,8 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint
     return st;
 }
 
-/* The translation-gradient fit as a step: items are records, 9 doubles each. */
+/* The translation-gradient fit as a step: items are records, 9 floats each (as records keep
+ * them: a farm's gradients are rounded where a single process's are). */
 static lmb_status fit_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
                             uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
@@ -280,7 +281,13 @@ static lmb_status fit_range(void *user, uint64_t first, uint64_t last, lmb_buf *
     if (!g)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for gradients");
     lmb_ic_records_fit_range(&c->records, (uint32_t)first, (uint32_t)last, (uint32_t)c->threads, g);
-    lmb_status st = lmb_buf_append(out, g, (size_t)(last - first) * sizeof *g, err);
+    lmb_status st = LMB_OK;
+    for (uint64_t i = 0; i < last - first && st == LMB_OK; i++) {
+        float gf[9];
+        for (int k = 0; k < 9; k++)
+            gf[k] = (float)g[i][k / 3][k % 3];
+        st = lmb_buf_append(out, gf, sizeof gf, err);
+    }
     free(g);
     return st;
 }
@@ -404,7 +411,7 @@ static lmb_status records_noise(const lmb_ic_records *s, uint32_t atlas_count, d
         uint32_t n = 0;
         for (uint32_t k = 0; k < s->count; k++) {
             const lmb_ic_record *r = &s->rec[k];
-            double lum = lmb_luminance(r->e);
+            double lum = lmb_luminance_f(r->e);
             if (r->atlas == a && lum > 0 && r->var > 0)
                 rel[n++] = sqrt(r->var) / lum;
         }

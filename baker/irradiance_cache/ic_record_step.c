@@ -39,32 +39,38 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     memset(r, 0, sizeof *r);
     memcpy(r->p, g->p, sizeof r->p);
     memcpy(r->n, g->n, sizeof r->n);
-    memcpy(r->e, g->e, sizeof r->e);
+    for (int ch = 0; ch < 3; ch++)
+        r->e[ch] = (float)g->e[ch];
     double size = c->t[x.atlas]->texel_size[x.index];
-    r->r_min = c->opt->min_spacing * size;
-    r->r_max = c->opt->max_spacing * size;
-    r->harmonic = g->harmonic;
-    r->var = g->var;
-    r->r = lmb_ic_reach(&c->records, r);
+    r->r_min = (float)(c->opt->min_spacing * size);
+    r->r_max = (float)(c->opt->max_spacing * size);
+    r->harmonic = (float)g->harmonic;
+    r->var = (float)g->var;
+    r->r = (float)lmb_ic_reach(&c->records, r);
     double turn = sqrt(2.0) * c->records.normal_limit; /* |n_i x n| at the largest difference */
     for (int ch = 0; ch < 3; ch++) {
         double mag = sqrt(lmb_dot3(g->rot[ch], g->rot[ch])) * turn;
         double scale = mag > r->e[ch] ? r->e[ch] / mag : 1;
         for (int k = 0; k < 3; k++)
-            r->grad_r[ch][k] = scale * g->rot[ch][k];
+            r->grad_r[ch][k] = (float)(scale * g->rot[ch][k]);
     }
     r->atlas = x.atlas;
     r->texel = x.index;
 }
 
-/* A record's bytes in a step (steps/runner.h): its doubles p .. var (32, contiguous), atlas, texel. */
-#define RECORD_DOUBLES 32
-_Static_assert(offsetof(lmb_ic_record, var) - offsetof(lmb_ic_record, p) == (RECORD_DOUBLES - 1) * sizeof(double),
-               "lmb_ic_record: p .. var are contiguous doubles");
+/* A record's bytes in a step (steps/runner.h): p and n (6 doubles), then its floats e .. var (26,
+ * contiguous), atlas, texel. */
+#define RECORD_FLOATS 26
+_Static_assert(offsetof(lmb_ic_record, var) - offsetof(lmb_ic_record, e) == (RECORD_FLOATS - 1) * sizeof(float),
+               "lmb_ic_record: e .. var are contiguous floats");
 
 static lmb_status put_record(lmb_buf *out, const lmb_ic_record *r, lmb_error *err)
 {
-    lmb_status st = lmb_buf_append(out, r->p, RECORD_DOUBLES * sizeof(double), err);
+    lmb_status st = lmb_buf_append(out, r->p, sizeof r->p, err);
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, r->n, sizeof r->n, err);
+    if (st == LMB_OK)
+        st = lmb_buf_append(out, r->e, RECORD_FLOATS * sizeof(float), err);
     if (st == LMB_OK)
         st = lmb_buf_append(out, &r->atlas, 4, err);
     if (st == LMB_OK)
@@ -75,7 +81,8 @@ static lmb_status put_record(lmb_buf *out, const lmb_ic_record *r, lmb_error *er
 static int take_record(lmb_buf *in, lmb_ic_record *r)
 {
     memset(r, 0, sizeof *r);
-    return lmb_buf_take(in, r->p, RECORD_DOUBLES * sizeof(double)) && lmb_buf_take(in, &r->atlas, 4) &&
+    return lmb_buf_take(in, r->p, sizeof r->p) && lmb_buf_take(in, r->n, sizeof r->n) &&
+           lmb_buf_take(in, r->e, RECORD_FLOATS * sizeof(float)) && lmb_buf_take(in, &r->atlas, 4) &&
            lmb_buf_take(in, &r->texel, 4);
 }
 

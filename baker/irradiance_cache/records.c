@@ -299,7 +299,9 @@ static void interp_visit(void *user, uint32_t k)
     double d[3] = {c->p[0] - r->p[0], c->p[1] - r->p[1], c->p[2] - r->p[2]}, rot[3];
     lmb_cross3(r->n, c->n, rot); /* the rotation taking n_i to n, for small angles */
     for (int ch = 0; ch < 3; ch++) {
-        double v = r->e[ch] + lmb_dot3(r->grad_t[ch], d) + lmb_dot3(r->grad_r[ch], rot);
+        const float *gt = r->grad_t[ch], *gr = r->grad_r[ch];
+        double v = r->e[ch] + (gt[0] * d[0] + gt[1] * d[1] + gt[2] * d[2]) +
+                   (gr[0] * rot[0] + gr[1] * rot[1] + gr[2] * rot[2]);
         c->e[ch] += w * (v > 0 ? v : 0);
     }
 }
@@ -378,8 +380,8 @@ lmb_status lmb_ic_records_clamp(lmb_ic_records *s, uint32_t threads, lmb_error *
         h[i] = c.harmonic;
     }
     for (uint32_t i = 0; i < s->count; i++) {
-        s->rec[i].harmonic = h[i];
-        s->rec[i].r = lmb_ic_reach(s, &s->rec[i]);
+        s->rec[i].harmonic = (float)h[i];
+        s->rec[i].r = (float)lmb_ic_reach(s, &s->rec[i]);
     }
     free(h);
     if (s->count)
@@ -465,7 +467,9 @@ lmb_status lmb_ic_records_fit_gradients(lmb_ic_records *s, uint32_t threads, lmb
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u gradients", s->count);
     lmb_ic_records_fit_range(s, 0, s->count, threads, g);
     for (uint32_t i = 0; i < s->count; i++)
-        memcpy(s->rec[i].grad_t, g[i], sizeof g[i]);
+        for (int ch = 0; ch < 3; ch++)
+            for (int k = 0; k < 3; k++)
+                s->rec[i].grad_t[ch][k] = (float)g[i][ch][k];
     free(g);
     return LMB_OK;
 }

@@ -181,6 +181,10 @@ static uint8_t *chart_interior_edges(const lmb_layout *l, uint32_t m)
 lmb_status lmb_seam_collect_edges(const lmb_scene *s, const lmb_layout *l, double snap, int threads, edge_ref **out,
                                   size_t *count, lmb_error *err)
 {
+    for (uint32_t m = 0; m < l->mesh_count; m++)
+        if (l->meshes[m].used && l->meshes[m].soup.triangle_count >= LMB_SEAM_MAX_TRIANGLES)
+            return lmb_error_set(err, LMB_ERR_INPUT, "seams: mesh %u has %u triangles, more than the %u whose edges can be stitched",
+                                 m, l->meshes[m].soup.triangle_count, LMB_SEAM_MAX_TRIANGLES - 1);
     size_t *first = malloc(((size_t)l->instance_count + 1) * sizeof *first);
     uint8_t **interior = calloc((size_t)l->mesh_count + 1, sizeof *interior);
     size_t *mesh_edges = calloc((size_t)l->mesh_count + 1, sizeof *mesh_edges);
@@ -233,7 +237,7 @@ lmb_status lmb_seam_collect_edges(const lmb_scene *s, const lmb_layout *l, doubl
                 int64_t key[6];
                 int swapped;
                 lmb_seam_edge_key(s, l, i, f, c, snap, key, &swapped);
-                e[m++] = (edge_ref){hash_key(key), i, f, (uint8_t)c, (uint8_t)swapped};
+                e[m++] = (edge_ref){hash_key(key), i, f, (uint32_t)c, (uint32_t)swapped};
             }
         }
     }

@@ -5,13 +5,18 @@
 
 #include "pack/layout.h"
 
-/* One triangle edge, found by a hash of its endpoints (snapped to 1/1000 texel, in order). */
+/* One triangle edge, found by a hash of its endpoints (snapped to 1/1000 texel, in order). 16
+ * bytes: a level of 1,900 props holds two million (and as many again while they are sorted). */
 typedef struct edge_ref {
     uint64_t hash;
-    uint32_t instance, triangle;
-    uint8_t corner;  /* the edge runs from corner `corner` to corner + 1 (mod 3) */
-    uint8_t swapped; /* corner + 1 holds the smaller endpoint */
+    uint32_t instance;
+    uint32_t triangle : 29; /* < LMB_SEAM_MAX_TRIANGLES */
+    uint32_t corner : 2;    /* the edge runs from corner `corner` to corner + 1 (mod 3) */
+    uint32_t swapped : 1;   /* corner + 1 holds the smaller endpoint */
 } edge_ref;
+
+/* Triangles a mesh may have for its edges to be stitched (edge_ref.triangle's bits). */
+#define LMB_SEAM_MAX_TRIANGLES (1u << 29)
 
 /* The snapping grid: 1/1000 of the finest texel of any lightmapped instance. */
 double lmb_seam_snap_size(const lmb_layout *l);

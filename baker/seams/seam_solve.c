@@ -54,7 +54,7 @@ static int64_t unknown_of(unknowns *u, uint32_t atlas, uint32_t texel)
 
 static int32_t unknown_at(const unknowns *u, const seam_row *r, int j)
 {
-    return u->of_texel[r->atlas[j]][r->texel[j]];
+    return u->of_texel[lmb_seam_tap_atlas(r, j)][r->texel[j]];
 }
 
 /* |lum A - lum B| / their mean at a seam point, from the atlases as they are. */
@@ -62,7 +62,7 @@ static double jump_at(float *const *rgb, const seam_row *r)
 {
     double side[2][3] = {{0, 0, 0}, {0, 0, 0}};
     for (int j = 0; j < 8; j++) {
-        const float *p = rgb[r->atlas[j]] + 3 * (size_t)r->texel[j];
+        const float *p = rgb[lmb_seam_tap_atlas(r, j)] + 3 * (size_t)r->texel[j];
         for (int c = 0; c < 3; c++)
             side[j / 4][c] += fabs(r->w[j]) * p[c];
     }
@@ -241,7 +241,7 @@ lmb_status lmb_seam_solve(const lmb_layout *l, float *const *rgb, const uint8_t 
     }
     for (size_t r = 0; st == LMB_OK && r < nr; r++)
         for (int j = 0; j < 8; j++)
-            if (unknown_of(&u, rows[r].atlas[j], rows[r].texel[j]) < 0)
+            if (unknown_of(&u, lmb_seam_tap_atlas(&rows[r], j), rows[r].texel[j]) < 0)
                 st = lmb_error_set(err, LMB_ERR_INTERNAL, "seams: out of memory for the unknowns");
     size_t n = u.count;
     uint32_t *block_of = malloc((n + 1) * sizeof *block_of), *local = malloc((n + 1) * sizeof *local);

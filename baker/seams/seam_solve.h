@@ -5,11 +5,18 @@
 
 #include "seams.h"
 
-/* One seam point: 8 taps (4 bilinear taps per side; side B's weights negated). */
+/* One seam point: 8 taps (4 bilinear taps per side, in the side's atlas; side B's weights
+ * negated). 72 bytes: a level of 1,900 props holds 660,000. */
 typedef struct seam_row {
-    uint32_t atlas[8], texel[8];
-    double w[8];
+    uint32_t atlas[2], texel[8];
+    float w[8];
 } seam_row;
+
+/* The atlas of tap j (0..7). */
+static inline uint32_t lmb_seam_tap_atlas(const seam_row *r, int j)
+{
+    return r->atlas[j / 4];
+}
 
 /* Unknowns solved together at most (a connected set of texels larger than this is one block):
  * bounds the memory of one factorisation. */

@@ -152,10 +152,10 @@ static void row_at(const lmb_layout *l, const seam_side sides[2], double t, seam
         uint32_t idx[4];
         double wt[4];
         bilinear_taps(x, y, l->width[sd->atlas], l->height[sd->atlas], idx, wt);
+        r->atlas[k] = sd->atlas;
         for (int j = 0; j < 4; j++) {
-            r->atlas[4 * k + j] = sd->atlas;
             r->texel[4 * k + j] = idx[j];
-            r->w[4 * k + j] = k ? -wt[j] : wt[j];
+            r->w[4 * k + j] = (float)(k ? -wt[j] : wt[j]);
         }
     }
 }
@@ -169,7 +169,7 @@ static int any_side_differs(float *const *rgb, const seam_row *rows, size_t nr, 
     for (size_t r = 0; r < nr; r++) {
         double side[2][3] = {{0, 0, 0}, {0, 0, 0}};
         for (int j = 0; j < 8; j++) {
-            const float *p = rgb[rows[r].atlas[j]] + 3 * (size_t)rows[r].texel[j];
+            const float *p = rgb[lmb_seam_tap_atlas(&rows[r], j)] + 3 * (size_t)rows[r].texel[j];
             for (int c = 0; c < 3; c++)
                 side[j / 4][c] += fabs(rows[r].w[j]) * p[c];
         }
@@ -185,7 +185,7 @@ static int seen_from_both_sides(const uint8_t *const *state, const seam_row *r)
 {
     int valid[2] = {0, 0};
     for (int j = 0; j < 8; j++)
-        if (r->w[j] != 0 && state[r->atlas[j]][r->texel[j]] == LMB_TEXEL_VALID)
+        if (r->w[j] != 0 && state[lmb_seam_tap_atlas(r, j)][r->texel[j]] == LMB_TEXEL_VALID)
             valid[j / 4] = 1;
     return valid[0] && valid[1];
 }
