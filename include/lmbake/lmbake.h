@@ -468,7 +468,7 @@ void lmb_scene_stats_compute(const lmb_scene *scene, lmb_scene_stats *out);
 #define LMB_MAX_REPORTED_BOUNCES 65
 
 /* Why bounces: auto stopped. */
-enum { LMB_BOUNCES_TAIL = 1, LMB_BOUNCES_SMALL_PASS = 2, LMB_BOUNCES_MAX = 3 };
+enum { LMB_BOUNCES_TAIL = 1, LMB_BOUNCES_SMALL_PASS = 2, LMB_BOUNCES_MAX = 3, LMB_BOUNCES_TAIL_BOUNDED = 4 };
 
 typedef struct lmb_bake_stats {
     uint32_t atlases;

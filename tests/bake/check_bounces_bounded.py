@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""`bounces: auto` stops once the tail is known well enough, even where the ratio never settles.
+
+An open yard under a noon sun: a 16 x 16 ground (albedo 0.5) and eight 2 x 4 x 2 blocks (albedo
+0.9). Light bounces between the ground and the blocks' sides and escapes to the open sky, so what
+a pass adds falls fast, and the passes' ratios (0.37, 0.30) differ by more than the settling
+test allows (0.02 + 5%). The third rule of `bounces: auto` (docs/defaults.md "Bounces auto") stops
+when every ratio the last two passes allow gives the same total within 0.5% of the light.
+Asserted:
+  - the log gives that rule as the reason, after fewer passes than `bounces_auto.max`;
+  - the yard's mean light is within 0.5% (the rule's bound) + 0.3% (the two bakes' noise) of
+    `bounces: 16`, fifteen passes and no extrapolation;
+  - the indirect light (the mean minus `bounces: 0`'s) is over 5% of the direct light, so the
+    comparison can see a missing bounce.
+
+usage: check_bounces_bounded.py LMBAKE WORKDIR
+"""
+import os
+import re
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import make_scenes  # noqa: E402
+
+ok = True
+
+
+def check(cond, what):
+    global ok
+    ok &= bool(cond)
+    print("%s %s" % ("ok  " if cond else "FAIL", what))
+
+
+def mean_light(out):
+    import numpy as np
+    import OpenImageIO as oiio
+    total, count = 0.0, 0
+    for n in sorted(os.listdir(out)):
+        if n.endswith(".exr") and not n.endswith("-dir.exr"):
+            px = np.array(oiio.ImageBuf(os.path.join(out, n)).get_pixels(oiio.FLOAT))[..., :3]
+            mask = np.array(oiio.ImageBuf(os.path.join(out, n[:-4] + "-mask.png")).get_pixels(oiio.UINT8))[..., 0]
+            lit = mask == 255
+            total += float(px[lit].sum())
+            count += int(lit.sum()) * 3
+    return total / count
+
+
+def bake(lmbake, scene, work, name, bounces):
+    config = os.path.join(work, name + ".yaml")
+    with open(config, "w") as f:
+        f.write("atlas:\n  texels: 20000\nbounces: %s\nprobes:\n  auto: false\noutput:\n  formats: [exr, mask]\n" % bounces)
+    out = os.path.join(work, name)
+    p = subprocess.run([lmbake, "bake", scene, "-c", config, "-o", out], capture_output=True, text=True, timeout=600)
+    if p.returncode != 0:
+        sys.exit("bake %s failed:\n%s" % (name, p.stderr[-2000:]))
+    return mean_light(out), p.stdout + p.stderr
+
+
+def main():
+    lmbake, work = sys.argv[1:3]
+    os.makedirs(work, exist_ok=True)
+    s = make_scenes.Scene()
+    grey, white = s.material("grey", (0.5, 0.5, 0.5)), s.material("white", (0.9, 0.9, 0.9))
+    s.mesh("ground", make_scenes.plane(16), grey)
+    for i, (x, z) in enumerate([(-5, -5), (0, -5), (5, -5), (-5, 0), (5, 0), (-5, 5), (0, 5), (5, 5)]):
+        s.mesh("block%d" % i, make_scenes.box(x - 1, 0, z - 1, x + 1, 4, z + 1, bottom=False), white)
+    s.light("sun", "directional", 3.0, rotation=(-0.7071068, 0.0, 0.0, 0.7071068))  # straight down
+    scene = os.path.join(work, "yard.gltf")
+    s.write(scene)
+
+    direct, _ = bake(lmbake, scene, work, "bounces-0", 0)
+    auto, log = bake(lmbake, scene, work, "bounces-auto", "auto")
+    many, _ = bake(lmbake, scene, work, "bounces-16", 16)
+    m = re.search(r"bounces: auto, ([0-9]+) pass\(es\).*", log)
+    print(m.group(0) if m else "no bounces line in the log")
+    check(m and "any ratio the last two passes allow" in m.group(0) and int(m.group(1)) < 31,
+          "bounces auto stopped by the tail's bound after %s pass(es)" % (m.group(1) if m else "?"))
+    check(many - direct > 0.05 * direct, "indirect light %.4g, %.1f%% of the direct light %.4g"
+          % (many - direct, 100 * (many - direct) / direct, direct))
+    check(abs(auto / many - 1) < 0.008, "bounces auto: mean %.5g = %.4f x bounces 16's %.5g (within 0.8%%)"
+          % (auto, auto / many, many))
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
