@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """The artist's loop, timed (docs/watch.md#cost): `lmbake preview --watch` of a level; once bake 1
 is final, the level is saved with its light brighter (x 2), then with the light moved; for each
-save, the seconds from the save to the quick picture and to the final one (the watch's /status:
-the moment each bake was ready), then a plain `lmbake bake` of the same file, one after the
-other in one run. The quick picture's error against the final: both atlases box-averaged over
-9 x 9 texels (valid texels only), rms of the difference over the final's mean, luminance.
+save, the seconds from the save to the quick picture, to its refinement with the changed lights'
+direct light (a change of punctual lights alone) and to the final one (the watch's /status: the
+moment each was shown), then a plain `lmbake bake` of the same file, one after the other in one
+run. Each quick picture's error against the final: both atlases box-averaged over 9 x 9 texels
+(valid texels only), rms of the difference over the final's mean, luminance.
 
 level-single-10: its lamp 'Lamp 1' (KHR_lights_punctual: a change of lights; LEVEL:NAME picks a
 point light by name, the first by default: level-single-10's 'Lamp 0', like every even lamp of
@@ -195,17 +196,35 @@ def status(url):
     return json.load(urllib.request.urlopen(url + "status", timeout=10))
 
 
-def wait_shown(url, generation, kind, timeout=1800):
+def wait_shown(url, generation, kind, timeout=1800, revision=None):
+    """/status once bake `generation` of `kind` is shown (at `revision` or later, when given)."""
     end = time.time() + timeout
     while time.time() < end:
         s = status(url)
         sh = s.get("shown")
-        if sh and sh["generation"] == generation and sh["kind"] == kind:
+        if sh and sh["generation"] == generation and sh["kind"] == kind and sh.get("revision", 0) >= (revision or 0):
             return s
+        if sh and revision and sh["generation"] == generation and sh["kind"] == "final":
+            return None  # no refined quick picture came before the final
         if s["state"] == "error":
             sys.exit("watch error: " + s["error"])
         time.sleep(0.05)
     sys.exit("timed out waiting for %s bake %d" % (kind, generation))
+
+
+def fetch_quick(url, generation, revision, stem, dest):
+    """The quick picture of bake `generation` at `revision` (the files scene.json names) into
+    dest; returns (its glTF, its lightmap)."""
+    shutil.rmtree(dest, ignore_errors=True)
+    os.makedirs(dest)
+    shown = json.load(urllib.request.urlopen("%sscene.json?kind=quick&gen=%d&rev=%d" % (url, generation, revision),
+                                             timeout=10))["gltf"]
+    base = url + shown.lstrip("/").rsplit("/", 1)[0] + "/"
+    get = lambda f: urllib.request.urlretrieve(base + f, os.path.join(dest, f))
+    get("%s.gltf" % stem)
+    for f in ["%s-lightmap-0.hdr" % stem] + [b["uri"] for b in json.load(open(os.path.join(dest, "%s.gltf" % stem)))["buffers"]]:
+        get(f)
+    return os.path.join(dest, "%s.gltf" % stem), os.path.join(dest, "%s-lightmap-0.hdr" % stem)
 
 
 def bench(lmbake, level_src, rows, light=None):
@@ -224,32 +243,31 @@ def bench(lmbake, level_src, rows, light=None):
             edit(doc)
             saved = time.time()
             write_level(level, doc, rest)
-            s = wait_shown(url, g, "quick")
-            quick_at = s["shown"]["readyAt"] / 1000
             stem = os.path.basename(level).rsplit(".", 1)[0]
-            quick = os.path.join(work, "quick")
-            shutil.rmtree(quick, ignore_errors=True)
-            os.makedirs(quick)
-            # the picture shown: the quick look, or composed on the last final (scene.json says which)
-            shown = json.load(urllib.request.urlopen("%sscene.json?kind=quick&gen=%d" % (url, g), timeout=10))["gltf"]
-            base = url + shown.lstrip("/").rsplit("/", 1)[0] + "/"
-            get = lambda f: urllib.request.urlretrieve(base + f, os.path.join(quick, f))
-            get("%s.gltf" % stem)
-            for f in ["%s-lightmap-0.hdr" % stem] + [b["uri"] for b in json.load(open(os.path.join(quick, "%s.gltf" % stem)))["buffers"]]:
-                get(f)
+            s = wait_shown(url, g, "quick")
+            first_at = s["shown"]["readyAt"] / 1000
             composed = s["shown"].get("composedOn")
+            first = fetch_quick(url, g, 0, stem, os.path.join(work, "quick0"))
+            s = wait_shown(url, g, "quick", revision=1)  # refined with the changed lights' direct light
+            refined = None
+            if s:
+                refined = (s["shown"]["readyAt"] / 1000, fetch_quick(url, g, 1, stem, os.path.join(work, "quick1")))
             s = wait_shown(url, g, "final")
             final_at = s["shown"]["readyAt"] / 1000
-            err = quick_error(os.path.join(quick, "%s.gltf" % stem), os.path.join(quick, "%s-lightmap-0.hdr" % stem),
-                              os.path.join(out, "%s.gltf" % stem), os.path.join(out, "%s-lightmap-0.exr" % stem))
+            final = (os.path.join(out, "%s.gltf" % stem), os.path.join(out, "%s-lightmap-0.exr" % stem))
+            err0 = quick_error(*first, *final)
+            err1 = quick_error(*refined[1], *final) if refined else None
             t0 = time.time()
             subprocess.run([lmbake, "bake", level, "-o", os.path.join(work, "plain"), "-q"], check=True)
             plain = time.time() - t0
             row = (name, what, ",".join(s["changed"]), "layout" if s["layout"] else "lighting",
-                   "composed" if composed else "quick", quick_at - saved, final_at - saved, plain, err)
+                   "composed" if composed else "quick", first_at - saved, err0,
+                   refined[0] - saved if refined else None, err1, final_at - saved, plain)
             rows.append(row)
-            print("%s: %s (%s; %s): %s picture %.1f s, final %.1f s, plain bake %.1f s; its 9x9 error %.2f%%"
-                  % (name, what, row[2], row[3], row[4], row[5], row[6], row[7], 100 * err), flush=True)
+            print("%s: %s (%s; %s): %s picture %.1f s (9x9 error %.2f%%)%s, final %.1f s, plain bake %.1f s"
+                  % (name, what, row[2], row[3], row[4], row[5], 100 * err0,
+                     "; refined with the direct light %.1f s (%.2f%%)" % (row[7], 100 * err1) if refined else "",
+                     row[9], row[10]), flush=True)
     finally:
         p.terminate()
         p.wait()
@@ -263,9 +281,12 @@ def main():
         m = re.match(r"(.*\.gl(?:b|tf)):(.+)$", arg)  # LEVEL:LIGHT
         bench(lmbake, m.group(1) if m else arg, rows, m.group(2) if m else None)
     with open(csv, "w") as f:
-        f.write("level,edit,changed,redone,quick_shown,save_to_quick_s,save_to_final_s,plain_bake_s,quick_error_9x9_rms\n")
+        f.write("level,edit,changed,redone,quick_shown,save_to_quick_s,quick_error_9x9_rms,save_to_refined_s,"
+                "refined_error_9x9_rms,save_to_final_s,plain_bake_s\n")
         for r in rows:
-            f.write("%s,%s,%s,%s,%s,%.2f,%.2f,%.2f,%.4f\n" % r)
+            cells = [("%.4f" if k in (6, 8) else "%.2f") % v if isinstance(v, float) else "" if v is None else str(v)
+                     for k, v in enumerate(r)]
+            f.write(",".join(cells) + "\n")
 
 
 if __name__ == "__main__":

@@ -59,7 +59,7 @@ try {
   page.on('pageerror', (e) => check(false, 'page error: ' + e.message));
   // a camera inside the box looking at the back wall, over the floor
   await page.goto(url + '?' + new URLSearchParams({ ui: '0', mode: 'lit', tonemap: 'none', ev: '-7', cam: '0.5,0.5,2.2,0.5,0.45,0' }));
-  const shown = (g, kind) => page.waitForFunction(([g, kind]) => window.lmbWatchShown && window.lmbWatchShown.generation === g && window.lmbWatchShown.kind === kind, [g, kind], { timeout: 240000, polling: 50 });
+  const shown = (g, kind, revision = 0) => page.waitForFunction(([g, kind, revision]) => window.lmbWatchShown && window.lmbWatchShown.generation === g && window.lmbWatchShown.kind === kind && window.lmbWatchShown.revision === revision, [g, kind, revision], { timeout: 240000, polling: 50 });
   await shown(1, 'final');
   await page.evaluate(() => { window.lmbTestMarker = 'no reload'; });
   // the points: pixels of the floor (in front of the blocks), back wall, left and right walls, ceiling
@@ -100,8 +100,10 @@ try {
     else await new Promise((r) => setTimeout(r, 25));
   }
   check(held !== null, `bake 2's final bake held while the quick one is read (pid ${held})`);
-  await shown(2, 'quick');
+  await shown(2, 'quick', 1); // revision 1: refined with the changed light's direct light
   const q2 = await pixels('bake2-quick'), camQ = await camera(), statusQ = await status();
+  check(statusQ.history.some((h) => h.generation === 2 && h.kind === 'quick' && h.revision === 0),
+    `bake 2's quick picture was shown before it was refined (/status history: ${JSON.stringify(statusQ.history.filter((h) => h.generation === 2))})`);
   if (held) process.kill(held, 'SIGCONT');
   await shown(2, 'final');
   const f2 = await pixels('bake2-final'), cam2 = await camera();

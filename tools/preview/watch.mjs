@@ -136,22 +136,35 @@ async function bakeNewest() {
     if (r.cancelled || dirty) return;
     if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
-    const correction = kind === 'quick' ? await correctionBakes(generation, change, fp) : null;
+    // A quick look is shown at once (composed on the last final where it can be); a change of
+    // punctual lights alone is then refined with their direct light at the final's resolution
+    // (revision 1 of the same bake), while the final bake waits.
+    const composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
+    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, correction: null });
+    if (kind !== 'quick' || composed === null) continue;
+    const correction = await correctionBakes(generation, change, fp);
     if ((correction && correction.cancelled) || dirty) return;
-    const composed = kind === 'quick' ? composeQuick(generation, change, correction) : null;
-    const seconds = (Date.now() - seen) / 1000;
-    status.shown = { generation, kind, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept: r.layoutKept, composedOn: composed, directOf: composed && correction ? correction.names : null };
-    status.history.push({ generation, kind, seconds, changed: change.what });
-    if (status.history.length > 50) status.history.shift();
-    status.error = null;
-    const exact = composed && correction ? `, the direct light of ${correction.names.map((n) => `'${n}'`).join(', ')} at its resolution` : '';
-    say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${r.layoutKept ? '; layout kept' : ''}${composed ? `; composed on final bake ${composed}${exact}` : ''})`);
-    tidyQuickDirs();
-    tidyLayouts();
+    if (!correction) continue;
+    const refined = composeQuick(generation, change, correction);
+    if (refined !== null) showBake({ generation, kind, revision: 1, seen, change, layoutKept: r.layoutKept, composed: refined, correction });
   }
   status.lastGood = { fp, generation, outdir: outdirStamp(), quick: opts.quick ? path.join(quickRoot, String(generation)) : null };
   goodPrint = print;
   status.state = 'idle';
+}
+
+// A bake (or a revision of one) on screen: /status, the history, the log line, the tidying.
+function showBake({ generation, kind, revision, seen, change, layoutKept, composed, correction }) {
+  const seconds = (Date.now() - seen) / 1000;
+  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept, composedOn: composed, directOf: composed !== null && correction ? correction.names : null };
+  status.history.push({ generation, kind, revision, seconds, changed: change.what });
+  if (status.history.length > 50) status.history.shift();
+  status.error = null;
+  const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}`;
+  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (the direct light of ${correction.names.map((n) => `'${n}'`).join(', ')} at the final's resolution)`);
+  else say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${what}${composed !== null ? `; composed on final bake ${composed}` : ''})`);
+  tidyQuickDirs();
+  tidyLayouts();
 }
 
 // OUTDIR's glTF as it stands (inode and time): the composed picture's base must be the final
@@ -220,12 +233,13 @@ function writeLevelCopy(level, dir) {
 // After quick bake N of a change that keeps the layout (and the output's units): the picture
 // shown is the last final bake plus the difference of the two quick looks, in the final's atlas
 // (compose.mjs), with the changed lights' direct light at the final's resolution when
-// correctionBakes made it, written to QUICK/N/composed. Returns the final bake's generation it
-// was composed on, or null (then the quick look is shown as baked, and the log says why).
+// correctionBakes made it, written to QUICK/N/composed (QUICK/N/composed-direct with the
+// correction). Returns the final bake's generation it was composed on, or null (then the quick
+// look is shown as baked, or the uncorrected composition stays, and the log says why).
 function composeQuick(generation, change, correction) {
   const base = status.lastGood;
   if (!base || !base.quick || change.layout || change.what.some((w) => /^config .*\boutput\./.test(w))) return null;
-  const dir = path.join(quickRoot, String(generation)), out = path.join(dir, 'composed');
+  const dir = path.join(quickRoot, String(generation)), out = path.join(dir, correction ? 'composed-direct' : 'composed');
   let r;
   if (!fs.existsSync(base.quick)) r = { ok: false, why: `its quick look is gone` };
   else if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
@@ -239,7 +253,7 @@ function composeQuick(generation, change, correction) {
   }
   if (r.ok) return base.generation;
   fs.rmSync(out, { recursive: true, force: true }); // a half-written one is never served
-  say(`quick bake ${generation}: shown as baked, not composed on final bake ${base.generation} (${r.why})`);
+  say(`quick bake ${generation}: ${correction ? 'not refined with the direct light' : `shown as baked, not composed on final bake ${base.generation}`} (${r.why})`);
   return null;
 }
 
@@ -319,10 +333,14 @@ const server = http.createServer((req, res) => {
     return send(200, 'application/json', JSON.stringify({ ...view, now: Date.now(), watching: files.map((f) => f.file) }));
   }
   if (url.pathname === '/scene.json') {
-    const kind = url.searchParams.get('kind'), gen = url.searchParams.get('gen');
-    if (!['quick', 'final'].includes(kind) || !/^\d+$/.test(gen || '')) return send(404, 'text/plain', 'no such bake\n');
-    const composed = kind === 'quick' && fs.existsSync(path.join(quickRoot, gen, 'composed', `${stem}.gltf`)) ? 'composed/' : '';
-    return send(200, 'application/json', JSON.stringify({ gltf: `/bake/${kind}/${gen}/${composed}${encodeURIComponent(stem)}.gltf`, name: `${stem}.gltf (${kind} bake ${gen}${composed ? ', composed on the last final' : ''})` }));
+    // rev: a quick bake's revision (0: as shown first, 1: refined with the direct light); the
+    // newest there is when it is not given
+    const kind = url.searchParams.get('kind'), gen = url.searchParams.get('gen'), rev = url.searchParams.get('rev');
+    if (!['quick', 'final'].includes(kind) || !/^\d+$/.test(gen || '') || (rev !== null && !['0', '1'].includes(rev))) return send(404, 'text/plain', 'no such bake\n');
+    const has = (d) => fs.existsSync(path.join(quickRoot, gen, d, `${stem}.gltf`));
+    const composed = kind !== 'quick' ? '' : rev !== '0' && has('composed-direct') ? 'composed-direct/' : has('composed') ? 'composed/' : '';
+    const name = composed === 'composed-direct/' ? ', composed on the last final, the direct light at full resolution' : composed ? ', composed on the last final' : '';
+    return send(200, 'application/json', JSON.stringify({ gltf: `/bake/${kind}/${gen}/${composed}${encodeURIComponent(stem)}.gltf`, name: `${stem}.gltf (${kind} bake ${gen}${name})` }));
   }
   const m = /^\/bake\/(quick|final)\/(\d+)\//.exec(url.pathname);
   const roots = m ? [[m[0], m[1] === 'quick' ? path.join(quickRoot, m[2]) : opts.outdir]] : staticRoots;

@@ -4,7 +4,7 @@
 // directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr, sphere=x,y,z: the probe-lit
 // sphere there, probes=1: the probes as markers) and the page exposes hooks for tests: window.lmbReady, lmbInfo,
 // lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView, lmbCamera;
-// gen and kind: the bake of `preview --watch` to show (page/watch.js sets them).
+// gen, kind and rev: the bake of `preview --watch` to show (page/watch.js sets them).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -59,7 +59,7 @@ renderer.debug.onShaderError = (gl, program, vs, fs) => fail('shader error: ' + 
 document.body.prepend(renderer.domElement);
 
 // the bake to show: the server's one, or under `preview --watch` the one the frame's gen and kind name
-const sceneInfo = await (await fetch('/scene.json' + (q.has('gen') ? `?gen=${q.get('gen')}&kind=${q.get('kind')}` : ''))).json();
+const sceneInfo = await (await fetch('/scene.json' + (q.has('gen') ? `?gen=${q.get('gen')}&kind=${q.get('kind')}${q.has('rev') ? `&rev=${q.get('rev')}` : ''}` : ''))).json();
 document.title = `lmbake preview: ${sceneInfo.name}`;
 $('title').textContent = sceneInfo.name;
 const atlases = [];

@@ -4,13 +4,14 @@
 // one has drawn: no reload, no blank moment. The bar says what is shown (quick or final, which
 // bake, how old, what changed) and what is baking; a bake that failed shows its error and the
 // last good bake stays. Hooks for tests: window.lmbWatch (the last /status), lmbWatchShown
-// ({generation, kind} of the frame on screen), lmbWatchFrame() (its window).
+// ({generation, kind, revision} of the frame on screen: a quick bake's revision 1 is it refined
+// with the changed lights' direct light), lmbWatchFrame() (its window).
 const q = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
 let shownFrame = null, shownKey = null, loadingKey = null;
 window.lmbWatchShown = null;
 window.lmbWatchFrame = () => (shownFrame ? shownFrame.contentWindow : null);
-const keyOf = (s) => `${s.generation}:${s.kind}`;
+const keyOf = (s) => `${s.generation}:${s.kind}:${s.revision || 0}`;
 
 // The view to open the next bake with: the page's own query, then what the shown frame has now.
 function viewParams() {
@@ -32,6 +33,7 @@ function show(s) {
   const p = viewParams();
   p.set('gen', s.generation);
   p.set('kind', s.kind);
+  p.set('rev', s.revision || 0);
   const frame = document.createElement('iframe');
   frame.className = 'pending';
   frame.src = '/index.html?' + p.toString();
@@ -48,7 +50,7 @@ function show(s) {
       shownFrame = frame;
       shownKey = key;
       loadingKey = null;
-      window.lmbWatchShown = { generation: s.generation, kind: s.kind };
+      window.lmbWatchShown = { generation: s.generation, kind: s.kind, revision: s.revision || 0 };
       return;
     }
     if (Date.now() - started > 120000) { loadingKey = null; frame.remove(); return; }
@@ -60,7 +62,7 @@ function show(s) {
 const age = (ms) => (ms < 60000 ? `${Math.round(ms / 1000)} s` : `${Math.round(ms / 60000)} min`);
 function bar(s) {
   const sh = s.shown;
-  $('shown').innerHTML = sh ? `<b class="${sh.kind}">${sh.kind} bake ${sh.generation}</b>, ${age(s.now - sh.readyAt)} old (${sh.changed.join('; ')}; ready ${sh.seconds.toFixed(1)} s after the change${sh.layoutKept ? ', layout kept' : ''}${sh.composedOn ? `; the last final bake ${sh.composedOn} plus the change at the quick look's resolution${sh.directOf ? ` (${sh.directOf.join(', ')}: direct light at full resolution)` : ''}` : ''})` : 'waiting for the first bake';
+  $('shown').innerHTML = sh ? `<b class="${sh.kind}">${sh.kind} bake ${sh.generation}</b>, ${age(s.now - sh.readyAt)} old (${sh.changed.join('; ')}; ready ${sh.seconds.toFixed(1)} s after the change${sh.layoutKept ? ', layout kept' : ''}${sh.composedOn ? `; the last final bake ${sh.composedOn} plus the change at the quick look's resolution${sh.directOf ? ` (${sh.directOf.join(', ')}: direct light at full resolution)` : s.baking && s.baking.kind === 'correction' && s.baking.generation === sh.generation ? ' (refining: the changed lights\' direct light at full resolution)' : ''}` : ''})` : 'waiting for the first bake';
   const b = s.baking;
   $('next').textContent = b ? `baking: ${b.kind} bake ${b.generation}, ${b.stage} ${b.percent}%` : s.state === 'idle' ? 'up to date' : s.state;
   $('werror').textContent = s.error ? `lmbake: ${s.error}\n${sh ? `(bake ${sh.generation} stays on screen until the next good save)` : ''}` : '';
