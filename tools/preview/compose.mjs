@@ -66,12 +66,22 @@ function accessor(g, index) {
   return out;
 }
 
-// A Radiance .hdr as three's HDRLoader reads it for the page: {width, height, data (RGBA float32)}.
+// A Radiance .hdr as three's HDRLoader reads it for the page: {width, height, data (RGBA float32),
+// read-only: the last few files read are kept, by path, inode, size and time, since the watch
+// composes on the same final and quick looks again (0.13 s a read of level-single-10's final).
+const HDR_KEPT = 6;
+const hdrKept = new Map();
 export function readHdr(file) {
+  const st = fs.statSync(file);
+  const key = `${path.resolve(file)}:${st.ino}:${st.size}:${st.mtimeMs}`;
+  if (hdrKept.has(key)) return hdrKept.get(key);
   const bytes = fs.readFileSync(file);
   const loader = new HDRLoader();
   loader.setDataType(FLOAT_TYPE);
-  return loader.parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
+  const img = loader.parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
+  hdrKept.set(key, img);
+  if (hdrKept.size > HDR_KEPT) hdrKept.delete(hdrKept.keys().next().value);
+  return img;
 }
 
 // Atlas index -> {width, height, data (RGBA float32, row 0 on top), hdr (the file's name), texture}
@@ -176,37 +186,67 @@ function mapRect(rf, rq, fa, sources, delta, covered) {
   }
 }
 
-// Uncovered texels next to covered ones take their neighbours' mean difference, pass by pass.
+// Uncovered texels next to covered ones take their neighbours' mean difference, pass by pass
+// (PAD_PASSES rings). Each pass visits only its ring: the uncovered texels next to the texels the
+// pass before covered (the first, those next to any covered texel).
 function padDelta(W, H, delta, covered) {
-  for (let pass = 0; pass < PAD_PASSES; pass++) {
-    const next = [];
-    for (let y = 0; y < H; y++) {
-      for (let x = 0; x < W; x++) {
-        if (covered[y * W + x]) continue;
-        let n = 0, r = 0, g = 0, b = 0;
-        for (let dy = -1; dy <= 1; dy++) {
-          for (let dx = -1; dx <= 1; dx++) {
-            const xx = x + dx, yy = y + dy;
-            if (xx < 0 || yy < 0 || xx >= W || yy >= H || !covered[yy * W + xx]) continue;
-            const j = yy * W + xx;
-            n++; r += delta[3 * j]; g += delta[3 * j + 1]; b += delta[3 * j + 2];
-          }
-        }
-        if (n) next.push(y * W + x, r / n, g / n, b / n);
+  const queued = new Uint8Array(W * H);
+  const coveredAround = (x, y) => {
+    for (let dy = -1; dy <= 1; dy++) {
+      for (let dx = -1; dx <= 1; dx++) {
+        const xx = x + dx, yy = y + dy;
+        if (xx >= 0 && yy >= 0 && xx < W && yy < H && covered[yy * W + xx]) return true;
       }
     }
-    if (!next.length) return;
-    for (let k = 0; k < next.length; k += 4) {
-      const i = next[k];
-      delta[3 * i] = next[k + 1]; delta[3 * i + 1] = next[k + 2]; delta[3 * i + 2] = next[k + 3];
-      covered[i] = 1;
+    return false;
+  };
+  let ring = [];
+  for (let y = 0; y < H; y++) {
+    for (let x = 0; x < W; x++) {
+      const i = y * W + x;
+      if (!covered[i] && coveredAround(x, y)) { ring.push(i); queued[i] = 1; }
     }
+  }
+  for (let pass = 0; pass < PAD_PASSES && ring.length; pass++) {
+    const value = new Float32Array(3 * ring.length);
+    ring.forEach((i, k) => {
+      const x = i % W, y = (i - x) / W;
+      let n = 0, r = 0, g = 0, b = 0;
+      for (let dy = -1; dy <= 1; dy++) {
+        for (let dx = -1; dx <= 1; dx++) {
+          const xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= W || yy >= H || !covered[yy * W + xx]) continue;
+          const j = yy * W + xx;
+          n++; r += delta[3 * j]; g += delta[3 * j + 1]; b += delta[3 * j + 2];
+        }
+      }
+      value[3 * k] = r / n; value[3 * k + 1] = g / n; value[3 * k + 2] = b / n;
+    });
+    ring.forEach((i, k) => {
+      delta[3 * i] = value[3 * k]; delta[3 * i + 1] = value[3 * k + 1]; delta[3 * i + 2] = value[3 * k + 2];
+      covered[i] = 1;
+    });
+    const next = [];
+    for (const i of ring) {
+      const x = i % W, y = (i - x) / W;
+      for (let dy = -1; dy <= 1; dy++) {
+        for (let dx = -1; dx <= 1; dx++) {
+          const xx = x + dx, yy = y + dy, j = yy * W + xx;
+          if (xx < 0 || yy < 0 || xx >= W || yy >= H || covered[j] || queued[j]) continue;
+          queued[j] = 1;
+          next.push(j);
+        }
+      }
+    }
+    ring = next;
   }
 }
 
 // A Radiance .hdr (RGBE, each scanline run-length framed with literal runs only: what three's
 // HDRLoader and OIIO read). Mantissas are rounded for three's decoding, byte x 2^(e-128) / 255
 // (the page's reader), so an .hdr read by HDRLoader and written again keeps its bytes.
+const POW2 = Float64Array.from({ length: 256 }, (_, k) => 2 ** (k - 128)); // 2^e at e + 128
+const f64 = new Float64Array(1), u32 = new Uint32Array(f64.buffer); // a double's bits (little-endian)
 export function encodeHdr(width, height, rgba) {
   const head = Buffer.from(`#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y ${height} +X ${width}\n`, 'ascii');
   const rle = width >= 8 && width < 32768;
@@ -221,11 +261,14 @@ export function encodeHdr(width, height, rgba) {
       const r = Math.max(rgba[i], 0), g = Math.max(rgba[i + 1], 0), b = Math.max(rgba[i + 2], 0);
       const m = Math.max(r, g, b);
       if (!(m > 1e-32) || !Number.isFinite(m)) { line.fill(0, 4 * x, 4 * x + 4); continue; }
-      let e = Math.ceil(Math.log2(m)); // the smallest e with m <= 2^e
-      while (m > 2 ** e) e++;
-      while (e > -127 && m <= 2 ** (e - 1)) e--;
+      // the smallest e with m <= 2^e, from the double's exponent: m = f 2^x, f in [0.5, 1)
+      f64[0] = m;
+      const hi = u32[1];
+      let e = ((hi >>> 20) & 0x7ff) - 1022;
+      if ((hi & 0xfffff) === 0 && u32[0] === 0) e--; // m is 2^(x - 1) exactly
       if (e > 127) e = 127;
-      const scale = 255 / 2 ** e;
+      if (e < -127) e = -127;
+      const scale = 255 / POW2[e + 128];
       line[4 * x] = Math.min(Math.round(r * scale), 255);
       line[4 * x + 1] = Math.min(Math.round(g * scale), 255);
       line[4 * x + 2] = Math.min(Math.round(b * scale), 255);
