@@ -211,7 +211,8 @@ static void print_bounces(const lmb_config *cfg, const lmb_bake_stats *bs)
     else if (bs->bounce_stop == LMB_BOUNCES_TAIL)
         printf("; the bounce ratio settled");
     else if (bs->bounce_stop == LMB_BOUNCES_TAIL_BOUNDED)
-        printf("; stopped: any ratio the last two passes allow gives the tail within 0.5%% of the light");
+        printf("; stopped: any ratio the last two passes allow gives the tail within %.2g%% of the light (a tenth of "
+               "bounces_auto.tail)", 10.0 * cfg->bounces_tail);
     if (bs->tail_added)
         printf("; bounce ratio %.3f, geometric tail of %.2f%% of the total added", bs->bounce_ratio,
                100.0 * bs->tail_share);

@@ -34,14 +34,16 @@ static void mean_rgb(const atlas_work *w, uint32_t n, size_t field, double out[3
         out[c] = count ? sum[c] / (double)count : 0;
 }
 
-/* The tail's uncertainty a stop may leave, as a share of the light (bounces_auto's third rule). */
-#define TAIL_BOUND 0.005
+/* The tail's uncertainty a stop may leave (bounces_auto's third rule), as a share of the
+ * light: a tenth of the tail bounces_auto.tail lets the passes leave out (0.5% at its default),
+ * so a bake that asks for a smaller tail gets a tighter bound too. */
+#define TAIL_BOUND_SHARE 0.1
 
 /* How far apart the geometric tails D r / (1 - r) of the ratios the last two passes allow can
  * be: r anywhere between the two ratios, widened by the settling test's tolerance (0.02 + 5%).
  * Where the later passes' ratios scatter (16 rays per texel gathering a few % of the light: an
  * open level's 0.19 0.45 0.28 0.43 0.34) they never settle, yet once what a pass adds is small
- * enough every ratio between them gives the same total within TAIL_BOUND; the passes after that
+ * enough every ratio between them gives the same total within that bound; the passes after that
  * would only pin down a number that no longer matters. */
 static double tail_range(double added, double r1, double r2)
 {
@@ -66,7 +68,7 @@ static double tail_range(double added, double r1, double r2)
  * a geometric series: the ratio r = D_b / D_{b-1} (per channel: the mean albedo seen, weighted
  * by where light goes) agrees with the previous pass's, and the tail the passes leave out,
  * T = D_b r / (1 - r) beyond E_b, is below bounces_auto.tail of the total; or the tail is known
- * to within TAIL_BOUND of the light whatever ratio the last two passes allow (tail_range); or a
+ * to within a tenth of bounces_auto.tail of the light whatever ratio the last two passes allow (tail_range); or a
  * pass adds under 0.1% of the light; or bounces_auto.max. The tail is then added texel by texel,
  * T_x = D_b,x r / (1 - r), so the final gather reads converged light: a closed room of albedo
  * rho gets pi Le / (1 - rho), not the series cut after b + 1 terms. (At rho = 0.8 a 1% tail
@@ -136,7 +138,7 @@ lmb_status lmb_lighting_bounces(const pass_env *env, uint32_t *passes, lmb_error
             int settled = b >= 2 && prev_ratio >= 0 && fabs(r - prev_ratio) <= 0.02 + 0.05 * r;
             /* a pass that adds under 0.1% of the light leaves a tail below the passes' noise */
             int small = lmb_luminance(added) <= 1e-3 * lmb_luminance(total);
-            int bounded = b >= 2 && prev_ratio >= 0 && tail_range(lmb_luminance(added), prev_ratio, r) <= TAIL_BOUND * all;
+            int bounded = b >= 2 && prev_ratio >= 0 && tail_range(lmb_luminance(added), prev_ratio, r) <= TAIL_BOUND_SHARE * cfg->bounces_tail * all;
             int converged = small || (settled && tail_share < cfg->bounces_tail) || bounded;
             stats->bounce_stop = small                                           ? LMB_BOUNCES_SMALL_PASS
                                  : settled && tail_share < cfg->bounces_tail ? LMB_BOUNCES_TAIL

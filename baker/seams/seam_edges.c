@@ -183,8 +183,8 @@ lmb_status lmb_seam_collect_edges(const lmb_scene *s, const lmb_layout *l, doubl
 {
     for (uint32_t m = 0; m < l->mesh_count; m++)
         if (l->meshes[m].used && l->meshes[m].soup.triangle_count >= LMB_SEAM_MAX_TRIANGLES)
-            return lmb_error_set(err, LMB_ERR_INPUT, "seams: mesh %u has %u triangles, more than the %u whose edges can be stitched",
-                                 m, l->meshes[m].soup.triangle_count, LMB_SEAM_MAX_TRIANGLES - 1);
+            return lmb_error_set(err, LMB_ERR_INPUT, "seams: mesh '%s' has %u triangles, more than the %u whose edges can be stitched",
+                                 s->meshes[m].name, l->meshes[m].soup.triangle_count, LMB_SEAM_MAX_TRIANGLES - 1);
     size_t *first = malloc(((size_t)l->instance_count + 1) * sizeof *first);
     uint8_t **interior = calloc((size_t)l->mesh_count + 1, sizeof *interior);
     size_t *mesh_edges = calloc((size_t)l->mesh_count + 1, sizeof *mesh_edges);

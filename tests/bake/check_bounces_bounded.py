@@ -5,9 +5,11 @@ An open yard under a noon sun: a 16 x 16 ground (albedo 0.5) and eight 2 x 4 x 2
 0.9). Light bounces between the ground and the blocks' sides and escapes to the open sky, so what
 a pass adds falls fast, and the passes' ratios (0.37, 0.30) differ by more than the settling
 test allows (0.02 + 5%). The third rule of `bounces: auto` (docs/defaults.md "Bounces auto") stops
-when every ratio the last two passes allow gives the same total within 0.5% of the light.
+when every ratio the last two passes allow gives the same total within a tenth of
+`bounces_auto.tail` (0.5% at the default) of the light.
 Asserted:
   - the log gives that rule as the reason, after fewer passes than `bounces_auto.max`;
+  - with `bounces_auto.tail: 0.005` (a bound of 0.05%) the passes go on longer;
   - the yard's mean light is within 0.5% (the rule's bound) + 0.3% (the two bakes' noise) of
     `bounces: 16`, fifteen passes and no extrapolation;
   - the indirect light (the mean minus `bounces: 0`'s) is over 5% of the direct light, so the
@@ -48,10 +50,11 @@ def mean_light(out):
     return total / count
 
 
-def bake(lmbake, scene, work, name, bounces):
+def bake(lmbake, scene, work, name, bounces, more=""):
     config = os.path.join(work, name + ".yaml")
     with open(config, "w") as f:
-        f.write("atlas:\n  texels: 20000\nbounces: %s\nprobes:\n  auto: false\noutput:\n  formats: [exr, mask]\n" % bounces)
+        f.write("atlas:\n  texels: 20000\nbounces: %s\nprobes:\n  auto: false\noutput:\n  formats: [exr, mask]\n%s"
+                % (bounces, more))
     out = os.path.join(work, name)
     p = subprocess.run([lmbake, "bake", scene, "-c", config, "-o", out], capture_output=True, text=True, timeout=600)
     if p.returncode != 0:
@@ -73,11 +76,16 @@ def main():
 
     direct, _ = bake(lmbake, scene, work, "bounces-0", 0)
     auto, log = bake(lmbake, scene, work, "bounces-auto", "auto")
+    _, log_tight = bake(lmbake, scene, work, "bounces-auto-tight", "auto", "bounces_auto:\n  tail: 0.005\n")
     many, _ = bake(lmbake, scene, work, "bounces-16", 16)
     m = re.search(r"bounces: auto, ([0-9]+) pass\(es\).*", log)
     print(m.group(0) if m else "no bounces line in the log")
     check(m and "any ratio the last two passes allow" in m.group(0) and int(m.group(1)) < 31,
           "bounces auto stopped by the tail's bound after %s pass(es)" % (m.group(1) if m else "?"))
+    t = re.search(r"bounces: auto, ([0-9]+) pass\(es\).*", log_tight)
+    print(t.group(0) if t else "no bounces line in the tight bake's log")
+    check(m and t and int(t.group(1)) > int(m.group(1)),
+          "bounces_auto.tail 0.005: %s pass(es), more than the default's" % (t.group(1) if t else "?"))
     check(many - direct > 0.05 * direct, "indirect light %.4g, %.1f%% of the direct light %.4g"
           % (many - direct, 100 * (many - direct) / direct, direct))
     check(abs(auto / many - 1) < 0.008, "bounces auto: mean %.5g = %.4f x bounces 16's %.5g (within 0.8%%)"
