@@ -1,6 +1,5 @@
-#!/usr/bin/env python3
-"""Builds glTF 2.0 scenes in code for lmbake's tests, demos and benchmarks (tools/make_scenes.py,
-tools/make_levels.py and the tests' own scenes): `Scene` (meshes, materials, textures, nodes,
+"""Builds glTF 2.0 scenes in code for lmbake's tests, demos and benchmarks (tools/make_scenes.py
+and the tests' own scenes): `Scene` (meshes, materials, textures, nodes,
 KHR_lights_punctual, EXT_mesh_gpu_instancing; written with embedded buffers) and the geometry
 the scenes are made of (quads, planes, boxes, spheres, bumped and smooth boxes)."""
 import base64
