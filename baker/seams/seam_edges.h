@@ -6,7 +6,7 @@
 #include "pack/layout.h"
 
 /* One triangle edge, found by a hash of its endpoints (snapped to 1/1000 texel, in order). 16
- * bytes: a level of 1,900 props holds two million (and as many again while they are sorted). */
+ * bytes: a level of 1,900 props holds 1.4 million (and as many again while they are sorted). */
 typedef struct edge_ref {
     uint64_t hash;
     uint32_t instance;
