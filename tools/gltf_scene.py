@@ -9,20 +9,29 @@ import struct
 import zlib
 
 
-class Scene:
-    def __init__(self):
-        self.doc = {"asset": {"version": "2.0", "generator": "lmbake tools/make_scenes.py"},
+class GltfBuffer:
+    """A glTF document with one binary buffer its views are appended to (4-byte aligned): what
+    Scene here and make_levels.py's Glb build on."""
+
+    def __init__(self, generator):
+        self.doc = {"asset": {"version": "2.0", "generator": generator},
                     "scene": 0, "scenes": [{"nodes": []}], "nodes": [], "meshes": [],
                     "materials": [], "accessors": [], "bufferViews": [], "buffers": []}
         self.blob = bytearray()
 
-    def _view(self, data, target):
+    def view(self, data, target):
+        """Appends data as a buffer view (target: 34962 vertices, 34963 indices, None); its index."""
         while len(self.blob) % 4:
             self.blob.append(0)
         self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data),
                                         "target": target})
         self.blob += data
         return len(self.doc["bufferViews"]) - 1
+
+
+class Scene(GltfBuffer):
+    def __init__(self):
+        super().__init__("lmbake tools/make_scenes.py")
 
     def _accessor(self, values, comps, is_index=False):
         if is_index:
@@ -35,7 +44,7 @@ class Scene:
             if comps == 3:
                 acc["min"] = [min(v[i] for v in values) for i in range(3)]
                 acc["max"] = [max(v[i] for v in values) for i in range(3)]
-        acc["bufferView"] = self._view(data, 34963 if is_index else 34962)
+        acc["bufferView"] = self.view(data, 34963 if is_index else 34962)
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 

@@ -27,6 +27,8 @@ import sys
 
 import numpy as np
 
+from gltf_scene import GltfBuffer  # the document and its buffer, shared with make_scenes.py
+
 
 class Mesh:
     """Triangles as numpy arrays: positions (n, 3) float32, indices (m, 3) uint32."""
@@ -144,20 +146,9 @@ def room(m, ox, oz, rng):
     degenerate(m, rng, 11, 24.0)
 
 
-class Glb:
+class Glb(GltfBuffer):
     def __init__(self):
-        self.doc = {"asset": {"version": "2.0", "generator": "lmbake tools/make_levels.py"}, "scene": 0,
-                    "scenes": [{"nodes": []}], "nodes": [], "meshes": [], "materials": [], "accessors": [],
-                    "bufferViews": [], "buffers": []}
-        self.blob = bytearray()
-
-    def view(self, data, target):
-        while len(self.blob) % 4:
-            self.blob.append(0)
-        self.doc["bufferViews"].append({"buffer": 0, "byteOffset": len(self.blob), "byteLength": len(data),
-                                        "target": target})
-        self.blob += data
-        return len(self.doc["bufferViews"]) - 1
+        super().__init__("lmbake tools/make_levels.py")
 
     def material(self, name, albedo, emissive=None):
         mat = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": [albedo, albedo, albedo, 1.0],

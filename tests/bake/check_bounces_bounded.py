@@ -19,12 +19,12 @@ usage: check_bounces_bounded.py LMBAKE WORKDIR
 """
 import os
 import re
-import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, "tools"))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(HERE)), "tools"))
+import bake_cli  # noqa: E402
 import make_scenes  # noqa: E402
 
 ok = True
@@ -36,10 +36,12 @@ def check(cond, what):
     print("%s %s" % ("ok  " if cond else "FAIL", what))
 
 
-def mean_light(out):
+def mean_light(exr):
+    """Mean of the lit texels (the bake's mask) over every atlas of the bake EXR is atlas 0 of."""
     import numpy as np
     import OpenImageIO as oiio
     total, count = 0.0, 0
+    out = os.path.dirname(exr)
     for n in sorted(os.listdir(out)):
         if n.endswith(".exr") and not n.endswith("-dir.exr"):
             px = np.array(oiio.ImageBuf(os.path.join(out, n)).get_pixels(oiio.FLOAT))[..., :3]
@@ -51,15 +53,10 @@ def mean_light(out):
 
 
 def bake(lmbake, scene, work, name, bounces, more=""):
-    config = os.path.join(work, name + ".yaml")
-    with open(config, "w") as f:
-        f.write("atlas:\n  texels: 20000\nbounces: %s\nprobes:\n  auto: false\noutput:\n  formats: [exr, mask]\n%s"
-                % (bounces, more))
-    out = os.path.join(work, name)
-    p = subprocess.run([lmbake, "bake", scene, "-c", config, "-o", out], capture_output=True, text=True, timeout=600)
-    if p.returncode != 0:
-        sys.exit("bake %s failed:\n%s" % (name, p.stderr[-2000:]))
-    return mean_light(out), p.stdout + p.stderr
+    """(mean light, stdout) of a bake at 20,000 texels with `bounces` and more config text."""
+    exr, log = bake_cli.bake(lmbake, work, scene, name, "atlas:\n  texels: 20000\nbounces: %s\nprobes:\n  auto: false\n"
+                             "output:\n  formats: [exr, mask]\n%s" % (bounces, more))
+    return mean_light(exr), log
 
 
 def main():
