@@ -27,6 +27,7 @@
 // .hdr (no KTX2 or EXR: those are the old final's), the final's other files hard-linked (or
 // copied), and the composed .hdr. It returns {ok: true, ms} or {ok: false, why} (then the quick
 // look is shown as baked).
+import crypto from 'node:crypto';
 import fs from 'node:fs';
 import path from 'node:path';
 import { HDRLoader } from 'three/examples/jsm/loaders/HDRLoader.js';
@@ -34,6 +35,7 @@ import { HDRLoader } from 'three/examples/jsm/loaders/HDRLoader.js';
 const FLOAT_TYPE = 1015; // three's FloatType: HDRLoader decodes to float32 RGBA
 const MAX_TRIANGLES = 5e6; // placed triangles mapped one by one at most (about 2 s here)
 const PAD_PASSES = 8; // texels beyond the triangles filled from a neighbour, at most this far out
+const HDR_KEPT = 6; // decoded .hdr files a composer keeps (the final's, the quick looks', the corrections')
 
 // A bake's folder: {dir, stem, doc (the glTF's JSON), buffer(i) (read once)}.
 export function readBake(dir, stem) {
@@ -66,31 +68,28 @@ function accessor(g, index) {
   return out;
 }
 
-// A Radiance .hdr as three's HDRLoader reads it for the page: {width, height, data (RGBA float32),
-// read-only: the last few files read are kept, by path, inode, size and time, since the watch
-// composes on the same final and quick looks again (0.13 s a read of level-single-10's final).
-const HDR_KEPT = 6;
-const hdrKept = new Map();
+// A Radiance .hdr as three's HDRLoader reads it for the page: {width, height, data (RGBA float32)}.
 export function readHdr(file) {
-  const st = fs.statSync(file);
-  const key = `${path.resolve(file)}:${st.ino}:${st.size}:${st.mtimeMs}`;
-  if (hdrKept.has(key)) return hdrKept.get(key);
   const bytes = fs.readFileSync(file);
   const loader = new HDRLoader();
   loader.setDataType(FLOAT_TYPE);
-  const img = loader.parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
-  hdrKept.set(key, img);
-  if (hdrKept.size > HDR_KEPT) hdrKept.delete(hdrKept.keys().next().value);
-  return img;
+  return loader.parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.length));
 }
 
-// Atlas index -> {width, height, data (RGBA float32, row 0 on top), hdr (the file's name), texture}
-function readAtlases(g) {
+// A file's identity for the composer's caches: path, inode, size and time.
+function stamp(file) {
+  const st = fs.statSync(file);
+  return `${path.resolve(file)}:${st.ino}:${st.size}:${st.mtimeMs}`;
+}
+
+// Atlas index -> {width, height, data (RGBA float32, row 0 on top), hdr (the file's name), texture};
+// read: a file -> readHdr's answer (the composer's, which keeps the last few).
+function readAtlases(g, read = readHdr) {
   const atlases = new Map();
   (g.doc.textures || []).forEach((t, ti) => {
     const lm = t.extras && t.extras.lightmap;
     if (!lm || !lm.files || !lm.files.hdr) return;
-    const img = readHdr(path.join(g.dir, lm.files.hdr));
+    const img = read(path.join(g.dir, lm.files.hdr));
     atlases.set(lm.atlas, { width: img.width, height: img.height, data: img.data, hdr: lm.files.hdr, texture: ti });
   });
   return atlases;
@@ -130,116 +129,233 @@ function meshUv1(g, mesh, cache) {
 
 const sameArray = (a, b) => a.length === b.length && a.every((x, i) => x === b[i]);
 
-// The weighted sum of quick images (sources: [{img, weight}], one atlas each, same size) at
-// quick atlas position (u, v), bilinear, into out[0..2].
-function sampleQuick(sources, u, v, out) {
-  const w = sources[0].img.width, h = sources[0].img.height;
-  const x = Math.min(Math.max(u * w - 0.5, 0), w - 1), y = Math.min(Math.max(v * h - 0.5, 0), h - 1);
-  const x0 = Math.floor(x), y0 = Math.floor(y), x1 = Math.min(x0 + 1, w - 1), y1 = Math.min(y0 + 1, h - 1);
-  const fx = x - x0, fy = y - y0;
-  const wts = [(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy];
-  const at = [(y0 * w + x0) * 4, (y0 * w + x1) * 4, (y1 * w + x0) * 4, (y1 * w + x1) * 4];
-  for (let c = 0; c < 3; c++) {
-    let s = 0;
-    for (const { img, weight } of sources) for (let k = 0; k < 4; k++) s += weight * wts[k] * img.data[at[k] + c];
-    out[c] = s;
+// A bake's layout as the map reads it (its lightmapped nodes, their rectangles and atlases, every
+// TEXCOORD_1 and index), hashed: two quick looks with the same signature share one map.
+function layoutSignature(g) {
+  const h = crypto.createHash('sha1'), nodes = lightmappedNodes(g), meshes = new Map();
+  h.update(JSON.stringify(nodes));
+  for (const n of nodes) {
+    if (meshes.has(n.mesh)) continue;
+    for (const p of meshUv1(g, n.mesh, meshes)) h.update(new Uint8Array(p.uv.buffer)).update(new Uint8Array(p.index.buffer));
   }
+  return h.digest('hex');
 }
 
-// Rasterises final triangle f (atlas uv, 6 numbers) into the final atlas; each covered texel
-// centre gets the quick images' sum at the same barycentric point of quick triangle q.
-function mapTriangle(f, q, fa, sources, delta, covered) {
-  const W = fa.width, H = fa.height;
+// The map's recorder for one final atlas (dst) read from quick atlas qa (qw x qh texels): put(t,
+// u, v) says final texel t reads the quick atlas at (u, v), bilinearly; a texel put again (two
+// triangles' edges) keeps the last.
+function recorder(dst, qa, qw, qh) {
+  return (t, u, v) => {
+    const x = Math.min(Math.max(u * qw - 0.5, 0), qw - 1), y = Math.min(Math.max(v * qh - 0.5, 0), qh - 1);
+    const x0 = Math.floor(x), y0 = Math.floor(y), x1 = Math.min(x0 + 1, qw - 1), y1 = Math.min(y0 + 1, qh - 1);
+    const fx = x - x0, fy = y - y0;
+    let k = dst.slot[t];
+    if (k < 0) { k = dst.count++; dst.slot[t] = k; dst.texel.push(t); }
+    dst.qatlas[k] = qa;
+    const o = 4 * k;
+    dst.tap[o] = y0 * qw + x0; dst.tap[o + 1] = y0 * qw + x1; dst.tap[o + 2] = y1 * qw + x0; dst.tap[o + 3] = y1 * qw + x1;
+    dst.wt[o] = (1 - fx) * (1 - fy); dst.wt[o + 1] = fx * (1 - fy); dst.wt[o + 2] = (1 - fx) * fy; dst.wt[o + 3] = fx * fy;
+    dst.covered[t] = 1;
+  };
+}
+
+// Rasterises final triangle f (atlas uv, 6 numbers) into the final atlas: each covered texel
+// centre reads the same barycentric point of quick triangle q.
+function mapTriangle(f, q, dst, put) {
+  const W = dst.width, H = dst.height;
   const ax = f[0] * W, ay = f[1] * H, bx = f[2] * W, by = f[3] * H, cx = f[4] * W, cy = f[5] * H;
   const det = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay);
   if (Math.abs(det) < 1e-12) return;
   const x0 = Math.max(Math.floor(Math.min(ax, bx, cx) - 0.5), 0), x1 = Math.min(Math.ceil(Math.max(ax, bx, cx) - 0.5), W - 1);
   const y0 = Math.max(Math.floor(Math.min(ay, by, cy) - 0.5), 0), y1 = Math.min(Math.ceil(Math.max(ay, by, cy) - 0.5), H - 1);
-  const d = [0, 0, 0], eps = 1e-9;
+  const eps = 1e-9;
   for (let y = y0; y <= y1; y++) {
     for (let x = x0; x <= x1; x++) {
       const px = x + 0.5 - ax, py = y + 0.5 - ay;
       const l1 = (px * (cy - ay) - (cx - ax) * py) / det, l2 = ((bx - ax) * py - px * (by - ay)) / det;
       if (l1 < -eps || l2 < -eps || l1 + l2 > 1 + eps) continue;
-      sampleQuick(sources, q[0] + l1 * (q[2] - q[0]) + l2 * (q[4] - q[0]), q[1] + l1 * (q[3] - q[1]) + l2 * (q[5] - q[1]), d);
-      const t = y * W + x;
-      delta[3 * t] = d[0]; delta[3 * t + 1] = d[1]; delta[3 * t + 2] = d[2];
-      covered[t] = 1;
+      put(y * W + x, q[0] + l1 * (q[2] - q[0]) + l2 * (q[4] - q[0]), q[1] + l1 * (q[3] - q[1]) + l2 * (q[5] - q[1]));
     }
   }
 }
 
-// Every texel of a copy's final rectangle from the same point of its quick rectangle (both bakes
+// Every texel of a copy's final rectangle reads the same point of its quick rectangle (both bakes
 // share the copy's TEXCOORD_1, so the map is the rectangles' affine map).
-function mapRect(rf, rq, fa, sources, delta, covered) {
-  const W = fa.width, H = fa.height, d = [0, 0, 0];
+function mapRect(rf, rq, dst, put) {
+  const W = dst.width, H = dst.height;
   const x0 = Math.max(Math.floor(rf[2] * W), 0), x1 = Math.min(Math.ceil((rf[2] + rf[0]) * W) - 1, W - 1);
   const y0 = Math.max(Math.floor(rf[3] * H), 0), y1 = Math.min(Math.ceil((rf[3] + rf[1]) * H) - 1, H - 1);
   for (let y = y0; y <= y1; y++) {
     for (let x = x0; x <= x1; x++) {
       const s = ((x + 0.5) / W - rf[2]) / rf[0], t = ((y + 0.5) / H - rf[3]) / rf[1];
-      sampleQuick(sources, s * rq[0] + rq[2], t * rq[1] + rq[3], d);
-      const i = y * W + x;
-      delta[3 * i] = d[0]; delta[3 * i + 1] = d[1]; delta[3 * i + 2] = d[2];
-      covered[i] = 1;
+      put(y * W + x, s * rq[0] + rq[2], t * rq[1] + rq[3]);
     }
   }
 }
 
-// Uncovered texels next to covered ones take their neighbours' mean difference, pass by pass
-// (PAD_PASSES rings). Each pass visits only its ring: the uncovered texels next to the texels the
-// pass before covered (the first, those next to any covered texel).
-function padDelta(W, H, delta, covered) {
-  const queued = new Uint8Array(W * H);
-  const coveredAround = (x, y) => {
+// The padding's plan: the uncovered texels next to covered ones take their covered neighbours'
+// mean, ring by ring (PAD_PASSES rings); each ring reads only the texels covered before it, so the
+// plan (texel k: pad.texel[k] is the mean of pad.from[pad.start[k] .. pad.start[k + 1]]) is
+// applied in order, in place.
+function padPlan(W, H, coveredIn) {
+  const covered = Uint8Array.from(coveredIn), queued = new Uint8Array(W * H);
+  const texel = [], start = [0], from = [];
+  const around = (i, each) => {
+    const x = i % W, y = (i - x) / W;
     for (let dy = -1; dy <= 1; dy++) {
       for (let dx = -1; dx <= 1; dx++) {
         const xx = x + dx, yy = y + dy;
-        if (xx >= 0 && yy >= 0 && xx < W && yy < H && covered[yy * W + xx]) return true;
+        if (xx >= 0 && yy >= 0 && xx < W && yy < H) each(yy * W + xx);
       }
     }
-    return false;
   };
   let ring = [];
-  for (let y = 0; y < H; y++) {
-    for (let x = 0; x < W; x++) {
-      const i = y * W + x;
-      if (!covered[i] && coveredAround(x, y)) { ring.push(i); queued[i] = 1; }
-    }
+  for (let i = 0; i < W * H; i++) {
+    if (covered[i]) continue;
+    let next = false;
+    around(i, (j) => { next = next || covered[j] === 1; });
+    if (next) { ring.push(i); queued[i] = 1; }
   }
   for (let pass = 0; pass < PAD_PASSES && ring.length; pass++) {
-    const value = new Float32Array(3 * ring.length);
-    ring.forEach((i, k) => {
-      const x = i % W, y = (i - x) / W;
-      let n = 0, r = 0, g = 0, b = 0;
-      for (let dy = -1; dy <= 1; dy++) {
-        for (let dx = -1; dx <= 1; dx++) {
-          const xx = x + dx, yy = y + dy;
-          if (xx < 0 || yy < 0 || xx >= W || yy >= H || !covered[yy * W + xx]) continue;
-          const j = yy * W + xx;
-          n++; r += delta[3 * j]; g += delta[3 * j + 1]; b += delta[3 * j + 2];
-        }
-      }
-      value[3 * k] = r / n; value[3 * k + 1] = g / n; value[3 * k + 2] = b / n;
-    });
-    ring.forEach((i, k) => {
-      delta[3 * i] = value[3 * k]; delta[3 * i + 1] = value[3 * k + 1]; delta[3 * i + 2] = value[3 * k + 2];
-      covered[i] = 1;
-    });
-    const next = [];
     for (const i of ring) {
-      const x = i % W, y = (i - x) / W;
-      for (let dy = -1; dy <= 1; dy++) {
-        for (let dx = -1; dx <= 1; dx++) {
-          const xx = x + dx, yy = y + dy, j = yy * W + xx;
-          if (xx < 0 || yy < 0 || xx >= W || yy >= H || covered[j] || queued[j]) continue;
-          queued[j] = 1;
-          next.push(j);
+      around(i, (j) => { if (covered[j]) from.push(j); });
+      texel.push(i);
+      start.push(from.length);
+    }
+    for (const i of ring) covered[i] = 1;
+    const next = [];
+    for (const i of ring) around(i, (j) => { if (!covered[j] && !queued[j]) { queued[j] = 1; next.push(j); } });
+    ring = next;
+  }
+  return { texel: Int32Array.from(texel), start: Int32Array.from(start), from: Int32Array.from(from) };
+}
+
+function applyPad(pad, delta) {
+  const { texel, start, from } = pad;
+  for (let k = 0; k < texel.length; k++) {
+    let r = 0, g = 0, b = 0;
+    const s = start[k], e = start[k + 1];
+    for (let m = s; m < e; m++) { const j = 3 * from[m]; r += delta[j]; g += delta[j + 1]; b += delta[j + 2]; }
+    const n = e - s, t = 3 * texel[k];
+    delta[t] = r / n; delta[t + 1] = g / n; delta[t + 2] = b / n;
+  }
+}
+
+// The map from the final bake f's atlases to quick bake q's layout (layoutSignature): {atlases
+// (the final's, readAtlases), byAtlas: final atlas -> {width, height, covered (1: a triangle's or
+// copy's texel), texel, qatlas, tap (4 texel indices a texel), wt (their bilinear weights), pad
+// (padPlan)}, quickSize: quick atlas -> [width, height]} or {why} when the bakes do not correspond.
+function buildMap(f, q, read) {
+  const nf = lightmappedNodes(f), nq = lightmappedNodes(q);
+  if (!(nf.length === nq.length && nf.every((x, i) => x.node === nq[i].node && x.mesh === nq[i].mesh && x.rects.length === nq[i].rects.length))) return { why: 'the bakes light different nodes' };
+  const atlases = readAtlases(f, read), qAtlases = readAtlases(q, read);
+  const build = new Map();
+  for (const [a, img] of atlases) {
+    build.set(a, { width: img.width, height: img.height, covered: new Uint8Array(img.width * img.height), slot: new Int32Array(img.width * img.height).fill(-1), count: 0, texel: [], qatlas: [], tap: [], wt: [] });
+  }
+  const fMeshes = new Map(), qMeshes = new Map(), meshChecked = new Map();
+  let triangles = 0;
+  for (let k = 0; k < nf.length; k++) {
+    const fn = nf[k], qn = nq[k];
+    const dst = build.get(fn.atlas), qimg = qAtlases.get(qn.atlas);
+    if (!dst || !qimg) return { why: `node ${fn.node}: an atlas has no .hdr` };
+    const put = recorder(dst, qn.atlas, qimg.width, qimg.height);
+    const fp = meshUv1(f, fn.mesh, fMeshes), qp = meshUv1(q, qn.mesh, qMeshes);
+    if (!meshChecked.has(fn.mesh)) { // once per mesh: the nodes that share it share its answers
+      if (fp.length !== qp.length) return { why: `mesh ${fn.mesh}: the bakes' primitives differ` };
+      meshChecked.set(fn.mesh, fp.every((p, i) => sameArray(p.uv, qp[i].uv) && sameArray(p.index, qp[i].index)));
+    }
+    const shared = meshChecked.get(fn.mesh); // the same TEXCOORD_1 in the final and quick bakes
+    const identity = fn.rects.length === 1 && sameArray(fn.rects[0], [1, 1, 0, 0]) && sameArray(qn.rects[0], [1, 1, 0, 0]);
+    if (shared && !identity) {
+      fn.rects.forEach((r, c) => mapRect(r, qn.rects[c], dst, put));
+      continue;
+    }
+    for (let p = 0; p < fp.length; p++) {
+      const { uv: fu, index: fi } = fp[p], { uv: qu, index: qi } = qp[p];
+      if (fi.length !== qi.length) return { why: `mesh ${fn.mesh}: the bakes' triangles differ` };
+      triangles += (fi.length / 3) * fn.rects.length;
+      if (triangles > MAX_TRIANGLES) return { why: `more than ${MAX_TRIANGLES} placed triangles to map` };
+      const tf = new Float64Array(6), tq = new Float64Array(6);
+      for (let c = 0; c < fn.rects.length; c++) {
+        const rf = fn.rects[c], rq = qn.rects[c];
+        for (let t = 0; t < fi.length; t += 3) {
+          for (let v = 0; v < 3; v++) {
+            tf[2 * v] = fu[2 * fi[t + v]] * rf[0] + rf[2]; tf[2 * v + 1] = fu[2 * fi[t + v] + 1] * rf[1] + rf[3];
+            tq[2 * v] = qu[2 * qi[t + v]] * rq[0] + rq[2]; tq[2 * v + 1] = qu[2 * qi[t + v] + 1] * rq[1] + rq[3];
+          }
+          mapTriangle(tf, tq, dst, put);
         }
       }
     }
-    ring = next;
   }
+  const byAtlas = new Map();
+  for (const [a, b] of build) {
+    byAtlas.set(a, { width: b.width, height: b.height, covered: b.covered, texel: Int32Array.from(b.texel), qatlas: Int32Array.from(b.qatlas), tap: Int32Array.from(b.tap), wt: Float64Array.from(b.wt), pad: padPlan(b.width, b.height, b.covered) });
+  }
+  const quickSize = new Map([...qAtlases].map(([a, img]) => [a, [img.width, img.height]]));
+  return { atlases, byAtlas, quickSize };
+}
+
+// value (3 numbers a final texel) += weight x quick bake g read through the map; {why} when g's
+// atlases are not the map's sizes.
+function addQuick(map, g, weight, values, read) {
+  const imgs = [];
+  for (const [a, img] of readAtlases(g, read)) {
+    const size = map.quickSize.get(a);
+    if (!size || size[0] !== img.width || size[1] !== img.height) return { why: 'the quick looks have different atlases' };
+    imgs[a] = img.data;
+  }
+  for (const [a, m] of map.byAtlas) {
+    const { texel, qatlas, tap, wt } = m, out = values.get(a);
+    for (let k = 0; k < texel.length; k++) {
+      const d = imgs[qatlas[k]], o = 4 * k, t = 3 * texel[k];
+      if (!d) return { why: 'the quick looks have different atlases' };
+      const i0 = 4 * tap[o], i1 = 4 * tap[o + 1], i2 = 4 * tap[o + 2], i3 = 4 * tap[o + 3];
+      const w0 = wt[o], w1 = wt[o + 1], w2 = wt[o + 2], w3 = wt[o + 3];
+      for (let c = 0; c < 3; c++) out[t + c] += weight * (w0 * d[i0 + c] + w1 * d[i1 + c] + w2 * d[i2 + c] + w3 * d[i3 + c]);
+    }
+  }
+  return {};
+}
+
+const zeros = (map) => new Map([...map.byAtlas].map(([a, m]) => [a, new Float64Array(3 * m.width * m.height)]));
+
+// The weighted sum of quick bakes read at each texel of the final bake's atlases. f: the final
+// (readBake); quicks: [{g (readBake), weight}] sharing one layout. Returns {atlases (the
+// final's, readAtlases), mapped: atlas -> {value (3 numbers a texel), covered (1: a triangle's or
+// copy's texel)}} or {why} when the bakes do not correspond.
+export function mapQuicks(f, quicks) {
+  const map = buildMap(f, quicks[0].g, readHdr);
+  if (map.why) return map;
+  const sig = layoutSignature(quicks[0].g);
+  if (!quicks.every((q) => layoutSignature(q.g) === sig)) return { why: 'the quick looks have different layouts' };
+  const values = zeros(map);
+  for (const q of quicks) {
+    const r = addQuick(map, q.g, q.weight, values, readHdr);
+    if (r.why) return r;
+  }
+  return { atlases: map.atlases, mapped: new Map([...map.byAtlas].map(([a, m]) => [a, { value: values.get(a), covered: m.covered }])) };
+}
+
+// The correction's final-layout part: direct(after) - direct(before), per final atlas (3 floats
+// a texel), or {why} when those bakes are not of the final's layout.
+function directChange(f, atlases, da, db, read) {
+  const nf = lightmappedNodes(f);
+  const change = new Map();
+  for (const g of [da, db]) {
+    const n = lightmappedNodes(g);
+    if (n.length !== nf.length || !n.every((x, i) => x.node === nf[i].node && x.atlas === nf[i].atlas && x.rects.length === nf[i].rects.length && x.rects.every((r, k) => sameArray(r, nf[i].rects[k])))) return { why: 'the direct-light bakes are of another layout' };
+  }
+  const [ia, ib] = [readAtlases(da, read), readAtlases(db, read)];
+  for (const [a, img] of atlases) {
+    const A = ia.get(a), B = ib.get(a);
+    if (!A || !B || A.width !== img.width || A.height !== img.height || B.width !== img.width || B.height !== img.height) return { why: 'the direct-light bakes have other atlases' };
+    const d = new Float32Array(3 * img.width * img.height);
+    for (let i = 0, n = img.width * img.height; i < n; i++) for (let c = 0; c < 3; c++) d[3 * i + c] = A.data[4 * i + c] - B.data[4 * i + c];
+    change.set(a, d);
+  }
+  return { change };
 }
 
 // A Radiance .hdr (RGBE, each scanline run-length framed with literal runs only: what three's
@@ -291,126 +407,111 @@ function linkOrCopy(from, to) {
   try { fs.linkSync(from, to); } catch { fs.copyFileSync(from, to); }
 }
 
-// The weighted sum of quick bakes, read at each texel of the final bake's atlases. f: the final
-// (readBake); quicks: [{g (readBake), weight}] sharing one layout. Returns {atlases (the
-// final's, readAtlases), mapped: atlas -> {value (3 floats a texel), covered (1: a triangle's or
-// copy's texel)}} or {why} when the bakes do not correspond.
-export function mapQuicks(f, quicks) {
-  const nf = lightmappedNodes(f), nq = quicks.map((q) => lightmappedNodes(q.g));
-  const sameNodes = (a, b) => a.length === b.length && a.every((x, i) => x.node === b[i].node && x.mesh === b[i].mesh && x.rects.length === b[i].rects.length);
-  if (!nq.every((n) => sameNodes(nf, n))) return { why: 'the bakes light different nodes' };
-  const sameLayout = (a, b) => a.every((x, i) => x.atlas === b[i].atlas && x.rects.every((r, k) => sameArray(r, b[i].rects[k])));
-  if (!nq.every((n) => sameLayout(nq[0], n))) return { why: 'the quick looks have different layouts' };
-  const atlases = readAtlases(f), qAtlases = quicks.map((q) => readAtlases(q.g));
-  for (const [a, img] of qAtlases[0]) {
-    if (!qAtlases.every((m) => m.has(a) && m.get(a).width === img.width && m.get(a).height === img.height)) return { why: 'the quick looks have different atlases' };
-  }
-  const mapped = new Map();
-  for (const [a, img] of atlases) mapped.set(a, { value: new Float32Array(3 * img.width * img.height), covered: new Uint8Array(img.width * img.height) });
-  const fMeshes = new Map(), qMeshes = quicks.map(() => new Map()), meshChecked = new Map();
-  let triangles = 0;
-  for (let k = 0; k < nf.length; k++) {
-    const fn = nf[k], qn = nq[0][k];
-    const fa = atlases.get(fn.atlas), dst = mapped.get(fn.atlas);
-    const sources = quicks.map((q, i) => ({ img: qAtlases[i].get(qn.atlas), weight: q.weight }));
-    if (!fa || sources.some((x) => !x.img)) return { why: `node ${fn.node}: an atlas has no .hdr` };
-    const fp = meshUv1(f, fn.mesh, fMeshes), qp = meshUv1(quicks[0].g, qn.mesh, qMeshes[0]);
-    if (!meshChecked.has(fn.mesh)) { // once per mesh: the nodes that share it share its answers
-      if (fp.length !== qp.length) return { why: `mesh ${fn.mesh}: the bakes' primitives differ` };
-      const qps = quicks.map((q, i) => meshUv1(q.g, qn.mesh, qMeshes[i]));
-      if (!qps.every((x) => x.length === qp.length && x.every((p, i) => sameArray(p.uv, qp[i].uv)))) return { why: 'the quick looks have different layouts' };
-      meshChecked.set(fn.mesh, fp.every((p, i) => sameArray(p.uv, qp[i].uv) && sameArray(p.index, qp[i].index)));
+// The watch's composer: compose() as below, keeping what the next composition on the same final
+// bake reads again (the last few decoded .hdr files, the map to the quick layout and the quick
+// look before the change read through it). prepare() builds those ahead, while the watch is idle
+// after a final bake, so that the picture after the next change waits only for its own quick look.
+export function createComposer() {
+  const hdrKept = new Map();
+  const read = (file) => {
+    const key = stamp(file);
+    if (hdrKept.has(key)) return hdrKept.get(key);
+    const img = readHdr(file);
+    hdrKept.set(key, img);
+    if (hdrKept.size > HDR_KEPT) hdrKept.delete(hdrKept.keys().next().value);
+    return img;
+  };
+  let kept = null; // {key, sig, map, before: {key, values}}: the last final and quick layout's map
+  const mapFor = (f, q) => {
+    const sig = layoutSignature(q), key = `${stamp(path.join(f.dir, `${f.stem}.gltf`))}|${sig}`;
+    if (kept && kept.key === key) return kept;
+    const map = buildMap(f, q, read);
+    if (map.why) return map;
+    kept = { key, sig, map, before: null };
+    return kept;
+  };
+  // -(quick look before) through the map, kept by its files' stamps
+  const before = (k, qb) => {
+    const key = [...readAtlases(qb, () => ({}))].map(([, x]) => stamp(path.join(qb.dir, x.hdr))).join('|');
+    if (!k.before || k.before.key !== key) {
+      const values = zeros(k.map);
+      const r = addQuick(k.map, qb, -1, values, read);
+      if (r.why) return r;
+      k.before = { key, values };
     }
-    const shared = meshChecked.get(fn.mesh); // the same TEXCOORD_1 in the final and quick bakes
-    const identity = fn.rects.length === 1 && sameArray(fn.rects[0], [1, 1, 0, 0]) && sameArray(qn.rects[0], [1, 1, 0, 0]);
-    if (shared && !identity) {
-      fn.rects.forEach((r, c) => mapRect(r, qn.rects[c], fa, sources, dst.value, dst.covered));
-      continue;
+    return { values: k.before.values };
+  };
+
+  // final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
+  // look's; out: the folder to write (made here). stem: the level's file name without extension.
+  // correction (optional): {directBefore, directAfter, quickDirectBefore, quickDirectAfter}, the
+  // folders of the changed lights' --direct-of bakes (final's layout, quick look's layout).
+  function compose({ final, quickBefore, quickAfter, out, stem, correction = null }) {
+    const t0 = Date.now();
+    let f, qb, qa, c = null, k, base;
+    try {
+      [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readBake(d, stem));
+      if (correction) c = Object.fromEntries(Object.entries(correction).map(([key, d]) => [key, readBake(d, stem)]));
+      k = mapFor(f, qb);
+      if (k.why) return { ok: false, why: k.why };
+      const quicks = [qa, ...(c ? [c.quickDirectAfter, c.quickDirectBefore] : [])];
+      if (!quicks.every((q) => layoutSignature(q) === k.sig)) return { ok: false, why: 'the quick looks have different layouts' };
+      base = before(k, qb);
+    } catch (e) {
+      return { ok: false, why: `cannot read a bake (${e.message})` };
     }
-    for (let p = 0; p < fp.length; p++) {
-      const { uv: fu, index: fi } = fp[p], { uv: qu, index: qi } = qp[p];
-      if (fi.length !== qi.length) return { why: `mesh ${fn.mesh}: the bakes' triangles differ` };
-      triangles += (fi.length / 3) * fn.rects.length;
-      if (triangles > MAX_TRIANGLES) return { why: `more than ${MAX_TRIANGLES} placed triangles to map` };
-      const tf = new Float64Array(6), tq = new Float64Array(6);
-      for (let c = 0; c < fn.rects.length; c++) {
-        const rf = fn.rects[c], rq = qn.rects[c];
-        for (let t = 0; t < fi.length; t += 3) {
-          for (let v = 0; v < 3; v++) {
-            tf[2 * v] = fu[2 * fi[t + v]] * rf[0] + rf[2]; tf[2 * v + 1] = fu[2 * fi[t + v] + 1] * rf[1] + rf[3];
-            tq[2 * v] = qu[2 * qi[t + v]] * rq[0] + rq[2]; tq[2 * v + 1] = qu[2 * qi[t + v] + 1] * rq[1] + rq[3];
-          }
-          mapTriangle(tf, tq, fa, sources, dst.value, dst.covered);
-        }
+    if (base.why) return { ok: false, why: base.why };
+    const values = new Map([...base.values].map(([a, v]) => [a, Float64Array.from(v)]));
+    for (const [g, weight] of [[qa, 1], ...(c ? [[c.quickDirectAfter, -1], [c.quickDirectBefore, 1]] : [])]) {
+      const r = addQuick(k.map, g, weight, values, read);
+      if (r.why) return { ok: false, why: r.why };
+    }
+    const direct = c ? directChange(f, k.map.atlases, c.directAfter, c.directBefore, read) : { change: null };
+    if (direct.why) return { ok: false, why: direct.why };
+    fs.rmSync(out, { recursive: true, force: true });
+    fs.mkdirSync(out, { recursive: true });
+    const hdrs = new Set([...k.map.atlases.values()].map((a) => a.hdr));
+    for (const [a, img] of k.map.atlases) {
+      const delta = values.get(a);
+      applyPad(k.map.byAtlas.get(a).pad, delta);
+      const exact = direct.change && direct.change.get(a); // the changed lights' direct light, texel for texel
+      const rgba = new Float32Array(img.data.length);
+      for (let i = 0, n = img.width * img.height; i < n; i++) {
+        for (let ch = 0; ch < 3; ch++) rgba[4 * i + ch] = Math.max(img.data[4 * i + ch] + delta[3 * i + ch] + (exact ? exact[3 * i + ch] : 0), 0);
+        rgba[4 * i + 3] = 1;
       }
+      fs.writeFileSync(path.join(out, img.hdr), encodeHdr(img.width, img.height, rgba));
+    }
+    // The glTF: lightmap files reduced to the composed .hdr and the PNG it carries beside.
+    const doc = f.doc;
+    const keep = (files) => Object.fromEntries(Object.entries(files).filter(([key]) => key === 'hdr' || key === 'png'));
+    for (const t of doc.textures || []) if (t.extras && t.extras.lightmap && t.extras.lightmap.files) t.extras.lightmap.files = keep(t.extras.lightmap.files);
+    for (const n of doc.nodes || []) if (n.extras && n.extras.lightmap && n.extras.lightmap.files) n.extras.lightmap.files = keep(n.extras.lightmap.files);
+    fs.writeFileSync(path.join(out, `${stem}.gltf`), JSON.stringify(doc));
+    for (const name of fs.readdirSync(final)) {
+      if (name === `${stem}.gltf` || hdrs.has(name) || /\.(ktx2|exr)$/i.test(name)) continue;
+      if (fs.statSync(path.join(final, name)).isFile()) linkOrCopy(path.join(final, name), path.join(out, name));
+    }
+    return { ok: true, ms: Date.now() - t0 };
+  }
+
+  // What the next compose() on this final and quick look reads again, built now: {ok, ms} or
+  // {ok: false, why}.
+  function prepare({ final, quickBefore, stem }) {
+    const t0 = Date.now();
+    try {
+      const [f, qb] = [final, quickBefore].map((d) => readBake(d, stem));
+      const k = mapFor(f, qb);
+      const r = k.why ? k : before(k, qb);
+      return r.why ? { ok: false, why: r.why } : { ok: true, ms: Date.now() - t0 };
+    } catch (e) {
+      return { ok: false, why: `cannot read a bake (${e.message})` };
     }
   }
-  return { atlases, mapped };
+  return { compose, prepare };
 }
 
-// The correction's final-layout part: direct(after) - direct(before), per final atlas (3 floats
-// a texel), or {why} when those bakes are not of the final's layout.
-function directChange(f, atlases, da, db) {
-  const nf = lightmappedNodes(f);
-  const change = new Map();
-  for (const g of [da, db]) {
-    const n = lightmappedNodes(g);
-    if (n.length !== nf.length || !n.every((x, i) => x.node === nf[i].node && x.atlas === nf[i].atlas && x.rects.length === nf[i].rects.length && x.rects.every((r, k) => sameArray(r, nf[i].rects[k])))) return { why: 'the direct-light bakes are of another layout' };
-  }
-  const [ia, ib] = [readAtlases(da), readAtlases(db)];
-  for (const [a, img] of atlases) {
-    const A = ia.get(a), B = ib.get(a);
-    if (!A || !B || A.width !== img.width || A.height !== img.height || B.width !== img.width || B.height !== img.height) return { why: 'the direct-light bakes have other atlases' };
-    const d = new Float32Array(3 * img.width * img.height);
-    for (let i = 0, n = img.width * img.height; i < n; i++) for (let c = 0; c < 3; c++) d[3 * i + c] = A.data[4 * i + c] - B.data[4 * i + c];
-    change.set(a, d);
-  }
-  return { change };
-}
-
-// final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
-// look's; out: the folder to write (made here). stem: the level's file name without extension.
-// correction (optional): {directBefore, directAfter, quickDirectBefore, quickDirectAfter}, the
-// folders of the changed lights' --direct-of bakes (final's layout, quick look's layout).
-export function compose({ final, quickBefore, quickAfter, out, stem, correction = null }) {
-  const t0 = Date.now();
-  let f, qb, qa, c = null;
-  try {
-    [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readBake(d, stem));
-    if (correction) c = Object.fromEntries(Object.entries(correction).map(([k, d]) => [k, readBake(d, stem)]));
-  } catch (e) {
-    return { ok: false, why: `cannot read a bake (${e.message})` };
-  }
-  const quicks = [{ g: qa, weight: 1 }, { g: qb, weight: -1 }];
-  if (c) quicks.push({ g: c.quickDirectAfter, weight: -1 }, { g: c.quickDirectBefore, weight: 1 });
-  const m = mapQuicks(f, quicks);
-  if (m.why) return { ok: false, why: m.why };
-  const direct = c ? directChange(f, m.atlases, c.directAfter, c.directBefore) : { change: null };
-  if (direct.why) return { ok: false, why: direct.why };
-  fs.rmSync(out, { recursive: true, force: true });
-  fs.mkdirSync(out, { recursive: true });
-  const hdrs = new Set([...m.atlases.values()].map((a) => a.hdr));
-  for (const [a, img] of m.atlases) {
-    const { value: delta, covered } = m.mapped.get(a);
-    padDelta(img.width, img.height, delta, covered);
-    const exact = direct.change && direct.change.get(a); // the changed lights' direct light, texel for texel
-    if (exact) for (let i = 0; i < delta.length; i++) delta[i] += exact[i];
-    const rgba = new Float32Array(img.data.length);
-    for (let i = 0, n = img.width * img.height; i < n; i++) {
-      for (let c = 0; c < 3; c++) rgba[4 * i + c] = Math.max(img.data[4 * i + c] + delta[3 * i + c], 0);
-      rgba[4 * i + 3] = 1;
-    }
-    fs.writeFileSync(path.join(out, img.hdr), encodeHdr(img.width, img.height, rgba));
-  }
-  // The glTF: lightmap files reduced to the composed .hdr and the PNG it carries beside.
-  const doc = f.doc;
-  const keep = (files) => Object.fromEntries(Object.entries(files).filter(([k]) => k === 'hdr' || k === 'png'));
-  for (const t of doc.textures || []) if (t.extras && t.extras.lightmap && t.extras.lightmap.files) t.extras.lightmap.files = keep(t.extras.lightmap.files);
-  for (const n of doc.nodes || []) if (n.extras && n.extras.lightmap && n.extras.lightmap.files) n.extras.lightmap.files = keep(n.extras.lightmap.files);
-  fs.writeFileSync(path.join(out, `${stem}.gltf`), JSON.stringify(doc));
-  for (const name of fs.readdirSync(final)) {
-    if (name === `${stem}.gltf` || hdrs.has(name) || /\.(ktx2|exr)$/i.test(name)) continue;
-    if (fs.statSync(path.join(final, name)).isFile()) linkOrCopy(path.join(final, name), path.join(out, name));
-  }
-  return { ok: true, ms: Date.now() - t0 };
+// One composition with nothing kept (createComposer's compose).
+export function compose(args) {
+  return createComposer().compose(args);
 }

@@ -16,10 +16,10 @@ import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { projectRoot, resolveFile, TYPES } from './server.mjs';
 import { watchedFiles, snapshot, configKeys, fingerprint, compare, changedLights } from './watch-inputs.mjs';
-import { compose } from './compose.mjs';
+import { createComposer } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
-const POLL_MS = 100; // how often the files' sizes and times are looked at
+const POLL_MS = 100; // how often the files' sizes and times are looked at (and on every inotify event)
 const SETTLE_MS = 200; // a change is baked once the files have stood still this long
 
 function parseArgs(args) {
@@ -51,6 +51,9 @@ const quickRoot = fs.mkdtempSync(path.join(os.tmpdir(), 'lmbake-watch-'));
 // sampling keys reads the layout back instead of unwrapping and packing again.
 const layoutRoot = path.join(quickRoot, 'layouts');
 const say = (line) => console.log(`watch: ${line}`);
+// The composed quick picture's maker: it keeps the last final bake's map to the quick layout
+// (built while idle after each final bake) and the last few lightmaps it read.
+const composer = createComposer();
 
 // What the page and /status see.
 const status = {
@@ -70,7 +73,7 @@ function stopChild(why) {
   status.cancelled++;
   child.cancelled = true;
   dying++;
-  child.once('close', () => { dying--; });
+  child.once('close', () => { dying--; safeTick(); });
   child.kill('SIGTERM');
   child = null;
   status.baking = null;
@@ -151,6 +154,8 @@ async function bakeNewest() {
   status.lastGood = { fp, generation, outdir: outdirStamp(), quick: opts.quick ? path.join(quickRoot, String(generation)) : null };
   goodPrint = print;
   status.state = 'idle';
+  // while the artist looks: what composing the next change on this final reads again
+  if (status.lastGood.quick && fs.existsSync(status.lastGood.quick)) composer.prepare({ final: opts.outdir, quickBefore: status.lastGood.quick, stem });
 }
 
 // A bake (or a revision of one) on screen: /status, the history, the log line, the tidying.
@@ -246,7 +251,7 @@ function composeQuick(generation, change, correction) {
   else {
     try {
       const { names, ...dirs } = correction || {}; // eslint-disable-line no-unused-vars
-      r = compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, correction: correction ? dirs : null });
+      r = composer.compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, correction: correction ? dirs : null });
     } catch (e) {
       r = { ok: false, why: e.message };
     }
@@ -301,16 +306,47 @@ function tidyLayouts() {
 // have settled, bakes the newest state.
 let running = false;
 function tick() {
-  const now = snapshot(files.length ? files : [{ file: opts.level }]);
+  const watched = files.length ? files : [{ file: opts.level }];
+  listen(watched);
+  const now = snapshot(watched);
   if (lastSnapshot !== null && now !== lastSnapshot) {
     lastSnapshot = now;
     movedAt = Date.now();
     dirty = true;
     stopChild('the files changed');
+    setTimeout(() => safeTick(), SETTLE_MS + 1); // baked as soon as it has settled, not at the next poll
   }
   if (dirty && !running && !dying && Date.now() - movedAt >= SETTLE_MS) { // not awaited: the polling goes on during the bake
     running = true;
     bakeNewest().catch((e) => failed(String((e && e.stack) || e))).finally(() => { running = false; });
+  }
+}
+
+function safeTick() {
+  try { tick(); } catch (e) { failed(String((e && e.stack) || e)); }
+}
+
+// inotify (fs.watch) on the folders of the watched files: a save is seen at once rather than at
+// the next poll. Events name files; only the watched names tick (the output or an editor's swap
+// file beside the level do not). The polling stays: it is what sees a change where inotify is
+// not there (a network file system).
+const listening = new Map(); // folder -> {watcher, names}
+function listen(watched) {
+  const want = new Map();
+  for (const { file } of watched) {
+    const dir = path.dirname(file);
+    if (!want.has(dir)) want.set(dir, new Set());
+    want.get(dir).add(path.basename(file));
+  }
+  for (const [dir, l] of listening) if (!want.has(dir)) { l.watcher.close(); listening.delete(dir); }
+  for (const [dir, names] of want) {
+    if (listening.has(dir)) { listening.get(dir).names = names; continue; }
+    try {
+      const l = { names, watcher: null };
+      l.watcher = fs.watch(dir, { persistent: false }, (_, name) => { if (!name || l.names.has(String(name))) safeTick(); });
+      l.watcher.on('error', () => { l.watcher.close(); });
+      listening.set(dir, l);
+    } catch { /* polled only */ }
   }
 }
 
@@ -351,10 +387,11 @@ server.once('error', (e) => { console.error(`preview: error: ${e.message}`); pro
 server.listen(opts.port, '127.0.0.1', () => {
   console.log(`preview: http://127.0.0.1:${server.address().port}/${opts.lightmap ? '?lightmap=' + opts.lightmap : ''}`);
   say(`watching ${opts.level}${opts.config ? ' and ' + opts.config : ''}; final bakes go to ${opts.outdir}; Ctrl-C stops`);
-  const loop = () => { try { tick(); } catch (e) { failed(String((e && e.stack) || e)); } setTimeout(loop, POLL_MS); };
+  const loop = () => { safeTick(); setTimeout(loop, POLL_MS); };
   loop();
 });
 const stop = () => {
+  for (const l of listening.values()) l.watcher.close();
   if (child) { child.cancelled = true; child.kill('SIGTERM'); }
   fs.rmSync(quickRoot, { recursive: true, force: true });
   server.closeAllConnections();
