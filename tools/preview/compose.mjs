@@ -319,6 +319,22 @@ function addQuick(map, g, weight, values, read) {
   return {};
 }
 
+// The composed atlas as an .hdr: final + delta (padded beyond the triangles, plus the exact part
+// when given), at least 0.
+function composedHdr(img, pad, delta, exact) {
+  applyPad(pad, delta);
+  if (exact) for (let i = 0; i < delta.length; i++) delta[i] += exact[i];
+  const rgba = new Float32Array(img.data.length), data = img.data;
+  for (let i = 0, n = img.width * img.height; i < n; i++) {
+    const o = 4 * i, t = 3 * i;
+    rgba[o] = Math.max(data[o] + delta[t], 0);
+    rgba[o + 1] = Math.max(data[o + 1] + delta[t + 1], 0);
+    rgba[o + 2] = Math.max(data[o + 2] + delta[t + 2], 0);
+    rgba[o + 3] = 1;
+  }
+  return encodeHdr(img.width, img.height, rgba);
+}
+
 const zeros = (map) => new Map([...map.byAtlas].map(([a, m]) => [a, new Float64Array(3 * m.width * m.height)]));
 
 // The weighted sum of quick bakes read at each texel of the final bake's atlases. f: the final
@@ -461,7 +477,7 @@ export function createComposer() {
       return { ok: false, why: `cannot read a bake (${e.message})` };
     }
     if (base.why) return { ok: false, why: base.why };
-    const values = new Map([...base.values].map(([a, v]) => [a, Float64Array.from(v)]));
+    const values = new Map([...base.values].map(([a, v]) => [a, new Float64Array(v)]));
     for (const [g, weight] of [[qa, 1], ...(c ? [[c.quickDirectAfter, -1], [c.quickDirectBefore, 1]] : [])]) {
       const r = addQuick(k.map, g, weight, values, read);
       if (r.why) return { ok: false, why: r.why };
@@ -472,15 +488,8 @@ export function createComposer() {
     fs.mkdirSync(out, { recursive: true });
     const hdrs = new Set([...k.map.atlases.values()].map((a) => a.hdr));
     for (const [a, img] of k.map.atlases) {
-      const delta = values.get(a);
-      applyPad(k.map.byAtlas.get(a).pad, delta);
       const exact = direct.change && direct.change.get(a); // the changed lights' direct light, texel for texel
-      const rgba = new Float32Array(img.data.length);
-      for (let i = 0, n = img.width * img.height; i < n; i++) {
-        for (let ch = 0; ch < 3; ch++) rgba[4 * i + ch] = Math.max(img.data[4 * i + ch] + delta[3 * i + ch] + (exact ? exact[3 * i + ch] : 0), 0);
-        rgba[4 * i + 3] = 1;
-      }
-      fs.writeFileSync(path.join(out, img.hdr), encodeHdr(img.width, img.height, rgba));
+      fs.writeFileSync(path.join(out, img.hdr), composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), exact));
     }
     // The glTF: lightmap files reduced to the composed .hdr and the PNG it carries beside.
     const doc = f.doc;
@@ -503,7 +512,11 @@ export function createComposer() {
       const [f, qb] = [final, quickBefore].map((d) => readBake(d, stem));
       const k = mapFor(f, qb);
       const r = k.why ? k : before(k, qb);
-      return r.why ? { ok: false, why: r.why } : { ok: true, ms: Date.now() - t0 };
+      if (r.why) return { ok: false, why: r.why };
+      // the final as composed on a change of nothing, thrown away: node compiles the loops the
+      // picture after the next change runs (0.3 -> 0.2 s on level-single-10)
+      for (const [a, img] of k.map.atlases) composedHdr(img, k.map.byAtlas.get(a).pad, zeros(k.map).get(a), null);
+      return { ok: true, ms: Date.now() - t0 };
     } catch (e) {
       return { ok: false, why: `cannot read a bake (${e.message})` };
     }

@@ -20,7 +20,7 @@ import { createComposer } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
 const POLL_MS = 100; // how often the files' sizes and times are looked at (and on every inotify event)
-const SETTLE_MS = 200; // a change is baked once the files have stood still this long
+const SETTLE_MS = 100; // a change is baked once the files have stood still this long (a bake that read a save half-way is stopped and baked again)
 
 function parseArgs(args) {
   const o = { level: null, config: null, outdir: 'lmbake-out', port: 0, lightmap: null, lmbake: process.env.LMBAKE || path.join(projectRoot, 'build', 'lmbake'), quick: true };
