@@ -134,22 +134,27 @@ async function bakeNewest() {
   Object.assign(status, { state: 'baking', changed: change.what, layout: change.layout });
   say(`bake ${generation}: ${change.what.join('; ')} (${change.layout ? 'layout and lighting' : 'lighting only'})`);
   const seen = movedAt || Date.now(), started = lastSnapshot;
+  let refine = null; // the correction of the quick picture, composed once the final bake has started
   for (const kind of opts.quick ? ['quick', 'final'] : ['final']) {
-    const r = await bake(kind, generation);
+    const running = bake(kind, generation);
+    if (refine) { // node composes on one core while the final bake starts on the others
+      const refined = composeQuick(generation, change, refine.correction);
+      if (refined !== null) showBake({ generation, kind: 'quick', revision: 1, seen, change, layoutKept: refine.layoutKept, composed: refined, correction: refine.correction });
+      refine = null;
+    }
+    const r = await running;
     if (r.cancelled || dirty) return;
     if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
     // A quick look is shown at once (composed on the last final where it can be); a change of
     // punctual lights alone is then refined with their direct light at the final's resolution
-    // (revision 1 of the same bake), while the final bake waits.
+    // (revision 1 of the same bake), composed as the final bake starts.
     const composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
     showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, correction: null });
     if (kind !== 'quick' || composed === null) continue;
     const correction = await correctionBakes(generation, change, fp);
     if ((correction && correction.cancelled) || dirty) return;
-    if (!correction) continue;
-    const refined = composeQuick(generation, change, correction);
-    if (refined !== null) showBake({ generation, kind, revision: 1, seen, change, layoutKept: r.layoutKept, composed: refined, correction });
+    if (correction) refine = { correction, layoutKept: r.layoutKept };
   }
   status.lastGood = { fp, generation, outdir: outdirStamp(), quick: opts.quick ? path.join(quickRoot, String(generation)) : null };
   goodPrint = print;
