@@ -13,6 +13,8 @@
 
 static void mark_triangle(const double uv[6], uint32_t w, uint32_t h, uint32_t samples, uint8_t *map)
 {
+    double box[4];
+    lmb_triangle_box_2d(uv, box);
     long x0 = (long)floor(fmin(uv[0], fmin(uv[2], uv[4]))) - 1, x1 = (long)floor(fmax(uv[0], fmax(uv[2], uv[4]))) + 1;
     long y0 = (long)floor(fmin(uv[1], fmin(uv[3], uv[5]))) - 1, y1 = (long)floor(fmax(uv[1], fmax(uv[3], uv[5]))) + 1;
     x0 = x0 < 0 ? 0 : x0;
@@ -30,7 +32,7 @@ static void mark_triangle(const double uv[6], uint32_t w, uint32_t h, uint32_t s
                 lmb_texel_subsample(k, samples, p);
                 p[0] += (double)x;
                 p[1] += (double)y;
-                if (lmb_closest_on_triangle_2d(uv, p, &b1, &b2) <= 1.0) {
+                if (!lmb_box_beyond_2d(box, p, 1.0) && lmb_closest_on_triangle_2d(uv, p, &b1, &b2) <= 1.0) {
                     seen = 1;
 #pragma omp atomic write
                     *t = 1;

@@ -224,8 +224,9 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
             uint32_t f = list ? list[n] : n;
             if (c->chart_of[f] == UINT32_MAX)
                 continue;
-            double uv[6];
+            double uv[6], box[4];
             lmb_layout_uv(l, i, f, uv);
+            lmb_triangle_box_2d(uv, box);
             long x0 = (long)floor(fmin(uv[0], fmin(uv[2], uv[4]))) - 1,
                  x1 = (long)floor(fmax(uv[0], fmax(uv[2], uv[4]))) + 1, y0, y1;
             triangle_rows(uv, &y0, &y1);
@@ -240,6 +241,8 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
                         if (bb->dist == 0.0f)
                             continue; /* inside an earlier triangle: nothing is closer, and ties keep the first */
                         double sp[2] = {offset[2 * k] + (double)x, offset[2 * k + 1] + (double)y}, b1 = 0, b2 = 0;
+                        if (lmb_box_beyond_2d(box, sp, bb->dist < 1.0f ? (double)bb->dist : 1.0))
+                            continue; /* it could not come closer than the best so far, nor within a texel */
                         double d = lmb_closest_on_triangle_2d(uv, sp, &b1, &b2);
                         if (d <= 1.0 && d < bb->dist) {
                             bb->dist = (float)d;

@@ -11,6 +11,14 @@ void lmb_texel_subsample(uint32_t k, uint32_t samples, double out[2])
     out[1] = ((k / sx) + 0.5) / sy;
 }
 
+void lmb_triangle_box_2d(const double *uv, double box[4])
+{
+    box[0] = fmin(uv[0], fmin(uv[2], uv[4]));
+    box[1] = fmin(uv[1], fmin(uv[3], uv[5]));
+    box[2] = fmax(uv[0], fmax(uv[2], uv[4]));
+    box[3] = fmax(uv[1], fmax(uv[3], uv[5]));
+}
+
 double lmb_closest_on_triangle_2d(const double *uv, const double p[2], double *b1, double *b2)
 {
     double ax = uv[0], ay = uv[1];
