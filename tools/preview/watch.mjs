@@ -349,7 +349,7 @@ function listen(watched) {
     try {
       const l = { names, watcher: null };
       l.watcher = fs.watch(dir, { persistent: false }, (_, name) => { if (!name || l.names.has(String(name))) safeTick(); });
-      l.watcher.on('error', () => { l.watcher.close(); });
+      l.watcher.on('error', () => { l.watcher.close(); listening.delete(dir); }); // listened to again at the next tick
       listening.set(dir, l);
     } catch { /* polled only */ }
   }
