@@ -9,12 +9,16 @@
 //   - with the moved lamp's direct light alone (`bake --direct-of`) before and after, in both
 //     layouts, F1 + Q2 - Q1 - (QD2 - QD1) + (D2 - D1) is closer to F2 still; a correction of
 //     nothing (D1 - D1) leaves F1 texel for texel;
-//   - a quick look of another layout (the texel density changed) is refused with a reason.
+//   - a quick look of another layout (the texel density changed) is refused with a reason;
+//   - a lamp made 3x as bright: its direct light baked again equals its direct light before times
+//     3 (compose.mjs scaleBake) to the .hdr's rounding; the watch's powerScale (watch-inputs.mjs)
+//     gives that factor for changes of intensity and colour alone and none for any other.
 //   usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { compose, mapQuicks, readBake, readHdr } from '../../tools/preview/compose.mjs';
+import { compose, mapQuicks, readBake, readHdr, scaleBake } from '../../tools/preview/compose.mjs';
+import { changedLights, fingerprint } from '../../tools/preview/watch-inputs.mjs';
 
 const [lmbake, work] = process.argv.slice(2);
 if (!work) { console.error('usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR'); process.exit(1); }
@@ -105,4 +109,43 @@ fs.writeFileSync(cfg32, 'texel_density: 32\nsamples: {gather: 256}\n');
 const Q32 = bakeState('q32', { quick: true, config: cfg32 });
 const other = compose({ final: F2, quickBefore: Q2, quickAfter: Q32, out: path.join(work, 'other'), stem });
 check(!other.ok && /layout|atlas/.test(other.why), `a quick look of another layout is refused: ${other.why}`);
+// the corner lamp (moved) 3x as bright: its direct light baked, against the one before times 3
+doc.extensions.KHR_lights_punctual.lights[doc.extensions.KHR_lights_punctual.lights.length - 1].intensity *= 3;
+const D3 = bakeState('d3', { extra: ['--direct-of', 'corner'] });
+scaleBake(D2.final, path.join(work, 'd2x3'), [3, 3, 3]);
+const baked = readHdr(path.join(D3, hdr)), scaled = readHdr(path.join(work, 'd2x3', hdr));
+let worst = 0, sumB = 0, sumS = 0;
+for (let i = 0; i < baked.data.length; i++) {
+  if (i % 4 === 3) continue;
+  worst = Math.max(worst, Math.abs(baked.data[i] - scaled.data[i]) / Math.max(baked.data[i], 1e-3));
+  sumB += baked.data[i]; sumS += scaled.data[i];
+}
+check(sumB > 0 && worst <= 1 / 64 && Math.abs(sumS / sumB - 1) < 1e-3, `a lamp 3x as bright: its direct light before times 3 is the baked one within ${(100 * worst).toFixed(2)}% a texel (want at most 1.6%, the .hdr's rounding), ${(100 * (sumS / sumB - 1)).toFixed(4)}% in all`);
+// powerScale: the factor for intensity and colour alone, none for anything else
+const lightLevel = (edit) => {
+  const d = { asset: { version: '2.0' }, extensions: { KHR_lights_punctual: { lights: [{ name: 'a', type: 'point', intensity: 2 }, { name: 'b', type: 'spot', intensity: 4, color: [1, 1, 1], spot: { outerConeAngle: 0.5 } }] } }, nodes: [{ name: 'lamp a', translation: [0, 1, 0], extensions: { KHR_lights_punctual: { light: 0 } } }, { name: 'lamp b', extensions: { KHR_lights_punctual: { light: 1 } } }], scenes: [{ nodes: [0, 1] }], scene: 0 };
+  edit(d);
+  const file = path.join(work, 'lights.gltf');
+  fs.writeFileSync(file, JSON.stringify(d));
+  return fingerprint(file, [], {});
+};
+const base = lightLevel(() => {});
+const scaleOf = (edit) => { const r = changedLights(base, lightLevel(edit)); return r.why ? r.why : JSON.stringify(r.scale); };
+const cases = [
+  ['a 2x', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 4; }, '[2,2,2]'],
+  ['a recoloured', (d) => { d.extensions.KHR_lights_punctual.lights[0].color = [1, 0.5, 0.25]; }, '[1,0.5,0.25]'],
+  ['a and b 3x', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 6; d.extensions.KHR_lights_punctual.lights[1].intensity = 12; }, '[3,3,3]'],
+  ['a 2x, b 3x', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 4; d.extensions.KHR_lights_punctual.lights[1].intensity = 12; }, 'null'],
+  ['a moved', (d) => { d.nodes[0].translation = [1, 1, 0]; }, 'null'],
+  ['a 2x and given a range', (d) => { Object.assign(d.extensions.KHR_lights_punctual.lights[0], { intensity: 4, range: 5 }); }, 'null'],
+  ["b's cone", (d) => { d.extensions.KHR_lights_punctual.lights[1].spot.outerConeAngle = 0.6; }, 'null'],
+  ['a off', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 0; }, '[0,0,0]'],
+];
+for (const [what, edit, want] of cases) {
+  const got = scaleOf(edit);
+  check(got === want, `powerScale, ${what}: ${got} (want ${want})`);
+}
+const off = lightLevel((d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 0; });
+const on = changedLights(off, base);
+check(on.scale === null, `powerScale, a from off to on: ${JSON.stringify(on.scale)} (want null: nothing to scale)`);
 process.exit(failures ? 1 : 0);

@@ -35,6 +35,7 @@ import { HDRLoader } from 'three/examples/jsm/loaders/HDRLoader.js';
 const FLOAT_TYPE = 1015; // three's FloatType: HDRLoader decodes to float32 RGBA
 const MAX_TRIANGLES = 5e6; // placed triangles mapped one by one at most (about 2 s here)
 const PAD_PASSES = 8; // texels beyond the triangles filled from a neighbour, at most this far out
+const KEEP_TEXELS = 8e6; // the composer keeps the quick look before read through its map up to this many final texels
 const HDR_KEPT = 6; // decoded .hdr files a composer keeps (the final's, the quick looks', the corrections')
 
 // A bake's folder: {dir, stem, doc (the glTF's JSON), buffer(i) (read once)}.
@@ -141,20 +142,14 @@ function layoutSignature(g) {
   return h.digest('hex');
 }
 
-// The map's recorder for one final atlas (dst) read from quick atlas qa (qw x qh texels): put(t,
-// u, v) says final texel t reads the quick atlas at (u, v), bilinearly; a texel put again (two
-// triangles' edges) keeps the last.
-function recorder(dst, qa, qw, qh) {
+// The map's recorder for one final atlas (dst) read from quick atlas qa: put(t, u, v) says
+// final texel t reads the quick atlas at (u, v); a texel put again (two triangles' edges) keeps
+// the last.
+function recorder(dst, qa) {
   return (t, u, v) => {
-    const x = Math.min(Math.max(u * qw - 0.5, 0), qw - 1), y = Math.min(Math.max(v * qh - 0.5, 0), qh - 1);
-    const x0 = Math.floor(x), y0 = Math.floor(y), x1 = Math.min(x0 + 1, qw - 1), y1 = Math.min(y0 + 1, qh - 1);
-    const fx = x - x0, fy = y - y0;
-    let k = dst.slot[t];
-    if (k < 0) { k = dst.count++; dst.slot[t] = k; dst.texel.push(t); }
-    dst.qatlas[k] = qa;
-    const o = 4 * k;
-    dst.tap[o] = y0 * qw + x0; dst.tap[o + 1] = y0 * qw + x1; dst.tap[o + 2] = y1 * qw + x0; dst.tap[o + 3] = y1 * qw + x1;
-    dst.wt[o] = (1 - fx) * (1 - fy); dst.wt[o + 1] = fx * (1 - fy); dst.wt[o + 2] = (1 - fx) * fy; dst.wt[o + 3] = fx * fy;
+    dst.u[t] = u;
+    dst.v[t] = v;
+    dst.qatlas[t] = qa;
     dst.covered[t] = 1;
   };
 }
@@ -243,15 +238,17 @@ function applyPad(pad, delta) {
 
 // The map from the final bake f's atlases to quick bake q's layout (layoutSignature): {atlases
 // (the final's, readAtlases), byAtlas: final atlas -> {width, height, covered (1: a triangle's or
-// copy's texel), texel, qatlas, tap (4 texel indices a texel), wt (their bilinear weights), pad
-// (padPlan)}, quickSize: quick atlas -> [width, height]} or {why} when the bakes do not correspond.
+// copy's texel), u, v, qatlas (per texel: where in which quick atlas it reads, bilinearly; float32:
+// 11 bytes a texel in all), pad (padPlan)}, quickSize: quick atlas -> [width, height]} or {why}
+// when the bakes do not correspond.
 function buildMap(f, q, read) {
   const nf = lightmappedNodes(f), nq = lightmappedNodes(q);
   if (!(nf.length === nq.length && nf.every((x, i) => x.node === nq[i].node && x.mesh === nq[i].mesh && x.rects.length === nq[i].rects.length))) return { why: 'the bakes light different nodes' };
   const atlases = readAtlases(f, read), qAtlases = readAtlases(q, read);
   const build = new Map();
   for (const [a, img] of atlases) {
-    build.set(a, { width: img.width, height: img.height, covered: new Uint8Array(img.width * img.height), slot: new Int32Array(img.width * img.height).fill(-1), count: 0, texel: [], qatlas: [], tap: [], wt: [] });
+    const n = img.width * img.height;
+    build.set(a, { width: img.width, height: img.height, covered: new Uint8Array(n), u: new Float32Array(n), v: new Float32Array(n), qatlas: new Uint16Array(n) });
   }
   const fMeshes = new Map(), qMeshes = new Map(), meshChecked = new Map();
   let triangles = 0;
@@ -259,7 +256,7 @@ function buildMap(f, q, read) {
     const fn = nf[k], qn = nq[k];
     const dst = build.get(fn.atlas), qimg = qAtlases.get(qn.atlas);
     if (!dst || !qimg) return { why: `node ${fn.node}: an atlas has no .hdr` };
-    const put = recorder(dst, qn.atlas, qimg.width, qimg.height);
+    const put = recorder(dst, qn.atlas);
     const fp = meshUv1(f, fn.mesh, fMeshes), qp = meshUv1(q, qn.mesh, qMeshes);
     if (!meshChecked.has(fn.mesh)) { // once per mesh: the nodes that share it share its answers
       if (fp.length !== qp.length) return { why: `mesh ${fn.mesh}: the bakes' primitives differ` };
@@ -291,7 +288,7 @@ function buildMap(f, q, read) {
   }
   const byAtlas = new Map();
   for (const [a, b] of build) {
-    byAtlas.set(a, { width: b.width, height: b.height, covered: b.covered, texel: Int32Array.from(b.texel), qatlas: Int32Array.from(b.qatlas), tap: Int32Array.from(b.tap), wt: Float64Array.from(b.wt), pad: padPlan(b.width, b.height, b.covered) });
+    byAtlas.set(a, { ...b, pad: padPlan(b.width, b.height, b.covered) });
   }
   const quickSize = new Map([...qAtlases].map(([a, img]) => [a, [img.width, img.height]]));
   return { atlases, byAtlas, quickSize };
@@ -306,14 +303,21 @@ function addQuick(map, g, weight, values, read) {
     if (!size || size[0] !== img.width || size[1] !== img.height) return { why: 'the quick looks have different atlases' };
     imgs[a] = img.data;
   }
+  const qwOf = [], qhOf = [];
+  for (const [qa, [w, h]] of map.quickSize) { qwOf[qa] = w; qhOf[qa] = h; }
   for (const [a, m] of map.byAtlas) {
-    const { texel, qatlas, tap, wt } = m, out = values.get(a);
-    for (let k = 0; k < texel.length; k++) {
-      const d = imgs[qatlas[k]], o = 4 * k, t = 3 * texel[k];
+    const { covered, u, v, qatlas } = m, out = values.get(a);
+    for (let t = 0; t < covered.length; t++) {
+      if (!covered[t]) continue;
+      const qa = qatlas[t], d = imgs[qa];
       if (!d) return { why: 'the quick looks have different atlases' };
-      const i0 = 4 * tap[o], i1 = 4 * tap[o + 1], i2 = 4 * tap[o + 2], i3 = 4 * tap[o + 3];
-      const w0 = wt[o], w1 = wt[o + 1], w2 = wt[o + 2], w3 = wt[o + 3];
-      for (let c = 0; c < 3; c++) out[t + c] += weight * (w0 * d[i0 + c] + w1 * d[i1 + c] + w2 * d[i2 + c] + w3 * d[i3 + c]);
+      const qw = qwOf[qa], qh = qhOf[qa];
+      const x = Math.min(Math.max(u[t] * qw - 0.5, 0), qw - 1), y = Math.min(Math.max(v[t] * qh - 0.5, 0), qh - 1);
+      const x0 = Math.floor(x), y0 = Math.floor(y), x1 = Math.min(x0 + 1, qw - 1), y1 = Math.min(y0 + 1, qh - 1);
+      const fx = x - x0, fy = y - y0;
+      const i0 = 4 * (y0 * qw + x0), i1 = 4 * (y0 * qw + x1), i2 = 4 * (y1 * qw + x0), i3 = 4 * (y1 * qw + x1);
+      const w0 = (1 - fx) * (1 - fy), w1 = fx * (1 - fy), w2 = (1 - fx) * fy, w3 = fx * fy;
+      for (let c = 0; c < 3; c++) out[3 * t + c] += weight * (w0 * d[i0 + c] + w1 * d[i1 + c] + w2 * d[i2 + c] + w3 * d[i3 + c]);
     }
   }
   return {};
@@ -419,8 +423,24 @@ export function encodeHdr(width, height, rgba) {
   return out.subarray(0, o);
 }
 
-function linkOrCopy(from, to) {
+export function linkOrCopy(from, to) {
   try { fs.linkSync(from, to); } catch { fs.copyFileSync(from, to); }
+}
+
+// A bake folder made from another (made here) with its light times a factor per channel: every
+// lightmap .hdr's texels times `scale` ([r, g, b]), every other file linked (or copied). Light is
+// linear in what emits it: the watch's correction of a lamp made brighter or recoloured is its
+// state before, scaled, instead of a bake of its state after (the same to the .hdr's rounding).
+export function scaleBake(from, to, scale) {
+  fs.mkdirSync(to, { recursive: true });
+  for (const name of fs.readdirSync(from)) {
+    const src = path.join(from, name), dst = path.join(to, name);
+    if (!fs.statSync(src).isFile()) continue;
+    if (!/\.hdr$/i.test(name)) { linkOrCopy(src, dst); continue; }
+    const img = readHdr(src), d = img.data;
+    for (let i = 0; i < d.length; i += 4) { d[i] *= scale[0]; d[i + 1] *= scale[1]; d[i + 2] *= scale[2]; }
+    fs.writeFileSync(dst, encodeHdr(img.width, img.height, d));
+  }
 }
 
 // The watch's composer: compose() as below, keeping what the next composition on the same final
@@ -446,13 +466,16 @@ export function createComposer() {
     kept = { key, sig, map, before: null };
     return kept;
   };
-  // -(quick look before) through the map, kept by its files' stamps
+  // -(quick look before) through the map, kept by its files' stamps (up to KEEP_TEXELS final
+  // texels: 24 bytes each)
   const before = (k, qb) => {
     const key = [...readAtlases(qb, () => ({}))].map(([, x]) => stamp(path.join(qb.dir, x.hdr))).join('|');
     if (!k.before || k.before.key !== key) {
       const values = zeros(k.map);
       const r = addQuick(k.map, qb, -1, values, read);
       if (r.why) return r;
+      const texels = [...k.map.byAtlas.values()].reduce((n, m) => n + m.width * m.height, 0);
+      if (texels > KEEP_TEXELS) return { values };
       k.before = { key, values };
     }
     return { values: k.before.values };
@@ -477,7 +500,7 @@ export function createComposer() {
       return { ok: false, why: `cannot read a bake (${e.message})` };
     }
     if (base.why) return { ok: false, why: base.why };
-    const values = new Map([...base.values].map(([a, v]) => [a, new Float64Array(v)]));
+    const values = k.before && k.before.values === base.values ? new Map([...base.values].map(([a, v]) => [a, new Float64Array(v)])) : base.values;
     for (const [g, weight] of [[qa, 1], ...(c ? [[c.quickDirectAfter, -1], [c.quickDirectBefore, 1]] : [])]) {
       const r = addQuick(k.map, g, weight, values, read);
       if (r.why) return { ok: false, why: r.why };

@@ -89,7 +89,7 @@ export function fingerprint(level, files, keys) {
   const defs = (lights.ext && lights.ext.lights) || [];
   const lightList = lightNodes.map((i) => {
     const n = json.nodes[i], def = defs[n.extensions.KHR_lights_punctual.light] || {};
-    return { node: i, name: def.name || '', nodeName: n.name || '', hash: hashBytes(JSON.stringify({ n, def })) };
+    return { node: i, name: def.name || '', nodeName: n.name || '', hash: hashBytes(JSON.stringify({ n, def })), nodeJson: JSON.stringify(n), def };
   });
   return {
     lights: hashBytes(JSON.stringify(lights)), materials: hashBytes(JSON.stringify(materials)),
@@ -98,9 +98,28 @@ export function fingerprint(level, files, keys) {
   };
 }
 
+// The one factor per channel that takes every changed light from its state before to its state
+// after, when they changed in intensity and colour alone (same node, same type, cone and range):
+// their direct light after is then the one before times it (light is linear in its power).
+// [r, g, b], or null.
+function powerScale(before, changed) {
+  const power = (d) => [0, 1, 2].map((c) => (d.intensity ?? 1) * ((d.color || [1, 1, 1])[c] ?? 1));
+  const shape = (d) => JSON.stringify({ ...d, intensity: undefined, color: undefined });
+  let scale = null;
+  for (const l of changed) {
+    const b = before.lightList.find((o) => o.node === l.node);
+    if (!b || b.nodeJson !== l.nodeJson || shape(b.def) !== shape(l.def)) return null;
+    const pb = power(b.def), pa = power(l.def), s = pa.map((x, c) => x / pb[c]);
+    if (!s.every((x) => Number.isFinite(x) && x >= 0) || (scale && !s.every((x, c) => x === scale[c]))) return null;
+    scale = s;
+  }
+  return scale;
+}
+
 // The punctual lights a change of lights alone touched, each with a name that picks it alone
-// (`lmbake bake --direct-of`: a glob over light and light node names): {names, before, after}
-// (before/after: a key of those lights' state, for reusing a correction), or {why}.
+// (`lmbake bake --direct-of`: a glob over light and light node names): {names, before, after,
+// scale} (before/after: a key of those lights' state, for reusing a correction; scale:
+// powerScale's factor or null), or {why}.
 export function changedLights(before, after) {
   if (before.lightList.length !== after.lightList.length || before.lightList.some((l, i) => l.node !== after.lightList[i].node)) return { why: 'the light nodes differ' };
   const changed = after.lightList.filter((l, i) => l.hash !== before.lightList[i].hash);
@@ -113,7 +132,7 @@ export function changedLights(before, after) {
   }
   if (names.length > 16) return { why: 'more than 16 lights changed' };
   const key = (fp) => hashBytes(JSON.stringify([names, changed.map((l) => fp.lightList.find((o) => o.node === l.node).hash), fp.geometry, fp.keys]));
-  return { names, before: key(before), after: key(after) };
+  return { names, before: key(before), after: key(after), scale: powerScale(before, changed) };
 }
 
 // What changed between two fingerprints: {what: ['lights', 'config samples.gather', ...],

@@ -16,7 +16,7 @@ import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { projectRoot, resolveFile, TYPES } from './server.mjs';
 import { watchedFiles, snapshot, configKeys, fingerprint, compare, changedLights } from './watch-inputs.mjs';
-import { createComposer } from './compose.mjs';
+import { createComposer, linkOrCopy, scaleBake } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
 const POLL_MS = 100; // how often the files' sizes and times are looked at (and on every inotify event)
@@ -171,7 +171,7 @@ function showBake({ generation, kind, revision, seen, change, layoutKept, compos
   if (status.history.length > 50) status.history.shift();
   status.error = null;
   const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}`;
-  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (the direct light of ${correction.names.map((n) => `'${n}'`).join(', ')} at the final's resolution)`);
+  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (the direct light of ${correction.names.map((n) => `'${n}'`).join(', ')} at the final's resolution${correction.scaled ? `; its state before, scaled` : ''})`);
   else say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${what}${composed !== null ? `; composed on final bake ${composed}` : ''})`);
   tidyQuickDirs();
   tidyLayouts();
@@ -187,9 +187,10 @@ function outdirStamp() {
 // of the changed lights, in the final's layout and in the quick look's, after the change and
 // before it (the last final's level, rebuilt in a private folder), each state's two bakes in
 // QUICK/corrections/KEY. A state baked for the change before is reused: the lamp an artist moves
-// again was this change's "after". Resolves to {names, directBefore, directAfter,
-// quickDirectBefore, quickDirectAfter}, null (no correction; the log says why when it is not
-// obvious) or {cancelled: true}.
+// again was this change's "after"; lights made brighter or recoloured bake only their state
+// before and scale it. Resolves to {names, scaled, directBefore, directAfter, quickDirectBefore,
+// quickDirectAfter}, null (no correction; the log says why when it is not obvious) or
+// {cancelled: true}.
 async function correctionBakes(generation, change, fp) {
   const base = status.lastGood;
   if (!base || !base.quick || change.layout || change.what.length !== 1 || change.what[0] !== 'lights') return null;
@@ -199,24 +200,45 @@ async function correctionBakes(generation, change, fp) {
   const root = path.join(quickRoot, 'corrections');
   const stateDir = (key) => path.join(root, key.slice(0, 24));
   const extra = lights.names.flatMap((n) => ['--direct-of', n]);
-  for (const [key, level] of [[lights.after, opts.level], [lights.before, null]]) {
+  const done = (key) => fs.existsSync(path.join(stateDir(key), 'done'));
+  // a state's two bakes: the lights' direct light in the final's layout and in the quick look's
+  const bakeState = async (key, level) => {
     const dir = stateDir(key);
-    if (fs.existsSync(path.join(dir, 'done'))) continue;
     fs.rmSync(dir, { recursive: true, force: true });
     let from = level;
     if (!from) {
-      try { from = writeLevelCopy(base.fp.level, path.join(quickRoot, 'before-level')); } catch (e) { return skip(`the level as it was: ${e.message}`); }
+      try { from = writeLevelCopy(base.fp.level, path.join(quickRoot, 'before-level')); } catch (e) { return { result: skip(`the level as it was: ${e.message}`) }; }
     }
     for (const [sub, more] of [['direct', []], ['quick', ['--quick']]]) {
       const r = await bake('correction', generation, { level: from, out: path.join(dir, sub), extra: [...extra, ...more] });
-      if (r.cancelled || dirty) return { cancelled: true };
-      if (!r.ok) return skip(`lmbake bake --direct-of: ${r.error.split('\n')[0]}`);
+      if (r.cancelled || dirty) return { result: { cancelled: true } };
+      if (!r.ok) return { result: skip(`lmbake bake --direct-of: ${r.error.split('\n')[0]}`) };
     }
     fs.writeFileSync(path.join(dir, 'done'), '');
+    return {};
+  };
+  // Lights changed in intensity and colour alone: the state after is the state before scaled
+  // (watch-inputs.mjs powerScale), so only the state before is baked.
+  const scaled = lights.scale !== null && !done(lights.after);
+  for (const [key, level] of scaled ? [[lights.before, null]] : [[lights.after, opts.level], [lights.before, null]]) {
+    if (done(key)) continue;
+    const r = await bakeState(key, level);
+    if ('result' in r) return r.result;
+  }
+  if (scaled) {
+    try { scaleState(stateDir(lights.before), stateDir(lights.after), lights.scale); } catch (e) { return skip(`the state before scaled: ${e.message}`); }
   }
   for (const d of fs.readdirSync(root)) if (![lights.after, lights.before].some((k) => k.startsWith(d))) fs.rmSync(path.join(root, d), { recursive: true, force: true });
   const [after, before] = [stateDir(lights.after), stateDir(lights.before)];
-  return { names: lights.names, directAfter: path.join(after, 'direct'), quickDirectAfter: path.join(after, 'quick'), directBefore: path.join(before, 'direct'), quickDirectBefore: path.join(before, 'quick') };
+  return { names: lights.names, scaled, directAfter: path.join(after, 'direct'), quickDirectAfter: path.join(after, 'quick'), directBefore: path.join(before, 'direct'), quickDirectBefore: path.join(before, 'quick') };
+}
+
+// A correction state made from another by a factor per channel (compose.mjs scaleBake: the same
+// as baking the lights at the new power, to the .hdr's rounding), then its `done` mark.
+function scaleState(from, to, scale) {
+  fs.rmSync(to, { recursive: true, force: true });
+  for (const sub of ['direct', 'quick']) scaleBake(path.join(from, sub), path.join(to, sub), scale);
+  fs.writeFileSync(path.join(to, 'done'), '');
 }
 
 // The level as a fingerprint read it ({file, bytes, json}), written into dir (emptied) with the
@@ -233,9 +255,7 @@ function writeLevelCopy(level, dir) {
     const rel = path.normalize(decodeURIComponent(x.uri));
     if (path.isAbsolute(rel) || rel.startsWith('..')) throw new Error(`'${x.uri}' is outside the level's folder`);
     fs.mkdirSync(path.dirname(path.join(dir, rel)), { recursive: true });
-    if (!fs.existsSync(path.join(dir, rel))) {
-      try { fs.linkSync(path.join(from, rel), path.join(dir, rel)); } catch { fs.copyFileSync(path.join(from, rel), path.join(dir, rel)); }
-    }
+    if (!fs.existsSync(path.join(dir, rel))) linkOrCopy(path.join(from, rel), path.join(dir, rel));
   }
   return copy;
 }
@@ -255,7 +275,7 @@ function composeQuick(generation, change, correction) {
   else if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
   else {
     try {
-      const { names, ...dirs } = correction || {}; // eslint-disable-line no-unused-vars
+      const { names, scaled, ...dirs } = correction || {}; // eslint-disable-line no-unused-vars
       r = composer.compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, correction: correction ? dirs : null });
     } catch (e) {
       r = { ok: false, why: e.message };
