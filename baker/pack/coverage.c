@@ -15,8 +15,8 @@ static void mark_triangle(const double uv[6], uint32_t w, uint32_t h, uint32_t s
 {
     double box[4];
     lmb_triangle_box_2d(uv, box);
-    long x0 = (long)floor(fmin(uv[0], fmin(uv[2], uv[4]))) - 1, x1 = (long)floor(fmax(uv[0], fmax(uv[2], uv[4]))) + 1;
-    long y0 = (long)floor(fmin(uv[1], fmin(uv[3], uv[5]))) - 1, y1 = (long)floor(fmax(uv[1], fmax(uv[3], uv[5]))) + 1;
+    long x0 = (long)floor(box[0]) - 1, x1 = (long)floor(box[2]) + 1;
+    long y0 = (long)floor(box[1]) - 1, y1 = (long)floor(box[3]) + 1;
     x0 = x0 < 0 ? 0 : x0;
     y0 = y0 < 0 ? 0 : y0;
     x1 = x1 >= (long)w ? (long)w - 1 : x1;

@@ -227,8 +227,7 @@ static void rasterize(const lmb_layout *l, const lmb_scene *s, uint32_t atlas, u
             double uv[6], box[4];
             lmb_layout_uv(l, i, f, uv);
             lmb_triangle_box_2d(uv, box);
-            long x0 = (long)floor(fmin(uv[0], fmin(uv[2], uv[4]))) - 1,
-                 x1 = (long)floor(fmax(uv[0], fmax(uv[2], uv[4]))) + 1, y0, y1;
+            long x0 = (long)floor(box[0]) - 1, x1 = (long)floor(box[2]) + 1, y0, y1;
             triangle_rows(uv, &y0, &y1);
             x0 = x0 < 0 ? 0 : x0;
             y0 = y0 < (long)y0_band ? (long)y0_band : y0;
