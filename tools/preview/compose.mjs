@@ -349,7 +349,7 @@ export function mapQuicks(f, quicks) {
   const map = buildMap(f, quicks[0].g, readHdr);
   if (map.why) return map;
   const sig = layoutSignature(quicks[0].g);
-  if (!quicks.every((q) => layoutSignature(q.g) === sig)) return { why: 'the quick looks have different layouts' };
+  if (!quicks.slice(1).every((q) => layoutSignature(q.g) === sig)) return { why: 'the quick looks have different layouts' };
   const values = zeros(map);
   for (const q of quicks) {
     const r = addQuick(map, q.g, q.weight, values, readHdr);
@@ -457,9 +457,20 @@ export function createComposer() {
     if (hdrKept.size > HDR_KEPT) hdrKept.delete(hdrKept.keys().next().value);
     return img;
   };
+  // layoutSignature by the bake's glTF stamp: the quick look before and the correction states are
+  // the same files from one change to the next
+  const sigKept = new Map();
+  const signature = (g) => {
+    const key = stamp(path.join(g.dir, `${g.stem}.gltf`));
+    if (!sigKept.has(key)) {
+      sigKept.set(key, layoutSignature(g));
+      if (sigKept.size > 2 * HDR_KEPT) sigKept.delete(sigKept.keys().next().value);
+    }
+    return sigKept.get(key);
+  };
   let kept = null; // {key, sig, map, before: {key, values}}: the last final and quick layout's map
   const mapFor = (f, q) => {
-    const sig = layoutSignature(q), key = `${stamp(path.join(f.dir, `${f.stem}.gltf`))}|${sig}`;
+    const sig = signature(q), key = `${stamp(path.join(f.dir, `${f.stem}.gltf`))}|${sig}`;
     if (kept && kept.key === key) return kept;
     const map = buildMap(f, q, read);
     if (map.why) return map;
@@ -494,7 +505,7 @@ export function createComposer() {
       k = mapFor(f, qb);
       if (k.why) return { ok: false, why: k.why };
       const quicks = [qa, ...(c ? [c.quickDirectAfter, c.quickDirectBefore] : [])];
-      if (!quicks.every((q) => layoutSignature(q) === k.sig)) return { ok: false, why: 'the quick looks have different layouts' };
+      if (!quicks.every((q) => signature(q) === k.sig)) return { ok: false, why: 'the quick looks have different layouts' };
       base = before(k, qb);
     } catch (e) {
       return { ok: false, why: `cannot read a bake (${e.message})` };
