@@ -159,15 +159,19 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     add_light(c, l, d, rgb, e);
 }
 
-void lmb_sun_disc_direction(const lmb_config *cfg, const lmb_light *l, double u1, double u2, double d[3])
+void lmb_sun_disc_init(const lmb_config *cfg, const lmb_light *l, lmb_sun_disc *disc)
 {
-    double half = 0.5 * cfg->sun_angle * LMB_PI / 180.0, cos_max = cos(half), axis[3], t[3], b[3];
+    disc->cos_max = cos(0.5 * cfg->sun_angle * LMB_PI / 180.0);
     for (int k = 0; k < 3; k++)
-        axis[k] = -l->direction[k];
-    lmb_frame(axis, t, b);
-    double ct = 1 - u1 * (1 - cos_max), st = sqrt(fmax(0.0, 1 - ct * ct)), phi = 2 * LMB_PI * u2;
+        disc->axis[k] = -l->direction[k];
+    lmb_frame(disc->axis, disc->t, disc->b);
+}
+
+void lmb_sun_disc_direction(const lmb_sun_disc *disc, double u1, double u2, double d[3])
+{
+    double ct = 1 - u1 * (1 - disc->cos_max), st = sqrt(fmax(0.0, 1 - ct * ct)), phi = 2 * LMB_PI * u2;
     for (int k = 0; k < 3; k++)
-        d[k] = ct * axis[k] + st * (cos(phi) * t[k] + sin(phi) * b[k]);
+        d[k] = ct * disc->axis[k] + st * (cos(phi) * disc->t[k] + sin(phi) * disc->b[k]);
 }
 
 /* A directional light as a disc of angular diameter lights.sun_angle: c->samples directions
@@ -175,14 +179,15 @@ void lmb_sun_disc_direction(const lmb_config *cfg, const lmb_light *l, double u1
  * stratified disc: its penumbrae converge faster than with independent directions). */
 static void sun_disc(point_ctx *c, const lmb_light *l, uint32_t which, double e[3])
 {
-    double cos_max = cos(0.5 * c->d->cfg->sun_angle * LMB_PI / 180.0);
+    lmb_sun_disc disc;
+    lmb_sun_disc_init(c->d->cfg, l, &disc);
     uint32_t n = c->samples;
-    double scale = c->d->cfg->light_intensity_scale * l->intensity / (0.5 * (1 + cos_max)) / n;
-    uint64_t key = lmb_mix64(c->sequence ^ (0x53554e00ull + which));
+    double scale = c->d->cfg->light_intensity_scale * l->intensity / (0.5 * (1 + disc.cos_max)) / n;
+    lmb_qmc_seq seq = lmb_qmc_sequence(lmb_mix64(c->sequence ^ (0x53554e00ull + which)));
     for (uint32_t s = 0; s < n; s++) {
         double u[2], d[3];
-        lmb_qmc_2d(key, c->first + s, u);
-        lmb_sun_disc_direction(c->d->cfg, l, u[0], u[1], d);
+        lmb_qmc_point(&seq, c->first + s, u);
+        lmb_sun_disc_direction(&disc, u[0], u[1], d);
         double cosang = lmb_dot3(c->n, d);
         if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
             continue;
@@ -252,10 +257,10 @@ static void local_lights(point_ctx *c, lmb_rng *rng, double e[3])
             punctual(c, &all[reach[i]], 1.0, e);
         return;
     }
-    uint64_t key = lmb_mix64(c->sequence ^ 0x4c4f43414cull);
+    lmb_qmc_seq seq = lmb_qmc_sequence(lmb_mix64(c->sequence ^ 0x4c4f43414cull));
     for (uint32_t s = 0; s < n; s++) {
         double u[2], p;
-        lmb_qmc_2d(key, c->first + s, u);
+        lmb_qmc_point(&seq, c->first + s, u);
         uint32_t k = lmb_cdf_pick(cdf, m, u[0], &p);
         punctual(c, &all[reach[k]], 1.0 / (p * n), e);
     }
@@ -298,11 +303,12 @@ static void area_lights(point_ctx *c, double e[3])
     const lmb_emitters *es = c->d->emitters;
     uint32_t n = c->samples, m = (n + COSINE_SHARE - 1) / COSINE_SHARE;
     double total = es->cdf[es->count];
-    uint64_t light_key = lmb_mix64(c->sequence ^ 0x41524541ull), cos_key = lmb_mix64(c->sequence ^ 0x434f5300ull);
+    lmb_qmc_seq light_seq = lmb_qmc_sequence(lmb_mix64(c->sequence ^ 0x41524541ull));
+    lmb_qmc_seq cos_seq = lmb_qmc_sequence(lmb_mix64(c->sequence ^ 0x434f5300ull));
     for (uint32_t s = 0; s < n; s++) {
         /* light sample */
         double prob, u[2];
-        lmb_qmc_2d(light_key, c->first + s, u);
+        lmb_qmc_point(&light_seq, c->first + s, u);
         uint32_t pick = lmb_emitter_pick(es, u[0], &prob);
         const emitter *x = &es->e[pick];
         double lo = es->cdf[pick] / total, u2 = prob > 0 ? (u[0] - lo) / prob : 0.5, u3 = u[1];
@@ -333,7 +339,7 @@ static void area_lights(point_ctx *c, double e[3])
     for (uint32_t s = 0; s < m; s++) {
         /* cosine sample */
         double v[2], t1[3], t2[3], w[3];
-        lmb_qmc_2d(cos_key, c->first / n * m + s, v); /* round r: cosine points r m .. */
+        lmb_qmc_point(&cos_seq, c->first / n * m + s, v); /* round r: cosine points r m .. */
         double v1 = v[0], v2 = v[1];
         double r = sqrt(v1), phi = 2 * LMB_PI * v2, cz = sqrt(fmax(0, 1 - v1));
         lmb_frame(c->n, t1, t2);

@@ -83,8 +83,16 @@ int lmb_emitter_radiance(const emitter *x, double b1, double b2, const double d[
 /* c := the shading point sp of d, no rays traced yet. */
 void lmb_point_init(point_ctx *c, const lmb_direct *d, const lmb_shading_point *sp);
 
-/* Direction (unit, toward the sun) of the sample (u1, u2) of directional light l as a disc of
- * lights.sun_angle: uniform in its cone of directions. */
-void lmb_sun_disc_direction(const lmb_config *cfg, const lmb_light *l, double u1, double u2, double d[3]);
+/* A directional light as a disc of lights.sun_angle: its cone's cosine and a frame about its
+ * axis (toward the sun), made once per light and point rather than per sample. */
+typedef struct lmb_sun_disc {
+    double cos_max, axis[3], t[3], b[3];
+} lmb_sun_disc;
+
+void lmb_sun_disc_init(const lmb_config *cfg, const lmb_light *l, lmb_sun_disc *disc);
+
+/* Direction (unit, toward the sun) of the sample (u1, u2) of the disc: uniform in its cone of
+ * directions. */
+void lmb_sun_disc_direction(const lmb_sun_disc *disc, double u1, double u2, double d[3]);
 
 #endif

@@ -16,9 +16,11 @@ static double visibility(point_ctx *c, const lmb_light *l, lmb_rng *rng)
     double d[3], dist = 1e300;
     if (l->type == LMB_LIGHT_DIRECTIONAL && c->d->cfg->sun_angle > 0) {
         uint32_t seen = 0;
+        lmb_sun_disc disc;
+        lmb_sun_disc_init(c->d->cfg, l, &disc);
         for (uint32_t s = 0; s < c->samples; s++) {
             double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng);
-            lmb_sun_disc_direction(c->d->cfg, l, u1, u2, d);
+            lmb_sun_disc_direction(&disc, u1, u2, d);
             if (lmb_dot3(c->n, d) <= 0 || lmb_dot3(c->ng, d) <= 0)
                 continue;
             c->rays++;

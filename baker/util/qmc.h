@@ -49,18 +49,51 @@ static inline uint32_t lmb_qmc_hash(uint64_t x)
     return (uint32_t)x;
 }
 
-/* Point `index` of the scrambled sequence `key`: u[0], u[1] in [0, 1). */
-static inline void lmb_qmc_2d(uint64_t key, uint32_t index, double u[2])
+/* Sobol's second dimension before its final bit reversal: the Pascal matrix mod 2 applied to i.
+ * Bit k of the result is the XOR of i's bits j with C(j, k) odd, that is (Lucas) with j a
+ * superset of k's bits: a superset sum over the five bits of a bit position, one shift and
+ * mask each (Burley's paper, section 3, loops over the 32 columns instead; same values,
+ * checked against that loop in tests/unit/test_qmc.c). */
+static inline uint32_t lmb_qmc_pascal(uint32_t i)
 {
-    uint32_t i = lmb_qmc_owen(index, lmb_qmc_hash(key));
-    uint32_t x = lmb_qmc_reverse(i), y = 0; /* dimension 0: van der Corput */
-    for (uint32_t v = 0x80000000u; i; i >>= 1, v ^= v >> 1) /* dimension 1: Pascal's matrix mod 2 */
-        if (i & 1)
-            y ^= v;
-    x = lmb_qmc_owen(x, lmb_qmc_hash(key ^ 0x9E3779B97F4A7C15ull));
-    y = lmb_qmc_owen(y, lmb_qmc_hash(key ^ 0xD1B54A32D192ED03ull));
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0F0F0F0Fu;
+    i ^= (i >> 8) & 0x00FF00FFu;
+    i ^= (i >> 16) & 0x0000FFFFu;
+    return i;
+}
+
+/* One scrambled sequence: its three scramble seeds (the index's and each coordinate's), hashed
+ * from its key once rather than at every point. */
+typedef struct lmb_qmc_seq {
+    uint32_t index_seed, x_seed, y_seed;
+} lmb_qmc_seq;
+
+static inline lmb_qmc_seq lmb_qmc_sequence(uint64_t key)
+{
+    lmb_qmc_seq q = {lmb_qmc_hash(key), lmb_qmc_hash(key ^ 0x9E3779B97F4A7C15ull),
+                     lmb_qmc_hash(key ^ 0xD1B54A32D192ED03ull)};
+    return q;
+}
+
+/* Point `index` of the scrambled sequence q: u[0], u[1] in [0, 1). Dimension 0 is van der
+ * Corput's (the bit reversal of the scrambled index), dimension 1 the Pascal matrix's; each is
+ * Owen-scrambled, reverse(permute(reverse(.))), whose inner reversal undoes the sequence's own. */
+static inline void lmb_qmc_point(const lmb_qmc_seq *q, uint32_t index, double u[2])
+{
+    uint32_t i = lmb_qmc_owen(index, q->index_seed);
+    uint32_t x = lmb_qmc_reverse(lmb_qmc_lk_permute(i, q->x_seed));
+    uint32_t y = lmb_qmc_reverse(lmb_qmc_lk_permute(lmb_qmc_pascal(i), q->y_seed));
     u[0] = x * (1.0 / 4294967296.0);
     u[1] = y * (1.0 / 4294967296.0);
+}
+
+/* Point `index` of the scrambled sequence `key` (lmb_qmc_point with its seeds hashed here). */
+static inline void lmb_qmc_2d(uint64_t key, uint32_t index, double u[2])
+{
+    lmb_qmc_seq q = lmb_qmc_sequence(key);
+    lmb_qmc_point(&q, index, u);
 }
 
 #endif
