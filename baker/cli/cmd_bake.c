@@ -10,10 +10,12 @@
 #include "progress.h"
 #include "timings.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static const char help[] =
     "usage: lmbake bake SCENE [options]\n"
@@ -39,6 +41,10 @@ static const char help[] =
     "                      node names; repeatable, at most 16): no bounces, sky or emissive\n"
     "                      surfaces, only the .hdr and .png (the watch's correction of a\n"
     "                      changed light, docs/watch.md)\n"
+    "      --direct-out DIR\n"
+    "                      write the direct stage's light as soon as it is known, per atlas\n"
+    "                      as DIR/<name>-lightmap-N.hdr, and say so in the log (what preview\n"
+    "                      --watch refines its quick picture with, docs/watch.md)\n"
     "      --plan PLAN     start from a plan written by 'lmbake plan' (same input and config,\n"
     "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
     "      --layout-cache DIR\n"
@@ -64,6 +70,7 @@ static const char help[] =
 typedef struct bake_args {
     const char *scene, *config, *outdir, *plan, *farm;
     const char *layout_cache; /* --layout-cache DIR */
+    const char *direct_out;   /* --direct-out DIR */
     const char *timings_csv; /* --timings=CSV */
     int timings;
     long long threads, seed, rays, method; /* -1: from the config */
@@ -149,6 +156,12 @@ static int parse_args(int argc, char **argv, bake_args *a)
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
             a->layout_cache = v;
+        } else if ((r = cli_opt_value(argc, argv, &i, "--direct-out", NULL, &v)) != 0) {
+            if (r < 0 || !*v)
+                return cli_usage_error("bake", "%s needs a folder", argv[i]);
+            if (strlen(v) >= sizeof ((lmb_config *)0)->direct_out)
+                return cli_usage_error("bake", "--direct-out: the folder's path is too long");
+            a->direct_out = v;
         } else if ((r = cli_opt_value(argc, argv, &i, "--farm", NULL, &v)) != 0) {
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
@@ -359,8 +372,10 @@ static int check_stage_args(stage_kind stage, bake_args *a, char *plan_path, siz
                                a->workers, a->shards);
 
     if (stage != STAGE_BAKE &&
-        (a->plan || a->reference || a->print_config || a->quick || a->layout_cache || a->direct_of_count))
-        return cli_usage_error(name, "--plan, --layout-cache, --quick, --direct-of, --reference and --print-config are "
+        (a->plan || a->reference || a->print_config || a->quick || a->layout_cache || a->direct_of_count ||
+         a->direct_out))
+        return cli_usage_error(name, "--plan, --layout-cache, --quick, --direct-of, --direct-out, --reference and "
+                               "--print-config are "
                                "'lmbake bake' options");
     if (a->plan && a->layout_cache)
         return cli_usage_error(name, "--plan and --layout-cache both give the layout: one or the other");
@@ -422,6 +437,14 @@ static int run(int argc, char **argv, stage_kind stage)
         lmb_config_quick(&cfg);
     if (a.direct_of_count && lmb_config_direct_of(&cfg, a.direct_of, a.direct_of_count, &err) != LMB_OK)
         return cli_fail(&err);
+    if (a.direct_out) {
+        if (mkdir(a.direct_out, 0777) != 0 && errno != EEXIST) {
+            lmb_error_set(&err, LMB_ERR_INPUT, "--direct-out: cannot make the folder '%s' (%s)", a.direct_out,
+                          strerror(errno));
+            return cli_fail(&err);
+        }
+        snprintf(cfg.direct_out, sizeof cfg.direct_out, "%s", a.direct_out);
+    }
     if (a.print_config) {
         size_t n = lmb_config_write(&cfg, NULL, 0);
         char *text = malloc(n + 1);

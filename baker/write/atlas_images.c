@@ -156,6 +156,19 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
     return st;
 }
 
+lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
+                               const float *irradiance, uint32_t w, uint32_t h, lmb_error *err)
+{
+    float *rgb = scaled_copy(cfg, irradiance, (size_t)w * h);
+    if (!rgb)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
+    image_job job = {IMAGE_F32, "", 3, rgb, NULL, 0, 0};
+    snprintf(job.path, sizeof job.path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
+    lmb_status st = write_images(&job, 1, w, h, image_threads(cfg), err);
+    free(rgb);
+    return st;
+}
+
 lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
                                       const float *d, uint32_t w, uint32_t h, lmb_error *err)
 {

@@ -30,6 +30,11 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
 lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
                                       const float *d, uint32_t width, uint32_t height, lmb_error *err);
 
+/* <stem>-lightmap-N.hdr alone in dir: irradiance (3 floats per texel) as output.scale says, as the
+ * lightmap's own .hdr is written (the watch's direct light, watch/direct_out.h). */
+lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
+                               const float *irradiance, uint32_t width, uint32_t height, lmb_error *err);
+
 /* output.shadowmask: <stem>-lightmap-N-shadowmask.png, RGBA8, per channel a light's visibility
  * (4 floats per texel in [0, 1]), linear. */
 lmb_status lmb_write_shadowmask_image(const char *dir, const char *stem, uint32_t atlas, const float *v, uint32_t width,

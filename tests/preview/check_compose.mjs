@@ -1,24 +1,22 @@
 #!/usr/bin/env node
 // The watch's composed quick picture (tools/preview/compose.mjs, docs/watch.md): on
 // tools/make_scenes.py's cornell-point box with a second lamp low in a corner, baked final and
-// quick (F1, Q1), then the second lamp moved across the floor and baked again (F2, Q2):
-//   - a change of nothing, F1 + Q1 - Q1, gives F1's .hdr back texel for texel (as the page reads it);
+// quick (F1, Q1), then the second lamp moved across the floor and baked again (F2, Q2), every bake
+// writing its direct stage's light (`bake --direct-out`: DF1, DQ1, DF2, DQ2):
+//   - a change of nothing, F1 + Q1 - Q1, gives F1's .hdr back texel for texel (as the page reads it),
+//     and so does its refinement with the direct light, F1 + Q1 - Q1 - (DQ1 - DQ1) + (DF1 - DF1);
 //   - F1 + Q2 - Q1 is closer to F2 than the quick look Q2 alone (both read in F2's atlas, 9 x 9
 //     texel box averages over the texels a triangle covers, rms of the luminance difference over
 //     F2's mean), and within 5%;
-//   - with the moved lamp's direct light alone (`bake --direct-of`) before and after, in both
-//     layouts, F1 + Q2 - Q1 - (QD2 - QD1) + (D2 - D1) is closer to F2 still; a correction of
-//     nothing (D1 - D1) leaves F1 texel for texel;
+//   - refined with the direct light, F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1) is closer to F2 still;
 //   - a quick look of another layout (the texel density changed) is refused with a reason;
-//   - a lamp made 3x as bright: its direct light baked again equals its direct light before times
-//     3 (compose.mjs scaleBake) to the .hdr's rounding; the watch's powerScale (watch-inputs.mjs)
-//     gives that factor for changes of intensity and colour alone and none for any other.
+//   - `--direct-out` changes no output byte, and what it writes is the direct light in the
+//     lightmap's units: with no bounces, the lightmap itself to within its denoising.
 //   usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { compose, mapQuicks, readBake, readHdr, scaleBake } from '../../tools/preview/compose.mjs';
-import { changedLights, fingerprint } from '../../tools/preview/watch-inputs.mjs';
+import { compose, mapQuicks, readBake, readHdr } from '../../tools/preview/compose.mjs';
 
 const [lmbake, work] = process.argv.slice(2);
 if (!work) { console.error('usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR'); process.exit(1); }
@@ -37,20 +35,20 @@ doc.scenes[doc.scene || 0].nodes.push(doc.nodes.length - 1);
 const cfg = path.join(work, 'bake.yaml');
 fs.writeFileSync(cfg, 'texel_density: 16\nsamples: {gather: 256}\n');
 
+// The level as doc stands, baked into WORK/TAG/out, its direct light into WORK/TAG/direct.
 function bakeState(tag, { quick = false, config = cfg, extra = [] } = {}) {
   const dir = path.join(work, tag);
   fs.mkdirSync(dir, { recursive: true });
   for (const b of doc.buffers) if (!b.uri.startsWith('data:')) fs.copyFileSync(path.join(work, 'scenes', b.uri), path.join(dir, b.uri));
   fs.writeFileSync(path.join(dir, `${stem}.gltf`), JSON.stringify(doc));
   const out = path.join(dir, 'out');
-  execFileSync(lmbake, ['bake', path.join(dir, `${stem}.gltf`), '-c', config, '-o', out, '-q', ...(quick ? ['--quick'] : []), ...extra]);
+  execFileSync(lmbake, ['bake', path.join(dir, `${stem}.gltf`), '-c', config, '-o', out, '-q', '--direct-out', path.join(dir, 'direct'), ...(quick ? ['--quick'] : []), ...extra]);
   return out;
 }
-// the corner lamp's direct light alone (`--direct-of`), in the final's layout and the quick look's
-const direct = (tag) => ({ final: bakeState(`d${tag}`, { extra: ['--direct-of', 'corner'] }), quick: bakeState(`qd${tag}`, { quick: true, extra: ['--direct-of', 'corner'] }) });
-const F1 = bakeState('f1'), Q1 = bakeState('q1', { quick: true }), Q1again = bakeState('q1-again', { quick: true }), D1 = direct(1);
+const directOf = (out) => path.join(path.dirname(out), 'direct');
+const F1 = bakeState('f1'), Q1 = bakeState('q1', { quick: true }), Q1again = bakeState('q1-again', { quick: true });
 doc.nodes[doc.nodes.length - 1].translation = [0.8, 0.15, 0.75];
-const F2 = bakeState('f2'), Q2 = bakeState('q2', { quick: true }), D2 = direct(2);
+const F2 = bakeState('f2'), Q2 = bakeState('q2', { quick: true });
 
 // a change of nothing: the final's .hdr back
 const same = compose({ final: F1, quickBefore: Q1, quickAfter: Q1again, out: path.join(work, 'same'), stem });
@@ -58,9 +56,9 @@ const hdr = `${stem}-lightmap-0.hdr`;
 const a = same.ok ? readHdr(path.join(work, 'same', hdr)) : null, b = readHdr(path.join(F1, hdr));
 check(same.ok && a.width === b.width && a.height === b.height && a.data.every((x, i) => x === b.data[i]),
   `F1 + Q1 - Q1 is F1's .hdr texel for texel, as the page reads it (${same.ok ? `${same.ms} ms` : same.why})`);
-const sameCorrected = compose({ final: F1, quickBefore: Q1, quickAfter: Q1again, out: path.join(work, 'same-corrected'), stem, correction: { directBefore: D1.final, directAfter: D1.final, quickDirectBefore: D1.quick, quickDirectAfter: D1.quick } });
-const c = sameCorrected.ok ? readHdr(path.join(work, 'same-corrected', hdr)) : null;
-check(sameCorrected.ok && c.data.every((x, i) => x === b.data[i]), `and with the lamp's direct light taken off and put back: F1 again (${sameCorrected.ok ? `${sameCorrected.ms} ms` : sameCorrected.why})`);
+const sameRefined = compose({ final: F1, quickBefore: Q1, quickAfter: Q1again, out: path.join(work, 'same-refined'), stem, direct: { before: directOf(F1), after: directOf(F1), quickBefore: directOf(Q1), quickAfter: directOf(Q1again) } });
+const c = sameRefined.ok ? readHdr(path.join(work, 'same-refined', hdr)) : null;
+check(sameRefined.ok && c.data.every((x, i) => x === b.data[i]), `and refined with the direct light of the same bakes again: F1 again (${sameRefined.ok ? `${sameRefined.ms} ms` : sameRefined.why})`);
 const gltf = JSON.parse(fs.readFileSync(path.join(work, 'same', `${stem}.gltf`), 'utf8'));
 const files = gltf.textures.filter((t) => t.extras && t.extras.lightmap).map((t) => Object.keys(t.extras.lightmap.files).sort().join(','));
 check(files.every((f) => f === 'hdr,png'), `the composed glTF names only its .hdr and .png (${files.join('; ')})`);
@@ -98,10 +96,12 @@ const error = (values) => {
 };
 const eQuick = error(quickAlone.mapped.get(0).value), eComposed = error(composed.mapped.get(0).value);
 check(eComposed < eQuick && eComposed <= 0.05, `the corner lamp moved: F1 + Q2 - Q1 is ${(100 * eComposed).toFixed(2)}% from F2, the quick look alone ${(100 * eQuick).toFixed(2)}% (9 x 9 rms; want below the quick look's and at most 5%)`);
-// with the lamp's direct light at the final's resolution: F1 + Q2 - Q1 - (QD2 - QD1) + (D2 - D1)
-const corrected = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'corrected'), stem, correction: { directBefore: D1.final, directAfter: D2.final, quickDirectBefore: D1.quick, quickDirectAfter: D2.quick } });
-const eCorrected = corrected.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'corrected'), stem), weight: 1 }]).mapped.get(0).value) : 1;
-check(corrected.ok && eCorrected < eComposed, `and with the lamp's direct light at the final's resolution: ${(100 * eCorrected).toFixed(2)}% from F2 (want below ${(100 * eComposed).toFixed(2)}%; ${corrected.ok ? `${corrected.ms} ms` : corrected.why})`);
+// refined with the direct light at the final's resolution: F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1)
+const refined = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'refined'), stem, direct: { before: directOf(F1), after: directOf(F2), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
+const eRefined = refined.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'refined'), stem), weight: 1 }]).mapped.get(0).value) : 1;
+check(refined.ok && eRefined < eComposed, `and refined with the direct light at the final's resolution: ${(100 * eRefined).toFixed(2)}% from F2 (want below ${(100 * eComposed).toFixed(2)}%; ${refined.ok ? `${refined.ms} ms` : refined.why})`);
+const missing = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'missing'), stem, direct: { before: directOf(F1), after: path.join(work, 'nowhere'), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
+check(!missing.ok && /direct light/.test(missing.why) && !fs.existsSync(path.join(work, 'missing')), `a direct light not written is refused, nothing written: ${missing.why}`);
 
 // another layout: refused, with the reason
 const cfg32 = path.join(work, 'bake32.yaml');
@@ -109,43 +109,22 @@ fs.writeFileSync(cfg32, 'texel_density: 32\nsamples: {gather: 256}\n');
 const Q32 = bakeState('q32', { quick: true, config: cfg32 });
 const other = compose({ final: F2, quickBefore: Q2, quickAfter: Q32, out: path.join(work, 'other'), stem });
 check(!other.ok && /layout|atlas/.test(other.why), `a quick look of another layout is refused: ${other.why}`);
-// the corner lamp (moved) 3x as bright: its direct light baked, against the one before times 3
-doc.extensions.KHR_lights_punctual.lights[doc.extensions.KHR_lights_punctual.lights.length - 1].intensity *= 3;
-const D3 = bakeState('d3', { extra: ['--direct-of', 'corner'] });
-scaleBake(D2.final, path.join(work, 'd2x3'), [3, 3, 3]);
-const baked = readHdr(path.join(D3, hdr)), scaled = readHdr(path.join(work, 'd2x3', hdr));
-let worst = 0, sumB = 0, sumS = 0;
-for (let i = 0; i < baked.data.length; i++) {
-  if (i % 4 === 3) continue;
-  worst = Math.max(worst, Math.abs(baked.data[i] - scaled.data[i]) / Math.max(baked.data[i], 1e-3));
-  sumB += baked.data[i]; sumS += scaled.data[i];
+// --direct-out: the same output; with no bounces, its light is the lightmap's (in the same units)
+const cfg0 = path.join(work, 'bake0.yaml');
+fs.writeFileSync(cfg0, 'texel_density: 16\nbounces: 0\noutput: {scale: radiance}\n');
+const plain = path.join(work, 'plain0');
+execFileSync(lmbake, ['bake', path.join(work, 'f2', `${stem}.gltf`), '-c', cfg0, '-o', plain, '-q']);
+const withDirect = bakeState('f2-direct0', { config: cfg0 });
+const names = fs.readdirSync(plain).sort();
+const differ = names.filter((n) => !fs.readFileSync(path.join(plain, n)).equals(fs.readFileSync(path.join(withDirect, n))));
+check(names.length > 3 && differ.length === 0 && fs.readdirSync(withDirect).length === names.length, `--direct-out changes no output file (${names.length} files; differ: ${differ.join(', ') || 'none'})`);
+const lightmap = readHdr(path.join(withDirect, hdr)), written = readHdr(path.join(directOf(withDirect), hdr));
+let se = 0, sum = 0, n = 0;
+for (let i = 0; i < lightmap.width * lightmap.height; i++) {
+  if (!covered[i] || lightmap.width !== final.width) continue;
+  const l = lum(lightmap.data, i, 4), d = lum(written.data, i, 4);
+  se += (l - d) ** 2; sum += l; n++;
 }
-check(sumB > 0 && worst <= 1 / 64 && Math.abs(sumS / sumB - 1) < 1e-3, `a lamp 3x as bright: its direct light before times 3 is the baked one within ${(100 * worst).toFixed(2)}% a texel (want at most 1.6%, the .hdr's rounding), ${(100 * (sumS / sumB - 1)).toFixed(4)}% in all`);
-// powerScale: the factor for intensity and colour alone, none for anything else
-const lightLevel = (edit) => {
-  const d = { asset: { version: '2.0' }, extensions: { KHR_lights_punctual: { lights: [{ name: 'a', type: 'point', intensity: 2 }, { name: 'b', type: 'spot', intensity: 4, color: [1, 1, 1], spot: { outerConeAngle: 0.5 } }] } }, nodes: [{ name: 'lamp a', translation: [0, 1, 0], extensions: { KHR_lights_punctual: { light: 0 } } }, { name: 'lamp b', extensions: { KHR_lights_punctual: { light: 1 } } }], scenes: [{ nodes: [0, 1] }], scene: 0 };
-  edit(d);
-  const file = path.join(work, 'lights.gltf');
-  fs.writeFileSync(file, JSON.stringify(d));
-  return fingerprint(file, [], {});
-};
-const base = lightLevel(() => {});
-const scaleOf = (edit) => { const r = changedLights(base, lightLevel(edit)); return r.why ? r.why : JSON.stringify(r.scale); };
-const cases = [
-  ['a 2x', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 4; }, '[2,2,2]'],
-  ['a recoloured', (d) => { d.extensions.KHR_lights_punctual.lights[0].color = [1, 0.5, 0.25]; }, '[1,0.5,0.25]'],
-  ['a and b 3x', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 6; d.extensions.KHR_lights_punctual.lights[1].intensity = 12; }, '[3,3,3]'],
-  ['a 2x, b 3x', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 4; d.extensions.KHR_lights_punctual.lights[1].intensity = 12; }, 'null'],
-  ['a moved', (d) => { d.nodes[0].translation = [1, 1, 0]; }, 'null'],
-  ['a 2x and given a range', (d) => { Object.assign(d.extensions.KHR_lights_punctual.lights[0], { intensity: 4, range: 5 }); }, 'null'],
-  ["b's cone", (d) => { d.extensions.KHR_lights_punctual.lights[1].spot.outerConeAngle = 0.6; }, 'null'],
-  ['a off', (d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 0; }, '[0,0,0]'],
-];
-for (const [what, edit, want] of cases) {
-  const got = scaleOf(edit);
-  check(got === want, `powerScale, ${what}: ${got} (want ${want})`);
-}
-const off = lightLevel((d) => { d.extensions.KHR_lights_punctual.lights[0].intensity = 0; });
-const on = changedLights(off, base);
-check(on.scale === null, `powerScale, a from off to on: ${JSON.stringify(on.scale)} (want null: nothing to scale)`);
+const rel = n ? Math.sqrt(se / n) / (sum / n) : 1;
+check(written.width === lightmap.width && written.height === lightmap.height && n > 1000 && rel < 0.02, `with no bounces the direct light written is the lightmap (radiance units) within ${(100 * rel).toFixed(3)}% rms a texel over ${n} texels (want below 2%: the denoiser and the direct refinement)`);
 process.exit(failures ? 1 : 0);

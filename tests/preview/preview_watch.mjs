@@ -5,11 +5,13 @@
 // points of the picture (floor, walls, ceiling, a block) the page's pixels change to bake 2's
 // quick values, then to its final ones, without a reload (a marker on the page's window
 // survives) and with the camera unchanged. Bake 2's final pixels are 3x bake 1's in linear light
-// (the bake is linear in the light; 3% and 2 levels allowed for the 8-bit screenshot), its quick
-// ones are those the plain preview shows of bake 1's final composed with the two files' quick
-// looks (`lmbake bake --quick`) and the light's direct light alone (`--direct-of`, in both
-// layouts; tools/preview/compose.mjs). Then a half-written level: the page shows the error and keeps bake
-// 2's pixels exactly. Screenshots in SHOTS_DIR (preview-watch-*.png).
+// (the bake is linear in the light; 3% and 2 levels allowed for the 8-bit screenshot). Its quick
+// picture is shown twice: first what the plain preview shows of bake 1's final composed with the
+// two files' quick looks (`lmbake bake --quick`), then, once bake 2's final bake has its direct
+// light, that refined with the direct light of both files' final and quick bakes (`--direct-out`,
+// tools/preview/compose.mjs). The final bake is held (SIGSTOP) while each is read. Then a
+// half-written level: the page shows the error and keeps bake 2's pixels exactly. Screenshots in
+// SHOTS_DIR (preview-watch-*.png).
 //   usage: node tests/preview/preview_watch.mjs LMBAKE WORKDIR SHOTS_DIR
 import fs from 'node:fs';
 import path from 'node:path';
@@ -25,7 +27,8 @@ const root = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..',
 const linear = (c) => { c /= 255; return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4); };
 
 // the level: cornell-point.gltf and its buffer, copied; a config whose final bake is slow enough
-// (1,024 gather rays, 4 bounces) for the quick picture to be seen first
+// after its direct stage (4,096 gather rays, 4 bounces: seconds) for the refined quick picture to be
+// seen before the final one
 fs.rmSync(work, { recursive: true, force: true });
 execFileSync('python3', [path.join(root, 'tools', 'make_scenes.py'), path.join(work, 'scenes')], { stdio: 'ignore' });
 const dir = path.join(work, 'level');
@@ -37,7 +40,11 @@ for (const b of doc.buffers || []) if (b.uri && !b.uri.startsWith('data:')) fs.c
 const save = () => fs.writeFileSync(level, JSON.stringify(doc, null, 1));
 save();
 const cfg = path.join(dir, 'bake.yaml');
-fs.writeFileSync(cfg, 'texel_density: 16\nbounces: 4\nsamples: {gather: 1024, bounce: 256}\n');
+fs.writeFileSync(cfg, 'texel_density: 16\nbounces: 4\nsamples: {gather: 4096, bounce: 1024}\n');
+// the direct light of a bake of cfg, written as the watch's bakes write it, without their bounces
+// (the direct stage does not depend on them)
+const cfgDirect = path.join(work, 'direct.yaml');
+fs.writeFileSync(cfgDirect, 'texel_density: 16\nbounces: 0\nsamples: {gather: 4096, bounce: 1024}\n');
 
 const watch = spawn(lmbake, ['preview', '--watch', level, '-c', cfg, '-o', path.join(work, 'out')], { stdio: ['ignore', 'pipe', 'inherit'] });
 let log = '';
@@ -74,36 +81,42 @@ try {
   const camera = async () => (await page.frames().filter((x) => x !== page.mainFrame()).pop().evaluate(() => window.lmbCamera()));
   const b1 = await pixels('bake1'), cam1 = await camera();
   check(b1.every((px) => Math.max(...px) > 8 && Math.max(...px) < 150), `bake 1 shown; pixels ${JSON.stringify(b1)}`);
-  // what bake 2's quick picture is composed from: bake 1's final (OUTDIR, copied now) and the
-  // quick look of bake 1's file (baked here as the watch did)
+  // what bake 2's quick picture is composed from: bake 1's final (OUTDIR, copied now), the quick
+  // look of bake 1's file and the direct light of both (baked here as the watch did)
   const final1 = path.join(work, 'final1'), quick1 = path.join(work, 'quick1');
   fs.cpSync(path.join(work, 'out'), final1, { recursive: true });
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quick1, '--quick', '-q']);
-  // and the changed light's direct light alone, in the final's layout and the quick look's
-  const directOf = (tag) => ['direct', 'qdirect'].map((k) => {
-    const out = path.join(work, `${k}${tag}`);
-    execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', out, '--direct-of', 'ceiling_point', ...(k === 'qdirect' ? ['--quick'] : []), '-q']);
+  const directOf = (tag) => ['final', 'quick'].map((k) => {
+    const out = path.join(work, `direct-${k}${tag}`);
+    execFileSync(lmbake, ['bake', level, '-c', cfgDirect, '-o', `${out}-bake`, '--direct-out', out, ...(k === 'quick' ? ['--quick'] : []), '-q']);
     return out;
   });
   const [direct1, qdirect1] = directOf(1);
 
   doc.extensions.KHR_lights_punctual.lights[0].intensity *= 3;
   save();
-  // hold the final bake (SIGSTOP) once it runs, so the quick picture is on screen to be read
-  // however fast the final would come; let it go on after
+  // hold bake 2's final bake (SIGSTOP) as soon as it runs, and again as soon as the quick picture
+  // is refined from its direct light, so that each picture is on screen to be read however fast
+  // the final would come; let it go on after
   const status = async () => (await fetch(url + 'status')).json();
-  let held = null;
-  for (let k = 0; k < 2400 && !held; k++) {
-    const st = await status();
-    if (st.baking && st.baking.generation === 2 && st.baking.kind === 'final') { held = st.baking.pid; process.kill(held, 'SIGSTOP'); }
-    else if (st.shown && st.shown.generation === 2 && st.shown.kind === 'final') break;
-    else await new Promise((r) => setTimeout(r, 25));
-  }
-  check(held !== null, `bake 2's final bake held while the quick one is read (pid ${held})`);
-  await shown(2, 'quick', 1); // revision 1: refined with the changed light's direct light
+  const hold = async (until) => {
+    for (let k = 0; k < 24000; k++) {
+      const st = await status();
+      if (until(st) && st.baking && st.baking.generation === 2 && st.baking.kind === 'final') { process.kill(st.baking.pid, 'SIGSTOP'); return st.baking.pid; }
+      if (st.shown && st.shown.generation === 2 && st.shown.kind === 'final') return null;
+      await new Promise((r) => setTimeout(r, 5));
+    }
+    return null;
+  };
+  let held = await hold(() => true);
+  check(held !== null, `bake 2's final bake held while the first quick picture is read (pid ${held})`);
+  await shown(2, 'quick', 0);
   const q2 = await pixels('bake2-quick'), camQ = await camera(), statusQ = await status();
-  check(statusQ.history.some((h) => h.generation === 2 && h.kind === 'quick' && h.revision === 0),
-    `bake 2's quick picture was shown before it was refined (/status history: ${JSON.stringify(statusQ.history.filter((h) => h.generation === 2))})`);
+  if (held) process.kill(held, 'SIGCONT');
+  held = await hold((st) => st.shown && st.shown.generation === 2 && st.shown.revision === 1);
+  check(held !== null, `bake 2's final bake held again once it refined the quick picture (pid ${held})`);
+  await shown(2, 'quick', 1); // revision 1: refined with the direct light at the final's resolution
+  const q2r = await pixels('bake2-quick-refined'), statusR = await status();
   if (held) process.kill(held, 'SIGCONT');
   await shown(2, 'final');
   const f2 = await pixels('bake2-final'), cam2 = await camera();
@@ -115,24 +128,31 @@ try {
     }
   }
   // the quick picture: bake 1's final plus the change at the quick look's resolution (bake 2's
-  // quick look less bake 1's, compose.mjs; its values are checked in watch_compose): what the
-  // plain preview shows of that composed from the same camera, within a level
-  const quickDir = path.join(work, 'quick2'), composedDir = path.join(work, 'composed2');
+  // quick look less bake 1's, compose.mjs; its values are checked in watch_compose), then refined
+  // with the direct light's change at the final's: what the plain preview shows of those composed
+  // here, from the same camera, within a level
+  const quickDir = path.join(work, 'quick2');
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quickDir, '--quick', '-q']);
   const [direct2, qdirect2] = directOf(2);
-  const correction = { directBefore: direct1, directAfter: direct2, quickDirectBefore: qdirect1, quickDirectAfter: qdirect2 };
-  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: composedDir, stem: 'cornell-point', correction });
-  check(composed.ok && statusQ.shown.composedOn === 1, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}; here: ${composed.ok || composed.why})`);
-  check(JSON.stringify(statusQ.shown.directOf) === '["ceiling_point"]', `with the changed light's direct light at the final's resolution (/status directOf: ${JSON.stringify(statusQ.shown.directOf)})`);
-  const srv = await startServer(path.join(composedDir, 'cornell-point.gltf'));
-  const v = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: '-7', cam: '0.5,0.5,2.2,0.5,0.45,0' });
-  const png = decodePng(await v.page.screenshot());
-  const wantQuick = [];
-  for (const p of points) { const s = await v.page.evaluate((p) => window.lmbProject(...p), p); wantQuick.push(png.at(Math.round(s.x - 0.5), Math.round(s.y - 0.5))); }
-  await v.context.close();
-  await srv.close();
-  const quickOff = Math.max(...q2.flatMap((px, i) => px.map((x, c) => Math.abs(x - wantQuick[i][c]))));
-  check(quickOff <= 1, `bake 2's quick picture is the composed one: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)} (largest difference ${quickOff})`);
+  const plainPixels = async (composedDir) => {
+    const srv = await startServer(path.join(composedDir, 'cornell-point.gltf'));
+    const v = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: '-7', cam: '0.5,0.5,2.2,0.5,0.45,0' });
+    const png = decodePng(await v.page.screenshot());
+    const at = [];
+    for (const p of points) { const s = await v.page.evaluate((p) => window.lmbProject(...p), p); at.push(png.at(Math.round(s.x - 0.5), Math.round(s.y - 0.5))); }
+    await v.context.close();
+    await srv.close();
+    return at;
+  };
+  const largest = (a, b) => Math.max(...a.flatMap((px, i) => px.map((x, c) => Math.abs(x - b[i][c]))));
+  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'composed2'), stem: 'cornell-point' });
+  check(composed.ok && statusQ.shown.composedOn === 1 && statusQ.shown.revision === 0, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}, revision ${statusQ.shown.revision}; here: ${composed.ok || composed.why})`);
+  const wantQuick = composed.ok ? await plainPixels(path.join(work, 'composed2')) : [];
+  check(composed.ok && largest(q2, wantQuick) <= 1, `bake 2's quick picture is the composed one: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)}`);
+  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: direct1, after: direct2, quickBefore: qdirect1, quickAfter: qdirect2 } });
+  check(refined.ok && statusR.shown.refined === true && statusR.shown.composedOn === 1, `then refined with the direct light at the final's resolution (/status refined: ${JSON.stringify(statusR.shown.refined)}; here: ${refined.ok || refined.why})`);
+  const wantRefined = refined.ok ? await plainPixels(path.join(work, 'refined2')) : [];
+  check(refined.ok && largest(q2r, wantRefined) <= 1, `bake 2's refined quick picture is the refined composition: ${JSON.stringify(q2r)} against ${JSON.stringify(wantRefined)}`);
   check(true, `bake 2 (light x 3): quick ${JSON.stringify(q2)} then final ${JSON.stringify(f2)} against bake 1 ${JSON.stringify(b1)}`);
   const same = (a, b) => a.position.every((v, k) => Math.abs(v - b.position[k]) < 1e-9) && a.target.every((v, k) => Math.abs(v - b.target[k]) < 1e-9);
   check(same(cam1, camQ) && same(cam1, cam2), `the camera stayed where it was (${cam2.position.map((v) => v.toFixed(3))})`);

@@ -13,14 +13,15 @@
 // TEXCOORD_1 in both bakes map rectangle to rectangle instead. Texels no triangle covers (the
 // atlas's padding) take the difference of a covered neighbour.
 //
-// A change of punctual lights can add a correction (the watch's `lmbake bake --direct-of` bakes of
-// the changed lights alone, before and after, in the final's layout and in the quick look's):
+// Once the final bake of the change has its direct light (each bake writes the light of its
+// direct stage beside it, `lmbake bake --direct-out`), the picture is refined:
 //
 //     final(before) + [quick(after) - quick(before)] - [qdirect(after) - qdirect(before)]
 //                   + [direct(after) - direct(before)]
 //
-// the changed lights' direct light is then taken at the final's resolution (texel for texel:
-// the same layout), and only the rest of the change (their bounced light) at the quick look's.
+// with qdirect the quick looks' direct light and direct the two final bakes': the change of the
+// direct light (lights, sky, emissive surfaces) is then taken at the final's resolution (texel for
+// texel: the same layout), and only the rest of the change, its bounced light, at the quick look's.
 // A moved lamp's hot spot, a few texels wide, is what the quick look's resolution blurs.
 //
 // compose(...) writes OUT: the final's glTF with its lightmap textures naming only the composed
@@ -36,7 +37,7 @@ const FLOAT_TYPE = 1015; // three's FloatType: HDRLoader decodes to float32 RGBA
 const MAX_TRIANGLES = 5e6; // placed triangles mapped one by one at most (about 2 s here)
 const PAD_PASSES = 8; // texels beyond the triangles filled from a neighbour, at most this far out
 const KEEP_TEXELS = 8e6; // the composer keeps the quick look before read through its map up to this many final texels
-const HDR_KEPT = 6; // decoded .hdr files a composer keeps (the final's, the quick looks', the corrections')
+const HDR_KEPT = 8; // decoded .hdr files a composer keeps (the final's, the quick looks', the four direct lights')
 
 // A bake's folder: {dir, stem, doc (the glTF's JSON), buffer(i) (read once)}.
 export function readBake(dir, stem) {
@@ -358,19 +359,19 @@ export function mapQuicks(f, quicks) {
   return { atlases: map.atlases, mapped: new Map([...map.byAtlas].map(([a, m]) => [a, { value: values.get(a), covered: m.covered }])) };
 }
 
-// The correction's final-layout part: direct(after) - direct(before), per final atlas (3 floats
-// a texel), or {why} when those bakes are not of the final's layout.
+// The direct light's change at the final's resolution: direct(after) - direct(before), per final
+// atlas (3 floats a texel), or {why} when those bakes are not of the final's layout.
 function directChange(f, atlases, da, db, read) {
   const nf = lightmappedNodes(f);
   const change = new Map();
   for (const g of [da, db]) {
     const n = lightmappedNodes(g);
-    if (n.length !== nf.length || !n.every((x, i) => x.node === nf[i].node && x.atlas === nf[i].atlas && x.rects.length === nf[i].rects.length && x.rects.every((r, k) => sameArray(r, nf[i].rects[k])))) return { why: 'the direct-light bakes are of another layout' };
+    if (n.length !== nf.length || !n.every((x, i) => x.node === nf[i].node && x.atlas === nf[i].atlas && x.rects.length === nf[i].rects.length && x.rects.every((r, k) => sameArray(r, nf[i].rects[k])))) return { why: 'the direct light is of another layout' };
   }
   const [ia, ib] = [readAtlases(da, read), readAtlases(db, read)];
   for (const [a, img] of atlases) {
     const A = ia.get(a), B = ib.get(a);
-    if (!A || !B || A.width !== img.width || A.height !== img.height || B.width !== img.width || B.height !== img.height) return { why: 'the direct-light bakes have other atlases' };
+    if (!A || !B || A.width !== img.width || A.height !== img.height || B.width !== img.width || B.height !== img.height) return { why: 'the direct light has other atlases' };
     const d = new Float32Array(3 * img.width * img.height);
     for (let i = 0, n = img.width * img.height; i < n; i++) for (let c = 0; c < 3; c++) d[3 * i + c] = A.data[4 * i + c] - B.data[4 * i + c];
     change.set(a, d);
@@ -427,22 +428,6 @@ export function linkOrCopy(from, to) {
   try { fs.linkSync(from, to); } catch { fs.copyFileSync(from, to); }
 }
 
-// A bake folder made from another (made here) with its light times a factor per channel: every
-// lightmap .hdr's texels times `scale` ([r, g, b]), every other file linked (or copied). Light is
-// linear in what emits it: the watch's correction of a lamp made brighter or recoloured is its
-// state before, scaled, instead of a bake of its state after (the same to the .hdr's rounding).
-export function scaleBake(from, to, scale) {
-  fs.mkdirSync(to, { recursive: true });
-  for (const name of fs.readdirSync(from)) {
-    const src = path.join(from, name), dst = path.join(to, name);
-    if (!fs.statSync(src).isFile()) continue;
-    if (!/\.hdr$/i.test(name)) { linkOrCopy(src, dst); continue; }
-    const img = readHdr(src), d = img.data;
-    for (let i = 0; i < d.length; i += 4) { d[i] *= scale[0]; d[i + 1] *= scale[1]; d[i + 2] *= scale[2]; }
-    fs.writeFileSync(dst, encodeHdr(img.width, img.height, d));
-  }
-}
-
 // The watch's composer: compose() as below, keeping what the next composition on the same final
 // bake reads again (the last few decoded .hdr files, the map to the quick layout and the quick
 // look before the change read through it). prepare() builds those ahead, while the watch is idle
@@ -494,18 +479,19 @@ export function createComposer() {
 
   // final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
   // look's; out: the folder to write (made here). stem: the level's file name without extension.
-  // correction (optional): {directBefore, directAfter, quickDirectBefore, quickDirectAfter}, the
-  // folders of the changed lights' --direct-of bakes (final's layout, quick look's layout).
-  function compose({ final, quickBefore, quickAfter, out, stem, correction = null }) {
+  // direct (optional): {before, after, quickBefore, quickAfter}, the folders of the direct light
+  // (`lmbake bake --direct-out`) of the last final bake, of this change's final bake and of the
+  // two quick looks: each the .hdr files of its bake's atlases, read with that bake's glTF.
+  function compose({ final, quickBefore, quickAfter, out, stem, direct = null }) {
     const t0 = Date.now();
     let f, qb, qa, c = null, k, base;
     try {
       [f, qb, qa] = [final, quickBefore, quickAfter].map((d) => readBake(d, stem));
-      if (correction) c = Object.fromEntries(Object.entries(correction).map(([key, d]) => [key, readBake(d, stem)]));
+      // a direct-light folder is its bake's atlases: the bake's glTF, the folder's .hdr files
+      if (direct) c = { quickDirectAfter: { ...qa, dir: direct.quickAfter }, quickDirectBefore: { ...qb, dir: direct.quickBefore }, directAfter: { ...f, dir: direct.after }, directBefore: { ...f, dir: direct.before } };
       k = mapFor(f, qb);
       if (k.why) return { ok: false, why: k.why };
-      const quicks = [qa, ...(c ? [c.quickDirectAfter, c.quickDirectBefore] : [])];
-      if (!quicks.every((q) => signature(q) === k.sig)) return { ok: false, why: 'the quick looks have different layouts' };
+      if (signature(qa) !== k.sig) return { ok: false, why: 'the quick looks have different layouts' };
       base = before(k, qb);
     } catch (e) {
       return { ok: false, why: `cannot read a bake (${e.message})` };
@@ -513,16 +499,22 @@ export function createComposer() {
     if (base.why) return { ok: false, why: base.why };
     const values = k.before && k.before.values === base.values ? new Map([...base.values].map(([a, v]) => [a, new Float64Array(v)])) : base.values;
     for (const [g, weight] of [[qa, 1], ...(c ? [[c.quickDirectAfter, -1], [c.quickDirectBefore, 1]] : [])]) {
-      const r = addQuick(k.map, g, weight, values, read);
+      let r;
+      try { r = addQuick(k.map, g, weight, values, read); } catch (e) { r = { why: `cannot read a quick look's light (${e.message})` }; }
       if (r.why) return { ok: false, why: r.why };
     }
-    const direct = c ? directChange(f, k.map.atlases, c.directAfter, c.directBefore, read) : { change: null };
-    if (direct.why) return { ok: false, why: direct.why };
+    let exactPart = { change: null };
+    try {
+      if (c) exactPart = directChange(f, k.map.atlases, c.directAfter, c.directBefore, read);
+    } catch (e) {
+      return { ok: false, why: `cannot read the direct light (${e.message})` };
+    }
+    if (exactPart.why) return { ok: false, why: exactPart.why };
     fs.rmSync(out, { recursive: true, force: true });
     fs.mkdirSync(out, { recursive: true });
     const hdrs = new Set([...k.map.atlases.values()].map((a) => a.hdr));
     for (const [a, img] of k.map.atlases) {
-      const exact = direct.change && direct.change.get(a); // the changed lights' direct light, texel for texel
+      const exact = exactPart.change && exactPart.change.get(a); // the direct light's change, texel for texel
       fs.writeFileSync(path.join(out, img.hdr), composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), exact));
     }
     // The glTF: lightmap files reduced to the composed .hdr and the PNG it carries beside.

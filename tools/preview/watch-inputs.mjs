@@ -16,7 +16,7 @@ const hashBytes = (b) => crypto.createHash('sha256').update(b).digest('hex');
 const hashFile = (f) => { try { return hashBytes(fs.readFileSync(f)); } catch { return 'missing'; } };
 const isFileUri = (u) => typeof u === 'string' && !/^[a-z][a-z0-9+.-]*:/i.test(u);
 
-// The level's glTF JSON (a .glb's JSON chunk), its BIN chunk and the file's bytes, or throws with the reason.
+// The level's glTF JSON (a .glb's JSON chunk) and its BIN chunk, or throws with the reason.
 function readLevel(file) {
   try { return parseLevel(file); } catch (e) { throw new Error(`${file}: ${e.code === 'ENOENT' ? 'missing' : e.message}`); }
 }
@@ -26,9 +26,9 @@ function parseLevel(file) {
     if (bytes.length < 20 || bytes.toString('latin1', 0, 4) !== 'glTF') throw new Error('not a .glb file');
     const jsonLength = bytes.readUInt32LE(12);
     const json = JSON.parse(bytes.toString('utf8', 20, 20 + jsonLength));
-    return { json, bin: bytes.subarray(20 + jsonLength), bytes };
+    return { json, bin: bytes.subarray(20 + jsonLength) };
   }
-  return { json: JSON.parse(bytes.toString('utf8')), bin: null, bytes };
+  return { json: JSON.parse(bytes.toString('utf8')), bin: null };
 }
 
 // The files a watch looks at: [{file, what}], the level first. A level that cannot be read
@@ -78,7 +78,7 @@ export function configKeys(lmbake, config) {
 // A fingerprint of what a bake reads: {lights, materials, geometry, keys, files} (hashes and
 // the config's keys); throws when the level cannot be read.
 export function fingerprint(level, files, keys) {
-  const { json, bin, bytes } = readLevel(level);
+  const { json, bin } = readLevel(level);
   const lightNodes = (json.nodes || []).map((n, i) => (n.extensions && n.extensions.KHR_lights_punctual && n.mesh === undefined ? i : -1)).filter((i) => i >= 0);
   const nodes = (json.nodes || []).map((n, i) => (lightNodes.includes(i) ? { light: n.extensions.KHR_lights_punctual, children: n.children } : n));
   const lights = { ext: json.extensions && json.extensions.KHR_lights_punctual, nodes: lightNodes.map((i) => json.nodes[i]) };
@@ -86,53 +86,10 @@ export function fingerprint(level, files, keys) {
   const rest = { ...json, nodes, materials: undefined, textures: undefined, images: undefined, samplers: undefined, extensions: { ...(json.extensions || {}), KHR_lights_punctual: undefined } };
   const fileHash = {};
   for (const f of files) if (f.what !== 'level' && f.what !== 'config') fileHash[f.file] = { what: f.what, hash: hashFile(f.file) };
-  const defs = (lights.ext && lights.ext.lights) || [];
-  const lightList = lightNodes.map((i) => {
-    const n = json.nodes[i], def = defs[n.extensions.KHR_lights_punctual.light] || {};
-    return { node: i, name: def.name || '', nodeName: n.name || '', hash: hashBytes(JSON.stringify({ n, def })), nodeJson: JSON.stringify(n), def };
-  });
   return {
     lights: hashBytes(JSON.stringify(lights)), materials: hashBytes(JSON.stringify(materials)),
     geometry: hashBytes(JSON.stringify(rest) + (bin ? hashBytes(bin) : '')), keys, files: fileHash,
-    lightList, level: { file: level, bytes, json }, // the level as read: the next change's "before"
   };
-}
-
-// The one factor per channel that takes every changed light from its state before to its state
-// after, when they changed in intensity and colour alone (same node, same type, cone and range):
-// their direct light after is then the one before times it (light is linear in its power).
-// [r, g, b], or null.
-function powerScale(before, changed) {
-  const power = (d) => [0, 1, 2].map((c) => (d.intensity ?? 1) * ((d.color || [1, 1, 1])[c] ?? 1));
-  const shape = (d) => JSON.stringify({ ...d, intensity: undefined, color: undefined });
-  let scale = null;
-  for (const l of changed) {
-    const b = before.lightList.find((o) => o.node === l.node);
-    if (!b || b.nodeJson !== l.nodeJson || shape(b.def) !== shape(l.def)) return null;
-    const pb = power(b.def), pa = power(l.def), s = pa.map((x, c) => x / pb[c]);
-    if (!s.every((x) => Number.isFinite(x) && x >= 0) || (scale && !s.every((x, c) => x === scale[c]))) return null;
-    scale = s;
-  }
-  return scale;
-}
-
-// The punctual lights a change of lights alone touched, each with a name that picks it alone
-// (`lmbake bake --direct-of`: a glob over light and light node names): {names, before, after,
-// scale} (before/after: a key of those lights' state, for reusing a correction; scale:
-// powerScale's factor or null), or {why}.
-export function changedLights(before, after) {
-  if (before.lightList.length !== after.lightList.length || before.lightList.some((l, i) => l.node !== after.lightList[i].node)) return { why: 'the light nodes differ' };
-  const changed = after.lightList.filter((l, i) => l.hash !== before.lightList[i].hash);
-  if (!changed.length) return { why: 'no light node changed' };
-  const names = [];
-  for (const l of changed) {
-    const own = [l.name, l.nodeName].find((p) => p && !/[*?]/.test(p) && after.lightList.filter((o) => o.name === p || o.nodeName === p).length === 1 && before.lightList.filter((o) => o.name === p || o.nodeName === p).length === 1);
-    if (!own) return { why: `light node ${l.node} has no name of its own` };
-    names.push(own);
-  }
-  if (names.length > 16) return { why: 'more than 16 lights changed' };
-  const key = (fp) => hashBytes(JSON.stringify([names, changed.map((l) => fp.lightList.find((o) => o.node === l.node).hash), fp.geometry, fp.keys]));
-  return { names, before: key(before), after: key(after), scale: powerScale(before, changed) };
 }
 
 // What changed between two fingerprints: {what: ['lights', 'config samples.gather', ...],

@@ -15,8 +15,8 @@ import os from 'node:os';
 import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { projectRoot, resolveFile, TYPES } from './server.mjs';
-import { watchedFiles, snapshot, configKeys, fingerprint, compare, changedLights } from './watch-inputs.mjs';
-import { createComposer, linkOrCopy, scaleBake } from './compose.mjs';
+import { watchedFiles, snapshot, configKeys, fingerprint, compare } from './watch-inputs.mjs';
+import { createComposer } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
 const POLL_MS = 100; // how often the files' sizes and times are looked at (and on every inotify event)
@@ -79,18 +79,28 @@ function stopChild(why) {
   status.baking = null;
 }
 
-// One `lmbake bake` of the newest state: quick into QUICK/N, final into OUTDIR, a correction
-// (the changed lights' direct light) wherever `to` says ({level, out, extra: more arguments}).
-// Resolves to {ok, seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
-function bake(kind, generation, to = {}) {
-  const out = to.out || (kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir);
-  const args = ['bake', to.level || opts.level, '-o', out, '--layout-cache', layoutRoot, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : []), ...(to.extra || [])];
+// One `lmbake bake` of the newest state: quick into QUICK/N, final into OUTDIR, each with the
+// light of its direct stage written to QUICK/N-direct-KIND (`--direct-out`; onDirect() is called
+// once the bake says those files are whole). Resolves to {ok, seconds} or {ok: false, error}; a
+// cancelled bake resolves {cancelled: true}.
+const directDir = (generation, kind) => path.join(quickRoot, `${generation}-direct-${kind}`);
+function bake(kind, generation, onDirect = null) {
+  const out = kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir;
+  const direct = directDir(generation, kind);
+  fs.rmSync(direct, { recursive: true, force: true });
+  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, '--direct-out', direct, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
   return new Promise((resolve) => {
     const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     child = p;
     status.baking = { generation, kind, stage: 'load', percent: 0, startedAt: Date.now(), pid: p.pid };
-    let stderr = '', pending = '', stdout = '';
-    p.stdout.on('data', (d) => { if (stdout.length < 65536) stdout += d; });
+    let stderr = '', pending = '', stdout = '', outPending = '';
+    p.stdout.on('data', (d) => {
+      if (stdout.length < 65536) stdout += d;
+      outPending += d;
+      const lines = outPending.split('\n');
+      outPending = lines.pop();
+      for (const l of lines) if (onDirect && child === p && !p.cancelled && l.startsWith('direct light: written to ')) onDirect();
+    });
     p.stderr.on('data', (d) => {
       stderr += d;
       pending += d;
@@ -134,44 +144,43 @@ async function bakeNewest() {
   Object.assign(status, { state: 'baking', changed: change.what, layout: change.layout });
   say(`bake ${generation}: ${change.what.join('; ')} (${change.layout ? 'layout and lighting' : 'lighting only'})`);
   const seen = movedAt || Date.now(), started = lastSnapshot;
-  let refine = null; // the correction of the quick picture, composed once the final bake has started
+  const base = status.lastGood;
+  let composed = null, quickLayoutKept = false;
   for (const kind of opts.quick ? ['quick', 'final'] : ['final']) {
-    const running = bake(kind, generation);
-    if (refine) { // node composes on one core while the final bake starts on the others
-      const refined = composeQuick(generation, change, refine.correction);
-      if (refined !== null) showBake({ generation, kind: 'quick', revision: 1, seen, change, layoutKept: refine.layoutKept, composed: refined, correction: refine.correction });
-      refine = null;
-    }
-    const r = await running;
+    // A composed quick picture is refined as soon as the final bake's direct light is written:
+    // the direct light's change at the final's resolution (revision 1 of the quick bake).
+    const refine = kind === 'final' && composed !== null && base.direct ? () => {
+      if (dirty) return;
+      const refined = composeQuick(generation, change, { before: base.direct.final, after: directDir(generation, 'final'), quickBefore: base.direct.quick, quickAfter: directDir(generation, 'quick') });
+      if (refined !== null) showBake({ generation, kind: 'quick', revision: 1, seen, change, layoutKept: quickLayoutKept, composed: refined, refined: true });
+    } : null;
+    const r = await bake(kind, generation, refine);
     if (r.cancelled || dirty) return;
     if (!r.ok && snapshot(files) !== started) return superseded(kind, generation); // it read a save half-way
     if (!r.ok) return failed(r.error);
-    // A quick look is shown at once (composed on the last final where it can be); a change of
-    // punctual lights alone is then refined with their direct light at the final's resolution
-    // (revision 1 of the same bake), composed as the final bake starts.
-    const composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
-    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, correction: null });
-    if (kind !== 'quick' || composed === null) continue;
-    const correction = await correctionBakes(generation, change, fp);
-    if ((correction && correction.cancelled) || dirty) return;
-    if (correction) refine = { correction, layoutKept: r.layoutKept };
+    // A quick look is shown at once, composed on the last final where it can be.
+    composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
+    quickLayoutKept = r.layoutKept;
+    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, refined: false });
   }
-  status.lastGood = { fp, generation, outdir: outdirStamp(), quick: opts.quick ? path.join(quickRoot, String(generation)) : null };
+  const quick = opts.quick ? path.join(quickRoot, String(generation)) : null;
+  status.lastGood = { fp, generation, outdir: outdirStamp(), quick, direct: quick ? { quick: directDir(generation, 'quick'), final: directDir(generation, 'final') } : null };
   goodPrint = print;
   status.state = 'idle';
+  tidyQuickDirs();
   // while the artist looks: what composing the next change on this final reads again
   if (status.lastGood.quick && fs.existsSync(status.lastGood.quick)) composer.prepare({ final: opts.outdir, quickBefore: status.lastGood.quick, stem });
 }
 
 // A bake (or a revision of one) on screen: /status, the history, the log line, the tidying.
-function showBake({ generation, kind, revision, seen, change, layoutKept, composed, correction }) {
+function showBake({ generation, kind, revision, seen, change, layoutKept, composed, refined }) {
   const seconds = (Date.now() - seen) / 1000;
-  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept, composedOn: composed, directOf: composed !== null && correction ? correction.names : null };
+  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept, composedOn: composed, refined };
   status.history.push({ generation, kind, revision, seconds, changed: change.what });
   if (status.history.length > 50) status.history.shift();
   status.error = null;
   const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}`;
-  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (the direct light of ${correction.names.map((n) => `'${n}'`).join(', ')} at the final's resolution${correction.scaled ? `; its state before, scaled` : ''})`);
+  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (the direct light at the final's resolution, from final bake ${generation}'s direct stage)`);
   else say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${what}${composed !== null ? `; composed on final bake ${composed}` : ''})`);
   tidyQuickDirs();
   tidyLayouts();
@@ -183,107 +192,30 @@ function outdirStamp() {
   try { const st = fs.statSync(path.join(opts.outdir, `${stem}.gltf`)); return `${st.ino}:${st.mtimeMs}`; } catch { return null; }
 }
 
-// The correction of a change of punctual lights alone (compose.mjs): `lmbake bake --direct-of`
-// of the changed lights, in the final's layout and in the quick look's, after the change and
-// before it (the last final's level, rebuilt in a private folder), each state's two bakes in
-// QUICK/corrections/KEY. A state baked for the change before is reused: the lamp an artist moves
-// again was this change's "after"; lights made brighter or recoloured bake only their state
-// before and scale it. Resolves to {names, scaled, directBefore, directAfter, quickDirectBefore,
-// quickDirectAfter}, null (no correction; the log says why when it is not obvious) or
-// {cancelled: true}.
-async function correctionBakes(generation, change, fp) {
-  const base = status.lastGood;
-  if (!base || !base.quick || change.layout || change.what.length !== 1 || change.what[0] !== 'lights') return null;
-  const lights = changedLights(base.fp, fp);
-  const skip = (why) => { say(`quick bake ${generation}: composed without the changed lights' direct light (${why})`); return null; };
-  if (lights.why) return skip(lights.why);
-  const root = path.join(quickRoot, 'corrections');
-  const stateDir = (key) => path.join(root, key.slice(0, 24));
-  const extra = lights.names.flatMap((n) => ['--direct-of', n]);
-  const done = (key) => fs.existsSync(path.join(stateDir(key), 'done'));
-  // a state's two bakes: the lights' direct light in the final's layout and in the quick look's
-  const bakeState = async (key, level) => {
-    const dir = stateDir(key);
-    fs.rmSync(dir, { recursive: true, force: true });
-    let from = level;
-    if (!from) {
-      try { from = writeLevelCopy(base.fp.level, path.join(quickRoot, 'before-level')); } catch (e) { return { result: skip(`the level as it was: ${e.message}`) }; }
-    }
-    for (const [sub, more] of [['direct', []], ['quick', ['--quick']]]) {
-      const r = await bake('correction', generation, { level: from, out: path.join(dir, sub), extra: [...extra, ...more] });
-      if (r.cancelled || dirty) return { result: { cancelled: true } };
-      if (!r.ok) return { result: skip(`lmbake bake --direct-of: ${r.error.split('\n')[0]}`) };
-    }
-    fs.writeFileSync(path.join(dir, 'done'), '');
-    return {};
-  };
-  // Lights changed in intensity and colour alone: the state after is the state before scaled
-  // (watch-inputs.mjs powerScale), so only the state before is baked.
-  const scaled = lights.scale !== null && !done(lights.after);
-  for (const [key, level] of scaled ? [[lights.before, null]] : [[lights.after, opts.level], [lights.before, null]]) {
-    if (done(key)) continue;
-    const r = await bakeState(key, level);
-    if ('result' in r) return r.result;
-  }
-  if (scaled) {
-    try { scaleState(stateDir(lights.before), stateDir(lights.after), lights.scale); } catch (e) { return skip(`the state before scaled: ${e.message}`); }
-  }
-  for (const d of fs.readdirSync(root)) if (![lights.after, lights.before].some((k) => k.startsWith(d))) fs.rmSync(path.join(root, d), { recursive: true, force: true });
-  const [after, before] = [stateDir(lights.after), stateDir(lights.before)];
-  return { names: lights.names, scaled, directAfter: path.join(after, 'direct'), quickDirectAfter: path.join(after, 'quick'), directBefore: path.join(before, 'direct'), quickDirectBefore: path.join(before, 'quick') };
-}
-
-// A correction state made from another by a factor per channel (compose.mjs scaleBake: the same
-// as baking the lights at the new power, to the .hdr's rounding), then its `done` mark.
-function scaleState(from, to, scale) {
-  fs.rmSync(to, { recursive: true, force: true });
-  for (const sub of ['direct', 'quick']) scaleBake(path.join(from, sub), path.join(to, sub), scale);
-  fs.writeFileSync(path.join(to, 'done'), '');
-}
-
-// The level as a fingerprint read it ({file, bytes, json}), written into dir (emptied) with the
-// buffers and images its relative URIs name linked (or copied) beside it, so that lmbake, which
-// reads files only inside the level's folder, bakes it there. Returns the copy's path.
-function writeLevelCopy(level, dir) {
-  fs.rmSync(dir, { recursive: true, force: true });
-  fs.mkdirSync(dir, { recursive: true });
-  const copy = path.join(dir, path.basename(level.file));
-  fs.writeFileSync(copy, level.bytes);
-  const from = path.dirname(level.file);
-  for (const x of [...(level.json.buffers || []), ...(level.json.images || [])]) {
-    if (typeof x.uri !== 'string' || /^[a-z][a-z0-9+.-]*:/i.test(x.uri)) continue; // embedded (data:) or not a file
-    const rel = path.normalize(decodeURIComponent(x.uri));
-    if (path.isAbsolute(rel) || rel.startsWith('..')) throw new Error(`'${x.uri}' is outside the level's folder`);
-    fs.mkdirSync(path.dirname(path.join(dir, rel)), { recursive: true });
-    if (!fs.existsSync(path.join(dir, rel))) linkOrCopy(path.join(from, rel), path.join(dir, rel));
-  }
-  return copy;
-}
-
 // After quick bake N of a change that keeps the layout (and the output's units): the picture
 // shown is the last final bake plus the difference of the two quick looks, in the final's atlas
-// (compose.mjs), with the changed lights' direct light at the final's resolution when
-// correctionBakes made it, written to QUICK/N/composed (QUICK/N/composed-direct with the
-// correction). Returns the final bake's generation it was composed on, or null (then the quick
-// look is shown as baked, or the uncorrected composition stays, and the log says why).
-function composeQuick(generation, change, correction) {
+// (compose.mjs), refined with the direct light's change at the final's resolution when `direct`
+// names the four direct-light folders ({before, after, quickBefore, quickAfter}), written to
+// QUICK/N/composed (QUICK/N/composed-direct when refined). Returns the final bake's generation it
+// was composed on, or null (then the quick look is shown as baked, or the first composition
+// stays, and the log says why).
+function composeQuick(generation, change, direct) {
   const base = status.lastGood;
   if (!base || !base.quick || change.layout || change.what.some((w) => /^config .*\boutput\./.test(w))) return null;
-  const dir = path.join(quickRoot, String(generation)), out = path.join(dir, correction ? 'composed-direct' : 'composed');
+  const dir = path.join(quickRoot, String(generation)), out = path.join(dir, direct ? 'composed-direct' : 'composed');
   let r;
   if (!fs.existsSync(base.quick)) r = { ok: false, why: `its quick look is gone` };
   else if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
   else {
     try {
-      const { names, scaled, ...dirs } = correction || {}; // eslint-disable-line no-unused-vars
-      r = composer.compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, correction: correction ? dirs : null });
+      r = composer.compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, direct });
     } catch (e) {
       r = { ok: false, why: e.message };
     }
   }
   if (r.ok) return base.generation;
   fs.rmSync(out, { recursive: true, force: true }); // a half-written one is never served
-  say(`quick bake ${generation}: ${correction ? 'not refined with the direct light' : `shown as baked, not composed on final bake ${base.generation}`} (${r.why})`);
+  say(`quick bake ${generation}: ${direct ? 'not refined with the direct light' : `shown as baked, not composed on final bake ${base.generation}`} (${r.why})`);
   return null;
 }
 
@@ -303,12 +235,14 @@ function failed(message) {
   say(`error: ${message.split('\n').join(' / ')}; ${status.shown ? `bake ${status.shown.generation} stays on screen` : 'nothing baked yet'}; waiting for the next save`);
 }
 
-// Quick folders no page can still want: all but the shown generation's and the newest.
+// Quick folders (and their direct light) no page can still want: all but the shown
+// generation's, the newest and the last good final's (the next composed picture's "before").
 function tidyQuickDirs() {
   for (const d of fs.readdirSync(quickRoot)) {
-    if (!/^\d+$/.test(d)) continue; // the layouts, the corrections, the level as it was
-    const g = Number(d);
-    const base = status.lastGood && status.lastGood.generation === g; // the next composed picture's quick(before)
+    const m = /^(\d+)(-direct-(quick|final))?$/.exec(d);
+    if (!m) continue; // the layouts
+    const g = Number(m[1]);
+    const base = status.lastGood && status.lastGood.generation === g;
     if (g !== status.generation && !base && !(status.shown && status.shown.generation === g && status.shown.kind === 'quick')) fs.rmSync(path.join(quickRoot, d), { recursive: true, force: true });
   }
 }
