@@ -248,7 +248,7 @@ def bench(lmbake, level_src, rows, light=None):
             first_at = s["shown"]["readyAt"] / 1000
             composed = s["shown"].get("composedOn")
             first = fetch_quick(url, g, 0, stem, os.path.join(work, "quick0"))
-            s = wait_shown(url, g, "quick", revision=1)  # refined with the changed lights' direct light
+            s = wait_shown(url, g, "quick", revision=1)  # refined with the direct light of the final bake
             refined = None
             if s:
                 refined = (s["shown"]["readyAt"] / 1000, fetch_quick(url, g, 1, stem, os.path.join(work, "quick1")))
