@@ -1,5 +1,5 @@
 /*
- * The watch's variants of a bake's config: the quick look, and the direct light of changed
+ * The watch's variants of a bake's config: the quick look, and the direct light of named
  * lights (lmb_config_direct_of, at the end).
  *
  * The quick look of `lmbake preview --watch` and `lmbake bake --quick` (docs/watch.md): a
@@ -60,13 +60,13 @@ void lmb_config_quick(lmb_config *cfg)
 }
 
 /*
- * The watch's correction of a changed light (docs/watch.md#the-composed-quick-picture): the
- * direct light of the named lights alone, at the final bake's layout and sampling, so that the
- * composed picture can take that light's change at the final's resolution. Everything else that
+ * `bake --direct-of`: the direct light of the named lights alone, at the bake's layout and
+ * sampling (one light's share of a bake, for a script that relights a level light by light;
+ * the watch itself takes the direct light from its own bakes, watch/direct_out.h). Everything else that
  * lights the level is left out (other lights realtime through lmb_scene_set_light_modes, no sky,
  * no emission, no bounces); the lights' own modes stay (an `indirect` light has no direct light in
  * the lightmap here either). The layout keys are untouched: the layout and the gather points'
- * validity are the final's (read back from the layout cache).
+ * validity are the bake's (read back from a layout cache).
  */
 lmb_status lmb_config_direct_of(lmb_config *cfg, const char *const *names, uint32_t count, lmb_error *err)
 {

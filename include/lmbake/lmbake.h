@@ -414,8 +414,8 @@ size_t lmb_config_write(const lmb_config *cfg, char *buf, size_t size);
 void lmb_config_quick(lmb_config *cfg);
 
 /* Turns cfg into the direct light of the lights whose name or node name matches one of the
- * `count` globs in names (`bake --direct-of`, the watch's correction of a changed light; docs/
- * watch.md): the same layout and the same direct light as cfg's bake holds of those lights, and
+ * `count` globs in names (`bake --direct-of`, one light's share of a bake; docs/cli.md): the
+ * same layout and the same direct light as cfg's bake holds of those lights, and
  * nothing else: no bounces, sky, emissive surfaces, seam stitching or probes; only the .hdr and
  * .png. LMB_ERR_USAGE for more than LMB_MAX_DIRECT_OF names or one too long. */
 lmb_status lmb_config_direct_of(lmb_config *cfg, const char *const *names, uint32_t count, lmb_error *err);
