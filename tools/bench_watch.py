@@ -249,25 +249,31 @@ def bench(lmbake, level_src, rows, light=None):
             composed = s["shown"].get("composedOn")
             first = fetch_quick(url, g, 0, stem, os.path.join(work, "quick0"))
             s = wait_shown(url, g, "quick", revision=1)  # refined with the direct light of the final bake
-            refined = None
+            refined = bounced = None
             if s:
                 refined = (s["shown"]["readyAt"] / 1000, fetch_quick(url, g, 1, stem, os.path.join(work, "quick1")))
+                s = wait_shown(url, g, "quick", revision=2)  # and with the light of its bounce passes
+                if s:
+                    bounced = (s["shown"]["readyAt"] / 1000, fetch_quick(url, g, 2, stem, os.path.join(work, "quick2")))
             s = wait_shown(url, g, "final")
             final_at = s["shown"]["readyAt"] / 1000
             final = (os.path.join(out, "%s.gltf" % stem), os.path.join(out, "%s-lightmap-0.exr" % stem))
             err0 = quick_error(*first, *final)
             err1 = quick_error(*refined[1], *final) if refined else None
+            err2 = quick_error(*bounced[1], *final) if bounced else None
             t0 = time.time()
             subprocess.run([lmbake, "bake", level, "-o", os.path.join(work, "plain"), "-q"], check=True)
             plain = time.time() - t0
             row = (name, what, ",".join(s["changed"]), "layout" if s["layout"] else "lighting",
                    "composed" if composed else "quick", first_at - saved, err0,
-                   refined[0] - saved if refined else None, err1, final_at - saved, plain)
+                   refined[0] - saved if refined else None, err1, bounced[0] - saved if bounced else None, err2,
+                   final_at - saved, plain)
             rows.append(row)
-            print("%s: %s (%s; %s): %s picture %.1f s (9x9 error %.2f%%)%s, final %.1f s, plain bake %.1f s"
+            print("%s: %s (%s; %s): %s picture %.1f s (9x9 error %.2f%%)%s%s, final %.1f s, plain bake %.1f s"
                   % (name, what, row[2], row[3], row[4], row[5], 100 * err0,
                      "; refined with the direct light %.1f s (%.2f%%)" % (row[7], 100 * err1) if refined else "",
-                     row[9], row[10]), flush=True)
+                     "; with the bounced light %.1f s (%.2f%%)" % (row[9], 100 * err2) if bounced else "",
+                     row[11], row[12]), flush=True)
     finally:
         p.terminate()
         p.wait()
@@ -282,9 +288,9 @@ def main():
         bench(lmbake, m.group(1) if m else arg, rows, m.group(2) if m else None)
     with open(csv, "w") as f:
         f.write("level,edit,changed,redone,quick_shown,save_to_quick_s,quick_error_9x9_rms,save_to_refined_s,"
-                "refined_error_9x9_rms,save_to_final_s,plain_bake_s\n")
+                "refined_error_9x9_rms,save_to_bounced_s,bounced_error_9x9_rms,save_to_final_s,plain_bake_s\n")
         for r in rows:
-            cells = [("%.4f" if k in (6, 8) else "%.2f") % v if isinstance(v, float) else "" if v is None else str(v)
+            cells = [("%.4f" if k in (6, 8, 10) else "%.2f") % v if isinstance(v, float) else "" if v is None else str(v)
                      for k, v in enumerate(r)]
             f.write(",".join(cells) + "\n")
 

@@ -79,12 +79,12 @@ int bake_args_parse(int argc, char **argv, bake_args *a, const char *help)
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
             a->layout_cache = v;
-        } else if ((r = cli_opt_value(argc, argv, &i, "--direct-out", NULL, &v)) != 0) {
+        } else if ((r = cli_opt_value(argc, argv, &i, "--stages-out", NULL, &v)) != 0) {
             if (r < 0 || !*v)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
-            if (strlen(v) >= sizeof ((lmb_config *)0)->direct_out)
-                return cli_usage_error("bake", "--direct-out: the folder's path is too long");
-            a->direct_out = v;
+            if (strlen(v) >= sizeof ((lmb_config *)0)->stages_out)
+                return cli_usage_error("bake", "--stages-out: the folder's path is too long");
+            a->stages_out = v;
         } else if ((r = cli_opt_value(argc, argv, &i, "--farm", NULL, &v)) != 0) {
             if (r < 0)
                 return cli_usage_error("bake", "%s needs a folder", argv[i]);
@@ -145,8 +145,8 @@ int bake_args_check_stage(stage_kind stage, bake_args *a, char *plan_path, size_
 
     if (stage != STAGE_BAKE &&
         (a->plan || a->reference || a->print_config || a->quick || a->layout_cache || a->direct_of_count ||
-         a->direct_out))
-        return cli_usage_error(name, "--plan, --layout-cache, --quick, --direct-of, --direct-out, --reference and "
+         a->stages_out))
+        return cli_usage_error(name, "--plan, --layout-cache, --quick, --direct-of, --stages-out, --reference and "
                                "--print-config are "
                                "'lmbake bake' options");
     if (a->plan && a->layout_cache)

@@ -12,7 +12,7 @@ typedef enum stage_kind { STAGE_BAKE, STAGE_PLAN, STAGE_STEP, STAGE_MERGE, STAGE
 typedef struct bake_args {
     const char *scene, *config, *outdir, *plan, *farm;
     const char *layout_cache; /* --layout-cache DIR */
-    const char *direct_out;   /* --direct-out DIR */
+    const char *stages_out;   /* --stages-out DIR */
     const char *timings_csv; /* --timings=CSV */
     int timings;
     long long threads, seed, rays, method; /* -1: from the config */

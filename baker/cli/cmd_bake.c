@@ -42,10 +42,11 @@ static const char help[] =
     "                      node names; repeatable, at most 16): no bounces, sky or emissive\n"
     "                      surfaces, only the .hdr and .png (one light's share of a bake,\n"
     "                      for scripts that relight a level light by light)\n"
-    "      --direct-out DIR\n"
-    "                      write the direct stage's light as soon as it is known, per atlas\n"
-    "                      as DIR/<name>-lightmap-N.hdr, and say so in the log (what preview\n"
-    "                      --watch refines its quick picture with, docs/watch.md)\n"
+    "      --stages-out DIR\n"
+    "                      write the light of each stage as soon as it is known, per atlas as\n"
+    "                      DIR/direct/<name>-lightmap-N.hdr (the direct light) and\n"
+    "                      DIR/bounces/... (after the bounce passes), and say so in the log\n"
+    "                      (what preview --watch refines its quick picture with, docs/watch.md)\n"
     "      --plan PLAN     start from a plan written by 'lmbake plan' (same input and config,\n"
     "                      threads aside; otherwise refused, naming what differs): no unwrap\n"
     "      --layout-cache DIR\n"
@@ -252,13 +253,13 @@ static int run(int argc, char **argv, stage_kind stage)
         lmb_config_quick(&cfg);
     if (a.direct_of_count && lmb_config_direct_of(&cfg, a.direct_of, a.direct_of_count, &err) != LMB_OK)
         return cli_fail(&err);
-    if (a.direct_out) {
-        if (mkdir(a.direct_out, 0777) != 0 && errno != EEXIST) {
-            lmb_error_set(&err, LMB_ERR_INPUT, "--direct-out: cannot make the folder '%s' (%s)", a.direct_out,
+    if (a.stages_out) {
+        if (mkdir(a.stages_out, 0777) != 0 && errno != EEXIST) {
+            lmb_error_set(&err, LMB_ERR_INPUT, "--stages-out: cannot make the folder '%s' (%s)", a.stages_out,
                           strerror(errno));
             return cli_fail(&err);
         }
-        snprintf(cfg.direct_out, sizeof cfg.direct_out, "%s", a.direct_out);
+        snprintf(cfg.stages_out, sizeof cfg.stages_out, "%s", a.stages_out);
     }
     if (a.print_config) {
         size_t n = lmb_config_write(&cfg, NULL, 0);

@@ -9,7 +9,7 @@
 #include "post/denoise_steps.h"
 #include "post/rim.h"
 #include "util/clock.h"
-#include "watch/direct_out.h"
+#include "watch/stages_out.h"
 #include "util/lmb_math.h"
 
 #include <math.h>
@@ -450,13 +450,13 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
             stats->valid_texels += w[a].t.valid[i];
         }
         total += w[a].t.count;
-        if (st == LMB_OK && cfg->direct_out[0])
-            st = lmb_direct_out_write(cfg, cache, a, &w[a].t, w[a].direct, w[a].deferred, err);
+        if (st == LMB_OK && cfg->stages_out[0])
+            st = lmb_stages_out_write(cfg, "direct", cache, a, &w[a].t, w[a].direct, w[a].deferred, err);
         if (st == LMB_OK)
             st = lmb_cache_store(cache, a, &w[a].t, w[a].direct, err);
     }
-    if (st == LMB_OK && cfg->direct_out[0])
-        lmb_info(log, "direct light: written to %s", cfg->direct_out);
+    if (st == LMB_OK && cfg->stages_out[0])
+        lmb_stages_out_done(cfg, "direct", log);
     stats->rim_limited = rim.limited;
     stats->rim_energy = rim.total > 0 ? rim.removed / rim.total : 0;
     if (rim.limited)

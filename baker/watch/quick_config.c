@@ -62,7 +62,7 @@ void lmb_config_quick(lmb_config *cfg)
 /*
  * `bake --direct-of`: the direct light of the named lights alone, at the bake's layout and
  * sampling (one light's share of a bake, for a script that relights a level light by light;
- * the watch itself takes the direct light from its own bakes, watch/direct_out.h). Everything else that
+ * the watch itself takes the direct light from its own bakes, watch/stages_out.h). Everything else that
  * lights the level is left out (other lights realtime through lmb_scene_set_light_modes, no sky,
  * no emission, no bounces); the lights' own modes stay (an `indirect` light has no direct light in
  * the lightmap here either). The layout keys are untouched: the layout and the gather points'

@@ -31,7 +31,7 @@ lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, co
                                       const float *d, uint32_t width, uint32_t height, lmb_error *err);
 
 /* <stem>-lightmap-N.hdr alone in dir: irradiance (3 floats per texel) as output.scale says, as the
- * lightmap's own .hdr is written (the watch's direct light, watch/direct_out.h). */
+ * lightmap's own .hdr is written (the watch's stages, watch/stages_out.h). */
 lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
                                const float *irradiance, uint32_t width, uint32_t height, lmb_error *err);
 

@@ -366,9 +366,10 @@ typedef struct lmb_config {
      * name or node name matches one of these are the only ones the bake holds (others realtime) */
     char direct_of[LMB_MAX_DIRECT_OF][LMB_PATTERN_LEN];
     uint32_t direct_of_count;
-    /* not a config key: `lmbake bake --direct-out DIR`: the folder the direct stage's light is
-     * written to as soon as it is known (watch/direct_out.h); "" = none */
-    char direct_out[4096];
+    /* not a config key: `lmbake bake --stages-out DIR`: the folder the light of each stage (the
+     * direct light, the bounce passes') is written to as soon as it is known (watch/stages_out.h);
+     * "" = none */
+    char stages_out[4096];
     int shadowmask;                /* output.shadowmask: the visibility of up to 4 `indirect` lights per texel */
     /* materials the file did not set, or set wrongly for a bake */
     double default_albedo[3];      /* materials.default.albedo: primitives with no material; [0] < 0: none (glTF's metal) */

@@ -2,21 +2,24 @@
 // The watch's composed quick picture (tools/preview/compose.mjs, docs/watch.md): on
 // tools/make_scenes.py's cornell-point box with a second lamp low in a corner, baked final and
 // quick (F1, Q1), then the second lamp moved across the floor and baked again (F2, Q2), every bake
-// writing its direct stage's light (`bake --direct-out`: DF1, DQ1, DF2, DQ2):
+// writing the light of its stages (`bake --stages-out`: the direct light DF1, DQ1, DF2, DQ2; the
+// light the bounce passes reached, BF1, BF2):
 //   - a change of nothing, F1 + Q1 - Q1, gives F1's .hdr back texel for texel (as the page reads it),
 //     and so does its refinement with the direct light, F1 + Q1 - Q1 - (DQ1 - DQ1) + (DF1 - DF1);
 //   - F1 + Q2 - Q1 is closer to F2 than the quick look Q2 alone (both read in F2's atlas, 9 x 9
 //     texel box averages over the texels a triangle covers, rms of the luminance difference over
 //     F2's mean), and within 5%;
-//   - refined with the direct light, F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1) is closer to F2 still;
+//   - refined with the direct light, F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1) is closer to F2 still,
+//     and with the bounced light, F1 + BF2 - BF1, closer again;
 //   - a quick look of another layout (the texel density changed) is refused with a reason;
-//   - `--direct-out` changes no output byte, and what it writes is the direct light in the
-//     lightmap's units: with no bounces, the lightmap itself to within its denoising.
+//   - `--stages-out` changes no output byte, and what it writes is the light in the lightmap's
+//     units: with no bounces, the direct light is the lightmap itself to within its denoising,
+//     and no bounces stage is written.
 //   usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { compose, mapQuicks, readBake, readHdr } from '../../tools/preview/compose.mjs';
+import { compose, composeBounces, mapQuicks, readBake, readHdr } from '../../tools/preview/compose.mjs';
 
 const [lmbake, work] = process.argv.slice(2);
 if (!work) { console.error('usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR'); process.exit(1); }
@@ -35,17 +38,18 @@ doc.scenes[doc.scene || 0].nodes.push(doc.nodes.length - 1);
 const cfg = path.join(work, 'bake.yaml');
 fs.writeFileSync(cfg, 'texel_density: 16\nsamples: {gather: 256}\n');
 
-// The level as doc stands, baked into WORK/TAG/out, its direct light into WORK/TAG/direct.
+// The level as doc stands, baked into WORK/TAG/out, its stages into WORK/TAG/stages.
 function bakeState(tag, { quick = false, config = cfg, extra = [] } = {}) {
   const dir = path.join(work, tag);
   fs.mkdirSync(dir, { recursive: true });
   for (const b of doc.buffers) if (!b.uri.startsWith('data:')) fs.copyFileSync(path.join(work, 'scenes', b.uri), path.join(dir, b.uri));
   fs.writeFileSync(path.join(dir, `${stem}.gltf`), JSON.stringify(doc));
   const out = path.join(dir, 'out');
-  execFileSync(lmbake, ['bake', path.join(dir, `${stem}.gltf`), '-c', config, '-o', out, '-q', '--direct-out', path.join(dir, 'direct'), ...(quick ? ['--quick'] : []), ...extra]);
+  execFileSync(lmbake, ['bake', path.join(dir, `${stem}.gltf`), '-c', config, '-o', out, '-q', '--stages-out', path.join(dir, 'stages'), ...(quick ? ['--quick'] : []), ...extra]);
   return out;
 }
-const directOf = (out) => path.join(path.dirname(out), 'direct');
+const directOf = (out) => path.join(path.dirname(out), 'stages', 'direct');
+const bouncesOf = (out) => path.join(path.dirname(out), 'stages', 'bounces');
 const F1 = bakeState('f1'), Q1 = bakeState('q1', { quick: true }), Q1again = bakeState('q1-again', { quick: true });
 doc.nodes[doc.nodes.length - 1].translation = [0.8, 0.15, 0.75];
 const F2 = bakeState('f2'), Q2 = bakeState('q2', { quick: true });
@@ -100,6 +104,13 @@ check(eComposed < eQuick && eComposed <= 0.05, `the corner lamp moved: F1 + Q2 -
 const refined = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'refined'), stem, direct: { before: directOf(F1), after: directOf(F2), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
 const eRefined = refined.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'refined'), stem), weight: 1 }]).mapped.get(0).value) : 1;
 check(refined.ok && eRefined < eComposed, `and refined with the direct light at the final's resolution: ${(100 * eRefined).toFixed(2)}% from F2 (want below ${(100 * eComposed).toFixed(2)}%; ${refined.ok ? `${refined.ms} ms` : refined.why})`);
+// refined with the bounced light at the final's resolution: F1 + BF2 - BF1
+const bounced = composeBounces({ final: F1, out: path.join(work, 'bounced'), stem, before: bouncesOf(F1), after: bouncesOf(F2) });
+const eBounced = bounced.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'bounced'), stem), weight: 1 }]).mapped.get(0).value) : 1;
+check(bounced.ok && eBounced < eRefined, `and refined with the bounced light at the final's resolution: ${(100 * eBounced).toFixed(2)}% from F2 (want below ${(100 * eRefined).toFixed(2)}%; ${bounced.ok ? `${bounced.ms} ms` : bounced.why})`);
+const sameBounced = composeBounces({ final: F1, out: path.join(work, 'same-bounced'), stem, before: bouncesOf(F1), after: bouncesOf(F1) });
+const sb = sameBounced.ok ? readHdr(path.join(work, 'same-bounced', hdr)) : null;
+check(sameBounced.ok && sb.data.every((x, i) => x === b.data[i]), `the bounced light of the same bake twice gives F1 back texel for texel (${sameBounced.ok ? `${sameBounced.ms} ms` : sameBounced.why})`);
 const missing = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'missing'), stem, direct: { before: directOf(F1), after: path.join(work, 'nowhere'), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
 check(!missing.ok && /direct light/.test(missing.why) && !fs.existsSync(path.join(work, 'missing')), `a direct light not written is refused, nothing written: ${missing.why}`);
 
@@ -109,7 +120,8 @@ fs.writeFileSync(cfg32, 'texel_density: 32\nsamples: {gather: 256}\n');
 const Q32 = bakeState('q32', { quick: true, config: cfg32 });
 const other = compose({ final: F2, quickBefore: Q2, quickAfter: Q32, out: path.join(work, 'other'), stem });
 check(!other.ok && /layout|atlas/.test(other.why), `a quick look of another layout is refused: ${other.why}`);
-// --direct-out: the same output; with no bounces, its light is the lightmap's (in the same units)
+// --stages-out: the same output; with no bounces, the direct light is the lightmap (in the same
+// units) and no bounces stage is written
 const cfg0 = path.join(work, 'bake0.yaml');
 fs.writeFileSync(cfg0, 'texel_density: 16\nbounces: 0\noutput: {scale: radiance}\n');
 const plain = path.join(work, 'plain0');
@@ -117,7 +129,7 @@ execFileSync(lmbake, ['bake', path.join(work, 'f2', `${stem}.gltf`), '-c', cfg0,
 const withDirect = bakeState('f2-direct0', { config: cfg0 });
 const names = fs.readdirSync(plain).sort();
 const differ = names.filter((n) => !fs.readFileSync(path.join(plain, n)).equals(fs.readFileSync(path.join(withDirect, n))));
-check(names.length > 3 && differ.length === 0 && fs.readdirSync(withDirect).length === names.length, `--direct-out changes no output file (${names.length} files; differ: ${differ.join(', ') || 'none'})`);
+check(names.length > 3 && differ.length === 0 && fs.readdirSync(withDirect).length === names.length && !fs.existsSync(bouncesOf(withDirect)), `--stages-out changes no output file and writes no bounces stage without bounce passes (${names.length} files; differ: ${differ.join(', ') || 'none'})`);
 const lightmap = readHdr(path.join(withDirect, hdr)), written = readHdr(path.join(directOf(withDirect), hdr));
 let se = 0, sum = 0, n = 0;
 for (let i = 0; i < lightmap.width * lightmap.height; i++) {

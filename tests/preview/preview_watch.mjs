@@ -6,10 +6,12 @@
 // quick values, then to its final ones, without a reload (a marker on the page's window
 // survives) and with the camera unchanged. Bake 2's final pixels are 3x bake 1's in linear light
 // (the bake is linear in the light; 3% and 2 levels allowed for the 8-bit screenshot). Its quick
-// picture is shown twice: first what the plain preview shows of bake 1's final composed with the
-// two files' quick looks (`lmbake bake --quick`), then, once bake 2's final bake has its direct
-// light, that refined with the direct light of both files' final and quick bakes (`--direct-out`,
-// tools/preview/compose.mjs). The final bake is held (SIGSTOP) while each is read. Then a
+// picture is shown three times: first what the plain preview shows of bake 1's final composed with
+// the two files' quick looks (`lmbake bake --quick`), then, once bake 2's final bake has its direct
+// light, that refined with the direct light of both files' final and quick bakes, then, once it
+// has run its bounce passes, bake 1's final plus the change of the light both final bakes' bounce
+// passes reached (`--stages-out`, tools/preview/compose.mjs). The final bake is held (SIGSTOP)
+// while each is read. Then a
 // half-written level: the page shows the error and keeps bake 2's pixels exactly. Screenshots in
 // SHOTS_DIR (preview-watch-*.png).
 //   usage: node tests/preview/preview_watch.mjs LMBAKE WORKDIR SHOTS_DIR
@@ -18,7 +20,7 @@ import path from 'node:path';
 import { spawn, execFileSync } from 'node:child_process';
 import { launchBrowser, openPreview, VIEWPORT } from '../../tools/preview/browser.mjs';
 import { startServer } from '../../tools/preview/server.mjs';
-import { compose } from '../../tools/preview/compose.mjs';
+import { compose, composeBounces } from '../../tools/preview/compose.mjs';
 import { decodePng, srgb } from './lib.mjs';
 
 const [lmbake, work, shots] = process.argv.slice(2);
@@ -27,8 +29,8 @@ const root = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..',
 const linear = (c) => { c /= 255; return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4); };
 
 // the level: cornell-point.gltf and its buffer, copied; a config whose final bake is slow enough
-// after its direct stage (4,096 gather rays, 4 bounces: seconds) for the refined quick picture to be
-// seen before the final one
+// after its direct stage (4,096 gather rays, 4 bounces: seconds) for the refined quick pictures to
+// be seen before the final one
 fs.rmSync(work, { recursive: true, force: true });
 execFileSync('python3', [path.join(root, 'tools', 'make_scenes.py'), path.join(work, 'scenes')], { stdio: 'ignore' });
 const dir = path.join(work, 'level');
@@ -41,10 +43,6 @@ const save = () => fs.writeFileSync(level, JSON.stringify(doc, null, 1));
 save();
 const cfg = path.join(dir, 'bake.yaml');
 fs.writeFileSync(cfg, 'texel_density: 16\nbounces: 4\nsamples: {gather: 4096, bounce: 1024}\n');
-// the direct light of a bake of cfg, written as the watch's bakes write it, without their bounces
-// (the direct stage does not depend on them)
-const cfgDirect = path.join(work, 'direct.yaml');
-fs.writeFileSync(cfgDirect, 'texel_density: 16\nbounces: 0\nsamples: {gather: 4096, bounce: 1024}\n');
 
 const watch = spawn(lmbake, ['preview', '--watch', level, '-c', cfg, '-o', path.join(work, 'out')], { stdio: ['ignore', 'pipe', 'inherit'] });
 let log = '';
@@ -82,16 +80,16 @@ try {
   const b1 = await pixels('bake1'), cam1 = await camera();
   check(b1.every((px) => Math.max(...px) > 8 && Math.max(...px) < 150), `bake 1 shown; pixels ${JSON.stringify(b1)}`);
   // what bake 2's quick picture is composed from: bake 1's final (OUTDIR, copied now), the quick
-  // look of bake 1's file and the direct light of both (baked here as the watch did)
+  // look of bake 1's file and the stages of both (baked here as the watch did)
   const final1 = path.join(work, 'final1'), quick1 = path.join(work, 'quick1');
   fs.cpSync(path.join(work, 'out'), final1, { recursive: true });
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quick1, '--quick', '-q']);
-  const directOf = (tag) => ['final', 'quick'].map((k) => {
-    const out = path.join(work, `direct-${k}${tag}`);
-    execFileSync(lmbake, ['bake', level, '-c', cfgDirect, '-o', `${out}-bake`, '--direct-out', out, ...(k === 'quick' ? ['--quick'] : []), '-q']);
+  const stagesOf = (tag) => ['final', 'quick'].map((k) => {
+    const out = path.join(work, `stages-${k}${tag}`);
+    execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', `${out}-bake`, '--stages-out', out, ...(k === 'quick' ? ['--quick'] : []), '-q']);
     return out;
   });
-  const [direct1, qdirect1] = directOf(1);
+  const [stages1, qstages1] = stagesOf(1);
 
   doc.extensions.KHR_lights_punctual.lights[0].intensity *= 3;
   save();
@@ -118,6 +116,11 @@ try {
   await shown(2, 'quick', 1); // revision 1: refined with the direct light at the final's resolution
   const q2r = await pixels('bake2-quick-refined'), statusR = await status();
   if (held) process.kill(held, 'SIGCONT');
+  held = await hold((st) => st.shown && st.shown.generation === 2 && st.shown.revision === 2);
+  check(held !== null, `bake 2's final bake held again once it refined the quick picture with its bounce passes (pid ${held})`);
+  await shown(2, 'quick', 2); // revision 2: all the light the bounce passes reached, at the final's resolution
+  const q2b = await pixels('bake2-quick-bounced'), statusB = await status();
+  if (held) process.kill(held, 'SIGCONT');
   await shown(2, 'final');
   const f2 = await pixels('bake2-final'), cam2 = await camera();
   for (let i = 0; i < points.length; i++) {
@@ -133,7 +136,7 @@ try {
   // here, from the same camera, within a level
   const quickDir = path.join(work, 'quick2');
   execFileSync(lmbake, ['bake', level, '-c', cfg, '-o', quickDir, '--quick', '-q']);
-  const [direct2, qdirect2] = directOf(2);
+  const [stages2, qstages2] = stagesOf(2);
   const plainPixels = async (composedDir) => {
     const srv = await startServer(path.join(composedDir, 'cornell-point.gltf'));
     const v = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: '-7', cam: '0.5,0.5,2.2,0.5,0.45,0' });
@@ -149,10 +152,14 @@ try {
   check(composed.ok && statusQ.shown.composedOn === 1 && statusQ.shown.revision === 0, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}, revision ${statusQ.shown.revision}; here: ${composed.ok || composed.why})`);
   const wantQuick = composed.ok ? await plainPixels(path.join(work, 'composed2')) : [];
   check(composed.ok && largest(q2, wantQuick) <= 1, `bake 2's quick picture is the composed one: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)}`);
-  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: direct1, after: direct2, quickBefore: qdirect1, quickAfter: qdirect2 } });
-  check(refined.ok && statusR.shown.refined === true && statusR.shown.composedOn === 1, `then refined with the direct light at the final's resolution (/status refined: ${JSON.stringify(statusR.shown.refined)}; here: ${refined.ok || refined.why})`);
+  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: path.join(stages1, 'direct'), after: path.join(stages2, 'direct'), quickBefore: path.join(qstages1, 'direct'), quickAfter: path.join(qstages2, 'direct') } });
+  check(refined.ok && statusR.shown.refined === 'direct' && statusR.shown.composedOn === 1, `then refined with the direct light at the final's resolution (/status refined: ${JSON.stringify(statusR.shown.refined)}; here: ${refined.ok || refined.why})`);
   const wantRefined = refined.ok ? await plainPixels(path.join(work, 'refined2')) : [];
   check(refined.ok && largest(q2r, wantRefined) <= 1, `bake 2's refined quick picture is the refined composition: ${JSON.stringify(q2r)} against ${JSON.stringify(wantRefined)}`);
+  const bounced = composeBounces({ final: final1, out: path.join(work, 'bounced2'), stem: 'cornell-point', before: path.join(stages1, 'bounces'), after: path.join(stages2, 'bounces') });
+  check(bounced.ok && statusB.shown.refined === 'bounces' && statusB.shown.composedOn === 1, `then refined with the bounced light at the final's resolution (/status refined: ${JSON.stringify(statusB.shown.refined)}; here: ${bounced.ok || bounced.why})`);
+  const wantBounced = bounced.ok ? await plainPixels(path.join(work, 'bounced2')) : [];
+  check(bounced.ok && largest(q2b, wantBounced) <= 1, `bake 2's quick picture refined with the bounced light is that composition: ${JSON.stringify(q2b)} against ${JSON.stringify(wantBounced)}`);
   check(true, `bake 2 (light x 3): quick ${JSON.stringify(q2)} then final ${JSON.stringify(f2)} against bake 1 ${JSON.stringify(b1)}`);
   const same = (a, b) => a.position.every((v, k) => Math.abs(v - b.position[k]) < 1e-9) && a.target.every((v, k) => Math.abs(v - b.target[k]) < 1e-9);
   check(same(cam1, camQ) && same(cam1, cam2), `the camera stayed where it was (${cam2.position.map((v) => v.toFixed(3))})`);

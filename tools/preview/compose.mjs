@@ -24,6 +24,13 @@
 // texel: the same layout), and only the rest of the change, its bounced light, at the quick look's.
 // A moved lamp's hot spot, a few texels wide, is what the quick look's resolution blurs.
 //
+// Once the final bake has run its bounce passes, the picture is refined again to
+//
+//     final(before) + [bounces(after) - bounces(before)]
+//
+// with bounces the light the two final bakes' bounce passes reached (the direct light, its
+// bounces and their extrapolated tail, before the final gather): texel for texel, no quick look.
+//
 // compose(...) writes OUT: the final's glTF with its lightmap textures naming only the composed
 // .hdr (no KTX2 or EXR: those are the old final's), the final's other files hard-linked (or
 // copied), and the composed .hdr. It returns {ok: true, ms} or {ok: false, why} (then the quick
@@ -428,6 +435,25 @@ export function linkOrCopy(from, to) {
   try { fs.linkSync(from, to); } catch { fs.copyFileSync(from, to); }
 }
 
+// OUT (emptied) := the final bake f (read from folder final) with each atlas's .hdr given by
+// hdrOf(atlas, img) (the bytes): its glTF naming only the .hdr and the PNG beside it (its KTX2
+// and EXR are the old light), its other files linked (or copied).
+function writeComposed(f, final, out, stem, atlases, hdrOf) {
+  fs.rmSync(out, { recursive: true, force: true });
+  fs.mkdirSync(out, { recursive: true });
+  const hdrs = new Set([...atlases.values()].map((a) => a.hdr));
+  for (const [a, img] of atlases) fs.writeFileSync(path.join(out, img.hdr), hdrOf(a, img));
+  const doc = f.doc;
+  const keep = (files) => Object.fromEntries(Object.entries(files).filter(([key]) => key === 'hdr' || key === 'png'));
+  for (const t of doc.textures || []) if (t.extras && t.extras.lightmap && t.extras.lightmap.files) t.extras.lightmap.files = keep(t.extras.lightmap.files);
+  for (const n of doc.nodes || []) if (n.extras && n.extras.lightmap && n.extras.lightmap.files) n.extras.lightmap.files = keep(n.extras.lightmap.files);
+  fs.writeFileSync(path.join(out, `${stem}.gltf`), JSON.stringify(doc));
+  for (const name of fs.readdirSync(final)) {
+    if (name === `${stem}.gltf` || hdrs.has(name) || /\.(ktx2|exr)$/i.test(name)) continue;
+    if (fs.statSync(path.join(final, name)).isFile()) linkOrCopy(path.join(final, name), path.join(out, name));
+  }
+}
+
 // The watch's composer: compose() as below, keeping what the next composition on the same final
 // bake reads again (the last few decoded .hdr files, the map to the quick layout and the quick
 // look before the change read through it). prepare() builds those ahead, while the watch is idle
@@ -510,23 +536,37 @@ export function createComposer() {
       return { ok: false, why: `cannot read the direct light (${e.message})` };
     }
     if (exactPart.why) return { ok: false, why: exactPart.why };
-    fs.rmSync(out, { recursive: true, force: true });
-    fs.mkdirSync(out, { recursive: true });
-    const hdrs = new Set([...k.map.atlases.values()].map((a) => a.hdr));
-    for (const [a, img] of k.map.atlases) {
-      const exact = exactPart.change && exactPart.change.get(a); // the direct light's change, texel for texel
-      fs.writeFileSync(path.join(out, img.hdr), composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), exact));
+    writeComposed(f, final, out, stem, k.map.atlases, (a, img) => composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), exactPart.change && exactPart.change.get(a)));
+    return { ok: true, ms: Date.now() - t0 };
+  }
+
+  // The picture once the final bake of the change has run its bounce passes: final(before) +
+  // [bounces(after) - bounces(before)], texel for texel in the final's layout (bounces: the
+  // light the bounce passes reached, `lmbake bake --stages-out`, of the last final bake and of the
+  // running one: no quick look). final, out, stem as for compose(); before, after: the two
+  // bounces folders. {ok, ms} or {ok: false, why}.
+  function composeBounces({ final, out, stem, before, after }) {
+    const t0 = Date.now();
+    let f, atlases, A, B;
+    try {
+      f = readBake(final, stem);
+      atlases = readAtlases(f, read);
+      [A, B] = [after, before].map((dir) => readAtlases({ ...f, dir }, read));
+    } catch (e) {
+      return { ok: false, why: `cannot read the bounced light (${e.message})` };
     }
-    // The glTF: lightmap files reduced to the composed .hdr and the PNG it carries beside.
-    const doc = f.doc;
-    const keep = (files) => Object.fromEntries(Object.entries(files).filter(([key]) => key === 'hdr' || key === 'png'));
-    for (const t of doc.textures || []) if (t.extras && t.extras.lightmap && t.extras.lightmap.files) t.extras.lightmap.files = keep(t.extras.lightmap.files);
-    for (const n of doc.nodes || []) if (n.extras && n.extras.lightmap && n.extras.lightmap.files) n.extras.lightmap.files = keep(n.extras.lightmap.files);
-    fs.writeFileSync(path.join(out, `${stem}.gltf`), JSON.stringify(doc));
-    for (const name of fs.readdirSync(final)) {
-      if (name === `${stem}.gltf` || hdrs.has(name) || /\.(ktx2|exr)$/i.test(name)) continue;
-      if (fs.statSync(path.join(final, name)).isFile()) linkOrCopy(path.join(final, name), path.join(out, name));
+    for (const [a, img] of atlases) {
+      const x = A.get(a), y = B.get(a);
+      if (!x || !y || x.width !== img.width || x.height !== img.height || y.width !== img.width || y.height !== img.height) return { ok: false, why: 'the bounced light has other atlases' };
     }
+    writeComposed(f, final, out, stem, atlases, (a, img) => {
+      const x = A.get(a).data, y = B.get(a).data, rgba = new Float32Array(img.data.length);
+      for (let i = 0; i < rgba.length; i += 4) {
+        for (let c = 0; c < 3; c++) rgba[i + c] = Math.max(img.data[i + c] + x[i + c] - y[i + c], 0);
+        rgba[i + 3] = 1;
+      }
+      return encodeHdr(img.width, img.height, rgba);
+    });
     return { ok: true, ms: Date.now() - t0 };
   }
 
@@ -547,10 +587,15 @@ export function createComposer() {
       return { ok: false, why: `cannot read a bake (${e.message})` };
     }
   }
-  return { compose, prepare };
+  return { compose, composeBounces, prepare };
 }
 
 // One composition with nothing kept (createComposer's compose).
 export function compose(args) {
   return createComposer().compose(args);
+}
+
+// One bounced-light composition with nothing kept (createComposer's composeBounces).
+export function composeBounces(args) {
+  return createComposer().composeBounces(args);
 }

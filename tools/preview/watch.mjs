@@ -80,15 +80,15 @@ function stopChild(why) {
 }
 
 // One `lmbake bake` of the newest state: quick into QUICK/N, final into OUTDIR, each with the
-// light of its direct stage written to QUICK/N-direct-KIND (`--direct-out`; onDirect() is called
-// once the bake says those files are whole). Resolves to {ok, seconds} or {ok: false, error}; a
-// cancelled bake resolves {cancelled: true}.
-const directDir = (generation, kind) => path.join(quickRoot, `${generation}-direct-${kind}`);
-function bake(kind, generation, onDirect = null) {
+// light of its stages written to QUICK/N-stages-KIND/STAGE (`--stages-out`; onStage(STAGE) is
+// called once the bake says a stage's files are whole: direct, bounces). Resolves to {ok,
+// seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
+const stageDir = (generation, kind, stage) => path.join(quickRoot, `${generation}-stages-${kind}`, stage);
+function bake(kind, generation, onStage = null) {
   const out = kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir;
-  const direct = directDir(generation, kind);
-  fs.rmSync(direct, { recursive: true, force: true });
-  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, '--direct-out', direct, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
+  const stages = path.dirname(stageDir(generation, kind, 'direct'));
+  fs.rmSync(stages, { recursive: true, force: true });
+  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, '--stages-out', stages, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
   return new Promise((resolve) => {
     const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     child = p;
@@ -99,7 +99,10 @@ function bake(kind, generation, onDirect = null) {
       outPending += d;
       const lines = outPending.split('\n');
       outPending = lines.pop();
-      for (const l of lines) if (onDirect && child === p && !p.cancelled && l.startsWith('direct light: written to ')) onDirect();
+      for (const l of lines) {
+        const m = /^stages: (\w+) written to /.exec(l);
+        if (m && onStage && child === p && !p.cancelled) onStage(m[1]);
+      }
     });
     p.stderr.on('data', (d) => {
       stderr += d;
@@ -147,12 +150,17 @@ async function bakeNewest() {
   const base = status.lastGood;
   let composed = null, quickLayoutKept = false;
   for (const kind of opts.quick ? ['quick', 'final'] : ['final']) {
-    // A composed quick picture is refined as soon as the final bake's direct light is written:
-    // the direct light's change at the final's resolution (revision 1 of the quick bake).
-    const refine = kind === 'final' && composed !== null && base.direct ? () => {
+    // A composed quick picture is refined while the final bake runs: once it has its direct light
+    // (the direct light's change at the final's resolution: revision 1 of the quick bake), and
+    // again once it has run its bounce passes (all the light's change at the final's resolution:
+    // revision 2).
+    const refine = kind === 'final' && composed !== null && base.stages ? (stage) => {
       if (dirty) return;
-      const refined = composeQuick(generation, change, { before: base.direct.final, after: directDir(generation, 'final'), quickBefore: base.direct.quick, quickAfter: directDir(generation, 'quick') });
-      if (refined !== null) showBake({ generation, kind: 'quick', revision: 1, seen, change, layoutKept: quickLayoutKept, composed: refined, refined: true });
+      let refined = null;
+      if (stage === 'direct') refined = composeQuick(generation, change, { before: base.stages.final.direct, after: stageDir(generation, 'final', 'direct'), quickBefore: base.stages.quick.direct, quickAfter: stageDir(generation, 'quick', 'direct') });
+      else if (stage === 'bounces') refined = composeBounced(generation, change, { before: base.stages.final.bounces, after: stageDir(generation, 'final', 'bounces') });
+      else return;
+      if (refined !== null) showBake({ generation, kind: 'quick', revision: stage === 'direct' ? 1 : 2, seen, change, layoutKept: quickLayoutKept, composed: refined, refined: stage });
     } : null;
     const r = await bake(kind, generation, refine);
     if (r.cancelled || dirty) return;
@@ -161,10 +169,11 @@ async function bakeNewest() {
     // A quick look is shown at once, composed on the last final where it can be.
     composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
     quickLayoutKept = r.layoutKept;
-    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, refined: false });
+    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, refined: null });
   }
   const quick = opts.quick ? path.join(quickRoot, String(generation)) : null;
-  status.lastGood = { fp, generation, outdir: outdirStamp(), quick, direct: quick ? { quick: directDir(generation, 'quick'), final: directDir(generation, 'final') } : null };
+  const stagesOf = (kind) => ({ direct: stageDir(generation, kind, 'direct'), bounces: stageDir(generation, kind, 'bounces') });
+  status.lastGood = { fp, generation, outdir: outdirStamp(), quick, stages: quick ? { quick: stagesOf('quick'), final: stagesOf('final') } : null };
   goodPrint = print;
   status.state = 'idle';
   tidyQuickDirs();
@@ -180,7 +189,7 @@ function showBake({ generation, kind, revision, seen, change, layoutKept, compos
   if (status.history.length > 50) status.history.shift();
   status.error = null;
   const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}`;
-  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (the direct light at the final's resolution, from final bake ${generation}'s direct stage)`);
+  if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (${refined === 'direct' ? 'the direct light' : 'the bounced light'} at the final's resolution, from final bake ${generation}'s ${refined === 'direct' ? 'direct stage' : 'bounce passes'})`);
   else say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${what}${composed !== null ? `; composed on final bake ${composed}` : ''})`);
   tidyQuickDirs();
   tidyLayouts();
@@ -219,6 +228,24 @@ function composeQuick(generation, change, direct) {
   return null;
 }
 
+// After final bake N's bounce passes (a change that keeps the layout, composed first): the last
+// final bake plus the change of the light the two final bakes' bounce passes reached, texel for
+// texel (compose.mjs composeBounces), written to QUICK/N/composed-bounces. Returns the final
+// bake's generation it was composed on, or null (the picture before stays; the log says why).
+function composeBounced(generation, change, bounces) {
+  const base = status.lastGood, out = path.join(quickRoot, String(generation), 'composed-bounces');
+  let r;
+  if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
+  else if (!fs.existsSync(bounces.before)) r = { ok: false, why: `final bake ${base.generation} ran no bounce passes` };
+  else {
+    try { r = composer.composeBounces({ final: opts.outdir, out, stem, ...bounces }); } catch (e) { r = { ok: false, why: e.message }; }
+  }
+  if (r.ok) return base.generation;
+  fs.rmSync(out, { recursive: true, force: true });
+  say(`quick bake ${generation}: not refined with the bounced light (${r.why})`);
+  return null;
+}
+
 // A bake that failed while the files moved under it (a save it read half-way, before the poll
 // saw the save) is a stopped bake, not an error: the newest state is baked once it settles.
 function superseded(kind, generation) {
@@ -239,7 +266,7 @@ function failed(message) {
 // generation's, the newest and the last good final's (the next composed picture's "before").
 function tidyQuickDirs() {
   for (const d of fs.readdirSync(quickRoot)) {
-    const m = /^(\d+)(-direct-(quick|final))?$/.exec(d);
+    const m = /^(\d+)(-stages-(quick|final))?$/.exec(d);
     if (!m) continue; // the layouts
     const g = Number(m[1]);
     const base = status.lastGood && status.lastGood.generation === g;
@@ -328,13 +355,14 @@ const server = http.createServer((req, res) => {
     return send(200, 'application/json', JSON.stringify({ ...view, now: Date.now(), watching: files.map((f) => f.file) }));
   }
   if (url.pathname === '/scene.json') {
-    // rev: a quick bake's revision (0: as shown first, 1: refined with the direct light); the
-    // newest there is when it is not given
+    // rev: a quick bake's revision (0: as shown first, 1: refined with the direct light, 2: with
+    // the bounced light); the newest there is (up to rev) when it is not given
     const kind = url.searchParams.get('kind'), gen = url.searchParams.get('gen'), rev = url.searchParams.get('rev');
-    if (!['quick', 'final'].includes(kind) || !/^\d+$/.test(gen || '') || (rev !== null && !['0', '1'].includes(rev))) return send(404, 'text/plain', 'no such bake\n');
+    if (!['quick', 'final'].includes(kind) || !/^\d+$/.test(gen || '') || (rev !== null && !['0', '1', '2'].includes(rev))) return send(404, 'text/plain', 'no such bake\n');
     const has = (d) => fs.existsSync(path.join(quickRoot, gen, d, `${stem}.gltf`));
-    const composed = kind !== 'quick' ? '' : rev !== '0' && has('composed-direct') ? 'composed-direct/' : has('composed') ? 'composed/' : '';
-    const name = composed === 'composed-direct/' ? ', composed on the last final, the direct light at full resolution' : composed ? ', composed on the last final' : '';
+    const upTo = rev === null ? 2 : Number(rev);
+    const composed = kind !== 'quick' ? '' : upTo >= 2 && has('composed-bounces') ? 'composed-bounces/' : upTo >= 1 && has('composed-direct') ? 'composed-direct/' : has('composed') ? 'composed/' : '';
+    const name = { 'composed-bounces/': ', composed on the last final, all the light at full resolution', 'composed-direct/': ', composed on the last final, the direct light at full resolution', 'composed/': ', composed on the last final' }[composed] || '';
     return send(200, 'application/json', JSON.stringify({ gltf: `/bake/${kind}/${gen}/${composed}${encodeURIComponent(stem)}.gltf`, name: `${stem}.gltf (${kind} bake ${gen}${name})` }));
   }
   const m = /^\/bake\/(quick|final)\/(\d+)\//.exec(url.pathname);

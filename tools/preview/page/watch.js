@@ -5,7 +5,8 @@
 // bake, how old, what changed) and what is baking; a bake that failed shows its error and the
 // last good bake stays. Hooks for tests: window.lmbWatch (the last /status), lmbWatchShown
 // ({generation, kind, revision} of the frame on screen: a quick bake's revision 1 is it refined
-// with the changed lights' direct light), lmbWatchFrame() (its window).
+// with the direct light at the final's resolution, 2 with all the light the final's bounce
+// passes reached), lmbWatchFrame() (its window).
 const q = new URLSearchParams(location.search);
 const $ = (id) => document.getElementById(id);
 let shownFrame = null, shownKey = null, loadingKey = null;
@@ -62,7 +63,7 @@ function show(s) {
 const age = (ms) => (ms < 60000 ? `${Math.round(ms / 1000)} s` : `${Math.round(ms / 60000)} min`);
 function bar(s) {
   const sh = s.shown;
-  $('shown').innerHTML = sh ? `<b class="${sh.kind}">${sh.kind} bake ${sh.generation}</b>, ${age(s.now - sh.readyAt)} old (${sh.changed.join('; ')}; ready ${sh.seconds.toFixed(1)} s after the change${sh.layoutKept ? ', layout kept' : ''}${sh.composedOn ? `; the last final bake ${sh.composedOn} plus the change at the quick look's resolution${sh.directOf ? ` (${sh.directOf.join(', ')}: direct light at full resolution)` : s.baking && s.baking.kind === 'correction' && s.baking.generation === sh.generation ? ' (refining: the changed lights\' direct light at full resolution)' : ''}` : ''})` : 'waiting for the first bake';
+  $('shown').innerHTML = sh ? `<b class="${sh.kind}">${sh.kind} bake ${sh.generation}</b>, ${age(s.now - sh.readyAt)} old (${sh.changed.join('; ')}; ready ${sh.seconds.toFixed(1)} s after the change${sh.layoutKept ? ', layout kept' : ''}${sh.composedOn ? `; the last final bake ${sh.composedOn} plus the change at the quick look's resolution${sh.refined === 'bounces' ? ' (all the light at full resolution, from the final bake\'s bounce passes)' : sh.refined === 'direct' ? ' (the direct light at full resolution; refining: the bounced light next)' : s.baking && s.baking.kind === 'final' && s.baking.generation === sh.generation ? ' (refining: the direct light at full resolution next)' : ''}` : ''})` : 'waiting for the first bake';
   const b = s.baking;
   $('next').textContent = b ? `baking: ${b.kind} bake ${b.generation}, ${b.stage} ${b.percent}%` : s.state === 'idle' ? 'up to date' : s.state;
   $('werror').textContent = s.error ? `lmbake: ${s.error}\n${sh ? `(bake ${sh.generation} stays on screen until the next good save)` : ''}` : '';
