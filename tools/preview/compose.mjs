@@ -13,8 +13,8 @@
 // TEXCOORD_1 in both bakes map rectangle to rectangle instead. Texels no triangle covers (the
 // atlas's padding) take the difference of a covered neighbour.
 //
-// Once the final bake of the change has its direct light (each bake writes the light of its
-// direct stage beside it, `lmbake bake --direct-out`), the picture is refined:
+// Once the final bake of the change has its direct light (each bake of the watch writes the light
+// of its stages as it goes, `lmbake bake --stages-out`), the picture is refined:
 //
 //     final(before) + [quick(after) - quick(before)] - [qdirect(after) - qdirect(before)]
 //                   + [direct(after) - direct(before)]
@@ -367,14 +367,10 @@ export function mapQuicks(f, quicks) {
 }
 
 // The direct light's change at the final's resolution: direct(after) - direct(before), per final
-// atlas (3 floats a texel), or {why} when those bakes are not of the final's layout.
-function directChange(f, atlases, da, db, read) {
-  const nf = lightmappedNodes(f);
+// atlas (3 floats a texel), or {why} when their atlases are not the final's (da, db: the final's
+// glTF with the direct-light folders' .hdr files).
+function directChange(atlases, da, db, read) {
   const change = new Map();
-  for (const g of [da, db]) {
-    const n = lightmappedNodes(g);
-    if (n.length !== nf.length || !n.every((x, i) => x.node === nf[i].node && x.atlas === nf[i].atlas && x.rects.length === nf[i].rects.length && x.rects.every((r, k) => sameArray(r, nf[i].rects[k])))) return { why: 'the direct light is of another layout' };
-  }
   const [ia, ib] = [readAtlases(da, read), readAtlases(db, read)];
   for (const [a, img] of atlases) {
     const A = ia.get(a), B = ib.get(a);
@@ -506,7 +502,7 @@ export function createComposer() {
   // final: the last final bake's folder; quickBefore: its quick look's; quickAfter: the new quick
   // look's; out: the folder to write (made here). stem: the level's file name without extension.
   // direct (optional): {before, after, quickBefore, quickAfter}, the folders of the direct light
-  // (`lmbake bake --direct-out`) of the last final bake, of this change's final bake and of the
+  // (`lmbake bake --stages-out`'s direct stage) of the last final bake, of this change's final bake and of the
   // two quick looks: each the .hdr files of its bake's atlases, read with that bake's glTF.
   function compose({ final, quickBefore, quickAfter, out, stem, direct = null }) {
     const t0 = Date.now();
@@ -531,7 +527,7 @@ export function createComposer() {
     }
     let exactPart = { change: null };
     try {
-      if (c) exactPart = directChange(f, k.map.atlases, c.directAfter, c.directBefore, read);
+      if (c) exactPart = directChange(k.map.atlases, c.directAfter, c.directBefore, read);
     } catch (e) {
       return { ok: false, why: `cannot read the direct light (${e.message})` };
     }
