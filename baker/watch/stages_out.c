@@ -2,6 +2,7 @@
 #include "stages_out.h"
 
 #include "write/atlas_images.h"
+#include "write/output_dir.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -26,12 +27,8 @@ lmb_status lmb_stages_out_write(const lmb_config *cfg, const char *stage, lmb_ca
     }
     lmb_status st = lmb_cache_store(cache, a, t, shown, err);
     free(shown);
-    const char *path = cache->scene->path, *base = strrchr(path, '/');
     char stem[256];
-    snprintf(stem, sizeof stem, "%s", base ? base + 1 : path);
-    char *dot = strrchr(stem, '.');
-    if (dot && dot != stem)
-        *dot = '\0';
+    lmb_output_stem(cache->scene->path, stem, sizeof stem);
     if (st == LMB_OK)
         st = lmb_write_hdr_image(cfg, dir, stem, a, cache->irradiance[a], cache->layout->width[a],
                                  cache->layout->height[a], err);

@@ -139,17 +139,22 @@ lmb_status lmb_make_folders(const char *dir, int *made, lmb_error *err)
     return LMB_OK;
 }
 
+void lmb_output_stem(const char *input_path, char *stem, size_t size)
+{
+    const char *base = strrchr(input_path, '/');
+    snprintf(stem, size, "%s", base ? base + 1 : input_path);
+    char *dot = strrchr(stem, '.');
+    if (dot && dot != stem)
+        *dot = '\0';
+}
+
 lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, const lmb_log *log,
                                lmb_error *err)
 {
     memset(od, 0, sizeof *od);
     od->log = log;
     snprintf(od->dir, sizeof od->dir, "%s", dir);
-    const char *base = strrchr(input_path, '/');
-    snprintf(od->stem, sizeof od->stem, "%s", base ? base + 1 : input_path);
-    char *dot = strrchr(od->stem, '.');
-    if (dot && dot != od->stem)
-        *dot = '\0';
+    lmb_output_stem(input_path, od->stem, sizeof od->stem);
     struct stat sb;
     if (stat(dir, &sb) == 0) {
         if (!S_ISDIR(sb.st_mode))

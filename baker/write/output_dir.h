@@ -37,6 +37,10 @@ typedef struct lmb_output_dir {
  * that cannot be made (LMB_ERR_INPUT). */
 lmb_status lmb_make_folders(const char *dir, int *made, lmb_error *err);
 
+/* The output files' stem: input_path's file name without its extension ("levels/a.glb" -> "a"),
+ * at most size - 1 bytes. */
+void lmb_output_stem(const char *input_path, char *stem, size_t size);
+
 lmb_status lmb_output_dir_open(lmb_output_dir *od, const char *dir, const char *input_path, const lmb_log *log,
                                lmb_error *err);
 
