@@ -44,6 +44,9 @@
 //
 // with bounces the light the two final bakes' bounce passes reached (the direct light, its
 // bounces and their extrapolated tail, before the final gather): texel for texel, no quick look.
+// (rho = 1 here too: rho from the two bakes' bounced light took level-single-10's lamp x 2 from
+// 0.58 to 0.53% and / 2 from 0.47 to 0.37%, the moved lamp 1.00% either way, but watch_compose's
+// corner lamp from 0.76 to 2.20%.)
 //
 // compose(...) writes OUT: the final's glTF with its lightmap textures naming only the composed
 // .hdr (no KTX2 or EXR: those are the old final's), the final's other files hard-linked (or
@@ -364,31 +367,20 @@ function composedHdr(img, pad, delta, exact) {
   return encodeHdr(img.width, img.height, rgba);
 }
 
-// rho per final texel (the header above): the ratio r of the two quick looks' luminance (each
-// plus RHO_FLOOR x the final's mean, so that dark texels' noise does not make it); where the light
-// fell (r < 1) rho = r; where it rose, rho = min(r, RHO_MAX), or 1 when it fell at a texel within
-// RHO_REACH (the light moved); 1 on uncovered texels. atlases: the final's (readAtlases); qa: the
-// quick look after, qbNeg: minus the quick look before, both through the map (3 numbers a texel).
-// Returns atlas -> Float32Array.
+// rho per final texel (the header above): the ratio r of the light after to the light before
+// (luminance; each plus RHO_FLOOR x the final's mean, so that dark texels' noise does not make
+// it); where the light fell (r < 1) rho = r; where it rose, rho = min(r, RHO_MAX), or 1 when it
+// fell at a texel within RHO_REACH (the light moved); 1 on uncovered texels. atlases: atlas ->
+// {width, height, covered (1: a texel with light), after, before (luminance a texel)}; meanLum:
+// the final's mean luminance over its covered texels. Returns atlas -> Float32Array.
 const lum = (r, g, b) => 0.2126 * r + 0.7152 * g + 0.0722 * b;
-function detailScale(map, atlases, qa, qbNeg) {
-  if (map.meanLum === undefined) {
-    let sum = 0, n = 0;
-    for (const [a, m] of map.byAtlas) {
-      const d = atlases.get(a).data;
-      for (let t = 0; t < m.covered.length; t++) if (m.covered[t]) { sum += lum(d[4 * t], d[4 * t + 1], d[4 * t + 2]); n++; }
-    }
-    map.meanLum = n ? sum / n : 0; // the final's mean luminance over covered texels (the map is the final's)
-  }
-  const floor = RHO_FLOOR * map.meanLum + 1e-30;
-  const scale = new Map();
-  for (const [a, m] of map.byAtlas) {
-    const { width: W, height: H, covered } = m, A = qa.get(a), B = qbNeg.get(a), N = W * H;
-    const rho = new Float32Array(N).fill(1), fell = new Uint8Array(N);
+function detailScale(atlases, meanLum) {
+  const floor = RHO_FLOOR * meanLum + 1e-30, scale = new Map();
+  for (const [a, { width: W, height: H, covered, after, before }] of atlases) {
+    const N = W * H, rho = new Float32Array(N).fill(1), fell = new Uint8Array(N);
     for (let t = 0; t < N; t++) {
       if (!covered[t]) continue;
-      const la = Math.max(lum(A[3 * t], A[3 * t + 1], A[3 * t + 2]), 0), lb = Math.max(-lum(B[3 * t], B[3 * t + 1], B[3 * t + 2]), 0);
-      rho[t] = (la + floor) / (lb + floor);
+      rho[t] = (Math.max(after[t], 0) + floor) / (Math.max(before[t], 0) + floor);
       fell[t] = rho[t] < 1 ? 1 : 0;
     }
     // texels with a fall within RHO_REACH (a (2 RHO_REACH + 1)^2 square): rows, then columns
@@ -410,6 +402,30 @@ function detailScale(map, atlases, qa, qbNeg) {
   return scale;
 }
 
+// detailScale of two quick looks through the map: qa, the quick look after, qbNeg, minus the
+// quick look before (3 numbers a final texel); the final's mean luminance kept in the map.
+function quickDetailScale(map, qa, qbNeg) {
+  if (map.meanLum === undefined) {
+    let sum = 0, n = 0;
+    for (const [a, m] of map.byAtlas) {
+      const d = map.atlases.get(a).data;
+      for (let t = 0; t < m.covered.length; t++) if (m.covered[t]) { sum += lum(d[4 * t], d[4 * t + 1], d[4 * t + 2]); n++; }
+    }
+    map.meanLum = n ? sum / n : 0;
+  }
+  const atlases = new Map();
+  for (const [a, m] of map.byAtlas) {
+    const A = qa.get(a), B = qbNeg.get(a), N = m.width * m.height, after = new Float32Array(N), before = new Float32Array(N);
+    for (let t = 0; t < N; t++) {
+      if (!m.covered[t]) continue;
+      after[t] = lum(A[3 * t], A[3 * t + 1], A[3 * t + 2]);
+      before[t] = -lum(B[3 * t], B[3 * t + 1], B[3 * t + 2]);
+    }
+    atlases.set(a, { width: m.width, height: m.height, covered: m.covered, after, before });
+  }
+  return detailScale(atlases, map.meanLum);
+}
+
 // The composed picture's change on the covered texels of the final's atlases (padded later, in
 // composedHdr): (rho - 1) final + quick(after) - rho quick(before); refined with the direct light
 // (q.qda, q.qdb given), with rho = 1: quick(after) - quick(before) - qdirect(after) +
@@ -417,7 +433,7 @@ function detailScale(map, atlases, qa, qbNeg) {
 // (directChange). q: {qa, qda, qdb} through the map (3 numbers a texel; q.qa becomes the change, in
 // place); qbNeg: minus the quick look before through the map.
 function composedDelta(map, q, qbNeg) {
-  const refined = !!q.qda, rho = refined ? null : detailScale(map, map.atlases, q.qa, qbNeg), values = new Map();
+  const refined = !!q.qda, rho = refined ? null : quickDetailScale(map, q.qa, qbNeg), values = new Map();
   for (const [a, m] of map.byAtlas) {
     const A = q.qa.get(a), F = map.atlases.get(a).data, Bneg = qbNeg.get(a);
     if (refined) {
