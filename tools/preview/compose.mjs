@@ -367,20 +367,29 @@ function composedHdr(img, pad, delta, exact) {
   return encodeHdr(img.width, img.height, rgba);
 }
 
-// rho per final texel (the header above): the ratio r of the light after to the light before
-// (luminance; each plus RHO_FLOOR x the final's mean, so that dark texels' noise does not make
-// it); where the light fell (r < 1) rho = r; where it rose, rho = min(r, RHO_MAX), or 1 when it
-// fell at a texel within RHO_REACH (the light moved); 1 on uncovered texels. atlases: atlas ->
-// {width, height, covered (1: a texel with light), after, before (luminance a texel)}; meanLum:
-// the final's mean luminance over its covered texels. Returns atlas -> Float32Array.
+// rho per final texel (the header above) from the two quick looks through the map (qa: the one
+// after, qbNeg: minus the one before; 3 numbers a final texel): the ratio r of their luminance
+// (each plus RHO_FLOOR x the final's mean, so that dark texels' noise does not make it; the mean
+// kept in the map); where the light fell (r < 1) rho = r; where it rose, rho = min(r, RHO_MAX),
+// or 1 when it fell at a texel within RHO_REACH (the light moved); 1 on uncovered texels.
+// Returns atlas -> Float32Array.
 const lum = (r, g, b) => 0.2126 * r + 0.7152 * g + 0.0722 * b;
-function detailScale(atlases, meanLum) {
-  const floor = RHO_FLOOR * meanLum + 1e-30, scale = new Map();
-  for (const [a, { width: W, height: H, covered, after, before }] of atlases) {
-    const N = W * H, rho = new Float32Array(N).fill(1), fell = new Uint8Array(N);
+function detailScale(map, qa, qbNeg) {
+  if (map.meanLum === undefined) {
+    let sum = 0, n = 0;
+    for (const [a, m] of map.byAtlas) {
+      const d = map.atlases.get(a).data;
+      for (let t = 0; t < m.covered.length; t++) if (m.covered[t]) { sum += lum(d[4 * t], d[4 * t + 1], d[4 * t + 2]); n++; }
+    }
+    map.meanLum = n ? sum / n : 0;
+  }
+  const floor = RHO_FLOOR * map.meanLum + 1e-30, scale = new Map();
+  for (const [a, { width: W, height: H, covered }] of map.byAtlas) {
+    const A = qa.get(a), B = qbNeg.get(a), N = W * H, rho = new Float32Array(N).fill(1), fell = new Uint8Array(N);
     for (let t = 0; t < N; t++) {
       if (!covered[t]) continue;
-      rho[t] = (Math.max(after[t], 0) + floor) / (Math.max(before[t], 0) + floor);
+      const after = Math.max(lum(A[3 * t], A[3 * t + 1], A[3 * t + 2]), 0), before = Math.max(-lum(B[3 * t], B[3 * t + 1], B[3 * t + 2]), 0);
+      rho[t] = (after + floor) / (before + floor);
       fell[t] = rho[t] < 1 ? 1 : 0;
     }
     // texels with a fall within RHO_REACH (a (2 RHO_REACH + 1)^2 square): rows, then columns
@@ -402,30 +411,6 @@ function detailScale(atlases, meanLum) {
   return scale;
 }
 
-// detailScale of two quick looks through the map: qa, the quick look after, qbNeg, minus the
-// quick look before (3 numbers a final texel); the final's mean luminance kept in the map.
-function quickDetailScale(map, qa, qbNeg) {
-  if (map.meanLum === undefined) {
-    let sum = 0, n = 0;
-    for (const [a, m] of map.byAtlas) {
-      const d = map.atlases.get(a).data;
-      for (let t = 0; t < m.covered.length; t++) if (m.covered[t]) { sum += lum(d[4 * t], d[4 * t + 1], d[4 * t + 2]); n++; }
-    }
-    map.meanLum = n ? sum / n : 0;
-  }
-  const atlases = new Map();
-  for (const [a, m] of map.byAtlas) {
-    const A = qa.get(a), B = qbNeg.get(a), N = m.width * m.height, after = new Float32Array(N), before = new Float32Array(N);
-    for (let t = 0; t < N; t++) {
-      if (!m.covered[t]) continue;
-      after[t] = lum(A[3 * t], A[3 * t + 1], A[3 * t + 2]);
-      before[t] = -lum(B[3 * t], B[3 * t + 1], B[3 * t + 2]);
-    }
-    atlases.set(a, { width: m.width, height: m.height, covered: m.covered, after, before });
-  }
-  return detailScale(atlases, map.meanLum);
-}
-
 // The composed picture's change on the covered texels of the final's atlases (padded later, in
 // composedHdr): (rho - 1) final + quick(after) - rho quick(before); refined with the direct light
 // (q.qda, q.qdb given), with rho = 1: quick(after) - quick(before) - qdirect(after) +
@@ -433,7 +418,7 @@ function quickDetailScale(map, qa, qbNeg) {
 // (directChange). q: {qa, qda, qdb} through the map (3 numbers a texel; q.qa becomes the change, in
 // place); qbNeg: minus the quick look before through the map.
 function composedDelta(map, q, qbNeg) {
-  const refined = !!q.qda, rho = refined ? null : quickDetailScale(map, q.qa, qbNeg), values = new Map();
+  const refined = !!q.qda, rho = refined ? null : detailScale(map, q.qa, qbNeg), values = new Map();
   for (const [a, m] of map.byAtlas) {
     const A = q.qa.get(a), F = map.atlases.get(a).data, Bneg = qbNeg.get(a);
     if (refined) {
