@@ -10,8 +10,8 @@
 // the two files' quick looks (`lmbake bake --quick`), then, once bake 2's final bake has its direct
 // light, that refined with the direct light of both files' final and quick bakes, then, once it
 // has run its bounce passes, bake 1's final plus the change of the light both final bakes' bounce
-// passes reached (`--stages-out`, tools/preview/compose.mjs). The final bake is held (SIGSTOP)
-// while each is read. Then a
+// passes reached (`--stages-out`, tools/preview/compose.mjs). The final bake waits (the watch
+// runs it through held_lmbake.sh) while each is read. Then a
 // half-written level: the page shows the error and keeps bake 2's pixels exactly. Screenshots in
 // SHOTS_DIR (preview-watch-*.png).
 //   usage: node tests/preview/preview_watch.mjs LMBAKE WORKDIR SHOTS_DIR
@@ -44,7 +44,16 @@ save();
 const cfg = path.join(dir, 'bake.yaml');
 fs.writeFileSync(cfg, 'texel_density: 16\nbounces: 4\nsamples: {gather: 4096, bounce: 1024}\n');
 
-const watch = spawn(lmbake, ['preview', '--watch', level, '-c', cfg, '-o', path.join(work, 'out')], { stdio: ['ignore', 'pipe', 'inherit'] });
+// The watch as `lmbake preview --watch` starts it (check_watch.py runs that command itself), its
+// bakes run through held_lmbake.sh: bake 2's final bake waits while its first quick picture is
+// read and stops at each stage the quick picture is refined from, until the test lets it go on
+// (it removes that hold file), however fast the bake or loaded the machine.
+const holds = path.join(work, 'holds');
+fs.mkdirSync(holds, { recursive: true });
+const hold = (name) => fs.writeFileSync(path.join(holds, name), '');
+const release = (name) => fs.rmSync(path.join(holds, name), { force: true });
+const watch = spawn('node', [path.join(root, 'tools', 'preview', 'watch.mjs'), level, '--lmbake', path.join(root, 'tests', 'preview', 'held_lmbake.sh'), '-c', cfg, '-o', path.join(work, 'out')],
+  { stdio: ['ignore', 'pipe', 'inherit'], env: { ...process.env, LMBAKE_REAL: path.resolve(lmbake), LMBAKE_HOLD_DIR: holds } });
 let log = '';
 const url = await new Promise((resolve, reject) => {
   watch.stdout.on('data', (d) => {
@@ -91,36 +100,23 @@ try {
   });
   const [stages1, qstages1] = stagesOf(1);
 
+  for (const h of ['final', 'direct', 'bounces']) hold(h);
   doc.extensions.KHR_lights_punctual.lights[0].intensity *= 3;
   save();
-  // hold bake 2's final bake (SIGSTOP) as soon as it runs, and again as soon as the quick picture
-  // is refined from its direct light, so that each picture is on screen to be read however fast
-  // the final would come; let it go on after
   const status = async () => (await fetch(url + 'status')).json();
-  const hold = async (until) => {
-    for (let k = 0; k < 24000; k++) {
-      const st = await status();
-      if (until(st) && st.baking && st.baking.generation === 2 && st.baking.kind === 'final') { process.kill(st.baking.pid, 'SIGSTOP'); return st.baking.pid; }
-      if (st.shown && st.shown.generation === 2 && st.shown.kind === 'final') return null;
-      await new Promise((r) => setTimeout(r, 5));
-    }
-    return null;
-  };
-  let held = await hold(() => true);
-  check(held !== null, `bake 2's final bake held while the first quick picture is read (pid ${held})`);
+  const finalBaking = (st) => !!(st.baking && st.baking.generation === 2 && st.baking.kind === 'final');
   await shown(2, 'quick', 0);
   const q2 = await pixels('bake2-quick'), camQ = await camera(), statusQ = await status();
-  if (held) process.kill(held, 'SIGCONT');
-  held = await hold((st) => st.shown && st.shown.generation === 2 && st.shown.revision === 1);
-  check(held !== null, `bake 2's final bake held again once it refined the quick picture (pid ${held})`);
+  check(finalBaking(statusQ), `bake 2's final bake waits to start while the first quick picture is read (/status baking: ${JSON.stringify(statusQ.baking)})`);
+  release('final');
   await shown(2, 'quick', 1); // revision 1: refined with the direct light at the final's resolution
   const q2r = await pixels('bake2-quick-refined'), statusR = await status();
-  if (held) process.kill(held, 'SIGCONT');
-  held = await hold((st) => st.shown && st.shown.generation === 2 && st.shown.revision === 2);
-  check(held !== null, `bake 2's final bake held again once it refined the quick picture with its bounce passes (pid ${held})`);
+  check(finalBaking(statusR), `bake 2's final bake waits after its direct stage while the refined picture is read (/status baking: ${JSON.stringify(statusR.baking)})`);
+  release('direct');
   await shown(2, 'quick', 2); // revision 2: all the light the bounce passes reached, at the final's resolution
   const q2b = await pixels('bake2-quick-bounced'), statusB = await status();
-  if (held) process.kill(held, 'SIGCONT');
+  check(finalBaking(statusB), `bake 2's final bake waits after its bounce passes while that picture is read (/status baking: ${JSON.stringify(statusB.baking)})`);
+  release('bounces');
   await shown(2, 'final');
   const f2 = await pixels('bake2-final'), cam2 = await camera();
   for (let i = 0; i < points.length; i++) {
