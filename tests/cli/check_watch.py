@@ -5,8 +5,8 @@
                final); the light's intensity is changed in the file: bake 2 is a change of
                "lights", lighting only; its final files in OUTDIR equal `lmbake bake` of the
                changed level byte for byte, its layout read back (--layout-cache); the quick bake
-               never wrote into OUTDIR; then the light
-               is moved (a node's translation: "lights" again) and a config sampling key changed
+               never wrote into OUTDIR; no light moved (/status placesKept); then the light
+               is moved (a node's translation: "lights" again, placesKept false) and a config sampling key changed
                ("config samples.gather", lighting only), then an atlas key ("layout and lighting":
                laid out again).
 2. errors      a half-written level (JSON cut short) and a config with an unknown key: state
@@ -139,8 +139,9 @@ def identical(lmbake, work):
         doc["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] *= 3
         save_json(level, doc)
         s = w.shown(2, "quick")
-        ok &= check(s["changed"] == ["lights"] and not s["layout"], "intensity changed: bake 2 is %s, layout %s"
-                    % (s["changed"], s["layout"]))
+        ok &= check(s["changed"] == ["lights"] and not s["layout"] and s["placesKept"] is True,
+                    "intensity changed: bake 2 is %s, layout %s, no light moved (placesKept %s)"
+                    % (s["changed"], s["layout"], s["placesKept"]))
         s = w.shown(2, "final")
         ok &= check(s["shown"].get("layoutKept") is True, "intensity changed: bake 2's final read its layout back (layoutKept "
                     "%s)" % s["shown"].get("layoutKept"))
@@ -154,8 +155,9 @@ def identical(lmbake, work):
         light_node["translation"][0] -= 0.2
         save_json(level, doc)
         s = w.shown(3, "final")
-        ok &= check(s["changed"] == ["lights"] and not s["layout"], "light moved: bake 3 is %s, layout %s"
-                    % (s["changed"], s["layout"]))
+        ok &= check(s["changed"] == ["lights"] and not s["layout"] and s["placesKept"] is False,
+                    "light moved: bake 3 is %s, layout %s, a light moved (placesKept %s)"
+                    % (s["changed"], s["layout"], s["placesKept"]))
         save_text(cfg, CONFIG + "samples: {gather: 128}\n")
         s = w.shown(4, "final")
         ok &= check(s["changed"] == ["config samples.gather"] and not s["layout"], "samples.gather: bake 4 is %s, "

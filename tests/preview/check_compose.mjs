@@ -12,6 +12,9 @@
 //     triangle covers, rms of the luminance difference over F2's mean), and within 5%;
 //   - refined with the direct light, F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1) is closer to F2 still,
 //     and with the bounced light, F1 + BF2 - BF1, closer again;
+//   - the corner lamp made brighter where it was (F3, Q3, DF3, DQ3: no light moved): refined with
+//     the final's detail besides the direct light scaled with rho (compose.mjs) is closer to F3
+//     than the first picture and no more than 2% further than with rho = 1;
 //   - a quick look of another layout (the texel density changed) is refused with a reason;
 //   - `--stages-out` changes no output byte, and what it writes is the light in the lightmap's
 //     units: with no bounces, the direct light is the lightmap itself to within its denoising,
@@ -92,13 +95,17 @@ function box9(values, stride, w, h) { // mean luminance over the covered texels 
   return out;
 }
 const { width: w, height: h } = final;
-const ref = box9(final.data, 4, w, h);
-const error = (values) => {
-  const b = box9(values, 3, w, h);
-  let se = 0, sum = 0, n = 0;
-  for (let i = 0; i < w * h; i++) if (covered[i]) { se += (b[i] - ref[i]) ** 2; sum += ref[i]; n++; }
-  return Math.sqrt(se / n) / (sum / n);
+// the 9 x 9 rms error against a final bake of the layout (F2's atlas), over its mean
+const errorAgainst = (finalImg) => {
+  const ref = box9(finalImg.data, 4, w, h);
+  return (values) => {
+    const b = box9(values, 3, w, h);
+    let se = 0, sum = 0, n = 0;
+    for (let i = 0; i < w * h; i++) if (covered[i]) { se += (b[i] - ref[i]) ** 2; sum += ref[i]; n++; }
+    return Math.sqrt(se / n) / (sum / n);
+  };
 };
+const error = errorAgainst(final);
 const eQuick = error(quickAlone.mapped.get(0).value), eComposed = error(composed.mapped.get(0).value);
 // the plain difference, F1 + Q2 - Q1 texel for texel (rho = 1 everywhere), at least 0 as composed
 const difference = mapQuicks(f2, [{ g: readBake(Q2, stem), weight: 1 }, { g: readBake(Q1, stem), weight: -1 }]).mapped.get(0).value;
@@ -117,6 +124,25 @@ check(bounced.ok && eBounced < eRefined, `and refined with the bounced light at 
 const sameBounced = composeBounces({ final: F1, out: path.join(work, 'same-bounced'), stem, before: bouncesOf(F1), after: bouncesOf(F1) });
 const sb = sameBounced.ok ? readHdr(path.join(work, 'same-bounced', hdr)) : null;
 check(sameBounced.ok && sb.data.every((x, i) => x === b.data[i]), `the bounced light of the same bake twice gives F1 back texel for texel (${sameBounced.ok ? `${sameBounced.ms} ms` : sameBounced.why})`);
+// the corner lamp back where it was and twice as bright (F3, Q3: a change that moves no light):
+// refined with the direct light and the final's other detail scaled with rho (direct.scaleDetail,
+// what the watch asks when no light moved) is closer to F3 than refined with rho = 1, and than the
+// first picture
+const corner = doc.nodes[doc.nodes.length - 1], cornerLight = doc.extensions.KHR_lights_punctual.lights[corner.extensions.KHR_lights_punctual.light];
+const movedTo = corner.translation;
+corner.translation = [0.2, 0.15, 0.25];
+cornerLight.intensity *= 2;
+const F3 = bakeState('f3'), Q3 = bakeState('q3', { quick: true });
+corner.translation = movedTo; // the level as F2 baked it again, for the checks below
+cornerLight.intensity /= 2;
+const f3 = readBake(F3, stem), error3 = errorAgainst(mapQuicks(f3, [{ g: readBake(Q3, stem), weight: 1 }]).atlases.get(0));
+const brighter = (tag, direct) => {
+  const r = compose({ final: F1, quickBefore: Q1, quickAfter: Q3, out: path.join(work, tag), stem, direct });
+  return r.ok ? error3(mapQuicks(f3, [{ g: readBake(path.join(work, tag), stem), weight: 1 }]).mapped.get(0).value) : 1;
+};
+const directTo3 = { before: directOf(F1), after: directOf(F3), quickBefore: directOf(Q1), quickAfter: directOf(Q3) };
+const eFirst3 = brighter('brighter', null), eRefined3 = brighter('brighter-refined', directTo3), eScaled3 = brighter('brighter-scaled', { ...directTo3, scaleDetail: true });
+check(eScaled3 < eFirst3 && eScaled3 <= 1.02 * eRefined3, `the corner lamp x 2: refined with the final's detail scaled ${(100 * eScaled3).toFixed(2)}% from F3, with rho = 1 ${(100 * eRefined3).toFixed(2)}%, the first picture ${(100 * eFirst3).toFixed(2)}% (want below the first picture and at most 2% above rho = 1: rho from the whole quick looks was 15% above it here)`);
 const missing = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'missing'), stem, direct: { before: directOf(F1), after: path.join(work, 'nowhere'), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
 check(!missing.ok && /direct light/.test(missing.why) && !fs.existsSync(path.join(work, 'missing')), `a direct light not written is refused, nothing written: ${missing.why}`);
 

@@ -8,7 +8,8 @@
 // (the bake is linear in the light; 3% and 2 levels allowed for the 8-bit screenshot). Its quick
 // picture is shown three times: first what the plain preview shows of bake 1's final composed with
 // the two files' quick looks (`lmbake bake --quick`), then, once bake 2's final bake has its direct
-// light, that refined with the direct light of both files' final and quick bakes, then, once it
+// light, that refined with the direct light of both files' final and quick bakes (and, since no
+// light moved, the final's other detail scaled with the light), then, once it
 // has run its bounce passes, bake 1's final plus the change of the light both final bakes' bounce
 // passes reached (`--stages-out`, tools/preview/compose.mjs). The final bake waits (the watch
 // runs it through held_lmbake.sh) while each is read. Then a
@@ -148,8 +149,8 @@ try {
   check(composed.ok && statusQ.shown.composedOn === 1 && statusQ.shown.revision === 0, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}, revision ${statusQ.shown.revision}; here: ${composed.ok || composed.why})`);
   const wantQuick = composed.ok ? await plainPixels(path.join(work, 'composed2')) : [];
   check(composed.ok && largest(q2, wantQuick) <= 1, `bake 2's quick picture is the composed one: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)}`);
-  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: path.join(stages1, 'direct'), after: path.join(stages2, 'direct'), quickBefore: path.join(qstages1, 'direct'), quickAfter: path.join(qstages2, 'direct') } });
-  check(refined.ok && statusR.shown.refined === 'direct' && statusR.shown.composedOn === 1, `then refined with the direct light at the final's resolution (/status refined: ${JSON.stringify(statusR.shown.refined)}; here: ${refined.ok || refined.why})`);
+  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: path.join(stages1, 'direct'), after: path.join(stages2, 'direct'), quickBefore: path.join(qstages1, 'direct'), quickAfter: path.join(qstages2, 'direct'), scaleDetail: true } });
+  check(refined.ok && statusR.shown.refined === 'direct' && statusR.shown.composedOn === 1 && statusR.shown.placesKept === true, `then refined with the direct light at the final's resolution, the final's other detail scaled (no light moved) (/status refined: ${JSON.stringify(statusR.shown.refined)}, placesKept ${statusR.shown.placesKept}; here: ${refined.ok || refined.why})`);
   const wantRefined = refined.ok ? await plainPixels(path.join(work, 'refined2')) : [];
   check(refined.ok && largest(q2r, wantRefined) <= 1, `bake 2's refined quick picture is the refined composition: ${JSON.stringify(q2r)} against ${JSON.stringify(wantRefined)}`);
   const bounced = composeBounces({ final: final1, out: path.join(work, 'bounced2'), stem: 'cornell-point', before: path.join(stages1, 'bounces'), after: path.join(stages2, 'bounces') });

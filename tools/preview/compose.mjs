@@ -34,9 +34,20 @@
 // with qdirect the quick looks' direct light and direct the two final bakes': the change of the
 // direct light (lights, sky, emissive surfaces) is then taken at the final's resolution (texel for
 // texel: the same layout), and only the rest of the change, its bounced light, at the quick look's.
-// A moved lamp's hot spot, a few texels wide, is what the quick look's resolution blurs. (rho = 1
-// here: the direct light, where the sharp detail is, is exact; rho from the quick looks made it
-// 6.2 -> 5.5% on the moved lamp but 3.1 -> 4.1% on watch_compose's corner lamp.)
+// A moved lamp's hot spot, a few texels wide, is what the quick look's resolution blurs.
+// When the change moved no light (only intensities, colours and material values: the watch's
+// placesKept, `direct.scaleDetail`), the final's detail of the rest of the light is scaled with it
+// as in the first picture:
+//
+//     direct(after) + rho [final(before) - direct(before)]
+//                   + [quick(after) - qdirect(after)] - rho [quick(before) - qdirect(before)]
+//
+// with rho as in the first picture but from the quick looks' light less their direct light (the
+// part it scales): on level-single-10 Lamp 1 x 2 1.73 -> 0.85%, / 2 0.90 -> 0.47% (without it the
+// refinement was further from the final than the first picture, 1.60 and 0.79%); watch_compose's
+// corner lamp x 2 2.02 -> 1.99%. (rho from the quick looks' whole light: 0.78, 0.47%, but 2.32% on
+// the corner lamp.) A moved light keeps rho = 1 here: rho made level-single-10's moved lamp 3.29
+// -> 2.94% but watch_compose's moved corner lamp 3.1 -> 4.1%.
 //
 // Once the final bake has run its bounce passes, the picture is refined again to
 //
@@ -414,14 +425,35 @@ function detailScale(map, qa, qbNeg) {
 // The composed picture's change on the covered texels of the final's atlases (padded later, in
 // composedHdr): (rho - 1) final + quick(after) - rho quick(before); refined with the direct light
 // (q.qda, q.qdb given), with rho = 1: quick(after) - quick(before) - qdirect(after) +
-// qdirect(before), the direct light's change, direct(after) - direct(before), added after padding
-// (directChange). q: {qa, qda, qdb} through the map (3 numbers a texel; q.qa becomes the change, in
-// place); qbNeg: minus the quick look before through the map.
-function composedDelta(map, q, qbNeg) {
-  const refined = !!q.qda, rho = refined ? null : detailScale(map, q.qa, qbNeg), values = new Map();
+// qdirect(before), or, given directBefore (the final's direct light before, readAtlases), with
+// rho of quick - qdirect: (rho - 1) (final - direct(before)) + quick(after) - qdirect(after) - rho (quick(before) -
+// qdirect(before)); the direct light's change, direct(after) - direct(before), is added after
+// padding (directChange). q: {qa, qda, qdb} through the map (3 numbers a texel; q.qa becomes the
+// change, in place); qbNeg: minus the quick look before through the map.
+function composedDelta(map, q, qbNeg, directBefore = null) {
+  const refined = !!q.qda, scaled = !refined || !!directBefore, values = new Map();
+  let rho = null;
+  if (!refined) rho = detailScale(map, q.qa, qbNeg);
+  else if (scaled) { // rho of the quick looks' light less their direct light: the part it scales
+    const rest = new Map(), restBeforeNeg = new Map();
+    for (const [a] of map.byAtlas) {
+      const A = q.qa.get(a), Bneg = qbNeg.get(a), QDA = q.qda.get(a), QDB = q.qdb.get(a);
+      rest.set(a, A.map((v, i) => v - QDA[i]));
+      restBeforeNeg.set(a, Bneg.map((v, i) => v + QDB[i]));
+    }
+    rho = detailScale(map, rest, restBeforeNeg);
+  }
   for (const [a, m] of map.byAtlas) {
     const A = q.qa.get(a), F = map.atlases.get(a).data, Bneg = qbNeg.get(a);
-    if (refined) {
+    if (refined && scaled) {
+      const QDA = q.qda.get(a), QDB = q.qdb.get(a), DB = directBefore.get(a).data, p = rho.get(a);
+      for (let t = 0; t < m.covered.length; t++) {
+        for (let ch = 0, i = 3 * t; ch < 3; ch++, i++) {
+          if (m.covered[t]) A[i] = (p[t] - 1) * (F[4 * t + ch] - DB[4 * t + ch]) + A[i] - QDA[i] + p[t] * (Bneg[i] + QDB[i]);
+          else A[i] += Bneg[i] - QDA[i] + QDB[i];
+        }
+      }
+    } else if (refined) {
       const QDA = q.qda.get(a), QDB = q.qdb.get(a);
       for (let i = 0; i < A.length; i++) A[i] += Bneg[i] - QDA[i] + QDB[i];
     } else {
@@ -455,9 +487,9 @@ export function mapQuicks(f, quicks) {
   return { atlases: map.atlases, mapped: new Map([...map.byAtlas].map(([a, m]) => [a, { value: values.get(a), covered: m.covered }])) };
 }
 
-// The direct light's change at the final's resolution: direct(after) - direct(before), per final
-// atlas (3 floats a texel), or {why} when their atlases are not the final's (da, db: the final's
-// glTF with the direct-light folders' .hdr files).
+// The direct light's change at the final's resolution: {change: direct(after) - direct(before), per
+// final atlas (3 floats a texel), before: direct(before)'s atlases}, or {why} when their atlases
+// are not the final's (da, db: the final's glTF with the direct-light folders' .hdr files).
 function directChange(atlases, da, db, read) {
   const change = new Map();
   const [ia, ib] = [readAtlases(da, read), readAtlases(db, read)];
@@ -468,7 +500,7 @@ function directChange(atlases, da, db, read) {
     for (let i = 0, n = img.width * img.height; i < n; i++) for (let c = 0; c < 3; c++) d[3 * i + c] = A.data[4 * i + c] - B.data[4 * i + c];
     change.set(a, d);
   }
-  return { change };
+  return { change, before: ib };
 }
 
 // A Radiance .hdr (RGBE, each scanline run-length framed with literal runs only: what three's
@@ -592,7 +624,8 @@ export function createComposer() {
   // look's; out: the folder to write (made here). stem: the level's file name without extension.
   // direct (optional): {before, after, quickBefore, quickAfter}, the folders of the direct light
   // (`lmbake bake --stages-out`'s direct stage) of the last final bake, of this change's final bake and of the
-  // two quick looks: each the .hdr files of its bake's atlases, read with that bake's glTF.
+  // two quick looks: each the .hdr files of its bake's atlases, read with that bake's glTF; and
+  // scaleDetail: true when the change moved no light (the final's other detail then scales with rho).
   function compose({ final, quickBefore, quickAfter, out, stem, direct = null }) {
     const t0 = Date.now();
     let f, qb, qa, c = null, k, base;
@@ -622,7 +655,7 @@ export function createComposer() {
       return { ok: false, why: `cannot read the direct light (${e.message})` };
     }
     if (exactPart.why) return { ok: false, why: exactPart.why };
-    const values = composedDelta(k.map, mapped, base.values);
+    const values = composedDelta(k.map, mapped, base.values, direct && direct.scaleDetail ? exactPart.before : null);
     writeComposed(f, final, out, stem, k.map.atlases, (a, img) => composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), exactPart.change && exactPart.change.get(a)));
     return { ok: true, ms: Date.now() - t0 };
   }

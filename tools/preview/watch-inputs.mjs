@@ -86,16 +86,24 @@ export function fingerprint(level, files, keys) {
   const rest = { ...json, nodes, materials: undefined, textures: undefined, images: undefined, samplers: undefined, extensions: { ...(json.extensions || {}), KHR_lights_punctual: undefined } };
   const fileHash = {};
   for (const f of files) if (f.what !== 'level' && f.what !== 'config') fileHash[f.file] = { what: f.what, hash: hashFile(f.file) };
+  // where the light comes from and its shape: the lights' nodes and everything of the lights
+  // but their intensity and colour,
+  const shapes = ((lights.ext && lights.ext.lights) || []).map((l) => ({ ...l, intensity: undefined, color: undefined }));
+  // and the materials' textures (what stays of them without their factors and strengths)
+  const places = { shapes, nodes: lights.nodes, materials: JSON.stringify(materials, (k, v) => (/(Factor|Strength)$/.test(k) ? undefined : v)) };
   return {
-    lights: hashBytes(JSON.stringify(lights)), materials: hashBytes(JSON.stringify(materials)),
+    lights: hashBytes(JSON.stringify(lights)), lightPlaces: hashBytes(JSON.stringify(places)), materials: hashBytes(JSON.stringify(materials)),
     geometry: hashBytes(JSON.stringify(rest) + (bin ? hashBytes(bin) : '')), keys, files: fileHash,
   };
 }
 
 // What changed between two fingerprints: {what: ['lights', 'config samples.gather', ...],
-// layout: true when the layout must be made again (geometry, buffers, layout keys)}.
+// layout: true when the layout must be made again (geometry, buffers, layout keys), placesKept:
+// true when only the lights' intensities or colours and the materials' values changed (no light
+// moved, turned or changed its shape; no file or config key changed): the light then falls
+// where it fell, only stronger or weaker, which the composed picture's refinement uses}.
 export function compare(before, after) {
-  if (!before) return { what: ['first bake'], layout: true };
+  if (!before) return { what: ['first bake'], layout: true, placesKept: false };
   const what = [];
   let layout = false;
   if (before.geometry !== after.geometry) { what.push('geometry'); layout = true; }
@@ -111,6 +119,7 @@ export function compare(before, after) {
   const changedKeys = [...keys].filter((k) => before.keys[k] !== after.keys[k]);
   for (const k of changedKeys) if (LAYOUT_KEYS.test(k)) layout = true;
   if (changedKeys.length) what.push('config ' + changedKeys.join(', '));
+  const placesKept = what.every((w) => w === 'lights' || w === 'materials') && before.lightPlaces === after.lightPlaces;
   if (!what.length) what.push('nothing a bake reads (saved unchanged)');
-  return { what, layout };
+  return { what, layout, placesKept };
 }

@@ -59,7 +59,7 @@ const composer = createComposer();
 const status = {
   state: 'starting', level: opts.level, config: opts.config, outdir: opts.outdir,
   generation: 0, // the newest change taken up (1: the first bake)
-  shown: null, // {generation, kind: quick|final, readyAt (ms), seconds (from the change seen), changed, layout}
+  shown: null, // {generation, kind: quick|final, readyAt (ms), seconds (from the change seen), changed, layout, placesKept}
   baking: null, // {generation, kind, stage, percent, startedAt}
   changed: [], layout: false, error: null, cancelled: 0, history: [],
 };
@@ -144,7 +144,7 @@ async function bakeNewest() {
   }
   const change = compare(status.lastGood ? status.lastGood.fp : null, fp);
   const generation = ++status.generation;
-  Object.assign(status, { state: 'baking', changed: change.what, layout: change.layout });
+  Object.assign(status, { state: 'baking', changed: change.what, layout: change.layout, placesKept: change.placesKept });
   say(`bake ${generation}: ${change.what.join('; ')} (${change.layout ? 'layout and lighting' : 'lighting only'})`);
   const seen = movedAt || Date.now(), started = lastSnapshot;
   const base = status.lastGood;
@@ -157,7 +157,7 @@ async function bakeNewest() {
     const refine = kind === 'final' && composed !== null && base.stages ? (stage) => {
       if (dirty) return;
       let refined = null;
-      if (stage === 'direct') refined = composeQuick(generation, change, { before: base.stages.final.direct, after: stageDir(generation, 'final', 'direct'), quickBefore: base.stages.quick.direct, quickAfter: stageDir(generation, 'quick', 'direct') });
+      if (stage === 'direct') refined = composeQuick(generation, change, { before: base.stages.final.direct, after: stageDir(generation, 'final', 'direct'), quickBefore: base.stages.quick.direct, quickAfter: stageDir(generation, 'quick', 'direct'), scaleDetail: change.placesKept });
       else if (stage === 'bounces') refined = composeBounced(generation, change, { before: base.stages.final.bounces, after: stageDir(generation, 'final', 'bounces') });
       else return;
       if (refined !== null) showBake({ generation, kind: 'quick', revision: stage === 'direct' ? 1 : 2, seen, change, layoutKept: quickLayoutKept, composed: refined, refined: stage });
@@ -184,7 +184,7 @@ async function bakeNewest() {
 // A bake (or a revision of one) on screen: /status, the history, the log line, the tidying.
 function showBake({ generation, kind, revision, seen, change, layoutKept, composed, refined }) {
   const seconds = (Date.now() - seen) / 1000;
-  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, layoutKept, composedOn: composed, refined };
+  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, placesKept: change.placesKept, layoutKept, composedOn: composed, refined };
   status.history.push({ generation, kind, revision, seconds, changed: change.what });
   if (status.history.length > 50) status.history.shift();
   status.error = null;
