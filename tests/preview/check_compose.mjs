@@ -7,14 +7,17 @@
 //   - a change of nothing, F1 + Q1 - Q1, gives F1's .hdr back texel for texel (as the page reads it),
 //     and so does its refinement with the direct light, F1 + Q1 - Q1 - (DQ1 - DQ1) + (DF1 - DF1);
 //   - the composed picture, rho F1 + Q2 - rho Q1 (rho: how much of the final's detail the light
-//     keeps, compose.mjs), is closer to F2 than the quick look Q2 alone and than the plain
+//     keeps, compose.mjs; 1 where the light rose, since it moved), is closer to F2 than the quick look Q2 alone and than the plain
 //     difference F1 + Q2 - Q1 (all read in F2's atlas, 9 x 9 texel box averages over the texels a
 //     triangle covers, rms of the luminance difference over F2's mean), and within 5%;
 //   - refined with the direct light, F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1) is closer to F2 still,
 //     and with the bounced light, F1 + BF2 - BF1, closer again;
-//   - the corner lamp made brighter where it was (F3, Q3, DF3, DQ3: no light moved): refined with
-//     the final's detail besides the direct light scaled with rho (compose.mjs) is closer to F3
-//     than the first picture and no more than 2% further than with rho = 1;
+//   - composed as if no light had moved (moved: false: rho scales where the light rose too), the
+//     moved lamp's picture is further from F2;
+//   - the corner lamp made brighter where it was (F3, Q3, DF3, DQ3: no light moved): its first
+//     picture is closer to F3 than composed as if a light had moved, and refined with the final's
+//     detail besides the direct light scaled with rho (compose.mjs) is closer to F3 than the
+//     first picture and no more than 2% further than with rho 1 where the light rose;
 //   - a quick look of another layout (the texel density changed) is refused with a reason;
 //   - `--stages-out` changes no output byte, and what it writes is the light in the lightmap's
 //     units: with no bounces, the direct light is the lightmap itself to within its denoising,
@@ -113,6 +116,10 @@ const f1 = readHdr(path.join(F1, `${stem}-lightmap-0.hdr`));
 const plainDifference = difference.map((d, i) => Math.max(f1.data[4 * Math.floor(i / 3) + (i % 3)] + d, 0));
 const ePlain = error(plainDifference);
 check(eComposed < eQuick && eComposed < ePlain && eComposed <= 0.05, `the corner lamp moved: rho F1 + Q2 - rho Q1 is ${(100 * eComposed).toFixed(2)}% from F2, the plain difference F1 + Q2 - Q1 ${(100 * ePlain).toFixed(2)}%, the quick look alone ${(100 * eQuick).toFixed(2)}% (9 x 9 rms; want below both and at most 5%)`);
+// told that no light moved, rho would scale the detail where the light rose too: further from F2
+const unmoved = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'moved-as-unmoved'), stem, moved: false });
+const eUnmoved = unmoved.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'moved-as-unmoved'), stem), weight: 1 }]).mapped.get(0).value) : 0;
+check(eComposed < eUnmoved, `composed as a moved light (rho 1 where the light rose) ${(100 * eComposed).toFixed(2)}% from F2, as if no light had moved ${(100 * eUnmoved).toFixed(2)}% (want below)`);
 // refined with the direct light at the final's resolution: F1 + Q2 - Q1 - (DQ2 - DQ1) + (DF2 - DF1)
 const refined = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'refined'), stem, direct: { before: directOf(F1), after: directOf(F2), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
 const eRefined = refined.ok ? error(mapQuicks(f2, [{ g: readBake(path.join(work, 'refined'), stem), weight: 1 }]).mapped.get(0).value) : 1;
@@ -136,13 +143,14 @@ const F3 = bakeState('f3'), Q3 = bakeState('q3', { quick: true });
 corner.translation = movedTo; // the level as F2 baked it again, for the checks below
 cornerLight.intensity /= 2;
 const f3 = readBake(F3, stem), error3 = errorAgainst(mapQuicks(f3, [{ g: readBake(Q3, stem), weight: 1 }]).atlases.get(0));
-const brighter = (tag, direct) => {
-  const r = compose({ final: F1, quickBefore: Q1, quickAfter: Q3, out: path.join(work, tag), stem, direct });
+const brighter = (tag, direct, moved) => {
+  const r = compose({ final: F1, quickBefore: Q1, quickAfter: Q3, out: path.join(work, tag), stem, direct, moved });
   return r.ok ? error3(mapQuicks(f3, [{ g: readBake(path.join(work, tag), stem), weight: 1 }]).mapped.get(0).value) : 1;
 };
 const directTo3 = { before: directOf(F1), after: directOf(F3), quickBefore: directOf(Q1), quickAfter: directOf(Q3) };
-const eFirst3 = brighter('brighter', null), eRefined3 = brighter('brighter-refined', directTo3), eScaled3 = brighter('brighter-scaled', { ...directTo3, scaleDetail: true });
-check(eScaled3 < eFirst3 && eScaled3 <= 1.02 * eRefined3, `the corner lamp x 2: refined with the final's detail scaled ${(100 * eScaled3).toFixed(2)}% from F3, with rho = 1 ${(100 * eRefined3).toFixed(2)}%, the first picture ${(100 * eFirst3).toFixed(2)}% (want below the first picture and at most 2% above rho = 1: rho from the whole quick looks was 15% above it here)`);
+const eFirst3 = brighter('brighter', null, false), eFirstMoved3 = brighter('brighter-as-moved', null, true), eRefined3 = brighter('brighter-refined', directTo3, true), eScaled3 = brighter('brighter-scaled', directTo3, false);
+check(eScaled3 < eFirst3 && eScaled3 <= 1.02 * eRefined3, `the corner lamp x 2: refined with the final's detail scaled where the light rose ${(100 * eScaled3).toFixed(2)}% from F3, not scaled there (as for a moved light) ${(100 * eRefined3).toFixed(2)}%, the first picture ${(100 * eFirst3).toFixed(2)}% (want below the first picture and at most 2% above the other: rho from the whole quick looks was 15% above it here)`);
+check(eFirst3 < eFirstMoved3, `and its first picture ${(100 * eFirst3).toFixed(2)}% from F3, composed as if a light had moved (rho 1 where the light rose) ${(100 * eFirstMoved3).toFixed(2)}% (want below)`);
 const missing = compose({ final: F1, quickBefore: Q1, quickAfter: Q2, out: path.join(work, 'missing'), stem, direct: { before: directOf(F1), after: path.join(work, 'nowhere'), quickBefore: directOf(Q1), quickAfter: directOf(Q2) } });
 check(!missing.ok && /direct light/.test(missing.why) && !fs.existsSync(path.join(work, 'missing')), `a direct light not written is refused, nothing written: ${missing.why}`);
 

@@ -145,11 +145,11 @@ try {
     return at;
   };
   const largest = (a, b) => Math.max(...a.flatMap((px, i) => px.map((x, c) => Math.abs(x - b[i][c]))));
-  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'composed2'), stem: 'cornell-point' });
+  const composed = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'composed2'), stem: 'cornell-point', moved: false });
   check(composed.ok && statusQ.shown.composedOn === 1 && statusQ.shown.revision === 0, `bake 2's quick picture composed on final bake 1 (/status: ${JSON.stringify(statusQ.shown.composedOn)}, revision ${statusQ.shown.revision}; here: ${composed.ok || composed.why})`);
   const wantQuick = composed.ok ? await plainPixels(path.join(work, 'composed2')) : [];
   check(composed.ok && largest(q2, wantQuick) <= 1, `bake 2's quick picture is the composed one: ${JSON.stringify(q2)} against ${JSON.stringify(wantQuick)}`);
-  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: path.join(stages1, 'direct'), after: path.join(stages2, 'direct'), quickBefore: path.join(qstages1, 'direct'), quickAfter: path.join(qstages2, 'direct'), scaleDetail: true } });
+  const refined = compose({ final: final1, quickBefore: quick1, quickAfter: quickDir, out: path.join(work, 'refined2'), stem: 'cornell-point', direct: { before: path.join(stages1, 'direct'), after: path.join(stages2, 'direct'), quickBefore: path.join(qstages1, 'direct'), quickAfter: path.join(qstages2, 'direct') }, moved: false });
   check(refined.ok && statusR.shown.refined === 'direct' && statusR.shown.composedOn === 1 && statusR.shown.placesKept === true, `then refined with the direct light at the final's resolution, the final's other detail scaled (no light moved) (/status refined: ${JSON.stringify(statusR.shown.refined)}, placesKept ${statusR.shown.placesKept}; here: ${refined.ok || refined.why})`);
   const wantRefined = refined.ok ? await plainPixels(path.join(work, 'refined2')) : [];
   check(refined.ok && largest(q2r, wantRefined) <= 1, `bake 2's refined quick picture is the refined composition: ${JSON.stringify(q2r)} against ${JSON.stringify(wantRefined)}`);

@@ -12,13 +12,16 @@
 //     leaves with its lamp instead of staying behind as a ghost (final(before)'s sharp spot minus
 //     the quick look's blurred one), and a dimmed lamp's spot dims with its detail;
 //   - where it rose, that ratio (at most RHO_MAX): a brighter lamp's spot keeps its shape at the
-//     final's resolution; but 1 where the light fell within RHO_REACH texels: there the light
-//     moved, and the detail there belongs to the light before.
-// On level-single-10 (Lamp 1 x 2, x 4, / 2, / 4, moved 2 m, and moved back) this took the 9 x
-// 9-averaged error against the final from 7.3, 21.2, 7.7, 24.5, 12.3, 12.3% (rho = 1: the plain
-// difference) to 2.0, 5.8, 1.3, 2.5, 10.1, 13.7%; ctest watch_compose's moved corner lamp 4.5 ->
-// 3.7%. Taking rho's least over the square where the light fell, or scaling up beside a fall,
-// did better on one and worse on the other. The quick looks are read at each final texel through the
+//     final's resolution; but 1 when a light moved (the caller says so: `moved`, the watch's
+//     /status placesKept false): the detail there belongs to the light before; and 1 where the
+//     light fell within RHO_REACH texels even when no light is said to have moved.
+// On level-single-10 (Lamp 1 x 2, x 4, / 2, / 4, moved 2 m, and moved back) rho with the
+// RHO_REACH rule alone took the 9 x 9-averaged error against the final from 7.3, 21.2, 7.7, 24.5,
+// 12.3, 12.3% (rho = 1: the plain difference) to 2.0, 5.8, 1.3, 2.5, 10.1, 13.7%; rho 1 wherever
+// a moved light's light rose: Lamp 1 moved from where it was 5.39 -> 5.20%, watch_compose's moved
+// corner lamp 3.72 -> 3.51% (4.51% plain), while for a brighter lamp it would lose (2.40 -> 2.89%).
+// Taking rho's least over the square where the light fell, or scaling up beside a fall, did
+// better on one and worse on the other. The quick looks are read at each final texel through the
 // triangles both bakes share (the unwrap keeps the input's triangles in order): the texel
 // centre's barycentric coordinates in its final TEXCOORD_1 triangle, the same point in the
 // quick bake's triangle, read bilinearly (tools/bench_watch.py's mapping). Copies that share one
@@ -28,26 +31,19 @@
 // Once the final bake of the change has its direct light (each bake of the watch writes the light
 // of its stages as it goes, `lmbake bake --stages-out`), the picture is refined:
 //
-//     final(before) + [quick(after) - quick(before)] - [qdirect(after) - qdirect(before)]
-//                   + [direct(after) - direct(before)]
-//
-// with qdirect the quick looks' direct light and direct the two final bakes': the change of the
-// direct light (lights, sky, emissive surfaces) is then taken at the final's resolution (texel for
-// texel: the same layout), and only the rest of the change, its bounced light, at the quick look's.
-// A moved lamp's hot spot, a few texels wide, is what the quick look's resolution blurs.
-// When the change moved no light (only intensities, colours and material values: the watch's
-// placesKept, `direct.scaleDetail`), the final's detail of the rest of the light is scaled with it
-// as in the first picture:
-//
 //     direct(after) + rho [final(before) - direct(before)]
 //                   + [quick(after) - qdirect(after)] - rho [quick(before) - qdirect(before)]
 //
-// with rho as in the first picture but from the quick looks' light less their direct light (the
-// part it scales): on level-single-10 Lamp 1 x 2 1.73 -> 0.85%, / 2 0.90 -> 0.47% (without it the
-// refinement was further from the final than the first picture, 1.60 and 0.79%); watch_compose's
-// corner lamp x 2 2.02 -> 1.99%. (rho from the quick looks' whole light: 0.78, 0.47%, but 2.32% on
-// the corner lamp.) A moved light keeps rho = 1 here: rho made level-single-10's moved lamp 3.29
-// -> 2.94% but watch_compose's moved corner lamp 3.1 -> 4.1%.
+// with qdirect the quick looks' direct light and direct the two final bakes': the direct light
+// (lights, sky, emissive surfaces) is then taken at the final's resolution (texel for texel: the
+// same layout), and only the rest, its bounced light, is composed as above, with rho from the
+// quick looks' light less their direct light (the part it scales). A moved lamp's hot spot, a few
+// texels wide, is what the quick look's resolution blurs. On level-single-10 against rho = 1
+// (the refinement until then): Lamp 1 x 2 1.73 -> 0.85%, / 2 0.90 -> 0.47% (rho = 1 had left the
+// refinement further from the final than the first picture, 1.60 and 0.79%), moved 3.29 ->
+// 2.88%; watch_compose's moved corner lamp 3.12 -> 2.78%, its corner lamp x 2 2.03 -> 1.99%. (rho
+// from the quick looks' whole light: 0.78, 0.47%, but 2.32% on the brighter corner lamp; rho
+// that scales up a moved light's rises too: the moved lamp 3.90%.)
 //
 // Once the final bake has run its bounce passes, the picture is refined again to
 //
@@ -382,10 +378,10 @@ function composedHdr(img, pad, delta, exact) {
 // after, qbNeg: minus the one before; 3 numbers a final texel): the ratio r of their luminance
 // (each plus RHO_FLOOR x the final's mean, so that dark texels' noise does not make it; the mean
 // kept in the map); where the light fell (r < 1) rho = r; where it rose, rho = min(r, RHO_MAX),
-// or 1 when it fell at a texel within RHO_REACH (the light moved); 1 on uncovered texels.
-// Returns atlas -> Float32Array.
+// or 1 when it fell at a texel within RHO_REACH (the light moved), or 1 wherever it rose when the
+// caller knows a light moved (moved); 1 on uncovered texels. Returns atlas -> Float32Array.
 const lum = (r, g, b) => 0.2126 * r + 0.7152 * g + 0.0722 * b;
-function detailScale(map, qa, qbNeg) {
+function detailScale(map, qa, qbNeg, moved) {
   if (map.meanLum === undefined) {
     let sum = 0, n = 0;
     for (const [a, m] of map.byAtlas) {
@@ -402,6 +398,7 @@ function detailScale(map, qa, qbNeg) {
       const after = Math.max(lum(A[3 * t], A[3 * t + 1], A[3 * t + 2]), 0), before = Math.max(-lum(B[3 * t], B[3 * t + 1], B[3 * t + 2]), 0);
       rho[t] = (after + floor) / (before + floor);
       fell[t] = rho[t] < 1 ? 1 : 0;
+      if (moved && rho[t] > 1) rho[t] = 1;
     }
     // texels with a fall within RHO_REACH (a (2 RHO_REACH + 1)^2 square): rows, then columns
     const rows = new Uint8Array(N);
@@ -424,38 +421,33 @@ function detailScale(map, qa, qbNeg) {
 
 // The composed picture's change on the covered texels of the final's atlases (padded later, in
 // composedHdr): (rho - 1) final + quick(after) - rho quick(before); refined with the direct light
-// (q.qda, q.qdb given), with rho = 1: quick(after) - quick(before) - qdirect(after) +
-// qdirect(before), or, given directBefore (the final's direct light before, readAtlases), with
-// rho of quick - qdirect: (rho - 1) (final - direct(before)) + quick(after) - qdirect(after) - rho (quick(before) -
-// qdirect(before)); the direct light's change, direct(after) - direct(before), is added after
-// padding (directChange). q: {qa, qda, qdb} through the map (3 numbers a texel; q.qa becomes the
-// change, in place); qbNeg: minus the quick look before through the map.
-function composedDelta(map, q, qbNeg, directBefore = null) {
-  const refined = !!q.qda, scaled = !refined || !!directBefore, values = new Map();
-  let rho = null;
-  if (!refined) rho = detailScale(map, q.qa, qbNeg);
-  else if (scaled) { // rho of the quick looks' light less their direct light: the part it scales
+// (q.qda, q.qdb and directBefore, the final's direct light before (readAtlases), given), with rho
+// of quick - qdirect: (rho - 1) (final - direct(before)) + quick(after) - qdirect(after) - rho
+// (quick(before) - qdirect(before)); the direct light's change, direct(after) - direct(before), is
+// added after padding (directChange). q: {qa, qda, qdb} through the map (3 numbers a texel; q.qa
+// becomes the change, in place); qbNeg: minus the quick look before through the map; moved: a
+// light moved (detailScale).
+function composedDelta(map, q, qbNeg, directBefore, moved) {
+  const refined = !!q.qda, values = new Map();
+  let rho;
+  if (!refined) rho = detailScale(map, q.qa, qbNeg, moved);
+  else { // rho of the quick looks' light less their direct light: the part it scales
     const rest = new Map(), restBeforeNeg = new Map();
     for (const [a] of map.byAtlas) {
       const A = q.qa.get(a), Bneg = qbNeg.get(a), QDA = q.qda.get(a), QDB = q.qdb.get(a);
       rest.set(a, A.map((v, i) => v - QDA[i]));
       restBeforeNeg.set(a, Bneg.map((v, i) => v + QDB[i]));
     }
-    rho = detailScale(map, rest, restBeforeNeg);
+    rho = detailScale(map, rest, restBeforeNeg, moved);
   }
   for (const [a, m] of map.byAtlas) {
     const A = q.qa.get(a), F = map.atlases.get(a).data, Bneg = qbNeg.get(a);
-    if (refined && scaled) {
+    if (refined) {
       const QDA = q.qda.get(a), QDB = q.qdb.get(a), DB = directBefore.get(a).data, p = rho.get(a);
       for (let t = 0; t < m.covered.length; t++) {
-        for (let ch = 0, i = 3 * t; ch < 3; ch++, i++) {
-          if (m.covered[t]) A[i] = (p[t] - 1) * (F[4 * t + ch] - DB[4 * t + ch]) + A[i] - QDA[i] + p[t] * (Bneg[i] + QDB[i]);
-          else A[i] += Bneg[i] - QDA[i] + QDB[i];
-        }
+        if (!m.covered[t]) continue;
+        for (let ch = 0, i = 3 * t; ch < 3; ch++, i++) A[i] = (p[t] - 1) * (F[4 * t + ch] - DB[4 * t + ch]) + A[i] - QDA[i] + p[t] * (Bneg[i] + QDB[i]);
       }
-    } else if (refined) {
-      const QDA = q.qda.get(a), QDB = q.qdb.get(a);
-      for (let i = 0; i < A.length; i++) A[i] += Bneg[i] - QDA[i] + QDB[i];
     } else {
       const p = rho.get(a);
       for (let t = 0; t < m.covered.length; t++) {
@@ -624,9 +616,10 @@ export function createComposer() {
   // look's; out: the folder to write (made here). stem: the level's file name without extension.
   // direct (optional): {before, after, quickBefore, quickAfter}, the folders of the direct light
   // (`lmbake bake --stages-out`'s direct stage) of the last final bake, of this change's final bake and of the
-  // two quick looks: each the .hdr files of its bake's atlases, read with that bake's glTF; and
-  // scaleDetail: true when the change moved no light (the final's other detail then scales with rho).
-  function compose({ final, quickBefore, quickAfter, out, stem, direct = null }) {
+  // two quick looks: each the .hdr files of its bake's atlases, read with that bake's glTF. moved:
+  // the change moved a light, or the caller cannot tell that it did not (rho is then 1 wherever
+  // the light rose: detailScale).
+  function compose({ final, quickBefore, quickAfter, out, stem, direct = null, moved = true }) {
     const t0 = Date.now();
     let f, qb, qa, c = null, k, base;
     try {
@@ -648,14 +641,14 @@ export function createComposer() {
       try { r = addQuick(k.map, g, 1, into, read); } catch (e) { r = { why: `cannot read a quick look's light (${e.message})` }; }
       if (r.why) return { ok: false, why: r.why };
     }
-    let exactPart = { change: null };
+    let exactPart = { change: null, before: null };
     try {
       if (c) exactPart = directChange(k.map.atlases, c.directAfter, c.directBefore, read);
     } catch (e) {
       return { ok: false, why: `cannot read the direct light (${e.message})` };
     }
     if (exactPart.why) return { ok: false, why: exactPart.why };
-    const values = composedDelta(k.map, mapped, base.values, direct && direct.scaleDetail ? exactPart.before : null);
+    const values = composedDelta(k.map, mapped, base.values, exactPart.before, moved);
     writeComposed(f, final, out, stem, k.map.atlases, (a, img) => composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), exactPart.change && exactPart.change.get(a)));
     return { ok: true, ms: Date.now() - t0 };
   }
@@ -701,7 +694,7 @@ export function createComposer() {
       if (r.why) return { ok: false, why: r.why };
       // the final as composed on a change of nothing, thrown away: node compiles the loops the
       // picture after the next change runs (0.3 -> 0.2 s on level-single-10)
-      const values = composedDelta(k.map, { qa: zeros(k.map) }, r.values);
+      const values = composedDelta(k.map, { qa: zeros(k.map) }, r.values, null, false);
       for (const [a, img] of k.map.atlases) composedHdr(img, k.map.byAtlas.get(a).pad, values.get(a), null);
       return { ok: true, ms: Date.now() - t0 };
     } catch (e) {

@@ -157,7 +157,7 @@ async function bakeNewest() {
     const refine = kind === 'final' && composed !== null && base.stages ? (stage) => {
       if (dirty) return;
       let refined = null;
-      if (stage === 'direct') refined = composeQuick(generation, change, { before: base.stages.final.direct, after: stageDir(generation, 'final', 'direct'), quickBefore: base.stages.quick.direct, quickAfter: stageDir(generation, 'quick', 'direct'), scaleDetail: change.placesKept });
+      if (stage === 'direct') refined = composeQuick(generation, change, { before: base.stages.final.direct, after: stageDir(generation, 'final', 'direct'), quickBefore: base.stages.quick.direct, quickAfter: stageDir(generation, 'quick', 'direct') });
       else if (stage === 'bounces') refined = composeBounced(generation, change, { before: base.stages.final.bounces, after: stageDir(generation, 'final', 'bounces') });
       else return;
       if (refined !== null) showBake({ generation, kind: 'quick', revision: stage === 'direct' ? 1 : 2, seen, change, layoutKept: quickLayoutKept, composed: refined, refined: stage });
@@ -217,7 +217,7 @@ function composeQuick(generation, change, direct) {
   else if (outdirStamp() !== base.outdir) r = { ok: false, why: `${opts.outdir} holds another bake` };
   else {
     try {
-      r = composer.compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, direct });
+      r = composer.compose({ final: opts.outdir, quickBefore: base.quick, quickAfter: dir, out, stem, direct, moved: !change.placesKept });
     } catch (e) {
       r = { ok: false, why: e.message };
     }
