@@ -51,9 +51,11 @@
 //
 // with bounces the light the two final bakes' bounce passes reached (the direct light, its
 // bounces and their extrapolated tail, before the final gather): texel for texel, no quick look.
-// (rho = 1 here too: rho from the two bakes' bounced light took level-single-10's lamp x 2 from
-// 0.58 to 0.53% and / 2 from 0.47 to 0.37%, the moved lamp 1.00% either way, but watch_compose's
-// corner lamp from 0.76 to 2.20%.)
+// (rho = 1 here, whether or not a light moved: rho from the two bakes' bounced light took
+// level-single-10's lamp x 2 from 0.58 to 0.53% and / 2 from 0.47 to 0.37%, the moved lamp 1.00%
+// either way, but watch_compose's moved corner lamp from 0.76 to 2.20%; for a change that moves
+// no light, bevy's Cornell box's emissive ceiling x 2 0.84 -> 0.40%, level-single-10's Lamp 1 x 2
+// and / 2 unchanged (0.40, 0.34%), but watch_compose's corner lamp x 2 0.54 -> 0.80%.)
 //
 // compose(...) writes OUT: the final's glTF with its lightmap textures naming only the composed
 // .hdr (no KTX2 or EXR: those are the old final's), the final's other files hard-linked (or
