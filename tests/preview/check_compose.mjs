@@ -26,7 +26,9 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
-import { compose, composeBounces, mapQuicks, readBake, readHdr } from '../../tools/preview/compose.mjs';
+import { compose, composeBounces } from '../../tools/preview/compose.mjs';
+import { mapQuicks, readBake } from '../../tools/preview/bake-map.mjs';
+import { readHdr } from '../../tools/preview/hdr.mjs';
 
 const [lmbake, work] = process.argv.slice(2);
 if (!work) { console.error('usage: node tests/preview/check_compose.mjs LMBAKE WORKDIR'); process.exit(1); }
