@@ -133,10 +133,11 @@ check(bounced.ok && eBounced < eRefined, `and refined with the bounced light at 
 const sameBounced = composeBounces({ final: F1, out: path.join(work, 'same-bounced'), stem, before: bouncesOf(F1), after: bouncesOf(F1) });
 const sb = sameBounced.ok ? readHdr(path.join(work, 'same-bounced', hdr)) : null;
 check(sameBounced.ok && sb.data.every((x, i) => x === b.data[i]), `the bounced light of the same bake twice gives F1 back texel for texel (${sameBounced.ok ? `${sameBounced.ms} ms` : sameBounced.why})`);
-// the corner lamp back where it was and twice as bright (F3, Q3: a change that moves no light):
-// refined with the direct light and the final's other detail scaled with rho (direct.scaleDetail,
-// what the watch asks when no light moved) is closer to F3 than refined with rho = 1, and than the
-// first picture
+// the corner lamp back where it was and twice as bright (F3, Q3: a change that moves no light,
+// composed with moved: false as the watch does then): its first picture is closer to F3 than
+// composed as a moved light, and refined with the direct light and the final's other detail
+// scaled with rho it is closer than the first picture and about as close as with rho 1 where the
+// light rose (as for a moved light)
 const corner = doc.nodes[doc.nodes.length - 1], cornerLight = doc.extensions.KHR_lights_punctual.lights[corner.extensions.KHR_lights_punctual.light];
 const movedTo = corner.translation;
 corner.translation = [0.2, 0.15, 0.25];

@@ -87,10 +87,16 @@ export function fingerprint(level, files, keys) {
   const fileHash = {};
   for (const f of files) if (f.what !== 'level' && f.what !== 'config') fileHash[f.file] = { what: f.what, hash: hashFile(f.file) };
   // where the light comes from and its shape: the lights' nodes and everything of the lights
-  // but their intensity and colour,
-  const shapes = ((lights.ext && lights.ext.lights) || []).map((l) => ({ ...l, intensity: undefined, color: undefined }));
-  // and the materials' textures (what stays of them without their factors and strengths)
-  const places = { shapes, nodes: lights.nodes, materials: JSON.stringify(materials, (k, v) => (/(Factor|Strength)$/.test(k) ? undefined : v)) };
+  // but their intensity and colour, save whether each is on (a light turned on is a light placed),
+  const on = (l) => (l.intensity === undefined || l.intensity > 0) && !(l.color && l.color.every((c) => c <= 0));
+  const shapes = ((lights.ext && lights.ext.lights) || []).map((l) => ({ ...l, intensity: undefined, color: undefined, on: on(l) }));
+  // and the materials without their factors and strengths, save whether each emits
+  const placeOf = (k, v) => {
+    if (k === 'emissiveFactor') return Array.isArray(v) && v.some((c) => c > 0);
+    if (k === 'emissiveStrength') return v > 0;
+    return /(Factor|Strength)$/.test(k) ? undefined : v;
+  };
+  const places = { shapes, nodes: lights.nodes, materials: JSON.stringify(materials, placeOf) };
   return {
     lights: hashBytes(JSON.stringify(lights)), lightPlaces: hashBytes(JSON.stringify(places)), materials: hashBytes(JSON.stringify(materials)),
     geometry: hashBytes(JSON.stringify(rest) + (bin ? hashBytes(bin) : '')), keys, files: fileHash,
@@ -99,9 +105,10 @@ export function fingerprint(level, files, keys) {
 
 // What changed between two fingerprints: {what: ['lights', 'config samples.gather', ...],
 // layout: true when the layout must be made again (geometry, buffers, layout keys), placesKept:
-// true when only the lights' intensities or colours and the materials' values changed (no light
-// moved, turned or changed its shape; no file or config key changed): the light then falls
-// where it fell, only stronger or weaker, which the composed picture's refinement uses}.
+// true when only the lights' intensities or colours and the materials' factors changed (no light
+// moved, turned, changed its shape or was turned on or off, no material started or stopped
+// emitting; no file or config key changed): the light then falls where it fell, only stronger or
+// weaker, which the composed picture uses (compose.mjs, `moved`)}.
 export function compare(before, after) {
   if (!before) return { what: ['first bake'], layout: true, placesKept: false };
   const what = [];
