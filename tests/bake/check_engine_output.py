@@ -38,7 +38,7 @@ from PIL import Image
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
-from object_means import _accessor, _cover_window, _image, lightmap_uv  # noqa: E402
+from object_means import _accessor, _image, claim_texels, cover_pairs, lightmap_uv  # noqa: E402
 
 MIXED = os.path.join(ROOT, "assets", "scenes", "mixed-lighting-bevy", "MixedLightingExample.gltf")
 CORNELL = os.path.join(ROOT, "assets", "scenes", "cornell-box-bevy", "CornellBox.glb")
@@ -103,8 +103,7 @@ def rects(lmbake, work):
     # untouched TEXCOORD_1 and rectangles
     boxes = []
     same_uv = True
-    owner = np.zeros((H, W), int)
-    clash = 0
+    all_tris, all_labels = [], []
     centroids = {}
     for label, node in enumerate(nodes, 1):
         sx, sy, ox, oy = node["extras"]["lightmap"]["scaleOffset"]
@@ -118,16 +117,16 @@ def rects(lmbake, work):
             same_uv &= np.array_equal(uv[idx].astype(np.float32), in_uv[in_idx].astype(np.float32))
             atlas_uv = lightmap_uv(node, uv)
             tri = atlas_uv[idx].reshape(-1, 3, 2)
-            for t in tri:
-                win, cover = _cover_window(t, W, H)
-                if cover is None:
-                    continue
-                o = owner[win]
-                clash += int((cover & (o != 0) & (o != label)).sum())
-                o[cover & (o == 0)] = label
+            all_tris.append(tri)
+            all_labels.append(np.full(len(tri), label))
             c = tri.mean(axis=1)
             centroids[label] = np.minimum((c * [W, H]).astype(int), [W - 1, H - 1])
     check(same_uv, "TEXCOORD_1 is the input's, untouched (each node's rectangle places it)")
+    # each texel to the first node whose triangles cover it, in node order
+    tri_of, texel = cover_pairs(np.concatenate(all_tris), W, H)
+    labels = np.concatenate(all_labels)[tri_of]
+    owner, clash = claim_texels(labels, texel, W * H)
+    owner = owner.reshape(H, W)
     gltf = os.path.join(out, [f for f in os.listdir(out) if f.endswith(".gltf")][0])
     v = subprocess.run(["node", os.path.join(HERE, "validate_gltf.js"), gltf], capture_output=True, text=True)
     check(v.returncode == 0 and "KHR_texture_transform" in doc["extensionsUsed"],

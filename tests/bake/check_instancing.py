@@ -35,7 +35,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
-from object_means import _accessor, _cover_window, _image  # noqa: E402
+from object_means import _accessor, _image, claim_texels, cover_pairs  # noqa: E402
 
 failures = []
 
@@ -174,17 +174,12 @@ def copies(lmbake, work):
     ratio = big.mean() / small.mean()
     check(abs(big.mean() - 1.5 * small.mean()) <= 1.0, "1.5 x copies get 1.5 x rectangles: %.2f and %.2f texels wide "
           "(ratio %.3f)" % (big.mean(), small.mean(), ratio))
-    owner = np.zeros((H, W), int)
-    clash, own, lit, total = 0, 0, 0, 0
-    for k in range(n):
-        a = tri_uv * scale[k] + offset[k]
-        for t in a:
-            win, cover = _cover_window(t, W, H)
-            if cover is None:
-                continue
-            o = owner[win]
-            clash += int((cover & (o != 0) & (o != k + 1)).sum())
-            o[cover & (o == 0)] = k + 1
+    # each texel to the first copy whose triangles cover it, in copy order
+    tris = (tri_uv[None] * scale[:, None, None, :] + offset[:, None, None, :]).reshape(-1, 3, 2)
+    tri_of, texel = cover_pairs(tris, W, H)
+    owner, clash = claim_texels(tri_of // len(tri_uv) + 1, texel, W * H)
+    owner = owner.reshape(H, W)
+    own, lit, total = 0, 0, 0
     for k in range(n):
         c = (tri_uv * scale[k] + offset[k]).mean(axis=1)
         x = np.minimum((c[:, 0] * W).astype(int), W - 1)

@@ -29,9 +29,9 @@ if (!shots) { console.error('usage: node tests/preview/preview_watch.mjs LMBAKE 
 const root = path.resolve(path.dirname(new URL(import.meta.url).pathname), '..', '..');
 const linear = (c) => { c /= 255; return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4); };
 
-// the level: cornell-point.gltf and its buffer, copied; a config whose final bake is slow enough
-// after its direct stage (4,096 gather rays, 4 bounces: seconds) for the refined quick pictures to
-// be seen before the final one
+// the level: cornell-point.gltf and its buffer, copied; a config with bounce passes (4 bounces:
+// the second refinement comes from them) and few rays (the holds below, not the bake's length,
+// keep each picture on screen while it is read)
 fs.rmSync(work, { recursive: true, force: true });
 execFileSync('python3', [path.join(root, 'tools', 'make_scenes.py'), path.join(work, 'scenes')], { stdio: 'ignore' });
 const dir = path.join(work, 'level');
@@ -43,7 +43,7 @@ for (const b of doc.buffers || []) if (b.uri && !b.uri.startsWith('data:')) fs.c
 const save = () => fs.writeFileSync(level, JSON.stringify(doc, null, 1));
 save();
 const cfg = path.join(dir, 'bake.yaml');
-fs.writeFileSync(cfg, 'texel_density: 16\nbounces: 4\nsamples: {gather: 4096, bounce: 1024}\n');
+fs.writeFileSync(cfg, 'texel_density: 16\nbounces: 4\nsamples: {gather: 256, bounce: 256}\n');
 
 // The watch as `lmbake preview --watch` starts it (check_watch.py runs that command itself), its
 // bakes run through held_lmbake.sh: bake 2's final bake waits while its first quick picture is
