@@ -37,7 +37,7 @@
 // texels wide, is what the quick look's resolution blurs. On level-single-10 against rho = 1
 // (the refinement until then): Lamp 1 x 2 1.73 -> 0.85%, / 2 0.90 -> 0.47% (rho = 1 had left the
 // refinement further from the final than the first picture, 1.60 and 0.79%), moved 3.29 ->
-// 2.88%; watch_compose's moved corner lamp 3.12 -> 2.78%, its corner lamp x 2 2.03 -> 1.99%. (rho
+// 2.88%; watch_compose's moved corner lamp 3.12 -> 2.78%, its corner lamp x 2 2.02 -> 1.99%. (rho
 // from the quick looks' whole light: 0.78, 0.47%, but 2.32% on the brighter corner lamp; rho
 // that scales up a moved light's rises too: the moved lamp 3.90%.)
 //
