@@ -178,6 +178,7 @@ try {
 } catch (e) {
   check(false, e.stack || String(e));
 } finally {
+  for (const h of ['final', 'direct', 'bounces']) release(h); // a held bake goes on (and ends with the watch)
   await browser.close();
   watch.kill('SIGTERM');
 }
