@@ -37,10 +37,9 @@ def _image(path):
 
 def cover_pairs(tris, w, h, reach=0.75, window_max=16):
     """(triangle index, texel index y * w + x) of every texel _cover_window covers, for all the
-    UV triangles tris (T x 3 x 2, atlas UV) at once: their windows side by side in one array
-    (the widest window's size; a triangle whose window is wider than window_max texels goes
-    through _cover_window alone). On a level's 40k triangles a loop of _cover_window cost most
-    of a test's time (20 of 40 s)."""
+    UV triangles tris (T x 3 x 2, atlas UV) at once: windows of like size side by side in arrays
+    (a triangle whose window is wider than window_max texels goes through _cover_window alone).
+    On a level's 40k triangles a loop of _cover_window cost most of a test's time (20 of 40 s)."""
     tris = np.asarray(tris, np.float64)
     p = tris * np.array([w, h])
     lo = np.maximum(np.floor(p.min(axis=1) - 1).astype(int), 0)
@@ -54,33 +53,43 @@ def cover_pairs(tris, w, h, reach=0.75, window_max=16):
         ys, xs = np.nonzero(local)
         tri_out.append(np.full(len(xs), t))
         texel_out.append((ys + win[0].start) * w + xs + win[1].start)
-    ts = np.nonzero(small)[0]
-    if len(ts):
-        P, L, Hh = p[ts], lo[ts], hi[ts]
-        kx, ky = size[ts, 0].max(), size[ts, 1].max()
-        xs = L[:, 0, None, None] + np.arange(kx)[None, None, :]
-        ys = L[:, 1, None, None] + np.arange(ky)[None, :, None]
-        xs, ys = np.broadcast_to(xs, (len(ts), ky, kx)), np.broadcast_to(ys, (len(ts), ky, kx))
-        in_win = (xs <= Hh[:, 0, None, None]) & (ys <= Hh[:, 1, None, None])
-        cx, cy = xs + 0.5, ys + 0.5
-        area = (P[:, 1, 0] - P[:, 0, 0]) * (P[:, 2, 1] - P[:, 0, 1]) - (P[:, 2, 0] - P[:, 0, 0]) * (P[:, 1, 1] - P[:, 0, 1])
-        sign = np.sign(area)[:, None, None]
-        inside = np.ones(xs.shape, bool)
-        dist = np.full(xs.shape, np.inf)
-        for k in range(3):
-            a, b = P[:, k], P[:, (k + 1) % 3]
-            ex, ey = (b[:, 0] - a[:, 0])[:, None, None], (b[:, 1] - a[:, 1])[:, None, None]
-            ax, ay = a[:, 0, None, None], a[:, 1, None, None]
-            inside &= (ex * (cy - ay) - ey * (cx - ax)) * sign >= 0
-            l2 = ex * ex + ey * ey
-            t = np.where(l2 > 0, np.clip(((cx - ax) * ex + (cy - ay) * ey) / np.where(l2 > 0, l2, 1), 0, 1), 0)
-            dist = np.minimum(dist, np.hypot(cx - (ax + t * ex), cy - (ay + t * ey)))
-        i, y, x = np.nonzero(in_win & (inside | (dist <= reach)))
-        tri_out.append(ts[i])
-        texel_out.append(ys[i, y, x] * w + xs[i, y, x])
+    # windows of like size together (at most 4, 8, 16 texels wide), about 2M texels at a time
+    side = size.max(axis=1)
+    for lo_side, hi_side in ((0, 4), (4, 8), (8, window_max)):
+        group = np.nonzero(small & (side > lo_side) & (side <= hi_side))[0]
+        step = max(1, 2_000_000 // (hi_side * hi_side))
+        for start in range(0, len(group), step):
+            ts = group[start:start + step]
+            i, texel = _cover_windows(p[ts], lo[ts], hi[ts], size[ts], reach, w)
+            tri_out.append(ts[i])
+            texel_out.append(texel)
     if not tri_out:
         return np.zeros(0, int), np.zeros(0, int)
     return np.concatenate(tri_out), np.concatenate(texel_out)
+
+
+def _cover_windows(P, lo, hi, size, reach, w):
+    """cover_pairs for triangles P (T x 3 x 2, in texels) whose windows [lo, hi] are at most
+    size.max() texels wide: (index into P, texel index) of every covered texel."""
+    kx, ky = size[:, 0].max(), size[:, 1].max()
+    xs = np.broadcast_to(lo[:, 0, None, None] + np.arange(kx)[None, None, :], (len(P), ky, kx))
+    ys = np.broadcast_to(lo[:, 1, None, None] + np.arange(ky)[None, :, None], (len(P), ky, kx))
+    in_win = (xs <= hi[:, 0, None, None]) & (ys <= hi[:, 1, None, None])
+    cx, cy = xs + 0.5, ys + 0.5
+    area = (P[:, 1, 0] - P[:, 0, 0]) * (P[:, 2, 1] - P[:, 0, 1]) - (P[:, 2, 0] - P[:, 0, 0]) * (P[:, 1, 1] - P[:, 0, 1])
+    sign = np.sign(area)[:, None, None]
+    inside = np.ones(xs.shape, bool)
+    dist = np.full(xs.shape, np.inf)
+    for k in range(3):
+        a, b = P[:, k], P[:, (k + 1) % 3]
+        ex, ey = (b[:, 0] - a[:, 0])[:, None, None], (b[:, 1] - a[:, 1])[:, None, None]
+        ax, ay = a[:, 0, None, None], a[:, 1, None, None]
+        inside &= (ex * (cy - ay) - ey * (cx - ax)) * sign >= 0
+        l2 = ex * ex + ey * ey
+        t = np.where(l2 > 0, np.clip(((cx - ax) * ex + (cy - ay) * ey) / np.where(l2 > 0, l2, 1), 0, 1), 0)
+        dist = np.minimum(dist, np.hypot(cx - (ax + t * ex), cy - (ay + t * ey)))
+    i, y, x = np.nonzero(in_win & (inside | (dist <= reach)))
+    return i, ys[i, y, x] * w + xs[i, y, x]
 
 
 def claim_texels(labels, texels, n):
