@@ -36,10 +36,11 @@ def _image(path):
 
 
 def cover_pairs(tris, w, h, reach=0.75, window_max=16):
-    """(triangle index, texel index y * w + x) of every texel _cover_window covers, for all the
-    UV triangles tris (T x 3 x 2, atlas UV) at once: windows of like size side by side in arrays
-    (a triangle whose window is wider than window_max texels goes through _cover_window alone).
-    On a level's 40k triangles a loop of _cover_window cost most of a test's time (20 of 40 s)."""
+    """(triangle index, texel index y * w + x) of every texel whose centre lies in a UV triangle
+    or within reach texels of it (the conservatively rasterized edge texels), for all the
+    triangles tris (T x 3 x 2, atlas UV) at once: windows of like size side by side in arrays (a
+    triangle whose window is wider than window_max texels alone). On a level's 40k triangles one
+    numpy call per triangle cost most of a test's time (20 of 40 s)."""
     tris = np.asarray(tris, np.float64)
     p = tris * np.array([w, h])
     lo = np.maximum(np.floor(p.min(axis=1) - 1).astype(int), 0)
@@ -48,11 +49,10 @@ def cover_pairs(tris, w, h, reach=0.75, window_max=16):
     on = (size > 0).all(axis=1)
     small = on & (size <= window_max).all(axis=1)
     tri_out, texel_out = [], []
-    for t in np.nonzero(on & ~small)[0]:
-        win, local = _cover_window(tris[t], w, h, reach)
-        ys, xs = np.nonzero(local)
-        tri_out.append(np.full(len(xs), t))
-        texel_out.append((ys + win[0].start) * w + xs + win[1].start)
+    for t in np.nonzero(on & ~small)[0]:  # wide windows one at a time
+        _, texel = _cover_windows(p[t:t + 1], lo[t:t + 1], hi[t:t + 1], size[t:t + 1], reach, w)
+        tri_out.append(np.full(len(texel), t))
+        texel_out.append(texel)
     # windows of like size together (at most 4, 8, 16 texels wide), about 2M texels at a time
     side = size.max(axis=1)
     for lo_side, hi_side in ((0, 4), (4, 8), (8, window_max)):
@@ -101,41 +101,6 @@ def claim_texels(labels, texels, n):
     np.minimum.at(first, texels, labels)
     owner = np.where(first == np.iinfo(np.int64).max, 0, first)
     return owner, int((owner[texels] < labels).sum())
-
-
-def _cover(uv, w, h, reach=0.75):
-    """Texels (boolean h x w) whose centre lies in the UV triangle or within reach texels of it."""
-    mask = np.zeros((h, w), bool)
-    win, local = _cover_window(uv, w, h, reach)
-    if local is not None:
-        mask[win] = local
-    return mask
-
-
-def _cover_window(uv, w, h, reach=0.75):
-    """_cover within the triangle's bounding window only: (slices, boolean mask of the window),
-    or (None, None) when the triangle is off the atlas. A level's thousands of triangles each
-    touch a few texels: a whole-atlas mask per triangle cost most of a test's time."""
-    p = uv * np.array([w, h])
-    x0, y0 = np.maximum(np.floor(p.min(axis=0) - 1).astype(int), 0)
-    x1, y1 = np.minimum(np.ceil(p.max(axis=0) + 1).astype(int), [w - 1, h - 1])
-    if x1 < x0 or y1 < y0:
-        return None, None
-    ys, xs = np.mgrid[y0:y1 + 1, x0:x1 + 1]
-    c = np.stack([xs + 0.5, ys + 0.5], axis=-1)
-    dist = np.full(xs.shape, np.inf)
-    inside = np.ones(xs.shape, bool)
-    area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])
-    for k in range(3):
-        a, b = p[k], p[(k + 1) % 3]
-        e = b - a
-        cross = e[0] * (c[..., 1] - a[1]) - e[1] * (c[..., 0] - a[0])
-        inside &= cross * np.sign(area) >= 0
-        l2 = e @ e
-        t = np.clip(((c - a) @ e) / l2, 0, 1) if l2 > 0 else np.zeros(xs.shape)
-        q = a + t[..., None] * e
-        dist = np.minimum(dist, np.linalg.norm(c - q, axis=-1))
-    return (slice(y0, y1 + 1), slice(x0, x1 + 1)), inside | (dist <= reach)
 
 
 def lightmap_uv(node, uv):
