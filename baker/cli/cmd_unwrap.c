@@ -249,9 +249,10 @@ static void print_report(const lmb_scene *s, const lmb_layout *l)
         lmb_uv_metrics um;
         mesh_stretch(lm, &um);
         chart_total += lm->chart_seconds;
-        printf("mesh '%s': %u triangles (%u zero-area), %u charts (%u planar, %u split, %u glued), L2 stretch %.4f, "
-               "charting %.3f s\n",
-               s->meshes[m].name, lm->soup.triangle_count, s->meshes[m].degenerate_count, lm->charts.chart_count,
+        printf("mesh '%s': %u triangles (%u zero-area, %u hidden), %u charts (%u planar, %u split, %u glued), "
+               "L2 stretch %.4f, charting %.3f s\n",
+               s->meshes[m].name, lm->soup.triangle_count, s->meshes[m].degenerate_count, lm->hidden_count,
+               lm->charts.chart_count,
                lm->charts.planar_charts, lm->charts.splits, lm->charts.glued, um.l2_stretch, lm->chart_seconds);
         print_topology(&lm->charts.topology);
     }

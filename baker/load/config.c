@@ -77,6 +77,7 @@ static const key_spec config_keys[] = {
     U32("atlas.padding", OFF(padding), 0, 64),
     BOOL("atlas.keep_uv1", OFF(keep_uv1)),
     BOOL("atlas.share_meshes", OFF(share_meshes)),
+    BOOL("atlas.skip_hidden", OFF(skip_hidden)),
     U32("atlas.min_chart_texels", OFF(min_chart_texels), 0, 64),
     U32("samples.texel", OFF(texel_samples), 1, 256),
     U32("samples.direct", OFF(direct_samples), 1, 65536),
@@ -200,6 +201,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->padding = 2;
     cfg->min_chart_texels = 4; /* a prop a few centimetres across in a 100 m level is still lit */
     cfg->keep_uv1 = 0;
+    cfg->skip_hidden = 1; /* faces nothing can see cost texels and padding (docs/unwrap.md) */
     cfg->texel_samples = 4;
     cfg->direct_samples = 16;
     cfg->adaptive = 1;

@@ -292,6 +292,7 @@ typedef struct lmb_config {
     uint32_t padding;              /* texels between charts */
     int keep_uv1;                  /* keep a mesh's own TEXCOORD_1 */
     int share_meshes;              /* atlas.share_meshes: nodes that share a mesh keep sharing it, a rectangle each */
+    int skip_hidden;               /* atlas.skip_hidden: faces back to back inside a solid get no texels */
     uint32_t min_chart_texels;     /* atlas.min_chart_texels: an instance's density is raised so its typical chart
                                       spans at least this many texels each way (0 = off; docs/defaults.md) */
     /* samples */

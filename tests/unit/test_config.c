@@ -251,7 +251,7 @@ static void test_value_errors(void)
 static void test_structure_errors(void)
 {
     expect_error("texel_density: 8\natlas:\n  maxsize: 512\n", "level.yaml:3: ",
-                 "unknown key 'atlas.maxsize' (known keys under 'atlas': texels, max_size, padding, keep_uv1, share_meshes, min_chart_texels)");
+                 "unknown key 'atlas.maxsize' (known keys under 'atlas': texels, max_size, padding, keep_uv1, share_meshes, skip_hidden, min_chart_texels)");
     expect_error("bouncez: 3\n", "level.yaml:1: ",
                  "unknown key 'bouncez' (known keys: texel_density, density_overrides, atlas");
     expect_error("seed: 1\nthreads: 2\nseed: 2\n", "level.yaml:3: ", "key 'seed' is given twice (first on line 1)");

@@ -1,0 +1,21 @@
+/*
+ * Faces nothing can see: a triangle pressed back to back against another face of the same mesh
+ * with its front side inside a closed solid (a crate's side against its neighbour's, a wall's foot
+ * on a floor slab, a pillar's base). Such a triangle gets no texels (atlas.skip_hidden): a texel
+ * there would be a gather point inside geometry, left unlit, and its padding ring costs as much
+ * as its texels. Two coincident faces with open space in front of each (a two-sided card, a
+ * plane doubled back to back) stay lit.
+ */
+#ifndef LMBAKE_UNWRAP_HIDDEN_FACES_H
+#define LMBAKE_UNWRAP_HIDDEN_FACES_H
+
+#include "unwrap.h"
+
+/* Sets hidden[f] = 1 for each triangle f of `in` (not in->skip) that is hidden as above, 0
+ * otherwise, and *count to their number, on `threads` threads. Deterministic: the same mesh gives
+ * the same flags at any thread count. Only the mesh's own faces count as occluders (a mesh's layout is shared by all its
+ * instances, so what hides a face must move with it). */
+lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_t *hidden, uint32_t *count,
+                                 lmb_error *err);
+
+#endif
