@@ -283,8 +283,11 @@ static lmb_status skip_hidden_faces_all(const lmb_scene *s, const lmb_config *cf
     lmb_status st = LMB_OK;
     for (uint32_t m = 0; m < s->mesh_count && st == LMB_OK; m++) {
         lmb_layout_mesh *lm = &l->meshes[m];
-        if (lm->used && !(cfg->keep_uv1 && lmb_mesh_has_uv1(s, m)))
+        if (lm->used && !(cfg->keep_uv1 && lmb_mesh_has_uv1(s, m))) {
+            double t0 = lmb_seconds();
             st = skip_hidden_faces(&lm->soup, threads, &lm->hidden_count, err);
+            lm->chart_seconds += lmb_seconds() - t0; /* part of deciding the charts */
+        }
     }
     return st;
 }
@@ -349,7 +352,7 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
         lm->kept_uv1 = cfg->keep_uv1 && lmb_mesh_has_uv1(s, m);
         lmb_status st = lm->kept_uv1 ? lmb_charts_from_uv1(s, m, &lm->soup, &lm->charts, &errs[m])
                                      : lmb_unwrap_mesh(&in, &opt, &lm->charts, &errs[m]);
-        lm->chart_seconds = lmb_seconds() - t0;
+        lm->chart_seconds += lmb_seconds() - t0;
         if (st != LMB_OK) {
 #pragma omp critical(lmb_unwrap_failed)
             failed = (int64_t)m < failed ? (int64_t)m : failed;

@@ -47,7 +47,7 @@ typedef struct lmb_layout_mesh {
     lmb_charts charts;  /* chart-local UVs, isometric; with kept_uv1 one chart of the mesh's TEXCOORD_1 */
     int kept_uv1;       /* atlas.keep_uv1 and the mesh has TEXCOORD_1 everywhere */
     uint32_t hidden_count; /* triangles skipped as hidden (atlas.skip_hidden; not kept in a plan) */
-    double chart_seconds;
+    double chart_seconds; /* hidden faces, unwrap, and the glue-all unwrap when the budget needed one */
 } lmb_layout_mesh;
 
 typedef struct lmb_layout_instance {

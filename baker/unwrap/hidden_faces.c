@@ -4,8 +4,8 @@
  * 1. Back to back: a triangle whose sample points (its centroid and points 98% of the way to its
  *    corners and edge midpoints) all lie on triangles of the opposite facing in its plane, within
  *    1e-5 of the mesh's diagonal. Planes are found by sorting the triangles on their quantized
- *    normal and offset; a triangle looks up the opposite plane's neighbouring cells, so a
- *    rounding boundary does not split a pair.
+ *    normal and offset; a triangle looks up every cell the opposite plane's key can round to
+ *    (one or two per component), so a rounding boundary does not split a pair.
  * 2. Inside a solid, on either side: from just off each sample point of such a triangle, rays
  *    along that side's normal and four directions 60 degrees off it must each meet the back of a
  *    face before the front of any other (a coincident front and back, two touching solids, count
@@ -25,7 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define NORMAL_CELLS 64.0   /* normal components quantized to 1/64 */
+#define NORMAL_CELLS 16.0   /* normal components quantized to 1/16 */
+#define NORMAL_SLACK 0.009  /* opposite normals: dot <= -0.99996, each component within 0.009 */
 #define SAMPLE_POINTS 7     /* centroid, 3 corners, 3 edge midpoints (pulled in) */
 #define RAY_POINTS 4        /* centroid and the 3 pulled corners trace rays */
 #define RAYS_PER_POINT 5
@@ -37,7 +38,8 @@
 typedef struct plane_key {
     int32_t n[3];
     int64_t d;
-    double lo, hi;
+    double lo, hi;    /* extent along the sort axis */
+    double lo2, hi2;  /* and along the plane's other axis */
     double run_width; /* the largest hi - lo among the keys of this (n, d) */
     uint32_t f;
 } plane_key;
@@ -58,7 +60,7 @@ static int compare_keys(const void *pa, const void *pb)
 /* The first key not below (n, d, lo) (f ignored). */
 static size_t lower_bound(const plane_key *keys, size_t count, const int32_t n[3], int64_t d, double lo)
 {
-    plane_key probe = {{n[0], n[1], n[2]}, d, lo, 0, 0, 0};
+    plane_key probe = {{n[0], n[1], n[2]}, d, lo, 0, 0, 0, 0, 0};
     size_t a = 0, b = count;
     while (a < b) {
         size_t mid = a + (b - a) / 2;
@@ -75,14 +77,20 @@ static int same_plane(const plane_key *k, const int32_t n[3], int64_t d)
     return k->n[0] == n[0] && k->n[1] == n[1] && k->n[2] == n[2] && k->d == d;
 }
 
-/* The axis a quantized normal's plane is sorted along. */
-static int sort_axis(const int32_t n[3])
+/* The normal's largest component, and the axis a quantized normal's plane is sorted along (the
+ * one after it); the third is the plane's other axis. */
+static int big_axis(const int32_t n[3])
 {
     int big = 0;
     for (int k = 1; k < 3; k++)
         if (abs(n[k]) > abs(n[big]))
             big = k;
-    return (big + 1) % 3;
+    return big;
+}
+
+static int sort_axis(const int32_t n[3])
+{
+    return (big_axis(n) + 1) % 3;
 }
 
 static void corner(const lmb_unwrap_input *in, uint32_t f, int k, double out[3])
@@ -332,6 +340,9 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
         int u = sort_axis(key->n);
         key->lo = fmin(a[u], fmin(b[u], c[u]));
         key->hi = fmax(a[u], fmax(b[u], c[u]));
+        int u2 = (u + 1) % 3 == big_axis(key->n) ? (u + 2) % 3 : (u + 1) % 3;
+        key->lo2 = fmin(a[u2], fmin(b[u2], c[u2]));
+        key->hi2 = fmax(a[u2], fmax(b[u2], c[u2]));
         key->f = f;
     }
     qsort(keys, nk, sizeof *keys, compare_keys);
@@ -355,28 +366,41 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
         double pts[SAMPLE_POINTS][3];
         sample_points(in, f, pts);
         int covered[SAMPLE_POINTS] = {0}, left = SAMPLE_POINTS;
-        int32_t on[3];
-        for (int k = 0; k < 3; k++)
-            on[k] = (int32_t)lround(-n[k] * NORMAL_CELLS);
-        int64_t od = (int64_t)floor(-n[3] / bucket);
-        for (int cell = 0; cell < 81 && left > 0; cell++) {
-            int32_t qn[3] = {on[0] + cell % 3 - 1, on[1] + cell / 3 % 3 - 1, on[2] + cell / 9 % 3 - 1};
-            int64_t qd = od + cell / 27 - 1;
+        /* the cells an opposite face's key can fall in: its normal within NORMAL_SLACK of -n per
+         * component, its offset within tol of -d (1 or 2 values each) */
+        int32_t nlo[3], nhi[3];
+        for (int k = 0; k < 3; k++) {
+            nlo[k] = (int32_t)lround((-n[k] - NORMAL_SLACK) * NORMAL_CELLS);
+            nhi[k] = (int32_t)lround((-n[k] + NORMAL_SLACK) * NORMAL_CELLS);
+        }
+        int64_t dlo = (int64_t)floor((-n[3] - tol) / bucket), dhi = (int64_t)floor((-n[3] + tol) / bucket);
+        uint32_t cells = (uint32_t)((nhi[0] - nlo[0] + 1) * (nhi[1] - nlo[1] + 1) * (nhi[2] - nlo[2] + 1) * (dhi - dlo + 1));
+        for (uint32_t cell = 0; cell < cells && left > 0; cell++) {
+            uint32_t c = cell;
+            int32_t qn[3];
+            for (int k = 0; k < 3; k++) {
+                uint32_t span = (uint32_t)(nhi[k] - nlo[k] + 1);
+                qn[k] = nlo[k] + (int32_t)(c % span);
+                c /= span;
+            }
+            int64_t qd = dlo + (int64_t)c;
             size_t run = lower_bound(keys, nk, qn, qd, -INFINITY);
             if (run >= nk || !same_plane(&keys[run], qn, qd))
                 continue;
-            int u = sort_axis(qn);
-            double flo = INFINITY, fhi = -INFINITY;
+            int u = sort_axis(qn), u2 = (u + 1) % 3 == big_axis(qn) ? (u + 2) % 3 : (u + 1) % 3;
+            double flo = INFINITY, fhi = -INFINITY, flo2 = INFINITY, fhi2 = -INFINITY;
             for (int p = 0; p < SAMPLE_POINTS; p++) {
                 flo = fmin(flo, pts[p][u]);
                 fhi = fmax(fhi, pts[p][u]);
+                flo2 = fmin(flo2, pts[p][u2]);
+                fhi2 = fmax(fhi2, pts[p][u2]);
             }
             for (size_t i = lower_bound(keys, nk, qn, qd, flo - tol - keys[run].run_width);
                  i < nk && left > 0 && checks < MAX_CHECKS; i++) {
                 const plane_key *k = &keys[i];
                 if (!same_plane(k, qn, qd) || k->lo > fhi + tol)
                     break;
-                if (k->hi < flo - tol)
+                if (k->hi < flo - tol || k->hi2 < flo2 - tol || k->lo2 > fhi2 + tol)
                     continue;
                 const double *m = plane + 4 * (size_t)k->f;
                 checks++;
