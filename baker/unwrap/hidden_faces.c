@@ -19,6 +19,8 @@
  */
 #include "hidden_faces.h"
 
+#include "../util/frame.h"
+
 #include <embree3/rtcore.h>
 
 #include <math.h>
@@ -204,28 +206,15 @@ static int meets_back_first(RTCScene scene, const double o[3], const double d[3]
     return !(r.tfar < 0); /* Embree sets tfar to -inf when occluded */
 }
 
-/* Any unit vector perpendicular to n, and n x it (Duff et al. 2017, "Building an orthonormal
- * basis, revisited"). */
-static void frame(const double n[3], double t[3], double b[3])
-{
-    double s = n[2] >= 0 ? 1.0 : -1.0, a = -1.0 / (s + n[2]), c = n[0] * n[1] * a;
-    t[0] = 1.0 + s * n[0] * n[0] * a;
-    t[1] = s * c;
-    t[2] = -s * n[0];
-    b[0] = c;
-    b[1] = s + n[1] * n[1] * a;
-    b[2] = -n[1];
-}
-
 /* 1 if just off triangle f on the side `side` (+1: its front, -1: its back) lies inside a solid:
  * rays from there along that side's normal and 60 degrees off it each meet a back first. */
 static int side_inside_a_solid(RTCScene scene, const lmb_unwrap_input *in, uint32_t f, const double front[3],
-                               double side, double tol)
+                               double side, const double centre[3], double tol)
 {
     double pts[SAMPLE_POINTS][3], t[3], b[3], dirs[RAYS_PER_POINT][3];
     double n[3] = {side * front[0], side * front[1], side * front[2]};
     sample_points(in, f, pts);
-    frame(n, t, b);
+    lmb_frame(n, t, b);
     const double s60 = sqrt(3.0) / 2.0, c60 = 0.5;
     for (int a = 0; a < 3; a++)
         dirs[0][a] = n[a];
@@ -237,7 +226,7 @@ static int side_inside_a_solid(RTCScene scene, const lmb_unwrap_input *in, uint3
     for (int p = 0; p < RAY_POINTS; p++) {
         double o[3];
         for (int a = 0; a < 3; a++)
-            o[a] = pts[p][a] + 2.0 * tol * n[a];
+            o[a] = pts[p][a] - centre[a] + 2.0 * tol * n[a];
         for (int r = 0; r < RAYS_PER_POINT; r++)
             if (!meets_back_first(scene, o, dirs[r], tol))
                 return 0;
@@ -249,12 +238,16 @@ static int side_inside_a_solid(RTCScene scene, const lmb_unwrap_input *in, uint3
  * (pressed into a solid: a floor's tile under a crate) or its back (it bounds a solid that rests
  * on the faces covering it: a crate's bottom on a one-sided floor, whose far side is the void
  * under the floor). A two-sided card (two faces back to back, open space on both sides) is neither. */
-static int hidden_face(RTCScene scene, const lmb_unwrap_input *in, uint32_t f, const double n[3], double tol)
+static int hidden_face(RTCScene scene, const lmb_unwrap_input *in, uint32_t f, const double n[3],
+                       const double centre[3], double tol)
 {
-    return side_inside_a_solid(scene, in, f, n, 1.0, tol) || side_inside_a_solid(scene, in, f, n, -1.0, tol);
+    return side_inside_a_solid(scene, in, f, n, 1.0, centre, tol) ||
+           side_inside_a_solid(scene, in, f, n, -1.0, centre, tol);
 }
 
-static RTCScene mesh_scene(RTCDevice device, const lmb_unwrap_input *in)
+/* The mesh's triangles less `centre` (its box's centre: rays keep float precision for a mesh far
+ * from its origin, a level of one mesh placed 10 km out). */
+static RTCScene mesh_scene(RTCDevice device, const lmb_unwrap_input *in, const double centre[3])
 {
     RTCScene scene = rtcNewScene(device);
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -275,7 +268,8 @@ static RTCScene mesh_scene(RTCDevice device, const lmb_unwrap_input *in)
         rtcReleaseScene(scene);
         return NULL;
     }
-    memcpy(v, in->positions, (size_t)in->vertex_count * 3 * sizeof(float));
+    for (size_t k = 0; k < 3 * (size_t)in->vertex_count; k++)
+        v[k] = (float)((double)in->positions[k] - centre[k % 3]);
     for (size_t k = 0; k < 3 * (size_t)in->triangle_count; k++)
         ix[k] = in->indices[k];
     rtcCommitGeometry(g);
@@ -424,7 +418,8 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
     lmb_status st = LMB_OK;
     if (candidates > 0) {
         RTCDevice device = rtcNewDevice("threads=1,verbose=0");
-        RTCScene scene = device ? mesh_scene(device, in) : NULL;
+        double centre[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+        RTCScene scene = device ? mesh_scene(device, in, centre) : NULL;
         if (!scene) {
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "hidden faces: Embree could not build the mesh's scene (%d)",
                                device ? (int)rtcGetDeviceError(device) : -1);
@@ -432,7 +427,7 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
             uint32_t found = 0;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 64) reduction(+ : found)
             for (uint32_t f = 0; f < tc; f++)
-                if (candidate[f] && hidden_face(scene, in, f, plane + 4 * (size_t)f, tol)) {
+                if (candidate[f] && hidden_face(scene, in, f, plane + 4 * (size_t)f, centre, tol)) {
                     hidden[f] = 1;
                     found++;
                 }

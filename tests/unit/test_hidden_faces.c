@@ -93,7 +93,8 @@ static void crates_on_a_slab(void)
     CHECK_INT(find(&s, skip, 2, hidden), 4);
     CHECK_INT(hidden[a + 10] + hidden[a + 11] + hidden[b + 8] + hidden[b + 9], 0);
 
-    /* far from the origin (a level's corner at 10 km): the same faces */
+    /* far from the origin (a level's corner at 10 km, its float positions 1 mm apart): the same
+     * faces */
     for (uint32_t v = 0; v < s.nv; v++) {
         s.pos[3 * v] += 10000.0f;
         s.pos[3 * v + 2] -= 10000.0f;
