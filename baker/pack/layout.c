@@ -10,10 +10,10 @@
 #include "coverage.h"
 #include "layout_internal.h"
 #include "density.h"
+#include "hidden_skip.h"
 #include "keep_uv1.h"
 #include "rect_instances.h"
 #include "pack.h"
-#include "unwrap/hidden_faces.h"
 #include "unwrap/metrics.h"
 #include "../util/mat4.h"
 
@@ -236,62 +236,6 @@ static int by_triangles_desc(const void *pa, const void *pb)
     return a->mesh < b->mesh ? -1 : a->mesh > b->mesh;
 }
 
-/* Faces back to back inside a solid (hidden_faces.h) join the skipped triangles: no chart, no
- * texels, TEXCOORD_1 (0, 0) as a zero-area triangle's. */
-static lmb_status skip_hidden_faces(lmb_mesh_soup *soup, int threads, uint32_t *count, lmb_error *err)
-{
-    uint8_t *hidden = malloc((size_t)soup->triangle_count + 1);
-    if (!hidden)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "hidden faces: out of memory");
-    lmb_unwrap_input in = {soup->vertex_count, soup->positions, soup->triangle_count, soup->indices, soup->skip};
-    lmb_status st = lmb_find_hidden_faces(&in, threads, hidden, count, err);
-    for (uint32_t f = 0; st == LMB_OK && f < soup->triangle_count; f++)
-        soup->skip[f] |= hidden[f];
-    free(hidden);
-    return st;
-}
-
-/* One line for the log: how many triangles were hidden, and in which mesh the most. */
-static void report_hidden(const lmb_scene *s, const lmb_layout *l, const lmb_log *log)
-{
-    uint64_t total = 0, all = 0;
-    uint32_t most = UINT32_MAX, meshes = 0;
-    for (uint32_t m = 0; m < s->mesh_count; m++) {
-        if (!l->meshes[m].used)
-            continue;
-        all += l->meshes[m].soup.triangle_count;
-        if (l->meshes[m].hidden_count == 0)
-            continue;
-        total += l->meshes[m].hidden_count;
-        meshes++;
-        if (most == UINT32_MAX || l->meshes[m].hidden_count > l->meshes[most].hidden_count)
-            most = m;
-    }
-    if (total > 0)
-        lmb_info(log, "layout: %llu of %llu triangles (%.1f%%) lie back to back with another face inside a solid "
-                 "(crates touching, a wall's foot on the floor) and get no texels, in %u mesh(es), most in '%s' (%u); "
-                 "atlas.skip_hidden: false keeps them",
-                 (unsigned long long)total, (unsigned long long)all, 100.0 * (double)total / (double)(all ? all : 1),
-                 meshes, s->meshes[most].name, l->meshes[most].hidden_count);
-}
-
-/* skip_hidden_faces for every used mesh that is unwrapped (a kept TEXCOORD_1 stays whole), one
- * mesh after the other, each over its triangles in parallel (a level is often one big mesh). */
-static lmb_status skip_hidden_faces_all(const lmb_scene *s, const lmb_config *cfg, lmb_layout *l, lmb_error *err)
-{
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
-    lmb_status st = LMB_OK;
-    for (uint32_t m = 0; m < s->mesh_count && st == LMB_OK; m++) {
-        lmb_layout_mesh *lm = &l->meshes[m];
-        if (lm->used && !(cfg->keep_uv1 && lmb_mesh_has_uv1(s, m))) {
-            double t0 = lmb_seconds();
-            st = skip_hidden_faces(&lm->soup, threads, &lm->hidden_count, err);
-            lm->chart_seconds += lmb_seconds() - t0; /* part of deciding the charts */
-        }
-    }
-    return st;
-}
-
 /* Every used mesh unwrapped (or its TEXCOORD_1 kept), the meshes in parallel, largest first:
  * a mesh's charts depend on the mesh and the options only, not on the thread that made them.
  * Progress comes from the driving thread (OpenMP's thread 0) as meshes finish. glue_all: the
@@ -312,7 +256,7 @@ static lmb_status unwrap_meshes(const lmb_scene *s, const lmb_config *cfg, lmb_l
         if (st != LMB_OK)
             return st;
     }
-    lmb_status hidden_st = glue_all || !cfg->skip_hidden ? LMB_OK : skip_hidden_faces_all(s, cfg, l, err);
+    lmb_status hidden_st = glue_all || !cfg->skip_hidden ? LMB_OK : lmb_layout_skip_hidden(s, cfg, l, err);
     if (hidden_st != LMB_OK) /* once: the glue_all pass keeps the skip flags */
         return hidden_st;
     /* narrow charts are glued at the density each mesh is expected to get */
@@ -491,7 +435,7 @@ lmb_status lmb_layout_build(const lmb_scene *s, const lmb_config *cfg, lmb_progr
         }
     lmb_status st = unwrap_meshes(s, cfg, l, progress, user, 0, err);
     if (st == LMB_OK)
-        report_hidden(s, l, log);
+        lmb_layout_report_hidden(s, l, log);
     lmb_density_measures measures = {NULL, NULL, NULL};
     if (st == LMB_OK && progress)
         progress(user, "texel density", 0, 1);

@@ -3,7 +3,7 @@
  *
  * 1. Back to back: a triangle whose sample points (its centroid and points 98% of the way to its
  *    corners and edge midpoints) all lie on triangles of the opposite facing in its plane, within
- *    1e-5 of the mesh's diagonal. Planes are found by sorting the triangles on their quantized
+ *    32 float steps of the mesh's largest coordinate or diagonal (1.3 mm on a 340-unit level). Planes are found by sorting the triangles on their quantized
  *    normal and offset; a triangle looks up every cell the opposite plane's key can round to
  *    (one or two per component), so a rounding boundary does not split a pair.
  * 2. Inside a solid, on either side: from just off each sample point of such a triangle, rays
@@ -23,6 +23,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -296,7 +297,10 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
         }
     double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    double tol = 1e-5 * diag, bucket = 4.0 * tol;
+    double reach = 0; /* the largest coordinate: float positions there are FLT_EPSILON x it apart */
+    for (int a = 0; a < 3; a++)
+        reach = fmax(reach, fmax(fabs(lo[a]), fabs(hi[a])));
+    double tol = 32.0 * FLT_EPSILON * fmax(reach, diag), bucket = 4.0 * tol;
     if (!(tol > 0) || !isfinite(tol))
         return LMB_OK;
 

@@ -13,8 +13,8 @@
 
 /* Sets hidden[f] = 1 for each triangle f of `in` (not in->skip) that is hidden as above, 0
  * otherwise, and *count to their number, on `threads` threads. Deterministic: the same mesh gives
- * the same flags at any thread count. Only the mesh's own faces count as occluders (a mesh's layout is shared by all its
- * instances, so what hides a face must move with it). */
+ * the same flags at any thread count. Only `in`'s own faces count as occluders: one mesh, or the
+ * world triangles of a level's meshes placed once (baker/pack/hidden_skip.h decides which). */
 lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_t *hidden, uint32_t *count,
                                  lmb_error *err);
 

@@ -11,12 +11,19 @@ stairs), through `lmbake unwrap`:
     before gluing) and below the defaults';
   - an explicit density above the fit estimate but within what the packer places (14 texels per
     unit in a 1024 atlas; the estimate is about 12.9) bakes, and says the packer decided;
-  - one the packer cannot place (15) is exit 2, naming the instance and the estimate.
+  - one the packer cannot place (15) is exit 2, naming the instance and the estimate;
+  - across nodes: a one-sided floor with a crate mesh placed by one node, a mirrored node's crate
+    (scale -1: its winding turned) and a crate mesh two nodes share, all standing on it: the two
+    crates placed once lose their bottoms (2 triangles each), the shared mesh keeps its own (what
+    hides it does not move with its layout), the floor, larger than what covers it, keeps all.
 
 usage: check_level_unwrap.py LMBAKE WORKDIR
 """
+import base64
+import json
 import os
 import re
+import struct
 import subprocess
 import sys
 
@@ -46,11 +53,65 @@ def atlas_line(out):
     return int(m.group(1)), int(m.group(2)), int(m.group(3)), float(m.group(4)), float(m.group(5)), int(m.group(6))
 
 
-def hidden_count(out):
-    m = re.search(r"mesh 'Level': [0-9]+ triangles \([0-9]+ zero-area, ([0-9]+) hidden\)", out)
+def hidden_count(out, mesh="Level"):
+    m = re.search(r"mesh '%s': [0-9]+ triangles \([0-9]+ zero-area, ([0-9]+) hidden\)" % mesh, out)
     if not m:
-        sys.exit("no mesh line in:\n" + out[-1500:])
+        sys.exit("no mesh line for '%s' in:\n" % mesh + out[-1500:])
     return int(m.group(1))
+
+
+def box(x0, y0, z0, x1, y1, z1):
+    """8 corners and 12 outward triangles of an axis-aligned box."""
+    p = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0), (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+    quads = [(0, 1, 5, 4), (3, 7, 6, 2), (0, 3, 2, 1), (4, 5, 6, 7), (0, 4, 7, 3), (1, 2, 6, 5)]
+    return p, [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+
+
+def nodes_level(path):
+    """A floor plane (8 x 8, one-sided, facing up) and crates standing on it, each a node."""
+    meshes = [("Floor", [(-4, 0, -4), (-4, 0, 4), (4, 0, 4), (4, 0, -4)], [(0, 1, 2), (0, 2, 3)]),
+              ("Crate", *box(-0.5, 0, -0.5, 0.5, 1, 0.5)), ("Mirrored", *box(-0.5, 0, -0.5, 0.5, 1, 0.5)),
+              ("Shared", *box(-0.5, 0, -0.5, 0.5, 1, 0.5))]
+    blob, views, accessors, gmeshes = b"", [], [], []
+    for name, pos, tris in meshes:
+        for data, target, comp, kind, count in ((struct.pack("<%df" % (3 * len(pos)), *[c for v in pos for c in v]),
+                                                  34962, 5126, "VEC3", len(pos)),
+                                                 (struct.pack("<%dI" % (3 * len(tris)), *[i for t in tris for i in t]),
+                                                  34963, 5125, "SCALAR", 3 * len(tris))):
+            views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data), "target": target})
+            acc = {"bufferView": len(views) - 1, "componentType": comp, "count": count, "type": kind}
+            if kind == "VEC3":
+                acc["min"] = [min(v[k] for v in pos) for k in range(3)]
+                acc["max"] = [max(v[k] for v in pos) for k in range(3)]
+            accessors.append(acc)
+            blob += data
+        gmeshes.append({"name": name, "primitives": [{"attributes": {"POSITION": len(accessors) - 2},
+                                                      "indices": len(accessors) - 1}]})
+    nodes = [{"name": "floor", "mesh": 0}, {"name": "crate", "mesh": 1, "translation": [-2, 0, -2]},
+             {"name": "mirrored", "mesh": 2, "translation": [2, 0, -2], "scale": [-1, 1, 1]},
+             {"name": "shared 1", "mesh": 3, "translation": [-2, 0, 2]},
+             {"name": "shared 2", "mesh": 3, "translation": [2, 0, 2]}]
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}], "nodes": nodes,
+           "meshes": gmeshes, "accessors": accessors, "bufferViews": views,
+           "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64,"
+                        + base64.b64encode(blob).decode()}]}
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def separate_nodes(lmbake, work):
+    level = os.path.join(work, "nodes.gltf")
+    nodes_level(level)
+    p = unwrap(lmbake, level, work, "{}\n")
+    check(p.returncode == 0, "nodes: unwrap exits 0")
+    if p.returncode != 0:
+        print(p.stderr[-1500:])
+        return
+    got = {m: hidden_count(p.stdout, m) for m in ("Floor", "Crate", "Mirrored", "Shared")}
+    check(got == {"Floor": 0, "Crate": 2, "Mirrored": 2, "Shared": 0},
+          "nodes: hidden per mesh %s (the bottoms of the crates placed once)" % got)
+    w, h, charts, coverage, stretch, overlaps = atlas_line(p.stdout)
+    check(overlaps == 0, "nodes: %d overlapping texels" % overlaps)
 
 
 def main():
@@ -88,6 +149,7 @@ def main():
     check(p.returncode == 2 and "instance 'Level'" in p.stderr and "is estimated to fit" in p.stderr
           and "atlas 0:" not in p.stdout,
           "15 texels per unit: exit %d, the packer's error names the instance and the estimate" % p.returncode)
+    separate_nodes(lmbake, work)
     sys.exit(0 if ok else 1)
 
 
