@@ -1,10 +1,10 @@
 /*
- * Faces nothing can see: a triangle pressed back to back against another face of the same mesh
- * with its front side inside a closed solid (a crate's side against its neighbour's, a wall's foot
- * on a floor slab, a pillar's base). Such a triangle gets no texels (atlas.skip_hidden): a texel
- * there would be a gather point inside geometry, left unlit, and its padding ring costs as much
- * as its texels. Two coincident faces with open space in front of each (a two-sided card, a
- * plane doubled back to back) stay lit.
+ * Faces nothing can see: a triangle pressed back to back against other faces with a closed solid
+ * on one side of it (a crate's side against its neighbour's, a wall's foot on a floor slab, a
+ * crate's bottom on a one-sided floor, a pillar's base). Such a triangle gets no texels
+ * (atlas.skip_hidden): a texel there would be a gather point inside geometry, left unlit, and its
+ * padding ring costs as much as its texels. Two coincident faces with open space on both sides (a
+ * two-sided card, a plane doubled back to back) stay lit.
  */
 #ifndef LMBAKE_UNWRAP_HIDDEN_FACES_H
 #define LMBAKE_UNWRAP_HIDDEN_FACES_H
