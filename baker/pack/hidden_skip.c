@@ -152,16 +152,15 @@ lmb_status lmb_layout_skip_hidden(const lmb_scene *s, const lmb_config *cfg, lmb
         st = hidden ? lmb_find_hidden_faces(&in, threads, hidden, &found, err)
                     : lmb_error_set(err, LMB_ERR_INTERNAL, "hidden faces: out of memory");
         uint32_t world_meshes = 0;
+        for (uint32_t m = 0; m < s->mesh_count; m++)
+            world_meshes += tested[m] && w.first[m] != UINT32_MAX;
+        double share = (lmb_seconds() - t0) / (world_meshes ? world_meshes : 1); /* part of deciding the charts */
         for (uint32_t m = 0; st == LMB_OK && m < s->mesh_count; m++)
             if (tested[m] && w.first[m] != UINT32_MAX) {
                 skip(&l->meshes[m].soup, hidden + w.first[m], &l->meshes[m].hidden_count);
+                l->meshes[m].chart_seconds += share;
                 tested[m] = 0;
-                world_meshes++;
             }
-        double share = (lmb_seconds() - t0) / (world_meshes ? world_meshes : 1);
-        for (uint32_t m = 0; st == LMB_OK && m < s->mesh_count; m++)
-            if (w.first[m] != UINT32_MAX && l->meshes[m].used)
-                l->meshes[m].chart_seconds += share; /* part of deciding the charts */
         free(hidden);
     }
     world_soup_free(&w);
