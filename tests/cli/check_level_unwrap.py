@@ -8,7 +8,7 @@ stairs), through `lmbake unwrap`:
     coverage at least 0.82 (0.846 now);
   - with `atlas.skip_hidden: false`: none hidden, at most 486 charts (0.6 x the 810 before coplanar
     links and gluing; 436 now), 0 overlapping texels, coverage at least 0.75 (0.776 now; 0.70
-    before gluing) and below the defaults';
+    before gluing) and below the defaults;
   - an explicit density above the fit estimate but within what the packer places (14 texels per
     unit in a 1024 atlas; the estimate is about 12.9) bakes, and says the packer decided;
   - one the packer cannot place (15) is exit 2, naming the instance and the estimate;
