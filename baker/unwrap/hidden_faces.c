@@ -13,7 +13,7 @@
  *    bounds a solid resting on the faces that cover it (a crate's bottom on a one-sided floor).
  *    Two-sided cards (two faces back to back, open space on both sides) stay lit.
  *
- * Embree (a scene of the mesh's own triangles, built on the calling thread) traces the rays: the
+ * Embree (a scene of the input's triangles, built on `threads` threads) traces the rays: the
  * back and the front are told apart by a context filter, each query keeping one side only. Both
  * steps run over the triangles in parallel (OpenMP); each triangle's answer is its own.
  */
@@ -25,6 +25,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -94,6 +95,11 @@ static int big_axis(const int32_t n[3])
 static int sort_axis(const int32_t n[3])
 {
     return (big_axis(n) + 1) % 3;
+}
+
+static int other_axis(const int32_t n[3])
+{
+    return (big_axis(n) + 2) % 3;
 }
 
 static void corner(const lmb_unwrap_input *in, uint32_t f, int k, double out[3])
@@ -260,6 +266,7 @@ static RTCScene mesh_scene(RTCDevice device, const lmb_unwrap_input *in, const d
         return NULL;
     }
     rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW); /* a few rays per triangle: build fast */
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
                                        in->vertex_count);
     unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
@@ -313,9 +320,12 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
         free(candidate);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "hidden faces: out of memory");
     }
-    size_t nk = 0;
+    /* each triangle's plane and key in parallel (a skipped one's key marked f = UINT32_MAX), then
+     * the keys packed in triangle order */
+#pragma omp parallel for num_threads(threads) schedule(static)
     for (uint32_t f = 0; f < tc; f++) {
         double a[3], b[3], c[3], *n = plane + 4 * (size_t)f;
+        plane_key *key = &keys[f];
         corner(in, f, 0, a);
         corner(in, f, 1, b);
         corner(in, f, 2, c);
@@ -326,23 +336,27 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
         double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if ((in->skip && in->skip[f]) || !(l > 0)) {
             n[3] = NAN;
+            key->f = UINT32_MAX;
             continue;
         }
         for (int k = 0; k < 3; k++)
             n[k] /= l;
         n[3] = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-        plane_key *key = &keys[nk++];
         for (int k = 0; k < 3; k++)
             key->n[k] = (int32_t)lround(n[k] * NORMAL_CELLS);
         key->d = (int64_t)floor(n[3] / bucket);
         int u = sort_axis(key->n);
         key->lo = fmin(a[u], fmin(b[u], c[u]));
         key->hi = fmax(a[u], fmax(b[u], c[u]));
-        int u2 = (u + 1) % 3 == big_axis(key->n) ? (u + 2) % 3 : (u + 1) % 3;
+        int u2 = other_axis(key->n);
         key->lo2 = fmin(a[u2], fmin(b[u2], c[u2]));
         key->hi2 = fmax(a[u2], fmax(b[u2], c[u2]));
         key->f = f;
     }
+    size_t nk = 0;
+    for (uint32_t f = 0; f < tc; f++)
+        if (keys[f].f != UINT32_MAX)
+            keys[nk++] = keys[f];
     qsort(keys, nk, sizeof *keys, compare_keys);
     for (size_t r0 = 0, r1; r0 < nk; r0 = r1) {
         double width = 0;
@@ -385,7 +399,7 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
             size_t run = lower_bound(keys, nk, qn, qd, -INFINITY);
             if (run >= nk || !same_plane(&keys[run], qn, qd))
                 continue;
-            int u = sort_axis(qn), u2 = (u + 1) % 3 == big_axis(qn) ? (u + 2) % 3 : (u + 1) % 3;
+            int u = sort_axis(qn), u2 = other_axis(qn);
             double flo = INFINITY, fhi = -INFINITY, flo2 = INFINITY, fhi2 = -INFINITY;
             for (int p = 0; p < SAMPLE_POINTS; p++) {
                 flo = fmin(flo, pts[p][u]);
@@ -421,7 +435,9 @@ lmb_status lmb_find_hidden_faces(const lmb_unwrap_input *in, int threads, uint8_
     /* step 2: inside a solid */
     lmb_status st = LMB_OK;
     if (candidates > 0) {
-        RTCDevice device = rtcNewDevice("threads=1,verbose=0");
+        char device_config[64]; /* Embree's build threads: hits and distances do not depend on the BVH */
+        snprintf(device_config, sizeof device_config, "threads=%d,verbose=0", threads > 0 ? threads : 1);
+        RTCDevice device = rtcNewDevice(device_config);
         double centre[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
         RTCScene scene = device ? mesh_scene(device, in, centre) : NULL;
         if (!scene) {
