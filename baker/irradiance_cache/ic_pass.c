@@ -66,7 +66,7 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, uint32_t
             const lmb_texels *t = c->t[a];
             for (uint32_t i = 0; i < t->count; i++) {
                 uint32_t x = t->texel[i] % t->width, y = t->texel[i] / t->width;
-                if (!t->valid[i] || c->is_record[a][i] || x % spacing || y % spacing)
+                if (!t->valid[i] || c->is_record[a][i] || lmb_ic_is_own(c, a, i) || x % spacing || y % spacing)
                     continue;
                 if (pass)
                     (*out)[n] = c->first_id[a] + i;
@@ -108,7 +108,7 @@ static lmb_status count_served(pass_ctx *c, lmb_error *err)
 #pragma omp parallel for num_threads(c->threads) schedule(dynamic, 1024)
         for (uint32_t i = 0; i < t->count; i++) {
             double p[3], n[3];
-            if (!t->valid[i])
+            if (!t->valid[i] || lmb_ic_is_own(c, a, i))
                 continue;
             lmb_ic_texel_point(c, (texel_at){a, i}, p, n);
             lmb_ic_add_shares(&c->records, p, n, share);
@@ -270,6 +270,76 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint
     return st;
 }
 
+/* Own texels per step: their records (168 bytes each) are held a part at a time. */
+#define OWN_PART 65536
+
+/*
+ * The texels whose surface turns faster than a record can follow (ic_own_records.c), gathered
+ * on their own in every pass, with a texel's rays and no second gather for samples.noise, as
+ * without the cache: they place no records, are no candidates, take no record's share and read
+ * no interpolation. Nothing when there are none: a flat level's pass is what it was.
+ */
+static lmb_status gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
+{
+    uint64_t n = 0;
+    c->own = calloc((size_t)c->atlas_count + 1, sizeof *c->own);
+    c->own_e = calloc((size_t)c->atlas_count + 1, sizeof *c->own_e);
+    c->own_var = calloc((size_t)c->atlas_count + 1, sizeof *c->own_var);
+    if (!c->own || !c->own_e || !c->own_var)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    lmb_status st = lmb_ic_mark_own_texels(c, c->own, &n, err);
+    if (st != LMB_OK || !n)
+        return st;
+    uint32_t *ids = malloc((size_t)n * sizeof *ids);
+    lmb_ic_record *part = malloc((size_t)(n < OWN_PART ? n : OWN_PART) * sizeof *part);
+    if (!ids || !part)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu texels",
+                           (unsigned long long)n);
+    uint64_t k = 0;
+    for (uint32_t a = 0; a < c->atlas_count && st == LMB_OK; a++) {
+        if (!c->own[a])
+            continue;
+        c->own_e[a] = calloc(3 * (size_t)c->t[a]->count + 1, sizeof **c->own_e);
+        c->own_var[a] = calloc((size_t)c->t[a]->count + 1, sizeof **c->own_var);
+        if (!c->own_e[a] || !c->own_var[a])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
+        for (uint32_t i = 0; i < c->t[a]->count; i++)
+            if (c->own[a][i])
+                ids[k++] = c->first_id[a] + i;
+    }
+    c->spacing = 1; /* a texel's rays (ic_record_step.c, ray_share) */
+    c->own_level = 1;
+    for (uint64_t first = 0; first < n && st == LMB_OK; first += OWN_PART, c->own_part++) {
+        uint64_t m = n - first < OWN_PART ? n - first : OWN_PART, made = 0;
+        st = lmb_ic_gather_records(c, ids + first, m, NULL, 0, part, &made, first, n, stats, err);
+        for (uint64_t q = 0; st == LMB_OK && q < made; q++) {
+            memcpy(c->own_e[part[q].atlas] + 3 * (size_t)part[q].texel, part[q].e, sizeof part[q].e);
+            c->own_var[part[q].atlas][part[q].texel] = part[q].var;
+        }
+    }
+    c->own_level = 0;
+    free(part);
+    free(ids);
+    return st;
+}
+
+static void free_own(pass_ctx *c)
+{
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        if (c->own)
+            free(c->own[a]);
+        if (c->own_e)
+            free(c->own_e[a]);
+        if (c->own_var)
+            free(c->own_var[a]);
+    }
+    free(c->own);
+    free(c->own_e);
+    free(c->own_var);
+    c->own = NULL;
+    c->own_e = c->own_var = NULL;
+}
+
 /* The translation-gradient fit as a step: items are records, 9 floats each (as records keep
  * them: a farm's gradients are rounded where a single process's are). */
 static lmb_status fit_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
@@ -332,7 +402,10 @@ static lmb_status interpolate_range(void *user, uint64_t first, uint64_t last, l
 #pragma omp parallel for num_threads(c->threads) schedule(dynamic, 1024)
         for (uint32_t i = i0; i < i1; i++) {
             double e[3] = {0, 0, 0}, p[3], n[3];
-            if (t->valid[i]) {
+            if (lmb_ic_is_own(c, a, i)) {
+                for (int k = 0; k < 3; k++)
+                    e[k] = c->own_e[a][3 * (size_t)i + k];
+            } else if (t->valid[i]) {
                 lmb_ic_texel_point(c, (texel_at){a, i}, p, n);
                 lmb_ic_interpolate(&c->records, p, n, e);
             }
@@ -402,18 +475,27 @@ static int compare_double(const void *a, const void *b)
 
 /* Per atlas, the median of sqrt(var) / lum(e) over its records with light and an estimated
  * variance (0 when it has none): how noisy the interpolated light is, for the denoiser. */
-static lmb_status records_noise(const lmb_ic_records *s, uint32_t atlas_count, double *noise, lmb_error *err)
+static lmb_status records_noise(const pass_ctx *c, double *noise, lmb_error *err)
 {
-    double *rel = malloc(((size_t)s->count + 1) * sizeof *rel);
+    const lmb_ic_records *s = &c->records;
+    size_t most = 0;
+    for (uint32_t a = 0; a < c->atlas_count; a++)
+        most = c->own_e[a] && c->t[a]->count > most ? c->t[a]->count : most;
+    double *rel = malloc(((size_t)s->count + most + 1) * sizeof *rel);
     if (!rel)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", s->count);
-    for (uint32_t a = 0; a < atlas_count; a++) {
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
         uint32_t n = 0;
         for (uint32_t k = 0; k < s->count; k++) {
             const lmb_ic_record *r = &s->rec[k];
             double lum = lmb_luminance_f(r->e);
             if (r->atlas == a && lum > 0 && r->var > 0)
                 rel[n++] = sqrt(r->var) / lum;
+        }
+        for (uint32_t i = 0; c->own_e[a] && i < c->t[a]->count; i++) { /* own texels: as records of one texel */
+            double lum = lmb_luminance_f(c->own_e[a] + 3 * (size_t)i);
+            if (c->own[a][i] && lum > 0 && c->own_var[a][i] > 0)
+                rel[n++] = sqrt(c->own_var[a][i]) / lum;
         }
         qsort(rel, n, sizeof *rel, compare_double);
         noise[a] = n ? (n % 2 ? rel[n / 2] : 0.5 * (rel[n / 2 - 1] + rel[n / 2])) : 0;
@@ -446,9 +528,12 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     lmb_gather_job record_job = *job;
     uint64_t rays = (uint64_t)job->estimator.rays * opt->ray_scale;
     record_job.estimator.rays = rays > 1048576 * 64 ? 1048576 * 64 : (uint32_t)rays;
+    lmb_gather_job own_job = record_job;
+    own_job.noise_target = 0;
     pass_ctx c;
     memset(&c, 0, sizeof c);
     c.job = &record_job;
+    c.own_job = &own_job;
     c.opt = opt;
     c.atlas_count = atlas_count;
     c.t = t;
@@ -489,6 +574,8 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
     if (st == LMB_OK)
         st = lmb_ic_records_index(&c.records, c.threads, err);
+    if (st == LMB_OK)
+        st = gather_own_texels(&c, stats, err);
     if (st == LMB_OK && reuse)
         st = regather(&c, stats, err);
     /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a
@@ -519,20 +606,25 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     }
     for (uint32_t a = 0; st == LMB_OK && pass && a < atlas_count; a++) {
         pass->records[a] = pass->valid[a] = 0;
+        if (pass->own)
+            pass->own[a] = 0;
         for (uint32_t i = 0; i < t[a]->count; i++) {
             pass->records[a] += c.is_record[a][i];
             pass->valid[a] += t[a]->valid[i];
         }
+        for (uint32_t i = 0; pass->own && c.own && i < t[a]->count; i++)
+            pass->own[a] += lmb_ic_is_own(&c, a, i);
     }
     if (st == LMB_OK && pass && pass->points)
         st = export_points(&c.records, pass->points, err);
     if (st == LMB_OK && pass && pass->noise)
-        st = records_noise(&c.records, atlas_count, pass->noise, err);
+        st = records_noise(&c, pass->noise, err);
     for (uint32_t a = 0; c.is_record && a < atlas_count; a++)
         free(c.is_record[a]);
     free(c.is_record);
     free(c.first_id);
     free_gather_state(&c);
+    free_own(&c);
     if (shared && st == LMB_OK) { /* handed to the next pass */
         lmb_ic_records_free(shared);
         *shared = c.records;

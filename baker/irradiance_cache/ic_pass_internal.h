@@ -19,6 +19,8 @@ typedef struct texel_at {
 
 typedef struct pass_ctx {
     const lmb_gather_job *job;    /* with the record's rays */
+    const lmb_gather_job *own_job; /* the same for own records: no second gather for samples.noise (a
+                                      texel's gather, as without the cache; the denoiser reads their noise) */
     const lmb_ic_options *opt;
     uint32_t atlas_count;
     const lmb_texels *const *t;
@@ -32,6 +34,12 @@ typedef struct pass_ctx {
     uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
     uint32_t regather_group;      /* the group being gathered again (step names) */
     uint32_t spacing;             /* the placement level's grid spacing (texels) being gathered */
+    /* texels gathered on their own (ic_own_records.c): per atlas, per listed texel, a flag (NULL
+     * for an atlas without any), their irradiance (3 floats) and its estimated variance */
+    uint8_t **own;
+    float **own_e, **own_var;
+    int own_level;                /* the gathers running are own texels' (no records made of them) */
+    uint32_t own_part;            /* their steps so far (step names) */
     /* guided gathering (gather/guide.h): per record, the mixture it gathered by or learned in
      * this pass; has_mix[k] is set once record k's whole group is gathered, so a record is
      * guided only by records of earlier groups (deterministic at any thread count) */
@@ -55,6 +63,16 @@ static inline uint32_t lmb_ic_texel_id(const pass_ctx *c, texel_at x)
 
 /* The world position and shading normal a texel gathers at. */
 void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3]);
+
+/* Marks the valid texels whose surface turns faster than a record can follow: own[a] := a flag
+ * per listed texel of atlas a (allocated here; NULL when the atlas has none), *count := how
+ * many in all (ic_own_records.c). */
+lmb_status lmb_ic_mark_own_texels(const pass_ctx *c, uint8_t **own, uint64_t *count, lmb_error *err);
+
+static inline int lmb_ic_is_own(const pass_ctx *c, uint32_t atlas, uint32_t i)
+{
+    return c->own && c->own[atlas] && c->own[atlas][i];
+}
 
 /* Progress: done_in_level of level_total gathers of the current level. */
 void lmb_ic_report(pass_ctx *c, uint64_t done_in_level, uint64_t level_total);

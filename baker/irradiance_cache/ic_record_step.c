@@ -188,7 +188,7 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                     if (covered[k - start])
                         continue;
                 }
-                if (c->guided) {
+                if (c->guided && !c->own_level) {
                     double p[3], n[3];
                     lmb_ic_texel_point(c, x, p, n);
                     int64_t j = lmb_ic_records_nearest(&c->records, p, n, LMB_GUIDE_SAME_SURFACE_COS, c->has_mix);
@@ -198,7 +198,8 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                     }
                 }
                 lmb_gather_point_result g;
-                if (lmb_gather_record(c->job, x.atlas, c->t[x.atlas], x.index, by, c->lobes, ray_share(c, rs->slots, k),
+                if (lmb_gather_record(c->own_level ? c->own_job : c->job, x.atlas, c->t[x.atlas], x.index, by,
+                                      c->own_level ? 0 : c->lobes, ray_share(c, rs->slots, k),
                                       &scratch, &g, &gs) !=
                     LMB_OK) {
                     failed = 1;
@@ -266,7 +267,7 @@ static lmb_status take_records(void *user, lmb_buf *bytes, lmb_error *err)
         lmb_mixture mix;
         if (flag == 2 || !take_record(bytes, &fresh) || (c->guided && !take_mixture(bytes, &mix)))
             return lmb_error_set(err, LMB_ERR_INPUT, "%s: a truncated record in step results", c->job->stage);
-        if (c->guided)
+        if (c->guided && !c->own_level)
             lmb_mixture_keep(&mix, &c->mix[slot]); /* not read before has_mix is set, when the whole group is in */
         if (rt->slots) {
             memcpy(c->records.rec[slot].e, fresh.e, sizeof fresh.e);
@@ -287,12 +288,15 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, co
                                  lmb_ic_record *rec, uint64_t *made, uint64_t done_before, uint64_t total,
                                  lmb_gather_stats *stats, lmb_error *err)
 {
-    if (!reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
+    if (!c->own_level && !reserve_mix(c, slots ? c->records.count : c->records.count + (uint32_t)m))
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for guides");
     records_step rs = {c, at, slots, candidates, done_before, total};
     char name[160];
-    snprintf(name, sizeof name, "%s: %s %u", c->stage, slots ? "records gathered again, group" : "records placed, level",
-             slots ? c->regather_group : c->group);
+    snprintf(name, sizeof name, "%s: %s %u", c->stage,
+             c->own_level ? "texels gathered on their own, part"
+             : slots      ? "records gathered again, group"
+                          : "records placed, level",
+             c->own_level ? c->own_part : slots ? c->regather_group : c->group);
     double rays = 0;
     for (uint64_t k = 0; k < m; k++)
         rays += ray_share(c, slots, k);
@@ -315,7 +319,7 @@ lmb_status lmb_ic_gather_records(pass_ctx *c, const uint32_t *at, uint64_t m, co
         *made = rt.made;
     if (st != LMB_OK)
         return st;
-    for (uint64_t k = 0; c->guided && k < rt.made; k++) /* the group is in: later groups may be guided by it */
+    for (uint64_t k = 0; c->guided && !c->own_level && k < rt.made; k++) /* the group is in: later groups may be guided by it */
         c->has_mix[slots ? slots[k] : c->records.count + (uint32_t)k] = 1;
     return LMB_OK;
 }

@@ -67,10 +67,11 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     uint32_t n = env->cache->atlas_count;
     const lmb_texels **t = calloc((size_t)n + 1, sizeof *t);
     float **out = calloc((size_t)n + 1, sizeof *out);
-    uint64_t *records = calloc((size_t)n + 1, sizeof *records), *valid = calloc((size_t)n + 1, sizeof *valid);
+    uint64_t *records = calloc((size_t)n + 1, sizeof *records), *valid = calloc((size_t)n + 1, sizeof *valid),
+             *own = calloc((size_t)n + 1, sizeof *own);
     double *noise = calloc((size_t)n + 1, sizeof *noise);
     lmb_status st = LMB_OK;
-    if (!t || !out || !records || !valid || !noise)
+    if (!t || !out || !records || !valid || !own || !noise)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
     for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
         t[a] = &env->w[a].t;
@@ -78,15 +79,20 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     }
     lmb_ic_options opt = {env->cfg->ic_error, env->cfg->ic_min_spacing, env->cfg->ic_max_spacing,
                           env->cfg->ic_ray_scale};
-    lmb_ic_pass_stats ps = {records, valid, env->points, noise};
+    lmb_ic_pass_stats ps = {records, valid, own, env->points, noise};
     if (st == LMB_OK)
         st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, env->shared, gs, err);
     uint64_t all = 0;
     for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
         all += records[a];
         env->w[a].gather_noise = noise[a];
-        lmb_info(env->log, "%s, atlas %u: %llu records, %.1f%% of %llu valid texels interpolated", env->job->stage, a,
-                 (unsigned long long)records[a], valid[a] ? 100.0 * (double)(valid[a] - records[a]) / (double)valid[a] : 0.0,
+        char own_note[128] = "";
+        if (own[a])
+            snprintf(own_note, sizeof own_note, ", %llu gathered on their own (curved at the texel's scale)",
+                     (unsigned long long)own[a]);
+        uint64_t interpolated = valid[a] - records[a] - own[a];
+        lmb_info(env->log, "%s, atlas %u: %llu records%s, %.1f%% of %llu valid texels interpolated", env->job->stage, a,
+                 (unsigned long long)records[a], own_note, valid[a] ? 100.0 * (double)interpolated / (double)valid[a] : 0.0,
                  (unsigned long long)valid[a]);
     }
     gs->records = all;
@@ -94,6 +100,7 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
     free(out);
     free(records);
     free(valid);
+    free(own);
     free(noise);
     return st;
 }
