@@ -270,76 +270,6 @@ static lmb_status place_level(pass_ctx *c, uint32_t spacing, uint32_t slot, uint
     return st;
 }
 
-/* Own texels per step: their records (168 bytes each) are held a part at a time. */
-#define OWN_PART 65536
-
-/*
- * The texels whose surface turns faster than a record can follow (ic_own_records.c), gathered
- * on their own in every pass, with a texel's rays and no second gather for samples.noise, as
- * without the cache: they place no records, are no candidates, take no record's share and read
- * no interpolation. Nothing when there are none: a flat level's pass is what it was.
- */
-static lmb_status gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
-{
-    uint64_t n = 0;
-    c->own = calloc((size_t)c->atlas_count + 1, sizeof *c->own);
-    c->own_e = calloc((size_t)c->atlas_count + 1, sizeof *c->own_e);
-    c->own_var = calloc((size_t)c->atlas_count + 1, sizeof *c->own_var);
-    if (!c->own || !c->own_e || !c->own_var)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
-    lmb_status st = lmb_ic_mark_own_texels(c, c->own, &n, err);
-    if (st != LMB_OK || !n)
-        return st;
-    uint32_t *ids = malloc((size_t)n * sizeof *ids);
-    lmb_ic_record *part = malloc((size_t)(n < OWN_PART ? n : OWN_PART) * sizeof *part);
-    if (!ids || !part)
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu texels",
-                           (unsigned long long)n);
-    uint64_t k = 0;
-    for (uint32_t a = 0; a < c->atlas_count && st == LMB_OK; a++) {
-        if (!c->own[a])
-            continue;
-        c->own_e[a] = calloc(3 * (size_t)c->t[a]->count + 1, sizeof **c->own_e);
-        c->own_var[a] = calloc((size_t)c->t[a]->count + 1, sizeof **c->own_var);
-        if (!c->own_e[a] || !c->own_var[a])
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
-        for (uint32_t i = 0; i < c->t[a]->count; i++)
-            if (c->own[a][i])
-                ids[k++] = c->first_id[a] + i;
-    }
-    c->spacing = 1; /* a texel's rays (ic_record_step.c, ray_share) */
-    c->own_level = 1;
-    for (uint64_t first = 0; first < n && st == LMB_OK; first += OWN_PART, c->own_part++) {
-        uint64_t m = n - first < OWN_PART ? n - first : OWN_PART, made = 0;
-        st = lmb_ic_gather_records(c, ids + first, m, NULL, 0, part, &made, first, n, stats, err);
-        for (uint64_t q = 0; st == LMB_OK && q < made; q++) {
-            memcpy(c->own_e[part[q].atlas] + 3 * (size_t)part[q].texel, part[q].e, sizeof part[q].e);
-            c->own_var[part[q].atlas][part[q].texel] = part[q].var;
-        }
-    }
-    c->own_level = 0;
-    free(part);
-    free(ids);
-    return st;
-}
-
-static void free_own(pass_ctx *c)
-{
-    for (uint32_t a = 0; a < c->atlas_count; a++) {
-        if (c->own)
-            free(c->own[a]);
-        if (c->own_e)
-            free(c->own_e[a]);
-        if (c->own_var)
-            free(c->own_var[a]);
-    }
-    free(c->own);
-    free(c->own_e);
-    free(c->own_var);
-    c->own = NULL;
-    c->own_e = c->own_var = NULL;
-}
-
 /* The translation-gradient fit as a step: items are records, 9 floats each (as records keep
  * them: a farm's gradients are rounded where a single process's are). */
 static lmb_status fit_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
@@ -575,7 +505,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     if (st == LMB_OK)
         st = lmb_ic_records_index(&c.records, c.threads, err);
     if (st == LMB_OK)
-        st = gather_own_texels(&c, stats, err);
+        st = lmb_ic_gather_own_texels(&c, stats, err);
     if (st == LMB_OK && reuse)
         st = regather(&c, stats, err);
     /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a
@@ -624,7 +554,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     free(c.is_record);
     free(c.first_id);
     free_gather_state(&c);
-    free_own(&c);
+    lmb_ic_free_own_texels(&c);
     if (shared && st == LMB_OK) { /* handed to the next pass */
         lmb_ic_records_free(shared);
         *shared = c.records;

@@ -20,7 +20,7 @@
  * Texels whose surface turns faster than a record can follow (a small curved prop: the normal
  * turns past a record's limit from one texel to the next) are gathered on their own first, in
  * every pass, as without the cache, and take no part in placement or interpolation
- * (ic_own_records.c).
+ * (ic_own_texels.c).
  */
 #ifndef LMBAKE_IC_PASS_H
 #define LMBAKE_IC_PASS_H
@@ -52,7 +52,7 @@ typedef struct lmb_ic_pass_stats {
     uint64_t *records;     /* records placed in the atlas */
     uint64_t *valid;       /* valid texels of the atlas */
     uint64_t *own;         /* when not NULL: valid texels gathered on their own, not through records
-                              (curved at the texel's scale: ic_own_records.c) */
+                              (curved at the texel's scale: ic_own_texels.c) */
     lmb_ic_points *points; /* when not NULL: receives the records (previous contents freed) */
     double *noise;         /* when not NULL: per atlas, the median relative standard error of its records'
                               gathers, sqrt(var) / lum(e) (0 when none was estimated): post/denoise.h */

@@ -19,7 +19,7 @@ typedef struct texel_at {
 
 typedef struct pass_ctx {
     const lmb_gather_job *job;    /* with the record's rays */
-    const lmb_gather_job *own_job; /* the same for own records: no second gather for samples.noise (a
+    const lmb_gather_job *own_job; /* the same for own texels: no second gather for samples.noise (a
                                       texel's gather, as without the cache; the denoiser reads their noise) */
     const lmb_ic_options *opt;
     uint32_t atlas_count;
@@ -34,7 +34,7 @@ typedef struct pass_ctx {
     uint32_t group;               /* placement levels so far (lmb_ic_record.group) */
     uint32_t regather_group;      /* the group being gathered again (step names) */
     uint32_t spacing;             /* the placement level's grid spacing (texels) being gathered */
-    /* texels gathered on their own (ic_own_records.c): per atlas, per listed texel, a flag (NULL
+    /* texels gathered on their own (ic_own_texels.c): per atlas, per listed texel, a flag (NULL
      * for an atlas without any), their irradiance (3 floats) and its estimated variance */
     uint8_t **own;
     float **own_e, **own_var;
@@ -64,10 +64,12 @@ static inline uint32_t lmb_ic_texel_id(const pass_ctx *c, texel_at x)
 /* The world position and shading normal a texel gathers at. */
 void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3]);
 
-/* Marks the valid texels whose surface turns faster than a record can follow: own[a] := a flag
- * per listed texel of atlas a (allocated here; NULL when the atlas has none), *count := how
- * many in all (ic_own_records.c). */
-lmb_status lmb_ic_mark_own_texels(const pass_ctx *c, uint8_t **own, uint64_t *count, lmb_error *err);
+/* The pass's own texels (ic_own_texels.c): marks the valid texels whose surface turns faster
+ * than a record can follow (c->own) and gathers each on its own with a texel's rays (c->own_e,
+ * c->own_var), before any record is placed or gathered again. Freed by lmb_ic_free_own_texels
+ * (idempotent). */
+lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err);
+void lmb_ic_free_own_texels(pass_ctx *c);
 
 static inline int lmb_ic_is_own(const pass_ctx *c, uint32_t atlas, uint32_t i)
 {

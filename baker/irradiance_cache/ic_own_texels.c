@@ -1,6 +1,6 @@
 /*
- * Texels whose surface turns faster than a record can follow (ic_pass_internal.h,
- * lmb_ic_mark_own_texels).
+ * Texels whose surface turns faster than a record can follow, gathered on their own
+ * (ic_pass_internal.h: lmb_ic_gather_own_texels).
  *
  * A record covers a texel only where its normal is close (Ward's eps_n: a record weighs at most
  * 1 - sqrt(1 - n.n_i) / normal_limit there, and a texel needs LMB_IC_COVERED). On a small curved
@@ -9,14 +9,14 @@
  * with a coarse level's rays for the one or two texels it serves, and every texel a blend of
  * neighbours with other normals: slower than a gather per texel and further from it
  * (docs/irradiance-cache.md, "Texels the cache does not serve"). Such texels are gathered on
- * their own, as without the cache (ic_pass.c, gather_own_texels), and the records go where the
- * light can be interpolated.
+ * their own, as without the cache, and the records go where the light can be interpolated.
  */
 #include "ic_pass_internal.h"
 
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* A neighbour turns when a record at it would fall below LMB_IC_COVERED here by the normal
  * alone: sqrt(1 - n.n_j) > (1 - LMB_IC_COVERED) x normal_limit. */
@@ -31,7 +31,7 @@ static uint32_t instance_of(const lmb_texels *t, uint32_t i)
     return t->refs[(size_t)i * t->samples + t->gather_at[i]].instance;
 }
 
-/* Per listed texel of atlas a: 1 when it needs a record of its own. A valid texel is one when at
+/* Per listed texel of atlas a: 1 when it is gathered on its own. A valid texel is one when at
  * least two of its four atlas neighbours (listed, valid, same instance) turn and at most one
  * does not: a surface curved both ways at the texel's scale (a cylinder's texels along its
  * axis keep two neighbours that do not turn, and interpolate). */
@@ -111,7 +111,8 @@ static lmb_status whole_instances(const pass_ctx *c, uint8_t **own, lmb_error *e
     return LMB_OK;
 }
 
-lmb_status lmb_ic_mark_own_texels(const pass_ctx *c, uint8_t **own, uint64_t *count, lmb_error *err)
+/* own[a] := a flag per listed texel of atlas a (NULL when the atlas has none); *count := how many. */
+static lmb_status mark_own_texels(const pass_ctx *c, uint8_t **own, uint64_t *count, lmb_error *err)
 {
     *count = 0;
     lmb_status st = LMB_OK;
@@ -133,4 +134,74 @@ lmb_status lmb_ic_mark_own_texels(const pass_ctx *c, uint8_t **own, uint64_t *co
         *count += n;
     }
     return st;
+}
+
+/* Own texels per step: their records (168 bytes each) are held a part at a time. */
+#define OWN_PART 65536
+
+/*
+ * The texels whose surface turns faster than a record can follow, gathered on their own in
+ * every pass, with a texel's rays and no second gather for samples.noise, as
+ * without the cache: they place no records, are no candidates, take no record's share and read
+ * no interpolation. Nothing when there are none: a flat level's pass is what it was.
+ */
+lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
+{
+    uint64_t n = 0;
+    c->own = calloc((size_t)c->atlas_count + 1, sizeof *c->own);
+    c->own_e = calloc((size_t)c->atlas_count + 1, sizeof *c->own_e);
+    c->own_var = calloc((size_t)c->atlas_count + 1, sizeof *c->own_var);
+    if (!c->own || !c->own_e || !c->own_var)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    lmb_status st = mark_own_texels(c, c->own, &n, err);
+    if (st != LMB_OK || !n)
+        return st;
+    uint32_t *ids = malloc((size_t)n * sizeof *ids);
+    lmb_ic_record *part = malloc((size_t)(n < OWN_PART ? n : OWN_PART) * sizeof *part);
+    if (!ids || !part)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %llu texels",
+                           (unsigned long long)n);
+    uint64_t k = 0;
+    for (uint32_t a = 0; a < c->atlas_count && st == LMB_OK; a++) {
+        if (!c->own[a])
+            continue;
+        c->own_e[a] = calloc(3 * (size_t)c->t[a]->count + 1, sizeof **c->own_e);
+        c->own_var[a] = calloc((size_t)c->t[a]->count + 1, sizeof **c->own_var);
+        if (!c->own_e[a] || !c->own_var[a])
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
+        for (uint32_t i = 0; i < c->t[a]->count; i++)
+            if (c->own[a][i])
+                ids[k++] = c->first_id[a] + i;
+    }
+    c->spacing = 1; /* a texel's rays (ic_record_step.c, ray_share) */
+    c->own_level = 1;
+    for (uint64_t first = 0; first < n && st == LMB_OK; first += OWN_PART, c->own_part++) {
+        uint64_t m = n - first < OWN_PART ? n - first : OWN_PART, made = 0;
+        st = lmb_ic_gather_records(c, ids + first, m, NULL, 0, part, &made, first, n, stats, err);
+        for (uint64_t q = 0; st == LMB_OK && q < made; q++) {
+            memcpy(c->own_e[part[q].atlas] + 3 * (size_t)part[q].texel, part[q].e, sizeof part[q].e);
+            c->own_var[part[q].atlas][part[q].texel] = part[q].var;
+        }
+    }
+    c->own_level = 0;
+    free(part);
+    free(ids);
+    return st;
+}
+
+void lmb_ic_free_own_texels(pass_ctx *c)
+{
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        if (c->own)
+            free(c->own[a]);
+        if (c->own_e)
+            free(c->own_e[a]);
+        if (c->own_var)
+            free(c->own_var[a]);
+    }
+    free(c->own);
+    free(c->own_e);
+    free(c->own_var);
+    c->own = NULL;
+    c->own_e = c->own_var = NULL;
 }
