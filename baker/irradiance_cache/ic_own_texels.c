@@ -145,15 +145,31 @@ static lmb_status mark_own_texels(const pass_ctx *c, uint8_t **own, uint64_t *co
  * without the cache: they place no records, are no candidates, take no record's share and read
  * no interpolation. Nothing when there are none: a flat level's pass is what it was.
  */
-lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err)
+lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_ic_own_texels *kept, lmb_gather_stats *stats, lmb_error *err)
 {
     uint64_t n = 0;
-    c->own = calloc((size_t)c->atlas_count + 1, sizeof *c->own);
+    lmb_status st = LMB_OK;
     c->own_e = calloc((size_t)c->atlas_count + 1, sizeof *c->own_e);
     c->own_var = calloc((size_t)c->atlas_count + 1, sizeof *c->own_var);
-    if (!c->own || !c->own_e || !c->own_var)
+    if (!c->own_e || !c->own_var)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
-    lmb_status st = mark_own_texels(c, c->own, &n, err);
+    if (kept && kept->marked) { /* an earlier pass marked them */
+        c->own = kept->own;
+        c->own_borrowed = 1;
+        for (uint32_t a = 0; a < c->atlas_count; a++)
+            for (uint32_t i = 0; c->own[a] && i < c->t[a]->count; i++)
+                n += c->own[a][i];
+    } else {
+        c->own = calloc((size_t)c->atlas_count + 1, sizeof *c->own);
+        st = c->own ? mark_own_texels(c, c->own, &n, err)
+                    : lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+        if (st == LMB_OK && kept) { /* handed over: later passes read them */
+            kept->own = c->own;
+            kept->atlas_count = c->atlas_count;
+            kept->marked = 1;
+            c->own_borrowed = 1;
+        }
+    }
     if (st != LMB_OK || !n)
         return st;
     uint32_t *ids = malloc((size_t)n * sizeof *ids);
@@ -189,19 +205,29 @@ lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_er
     return st;
 }
 
+void lmb_ic_own_texels_free(lmb_ic_own_texels *o)
+{
+    for (uint32_t a = 0; o->own && a < o->atlas_count; a++)
+        free(o->own[a]);
+    free(o->own);
+    memset(o, 0, sizeof *o);
+}
+
 void lmb_ic_free_own_texels(pass_ctx *c)
 {
     for (uint32_t a = 0; a < c->atlas_count; a++) {
-        if (c->own)
+        if (c->own && !c->own_borrowed)
             free(c->own[a]);
         if (c->own_e)
             free(c->own_e[a]);
         if (c->own_var)
             free(c->own_var[a]);
     }
-    free(c->own);
+    if (!c->own_borrowed)
+        free(c->own);
     free(c->own_e);
     free(c->own_var);
     c->own = NULL;
+    c->own_borrowed = 0;
     c->own_e = c->own_var = NULL;
 }

@@ -453,7 +453,8 @@ static void free_gather_state(pass_ctx *c)
 
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
-                              lmb_ic_records *shared, lmb_gather_stats *stats, lmb_error *err)
+                              lmb_ic_records *shared, lmb_ic_own_texels *own, lmb_gather_stats *stats,
+                              lmb_error *err)
 {
     lmb_gather_job record_job = *job;
     uint64_t rays = (uint64_t)job->estimator.rays * opt->ray_scale;
@@ -505,7 +506,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
     if (st == LMB_OK)
         st = lmb_ic_records_index(&c.records, c.threads, err);
     if (st == LMB_OK)
-        st = lmb_ic_gather_own_texels(&c, stats, err);
+        st = lmb_ic_gather_own_texels(&c, own, stats, err);
     if (st == LMB_OK && reuse)
         st = regather(&c, stats, err);
     /* Rounds of the whole coarse-to-fine sequence until one places nothing: clamping after a

@@ -58,15 +58,28 @@ typedef struct lmb_ic_pass_stats {
                               gathers, sqrt(var) / lum(e) (0 when none was estimated): post/denoise.h */
 } lmb_ic_pass_stats;
 
+/* Which texels every pass gathers on their own (ic_own_texels.c). They follow from the geometry
+ * alone, so the first pass marks them and later passes given the same struct read them. Zeroed
+ * to start; lmb_ic_own_texels_free frees it. */
+typedef struct lmb_ic_own_texels {
+    uint8_t **own;         /* per atlas, a flag per listed texel (NULL: none in that atlas) */
+    uint32_t atlas_count;
+    int marked;
+} lmb_ic_own_texels;
+
+void lmb_ic_own_texels_free(lmb_ic_own_texels *o);
+
 /* Indirect irradiance of every listed texel of every atlas (t[a], out[a]: 3 floats per listed
  * texel) through a cache built for this pass. job->estimator gives the method and the rays
  * per texel; stats add up the gathers' rays.
  * shared: NULL, each pass places its own records (irradiance_cache.records: per_pass); else
  * the records of one pass refined by the next (shared): empty, this pass places records and
  * leaves them there; holding records, this pass gathers again at them (same positions and
- * reaches, this pass's light) and leaves them updated. The caller frees it. */
+ * reaches, this pass's light) and leaves them updated. The caller frees it. own: NULL, this
+ * pass marks its texels gathered on their own for itself; else as lmb_ic_own_texels says. */
 lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *opt, uint32_t atlas_count,
                               const lmb_texels *const *t, float *const *out, lmb_ic_pass_stats *pass,
-                              lmb_ic_records *shared, lmb_gather_stats *stats, lmb_error *err);
+                              lmb_ic_records *shared, lmb_ic_own_texels *own, lmb_gather_stats *stats,
+                              lmb_error *err);
 
 #endif

@@ -37,6 +37,7 @@ typedef struct pass_ctx {
     /* texels gathered on their own (ic_own_texels.c): per atlas, per listed texel, a flag (NULL
      * for an atlas without any), their irradiance (3 floats) and its estimated variance */
     uint8_t **own;
+    int own_borrowed;             /* own belongs to the caller's lmb_ic_own_texels */
     float **own_e, **own_var;
     int own_level;                /* the gathers running are own texels' (no records made of them) */
     uint32_t own_part;            /* their steps so far (step names) */
@@ -64,11 +65,12 @@ static inline uint32_t lmb_ic_texel_id(const pass_ctx *c, texel_at x)
 /* The world position and shading normal a texel gathers at. */
 void lmb_ic_texel_point(const pass_ctx *c, texel_at x, double p[3], double n[3]);
 
-/* The pass's own texels (ic_own_texels.c): marks the valid texels whose surface turns faster
- * than a record can follow (c->own) and gathers each on its own with a texel's rays (c->own_e,
- * c->own_var), before any record is placed or gathered again. Freed by lmb_ic_free_own_texels
- * (idempotent). */
-lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_gather_stats *stats, lmb_error *err);
+/* The pass's own texels (ic_own_texels.c): the valid texels whose surface turns faster than a
+ * record can follow (c->own: kept's when it is marked already, else marked here and, with kept,
+ * handed to it), each gathered on its own with a texel's rays (c->own_e, c->own_var), before any
+ * record is placed or gathered again. Freed by lmb_ic_free_own_texels (idempotent; the flags only
+ * when the pass owns them). */
+lmb_status lmb_ic_gather_own_texels(pass_ctx *c, lmb_ic_own_texels *kept, lmb_gather_stats *stats, lmb_error *err);
 void lmb_ic_free_own_texels(pass_ctx *c);
 
 static inline int lmb_ic_is_own(const pass_ctx *c, uint32_t atlas, uint32_t i)

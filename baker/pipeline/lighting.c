@@ -81,7 +81,7 @@ static lmb_status cached_gather(const pass_env *env, lmb_gather_stats *gs, lmb_e
                           env->cfg->ic_ray_scale};
     lmb_ic_pass_stats ps = {records, valid, own, env->points, noise};
     if (st == LMB_OK)
-        st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, env->shared, gs, err);
+        st = lmb_ic_gather_pass(env->job, &opt, n, t, out, &ps, env->shared, env->own, gs, err);
     uint64_t all = 0;
     for (uint32_t a = 0; st == LMB_OK && a < n; a++) {
         all += records[a];
@@ -482,7 +482,9 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     job.steps = steps;
     lmb_ic_records shared;
     lmb_ic_records_init(&shared, cfg->ic_error > 0 ? cfg->ic_error : 1);
-    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL};
+    lmb_ic_own_texels own = {0};
+    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL,
+                    &own};
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);
     stats->no_light = dark;
@@ -556,6 +558,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     if (st == LMB_OK && cfg->directional && progress)
         progress(user, "directions", 1, 1);
     lmb_ic_records_free(&shared);
+    lmb_ic_own_texels_free(&own);
     work_free(w, n);
     return st;
 }

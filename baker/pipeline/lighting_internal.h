@@ -32,6 +32,7 @@ typedef struct pass_env {
     lmb_bake_stats *stats;
     lmb_ic_points *points; /* set during the final gather only: where its records go */
     lmb_ic_records *shared; /* irradiance_cache.records: shared: the records passed on; else NULL */
+    lmb_ic_own_texels *own; /* the texels every cached pass gathers on their own, marked by the first */
 } pass_env;
 
 /* The cache := every atlas's result (dilated). */
