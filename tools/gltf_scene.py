@@ -48,6 +48,14 @@ class Scene(GltfBuffer):
         self.doc["accessors"].append(acc)
         return len(self.doc["accessors"]) - 1
 
+    def byte_accessor(self, values):
+        """Normalized unsigned-byte VEC4 values (COLOR_0); its accessor index."""
+        flat = [c for v in values for c in v]
+        acc = {"componentType": 5121, "normalized": True, "count": len(values), "type": "VEC4",
+               "bufferView": self.view(struct.pack("<%dB" % len(flat), *flat), 34962)}
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
     def material(self, name, color, emissive=None, strength=None, double_sided=False):
         m = {"name": name, "pbrMetallicRoughness": {"baseColorFactor": list(color) + [1.0], "metallicFactor": 0.0}}
         if double_sided:
@@ -65,12 +73,12 @@ class Scene(GltfBuffer):
         return self.texture_pixels([[tuple(rgb)] * size] * size)
 
     def texture_pixels(self, rows, sampler=None):
-        """A PNG of 8-bit RGB pixels (rows top to bottom) as a data-URI image, with an optional
-        sampler (a glTF sampler object); returns the texture."""
+        """A PNG of 8-bit RGB (or RGBA, when pixels have 4 values) pixels (rows top to bottom) as a
+        data-URI image, with an optional sampler (a glTF sampler object); returns the texture."""
         raw = b"".join(b"\0" + b"".join(bytes(p) for p in row) for row in rows)
         def chunk(kind, data):
             return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
-        ihdr = struct.pack(">IIBBBBB", len(rows[0]), len(rows), 8, 2, 0, 0, 0)
+        ihdr = struct.pack(">IIBBBBB", len(rows[0]), len(rows), 8, 6 if len(rows[0][0]) == 4 else 2, 0, 0, 0)
         png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
         self.doc.setdefault("images", []).append(
             {"uri": "data:image/png;base64," + base64.b64encode(png).decode(), "mimeType": "image/png"})

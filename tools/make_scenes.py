@@ -16,6 +16,10 @@ usage: make_scenes.py OUTDIR
   sky-bare-wall.gltf  the open plane and a wall on it with no material (materials.default)
   sun-plate.gltf      4 x 4 ground, a sun straight down, a plate 1.5 above the x < 0 half: the
                       shadow edge's penumbra (lights.sun_angle)
+  alpha-cards.gltf    6 x 3 ground (albedo 0), a sun straight down (1000 lux), three 1 x 1 cards 1 m
+                      above it facing up (ALPHA_CARDS): alphaMode MASK with a 2 x 2 checker of
+                      texture alpha (NEAREST), BLEND with alpha 0.3, and KHR_materials_transmission 1
+                      with base colour (0.2, 0.9, 0.2): what light each lets through
   many-lights.gltf    10 x 10 plane under 20 point lights (more than are looped: drawn by
                       their unshadowed irradiance at each point)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
@@ -72,8 +76,16 @@ FURNACE_MATERIALS = {
     "metal-blue255": 0.0,
     "basecolor-mirror": srgb_to_linear(188),
     "basecolor-large": 0.5,
+    "vertex-colour": 102 / 255.0,
 }
 LARGE_TEXTURE_WIDTH = 9000  # over lmbake's 4096 a side: read reduced 3x, averaging in linear light
+
+# alpha-cards.gltf: card name -> the x of its corner (its node's translation (x, 1, -0.5)); each card
+# spans [x, x + 1] x [-0.5, 0.5], its TEXCOORD_0 = (local x, local z) in [0, 1]^2
+ALPHA_CARDS = {"mask": -2.0, "blend": -0.5, "glass": 1.0}
+ALPHA_CHECKER = [[(255, 255, 255, 0), (255, 255, 255, 255)], [(255, 255, 255, 255), (255, 255, 255, 0)]]
+BLEND_ALPHA = 0.3
+GLASS_TINT = (0.2, 0.9, 0.2)
 
 # 20 point lights 2 m above the plane (x, z, candela): more than lmbake evaluates exactly
 MANY_LIGHTS = [(-4 + 2 * (k % 5), -3 + 2 * (k // 5), 10.0 + 7.0 * k) for k in range(20)]
@@ -278,6 +290,13 @@ def furnace_variant(out, name):
         pbr["baseColorFactor"] = [1.0, 1.0, 1.0, 1.0]
         pbr["baseColorTexture"] = {"index": s.texture_pixels([row, row])}
     s.mesh("room", box(-1, 0, -1, 1, 2, 1, inward=True), mat, uv=True)
+    if name == "vertex-colour":
+        # COLOR_0 multiplies the base colour (1): normalized unsigned bytes 102 / 255 = 0.4, linear
+        # (no sRGB decoding: it would give 0.133), its alpha 255 ignored by an opaque material
+        pbr["baseColorFactor"] = [1.0, 1.0, 1.0, 1.0]
+        prim = s.doc["meshes"][-1]["primitives"][0]
+        count = s.doc["accessors"][prim["attributes"]["POSITION"]]["count"]
+        prim["attributes"]["COLOR_0"] = s.byte_accessor([(102, 102, 102, 255)] * count)
     s.write(os.path.join(out, "furnace-%s.gltf" % name))
 
 
@@ -422,6 +441,28 @@ def instanced(out):
     s.write(os.path.join(out, "instanced-boxes.gltf"))
 
 
+def alpha_cards(out):
+    s = Scene()
+    black = s.material("ground", (0.0, 0.0, 0.0))
+    s.mesh("ground", quad((-3, 0, 1.5), (3, 0, 1.5), (3, 0, -1.5), (-3, 0, -1.5)), black)
+    card = quad((0, 0, 1), (1, 0, 1), (1, 0, 0), (0, 0, 0))  # faces +y; TEXCOORD_0 = (x, z)
+    mask = s.material("card-mask", (0.5, 0.5, 0.5))
+    m = s.doc["materials"][mask]
+    m["alphaMode"] = "MASK"
+    m["alphaCutoff"] = 0.5
+    m["pbrMetallicRoughness"]["baseColorTexture"] = {"index": s.texture_pixels(ALPHA_CHECKER, NEAREST_CLAMP)}
+    blend = s.material("card-blend", (0.5, 0.5, 0.5))
+    s.doc["materials"][blend]["alphaMode"] = "BLEND"
+    s.doc["materials"][blend]["pbrMetallicRoughness"]["baseColorFactor"][3] = BLEND_ALPHA
+    glass = s.material("card-glass", GLASS_TINT)
+    s.doc["materials"][glass]["extensions"] = {"KHR_materials_transmission": {"transmissionFactor": 1.0}}
+    s.require("KHR_materials_transmission")
+    for name, mat in (("mask", mask), ("blend", blend), ("glass", glass)):
+        s.mesh("card-" + name, card, mat, translation=(ALPHA_CARDS[name], 1.0, -0.5), uv=True)
+    s.light("sun", "directional", 1000.0, rotation=[-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)])  # -Z turned to -y
+    s.write(os.path.join(out, "alpha-cards.gltf"))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -432,3 +473,4 @@ if __name__ == "__main__":
     indirect(out)
     artists(out)
     instanced(out)
+    alpha_cards(out)

@@ -32,29 +32,20 @@ static void hit_point(const lmb_rt *rt, const double o[3], const double w[3], co
     y->eps = 4 * rt->eps;
 }
 
-/* Radiance arriving from w: B at the first hit, from the cache or (no lightmap) direct light. */
-static double cached_radiance(void *user, const double w[3], uint32_t sample, double out[3])
+/* B leaving hit h toward the gather point: from the cache or (no lightmap) direct light there; 0
+ * from a back face. */
+static void hit_radiance(point_rays *pr, const double w[3], const lmb_rt_hit *h, uint32_t sample, double out[3])
 {
-    point_rays *pr = user;
     const lmb_gather_job *job = pr->job;
-    lmb_rt_hit h;
-    out[0] = out[1] = out[2] = 0;
-    pr->rays++;
-    int hit = lmb_rt_intersect(job->rt, pr->o, w, pr->sp.eps, 1e300, &h);
-    if (sample < pr->cosine_samples) {
-        pr->distances++;
-        pr->inverse_distances += hit && h.t > 0 ? 1.0 / h.t : 0.0;
-    }
-    if (!hit)
-        return INFINITY;
     double albedo[3], e[3];
-    lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
+    out[0] = out[1] = out[2] = 0;
+    lmb_hit_kind kind = lmb_cache_lookup(job->cache, h, albedo, e);
     if (kind == LMB_HIT_DARK || (kind == LMB_HIT_UNMAPPED && job->unmapped_dark))
-        return h.t;
+        return;
     if (kind == LMB_HIT_UNMAPPED || job->direct_at_hits) {
         lmb_shading_point y;
         double d[3];
-        hit_point(job->rt, pr->o, w, &h, &y);
+        hit_point(job->rt, pr->o, w, h, &y);
         lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
         pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, d, NULL);
         for (int k = 0; k < 3; k++) /* unmapped: direct light only (one bounce) */
@@ -62,7 +53,69 @@ static double cached_radiance(void *user, const double w[3], uint32_t sample, do
     }
     for (int k = 0; k < 3; k++)
         out[k] = albedo[k] * e[k];
-    return h.t;
+}
+
+/* Radiance arriving from w: B at the first opaque hit, seen through the surfaces light partly
+ * passes before it, each adding what its covered share reflects (rt_surface.h). Returns the
+ * distance to the nearest surface met (INFINITY: none). */
+static double cached_radiance(void *user, const double w[3], uint32_t sample, double out[3])
+{
+    point_rays *pr = user;
+    const lmb_gather_job *job = pr->job;
+    lmb_rt_hit h;
+    lmb_rt_layer layers[LMB_RT_MAX_LAYERS];
+    uint32_t nl;
+    out[0] = out[1] = out[2] = 0;
+    pr->rays++;
+    int hit = lmb_rt_intersect_layers(job->rt, pr->o, w, pr->sp.eps, 1e300, &h, layers, &nl);
+    double first = nl ? layers[0].hit.t : hit ? h.t : INFINITY;
+    if (sample < pr->cosine_samples) {
+        pr->distances++;
+        pr->inverse_distances += isfinite(first) && first > 0 ? 1.0 / first : 0.0;
+    }
+    if (!nl) {
+        if (hit)
+            hit_radiance(pr, w, &h, sample, out);
+        return first;
+    }
+    double through[3] = {1, 1, 1}, b[3];
+    for (uint32_t j = 0; j < nl; j++) {
+        hit_radiance(pr, w, &layers[j].hit, sample, b);
+        for (int k = 0; k < 3; k++) {
+            out[k] += through[k] * layers[j].cover * b[k];
+            through[k] *= layers[j].pass[k];
+        }
+    }
+    if (hit) {
+        hit_radiance(pr, w, &h, sample, b);
+        for (int k = 0; k < 3; k++)
+            out[k] += through[k] * b[k];
+    }
+    return first;
+}
+
+/* The reference path's next surface along w: the opaque hit, or a surface light partly passes
+ * chosen to reflect with probability cover / (cover + mean pass) (else the path goes through it,
+ * beta times pass over the probability of passing), so the reference stays unbiased. */
+static int reference_hit(const lmb_gather_job *job, const double o[3], const double w[3], double eps, lmb_rng *rng,
+                         double beta[3], lmb_rt_hit *h, double *cover)
+{
+    lmb_rt_layer layers[LMB_RT_MAX_LAYERS];
+    uint32_t nl;
+    int hit = lmb_rt_intersect_layers(job->rt, o, w, eps, 1e300, h, layers, &nl);
+    *cover = 1.0;
+    for (uint32_t j = 0; j < nl; j++) {
+        double mean = (layers[j].pass[0] + layers[j].pass[1] + layers[j].pass[2]) / 3.0;
+        double q = layers[j].cover / (layers[j].cover + mean);
+        if (lmb_rng_next(rng) < q) {
+            *h = layers[j].hit;
+            *cover = layers[j].cover / q;
+            return 1;
+        }
+        for (int k = 0; k < 3; k++)
+            beta[k] *= layers[j].pass[k] / (1.0 - q);
+    }
+    return hit;
 }
 
 /* Path-traced indirect irradiance at sp: paths x depth cosine bounces, direct light at each hit. */
@@ -82,12 +135,15 @@ static void reference(point_rays *pr, double out[3])
             if (lmb_dot3(w, x.ng) <= 0)
                 break;
             lmb_rt_hit h;
+            double cover;
             pr->rays++;
-            if (!lmb_rt_intersect(job->rt, o, w, x.eps, 1e300, &h))
+            if (!reference_hit(job, o, w, x.eps, &rng, beta, &h, &cover))
                 break;
             double albedo[3], unused[3];
             if (lmb_cache_lookup(job->cache, &h, albedo, unused) == LMB_HIT_DARK)
                 break;
+            for (int k = 0; k < 3; k++)
+                albedo[k] *= cover;
             lmb_shading_point y;
             hit_point(job->rt, o, w, &h, &y);
             double e[3];

@@ -151,11 +151,13 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     if (!punctual_reaches(c, l, d, &dist, &cosang, &w))
         return;
     c->rays++;
-    if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps))
+    double pass[3];
+    if (lmb_rt_transmittance(c->d->rt, c->o, d, c->eps,
+                             l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6) - c->eps, pass))
         return;
     double rgb[3];
     for (int k = 0; k < 3; k++)
-        rgb[k] = weight * scale * l->intensity * l->color[k] * cosang * w;
+        rgb[k] = weight * scale * l->intensity * l->color[k] * cosang * w * pass[k];
     add_light(c, l, d, rgb, e);
 }
 
@@ -192,11 +194,12 @@ static void sun_disc(point_ctx *c, const lmb_light *l, uint32_t which, double e[
         if (cosang <= 0 || lmb_dot3(c->ng, d) <= 0)
             continue;
         c->rays++;
-        if (lmb_rt_occluded(c->d->rt, c->o, d, c->eps, 1e300))
+        double pass[3];
+        if (lmb_rt_transmittance(c->d->rt, c->o, d, c->eps, 1e300, pass))
             continue;
         double rgb[3];
         for (int k = 0; k < 3; k++)
-            rgb[k] = scale * l->color[k] * cosang;
+            rgb[k] = scale * l->color[k] * cosang * pass[k];
         add_light(c, l, d, rgb, e);
     }
 }
@@ -325,12 +328,13 @@ static void area_lights(point_ctx *c, double e[3])
             double cx = lmb_dot3(c->n, d);
             if (cx > 0 && lmb_dot3(c->ng, d) > 0 && lmb_emitter_radiance(x, b1, b2, d, &cy, le)) {
                 c->rays++;
-                if (!lmb_rt_occluded(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps)) {
+                double pass[3];
+                if (!lmb_rt_transmittance(c->d->rt, c->o, d, c->eps, dist * (1 - 1e-4) - c->eps, pass)) {
                     double pl = prob / x->area * dist2 / cy, pb = cx * LMB_INV_PI;
                     double nl = n * pl, mb = m * pb;
                     double g = cx * nl / (nl * nl + mb * mb), rgb[3]; /* (cx / (n pl)) x power weight */
                     for (int k = 0; k < 3; k++)
-                        rgb[k] = le[k] * g;
+                        rgb[k] = le[k] * g * pass[k];
                     add_light(c, NULL, d, rgb, e);
                 }
             }
@@ -348,9 +352,15 @@ static void area_lights(point_ctx *c, double e[3])
         if (!(cz > 0) || lmb_dot3(c->ng, w) <= 0)
             continue;
         lmb_rt_hit h;
+        lmb_rt_layer layers[LMB_RT_MAX_LAYERS];
+        uint32_t nlayers;
         c->rays++;
-        if (!lmb_rt_intersect(c->d->rt, c->o, w, c->eps, 1e300, &h))
+        if (!lmb_rt_intersect_layers(c->d->rt, c->o, w, c->eps, 1e300, &h, layers, &nlayers))
             continue;
+        double pass[3] = {1, 1, 1}; /* what the surfaces before the emitter let through */
+        for (uint32_t j = 0; j < nlayers; j++)
+            for (int k = 0; k < 3; k++)
+                pass[k] *= layers[j].pass[k];
         const uint32_t *map = c->d->emitter_of[h.geom];
         uint32_t k1 = map ? map[h.prim] : 0;
         if (!k1)
@@ -364,7 +374,7 @@ static void area_lights(point_ctx *c, double e[3])
         double nl = n * pl, mb = m * pb;
         double g = cz * mb / (nl * nl + mb * mb), rgb[3]; /* (cz / (m pb)) x power weight */
         for (int k = 0; k < 3; k++)
-            rgb[k] = le[k] * g;
+            rgb[k] = le[k] * g * pass[k];
         add_light(c, NULL, w, rgb, e);
     }
 }
@@ -492,6 +502,14 @@ void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t 
         sp->ng[r] = g.ng[r];
     }
     sp->eps = d->rt->eps + 1e-4 * t->texel_size[i];
+}
+
+int lmb_texel_point_cut(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k)
+{
+    if (!d->rt->cut_geoms || !t->refs)
+        return 0;
+    const lmb_point_ref *r = &t->refs[(size_t)i * t->samples + k];
+    return lmb_rt_triangle_cut(d->rt, d->scene, r->instance, r->triangle, r->b1, r->b2);
 }
 
 /* Splits the scene's lights into directional and local, with the local lights' power CDF

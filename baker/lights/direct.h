@@ -105,6 +105,11 @@ const lmb_config *lmb_direct_config(const lmb_direct *d);
 /* Gather point k of listed texel i of t as a shading point (offset scaled to the texel). */
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp);
 
+/* 1 when point k of listed texel i lies on a cut-away part of a MASK surface: it is not on the
+ * surface, so it gets no light and gathers none (a texel with no other point is invalid and
+ * filled from its neighbours, as one inside geometry). */
+int lmb_texel_point_cut(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k);
+
 typedef struct lmb_direct_job {
     const lmb_direct *direct;
     uint32_t atlas;      /* keys the random streams */

@@ -33,9 +33,11 @@ uint32_t lmb_direct_deltas_at(const lmb_direct *d, const double p[3], lmb_delta_
         if (!(w > 0))
             continue;
         rays++;
-        if (lmb_rt_occluded(d->rt, p, dir, d->rt->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6)))
+        double pass[3];
+        if (lmb_rt_transmittance(d->rt, p, dir, d->rt->eps, l->type == LMB_LIGHT_DIRECTIONAL ? 1e300 : dist * (1 - 1e-6),
+                                 pass))
             continue;
-        double e[3] = {w * l->color[0], w * l->color[1], w * l->color[2]};
+        double e[3] = {w * l->color[0] * pass[0], w * l->color[1] * pass[1], w * l->color[2] * pass[2]};
         fn(user, dir, e);
     }
     return rays;
@@ -62,11 +64,12 @@ uint32_t lmb_direct_emitter_samples_at(const lmb_direct *d, const double p[3], u
         if (!lmb_emitter_radiance(x, b1, b2, w, &cy, le))
             continue;
         rays++;
-        if (lmb_rt_occluded(d->rt, p, w, d->rt->eps, dist * (1 - 1e-4)))
+        double pass[3];
+        if (lmb_rt_transmittance(d->rt, p, w, d->rt->eps, dist * (1 - 1e-4), pass))
             continue;
         double weight = x->area * cy / (prob * dist2 * samples), e[3]; /* 1 / (pdf in solid angle x samples) */
         for (int k = 0; k < 3; k++)
-            e[k] = le[k] * weight;
+            e[k] = le[k] * weight * pass[k];
         fn(user, w, e);
     }
     return rays;

@@ -372,13 +372,14 @@ uint32_t lmb_sky_irradiance(const lmb_sky *s, const lmb_rt *rt, const double o[3
         if (!(denom > 0))
             continue;
         rays++;
-        if (lmb_rt_occluded(rt, o, w, eps, 1e300))
+        double pass[3];
+        if (lmb_rt_transmittance(rt, o, w, eps, 1e300, pass))
             continue;
         double l[3];
         lmb_sky_radiance(s, w, l);
         double lum = 0;
         for (int ch = 0; ch < 3; ch++) {
-            double v = l[ch] * c / denom;
+            double v = l[ch] * c / denom * pass[ch];
             e[ch] += v;
             lum += v * (ch == 0 ? 0.2126 : ch == 1 ? 0.7152 : 0.0722);
         }

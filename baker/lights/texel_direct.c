@@ -73,6 +73,8 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         lmb_texel_shading_point(job->direct, t, i, k, &p->sp);
         p->rng = lmb_rng_make(cfg->seed, key, k);
         int sees_back;
+        if (lmb_texel_point_cut(job->direct, t, i, k))
+            continue;
         if (lmb_point_inside_geometry(job->direct, &p->sp, job->atlas, t->texel[i], k, &p->rng, &r, &sees_back))
             continue;
         near_back |= sees_back;

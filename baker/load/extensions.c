@@ -10,8 +10,9 @@
  *   - KHR_materials_unlit: an unlit surface shows its base colour whatever the light, so it
  *     reflects none in the bake (albedo 0: no invented bounce off a backdrop or sky dome); it
  *     still blocks light and still emits its emissiveFactor, if any.
- *   - KHR_materials_transmission / volume: baked as opaque (they block light and reflect their
- *     diffuse colour); light through glass is not baked.
+ *   - KHR_materials_transmission / volume: a thin surface that lets transmission x base colour
+ *     of the light through (a volume: tinted once more by its attenuation over its thickness on
+ *     entering) and reflects the rest of its diffuse colour (docs/materials.md).
  *   - KHR_materials_variants: the primitive's default material is baked.
  */
 #include "extensions.h"
@@ -33,9 +34,8 @@ static const lmb_extension_info table[] = {
     {"KHR_materials_iridescence", LMB_EXT_IGNORED, "it changes specular reflection only, which a diffuse bake ignores"},
     {"KHR_materials_anisotropy", LMB_EXT_IGNORED, "it changes specular reflection only, which a diffuse bake ignores"},
     {"KHR_materials_dispersion", LMB_EXT_IGNORED, "it changes refraction only, which a diffuse bake ignores"},
-    {"KHR_materials_transmission", LMB_EXT_IGNORED,
-     "transmissive surfaces are baked as opaque (they block light and reflect their base colour)"},
-    {"KHR_materials_volume", LMB_EXT_IGNORED, "volumes are baked as opaque surfaces"},
+    {"KHR_materials_transmission", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_materials_volume", LMB_EXT_SUPPORTED, NULL},
     {"KHR_materials_variants", LMB_EXT_IGNORED, "each primitive is baked with its default material, not the variants"},
     {"KHR_materials_unlit", LMB_EXT_IGNORED,
      "unlit materials reflect no light in the bake (their colour does not depend on light) but still block it"},

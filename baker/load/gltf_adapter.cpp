@@ -169,6 +169,7 @@ void fill_meshes(lmb_gltf_doc &d)
             q.normal = attribute(p, "NORMAL");
             q.texcoord0 = attribute(p, "TEXCOORD_0");
             q.texcoord1 = attribute(p, "TEXCOORD_1");
+            q.color0 = attribute(p, "COLOR_0");
             q.any_attribute = p.attributes.empty() ? -1 : p.attributes.begin()->second;
             d.primitives.push_back(q);
         }
@@ -318,6 +319,21 @@ void fill_materials(lmb_gltf_doc &d)
             c.glossiness = number_member(sg, "glossinessFactor", 1.0);
         }
         c.unlit = extension(m.extensions, "KHR_materials_unlit") != nullptr;
+        c.alpha_mode = m.alphaMode.empty() || m.alphaMode == "OPAQUE" ? 0
+                       : m.alphaMode == "MASK"                        ? 1
+                       : m.alphaMode == "BLEND"                       ? 2
+                                                                      : -1;
+        c.alpha_cutoff = m.alphaCutoff;
+        const tinygltf::Value *tr = extension(m.extensions, "KHR_materials_transmission");
+        c.has_transmission = tr != nullptr;
+        c.transmission = number_member(tr, "transmissionFactor", 0.0);
+        c.transmission_texture = texture_info(tr ? member(*tr, "transmissionTexture") : nullptr);
+        const tinygltf::Value *vol = extension(m.extensions, "KHR_materials_volume");
+        c.has_volume = vol != nullptr;
+        c.thickness = number_member(vol, "thicknessFactor", 0.0);
+        c.attenuation_distance = number_member(vol, "attenuationDistance", INFINITY);
+        c.attenuation_color[0] = c.attenuation_color[1] = c.attenuation_color[2] = 1.0;
+        number_array(vol, "attenuationColor", c.attenuation_color, 3);
         d.materials.push_back(c);
     }
 }

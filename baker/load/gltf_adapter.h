@@ -45,6 +45,7 @@ typedef struct lmb_gltf_primitive {
     int32_t material; /* -1: default */
     int32_t indices;  /* accessor or -1 */
     int32_t position, normal, texcoord0, texcoord1; /* accessors or -1 */
+    int32_t color0;   /* COLOR_0 accessor or -1 */
     int32_t any_attribute; /* the first attribute's accessor, -1 if none (for counting) */
 } lmb_gltf_primitive;
 
@@ -91,6 +92,18 @@ typedef struct lmb_gltf_material {
     double diffuse[4], specular[3], glossiness;
     lmb_gltf_texture_info diffuse_texture, specular_glossiness_texture;
     int unlit; /* KHR_materials_unlit */
+    /* alphaMode as written: 0 OPAQUE (also when absent), 1 MASK, 2 BLEND, -1 anything else;
+     * alphaCutoff 0.5 when absent (preflight checks the JSON value is a number in [0, 1]) */
+    int alpha_mode;
+    double alpha_cutoff;
+    /* KHR_materials_transmission (has_transmission: present): factor 0 and texture (red) */
+    int has_transmission;
+    double transmission;
+    lmb_gltf_texture_info transmission_texture;
+    /* KHR_materials_volume (has_volume: present): thicknessFactor, attenuationDistance
+     * (INFINITY when absent) and attenuationColor */
+    int has_volume;
+    double thickness, attenuation_distance, attenuation_color[3];
 } lmb_gltf_material;
 
 /* A glTF texture and its sampler (glTF defaults when it has none). */

@@ -34,9 +34,55 @@ static lmb_status texture_ref(const char *path, const char *material, const char
     return LMB_OK;
 }
 
+/* alphaMode, alphaCutoff, KHR_materials_transmission and _volume: what light the surface lets
+ * through (docs/materials.md). preflight.c has checked alphaCutoff in the JSON; the values here
+ * are checked again for a document that did not come through it. */
+static lmb_status load_passage(const char *path, const lmb_gltf_material *g, const char *label, lmb_material *m,
+                               lmb_error *err)
+{
+    if (g->alpha_mode < 0)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: alphaMode must be OPAQUE, MASK or BLEND", path, label);
+    m->alpha_mode = (lmb_alpha_mode)g->alpha_mode;
+    if (!(g->alpha_cutoff >= 0.0 && g->alpha_cutoff <= 1.0))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: alphaCutoff %g must be a number in [0, 1]", path, label,
+                             g->alpha_cutoff);
+    m->alpha_cutoff = (float)g->alpha_cutoff;
+    m->transmission_texture.texture = -1;
+    m->volume_tint[0] = m->volume_tint[1] = m->volume_tint[2] = 1.0f;
+    if (!g->has_transmission)
+        return LMB_OK;
+    if (!(g->transmission >= 0.0 && g->transmission <= 1.0))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: KHR_materials_transmission transmissionFactor %g must be a "
+                             "number in [0, 1]", path, label, g->transmission);
+    m->transmission = (float)g->transmission;
+    lmb_status st = texture_ref(path, label, "transmissionTexture", &g->transmission_texture, &m->transmission_texture,
+                                err);
+    if (st != LMB_OK || !g->has_volume)
+        return st;
+    if (!(g->thickness >= 0.0) || !(g->attenuation_distance > 0.0))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: KHR_materials_volume needs thicknessFactor >= 0 and "
+                             "attenuationDistance > 0 (got %g and %g)", path, label, g->thickness,
+                             g->attenuation_distance);
+    m->volume = g->thickness > 0.0;
+    for (int c = 0; c < 3; c++) {
+        double col = g->attenuation_color[c];
+        if (!(col >= 0.0 && col <= 1.0))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: KHR_materials_volume attenuationColor[%d] %g must be in "
+                                 "[0, 1]", path, label, c, col);
+        /* Beer-Lambert over the thickness the material states (the glTF sample viewer's model):
+         * isinf(distance): no attenuation */
+        m->volume_tint[c] = isinf(g->attenuation_distance) ? 1.0f
+                                                           : (float)pow(col, g->thickness / g->attenuation_distance);
+    }
+    return LMB_OK;
+}
+
 static lmb_status load_one(const char *path, const lmb_gltf_material *g, const char *label, lmb_material *m,
                            lmb_error *err)
 {
+    lmb_status pst = load_passage(path, g, label, m, err);
+    if (pst != LMB_OK)
+        return pst;
     if (!(g->emissive_strength >= 0.0) || g->emissive_strength > 1e30)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: KHR_materials_emissive_strength %g must be a finite number >= 0",
                              path, label, g->emissive_strength);

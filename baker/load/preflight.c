@@ -8,6 +8,8 @@
  *     only if every texture lmbake reads keeps a fallback `source` image;
  *   - compressed geometry (KHR_draco_mesh_compression on a primitive,
  *     EXT_meshopt_compression on a buffer view) is refused, naming the mesh or view;
+ *   - alphaMode must be OPAQUE, MASK or BLEND and alphaCutoff a number in [0, 1], naming the
+ *     material (tinygltf reads a malformed cutoff as 0.5 without a word);
  *   - a buffer's uri must name a file inside the input's folder (uri.h).
  * For .glb the JSON chunk is read from the container (glTF 2.0 spec section 4.4).
  */
@@ -185,6 +187,35 @@ static lmb_status check_compression(const char *path, const cJSON *root, lmb_err
     return LMB_OK;
 }
 
+/* alphaMode and alphaCutoff as written (glTF 2.0 section 5.19): tinygltf would read a cutoff
+ * that is not a number as the default 0.5, silently; here it is named. */
+static lmb_status check_alpha(const char *path, const cJSON *root, lmb_error *err)
+{
+    const cJSON *mat;
+    uint32_t mi = 0;
+    char label[160];
+    cJSON_ArrayForEach(mat, cJSON_GetObjectItemCaseSensitive(root, "materials"))
+    {
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(mat, "name");
+        const cJSON *mode = cJSON_GetObjectItemCaseSensitive(mat, "alphaMode");
+        const cJSON *cut = cJSON_GetObjectItemCaseSensitive(mat, "alphaCutoff");
+        lmb_object_label(label, "material", mi, cJSON_IsString(name) ? name->valuestring : NULL);
+        if (mode && (!cJSON_IsString(mode) || (strcmp(mode->valuestring, "OPAQUE") && strcmp(mode->valuestring, "MASK") &&
+                                               strcmp(mode->valuestring, "BLEND"))))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: alphaMode %.40s%s%s is not OPAQUE, MASK or BLEND", path,
+                                 label, cJSON_IsString(mode) ? "'" : "", cJSON_IsString(mode) ? mode->valuestring : "(not a string)",
+                                 cJSON_IsString(mode) ? "'" : "");
+        if (cut && !cJSON_IsNumber(cut))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: alphaCutoff is not a number; it must be a number in [0, 1]",
+                                 path, label);
+        if (cut && !(cut->valuedouble >= 0.0 && cut->valuedouble <= 1.0))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: alphaCutoff %g is outside [0, 1]", path, label,
+                                 cut->valuedouble);
+        mi++;
+    }
+    return LMB_OK;
+}
+
 /* Buffers are read only from the input's folder (load/uri.h): a buffer whose uri points
  * elsewhere is an error (without it there is no geometry). */
 static lmb_status check_buffer_uris(const char *path, const cJSON *root, lmb_error *err)
@@ -260,6 +291,8 @@ lmb_status lmb_preflight(const char *path, lmb_error *err)
         st = check_required(path, root, err);
     if (st == LMB_OK)
         st = check_compression(path, root, err);
+    if (st == LMB_OK)
+        st = check_alpha(path, root, err);
     if (st == LMB_OK)
         st = check_buffer_uris(path, root, err);
     cJSON_Delete(root);

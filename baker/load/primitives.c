@@ -26,6 +26,7 @@ void lmb_primitive_release(lmb_primitive *p)
     free(p->normals);
     free(p->uv0);
     free(p->uv1);
+    free(p->colors);
     free(p->indices);
     free(p->degenerate);
     memset(p, 0, sizeof *p);
@@ -75,6 +76,37 @@ static lmb_status read_attribute(const lmb_accessor_ctx *ctx, int32_t accessor, 
             return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: vertex %zu is not a finite number (NaN or Inf)",
                                  ctx->path, what, i / (size_t)comps);
         }
+    return LMB_OK;
+}
+
+/* COLOR_0 (glTF 2.0 section 3.7.2.1: VEC3 or VEC4, float or normalized unsigned byte/short,
+ * linear) as RGBA, alpha 1 where the accessor is VEC3; it multiplies the base colour. */
+static lmb_status read_colors(const lmb_accessor_ctx *ctx, int32_t accessor, const char *what, size_t vertex_count,
+                              float **out, lmb_error *err)
+{
+    char attr[224];
+    *out = NULL;
+    if (accessor < 0)
+        return LMB_OK;
+    snprintf(attr, sizeof attr, "%s COLOR_0", what);
+    int comps = (uint32_t)accessor < ctx->view->accessor_count ? ctx->view->accessors[accessor].components : 0;
+    if (comps != 3 && comps != 4)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s must be VEC3 or VEC4 (glTF 2.0 section 3.7.2.1)", ctx->path,
+                             attr);
+    float *c = NULL;
+    lmb_status st = read_attribute(ctx, accessor, comps, attr, vertex_count, &c, err);
+    if (st != LMB_OK)
+        return st;
+    float *rgba = malloc((4 * vertex_count + 1) * sizeof *rgba);
+    if (!rgba) {
+        free(c);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: %s: out of memory", ctx->path, attr);
+    }
+    for (size_t i = 0; i < vertex_count; i++)
+        for (int k = 0; k < 4; k++)
+            rgba[4 * i + (size_t)k] = k < comps ? c[(size_t)comps * i + (size_t)k] : 1.0f;
+    free(c);
+    *out = rgba;
     return LMB_OK;
 }
 
@@ -191,6 +223,8 @@ lmb_status lmb_load_primitive(const lmb_accessor_ctx *ctx, uint32_t mesh_index, 
         return st;
     snprintf(attr, sizeof attr, "%s TEXCOORD_1", what);
     if ((st = read_attribute(ctx, gp->texcoord1, 2, attr, nv, &out->uv1, err)) != LMB_OK)
+        return st;
+    if ((st = read_colors(ctx, gp->color0, what, nv, &out->colors, err)) != LMB_OK)
         return st;
     return build_triangles(ctx, gp, what, out, log, err);
 }

@@ -16,6 +16,7 @@ void lmb_textures_free(lmb_textures *t)
     for (uint32_t i = 0; t->t && i < t->count; i++) {
         free(t->t[i].pixels[LMB_TEX_COLOUR]);
         free(t->t[i].pixels[LMB_TEX_DATA]);
+        free(t->t[i].alpha);
     }
     free(t->t);
     memset(t, 0, sizeof *t);
@@ -280,6 +281,92 @@ static void load_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_mater
     }
 }
 
+/* Reads the alpha of texture tex (base colour of a MASK or BLEND material) at the size its
+ * colour is read at (the same reduction); its sampler is set as load_one sets it. */
+static lmb_status read_alpha(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, lmb_texture *out,
+                             const lmb_log *log, lmb_error *err)
+{
+    if (out->has_alpha)
+        return LMB_OK;
+    int32_t src = v->textures[tex].source;
+    if (src < 0 || (uint32_t)src >= v->image_count)
+        return lmb_error_set(err, LMB_ERR_INPUT, "texture %u has no usable image", tex);
+    const lmb_gltf_image *img = &v->images[src];
+    char name[8300];
+    const uint8_t *bytes = img->bytes;
+    if (bytes) {
+        snprintf(name, sizeof name, "%s", mem_name(img->mime));
+    } else { /* the same containment as read_pixels */
+        char folder[4096], rel[4096], real[4096];
+        const char *slash = strrchr(s->path, '/');
+        snprintf(folder, sizeof folder, "%.*s", slash ? (int)(slash - s->path) : 1, slash ? s->path : ".");
+        lmb_uri_kind kind = lmb_uri_check(img->uri, rel, sizeof rel);
+        if (kind != LMB_URI_INSIDE)
+            return lmb_error_set(err, LMB_ERR_INPUT, "image %d: uri '%s' %s", src, img->uri, lmb_uri_refusal(kind));
+        snprintf(name, sizeof name, "%s/%s", folder, rel);
+        if (!lmb_path_inside(folder, name, real, sizeof real))
+            return lmb_error_set(err, LMB_ERR_INPUT, "image %d: '%s' is not a file inside the input's folder", src,
+                                 img->uri);
+        snprintf(name, sizeof name, "%s", real);
+    }
+    uint32_t w, h;
+    lmb_status st = lmb_image_size(name, bytes, img->size, &w, &h, err);
+    if (st != LMB_OK)
+        return st;
+    if ((uint64_t)w * h > LMB_MAX_TEXTURE_PIXELS)
+        return lmb_error_set(err, LMB_ERR_INPUT, "image %d is %ux%u: over lmbake's limit of %llu pixels", src, w, h,
+                             (unsigned long long)LMB_MAX_TEXTURE_PIXELS);
+    uint32_t side = w > h ? w : h, factor = (side + LMB_TEXTURE_MAX_SIDE - 1) / LMB_TEXTURE_MAX_SIDE;
+    float *alpha = NULL;
+    uint32_t aw = 0, ah = 0;
+    st = lmb_image_read_alpha(name, bytes, img->size, factor ? factor : 1, &aw, &ah, &alpha, err);
+    if (st != LMB_OK)
+        return st;
+    if (out->pixels[LMB_TEX_COLOUR] || out->pixels[LMB_TEX_DATA]) {
+        if (alpha && (aw != out->width || ah != out->height)) {
+            free(alpha);
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "image %d: alpha read at %ux%u, colour at %ux%u", src, aw, ah,
+                                 out->width, out->height);
+        }
+    } else {
+        out->width = aw;
+        out->height = ah;
+        const lmb_gltf_texture *gt = &v->textures[tex];
+        out->wrap_s = wrap_mode(gt->wrap_s, "wrapS", s, tex, log);
+        out->wrap_t = wrap_mode(gt->wrap_t, "wrapT", s, tex, log);
+        out->nearest = gt->mag_filter == LMB_FILTER_NEAREST;
+    }
+    out->alpha = alpha;
+    out->has_alpha = 1;
+    return LMB_OK;
+}
+
+/* A MASK or BLEND material's base colour alpha: a texture that cannot be read is an error for
+ * MASK (its cut-outs would vanish: light would be blocked where the level has holes) and a
+ * warning for BLEND (its factor alone then gives the coverage). */
+static void load_alpha_for(const lmb_scene *s, const lmb_gltf_view *v, const lmb_material *m, lmb_textures *out,
+                           const lmb_log *log, lmb_status *st, lmb_error *err)
+{
+    int32_t tex = m->base_color_texture.texture;
+    if (m->alpha_mode == LMB_ALPHA_OPAQUE || tex < 0 || *st != LMB_OK)
+        return;
+    lmb_error e;
+    if ((uint32_t)tex >= v->texture_count) {
+        if (m->alpha_mode == LMB_ALPHA_MASK)
+            *st = lmb_error_set(err, LMB_ERR_INPUT, "%s: material '%s' (alphaMode MASK) names base colour texture %d, "
+                                "which does not exist: its cut-outs cannot be read", s->path, m->name, tex);
+        return;
+    }
+    if (read_alpha(s, v, (uint32_t)tex, &out->t[tex], log, &e) == LMB_OK)
+        return;
+    if (m->alpha_mode == LMB_ALPHA_MASK)
+        *st = lmb_error_set(err, LMB_ERR_INPUT, "%s: material '%s' (alphaMode MASK): the alpha of its base colour "
+                            "texture %d cannot be read, so its cut-outs are unknown: %s", s->path, m->name, tex, e.message);
+    else
+        lmb_warn(log, "%s: material '%s' (alphaMode BLEND): the alpha of its base colour texture %d cannot be read; "
+                 "its baseColorFactor alpha alone is the coverage: %s", s->path, m->name, tex, e.message);
+}
+
 lmb_status lmb_textures_load(const lmb_scene *s, lmb_textures *out, const lmb_log *log, lmb_error *err)
 {
     const lmb_gltf_view *v = lmb_gltf_get_view(s->doc);
@@ -293,6 +380,11 @@ lmb_status lmb_textures_load(const lmb_scene *s, lmb_textures *out, const lmb_lo
         const lmb_material *m = &s->materials[i];
         if (lmb_material_is_emissive(m))
             load_for(s, v, m, &m->emissive_texture, LMB_TEX_COLOUR, "emissive", out, log, &st, err);
+        load_alpha_for(s, v, m, out, log, &st, err);
+        if (m->transmission > 0) { /* the tint of light through it: its base colour, even where unlit or metal */
+            load_for(s, v, m, &m->transmission_texture, LMB_TEX_DATA, "transmission", out, log, &st, err);
+            load_for(s, v, m, &m->base_color_texture, LMB_TEX_COLOUR, "base colour", out, log, &st, err);
+        }
         if (m->unlit)
             continue;
         if (m->spec_gloss) {
@@ -330,11 +422,11 @@ static long wrap(long i, long n, int mode)
     return m + (m < 0 ? n : 0);
 }
 
-static const float *texel(const lmb_texture *t, const float *px, long x, long y)
+static const float *texel(const lmb_texture *t, const float *px, int stride, long x, long y)
 {
     x = wrap(x, (long)t->width, t->wrap_s);
     y = wrap(y, (long)t->height, t->wrap_t);
-    return px + 3 * ((size_t)y * t->width + (size_t)x);
+    return px + (size_t)stride * ((size_t)y * t->width + (size_t)x);
 }
 
 /* Texel coordinates beyond this are folded back by whole periods first (REPEAT and
@@ -348,9 +440,10 @@ static double fold(double x, long n)
     return fmod(x, period);
 }
 
-void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3])
+/* `stride` channels per texel of px, the first `stride` of them looked up at glTF UV (u, v)
+ * with t's wrap modes and filter. */
+static void sample_px(const lmb_texture *t, const float *px, int stride, double u, double v, float *out)
 {
-    const float *px = t->pixels[space];
     double x = u * t->width, y = v * t->height;
     if (!isfinite(x) || !isfinite(y)) /* a broken UV or transform reads texel (0, 0) */
         x = y = 0;
@@ -363,20 +456,33 @@ void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, dou
     else
         y = fold(y, (long)t->height);
     if (t->nearest) {
-        const float *a = texel(t, px, (long)floor(x), (long)floor(y));
-        out[0] = a[0];
-        out[1] = a[1];
-        out[2] = a[2];
+        const float *a = texel(t, px, stride, (long)floor(x), (long)floor(y));
+        for (int k = 0; k < stride; k++)
+            out[k] = a[k];
         return;
     }
     x -= 0.5;
     y -= 0.5;
     double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
     long x0 = (long)fx, y0 = (long)fy;
-    const float *a = texel(t, px, x0, y0), *b = texel(t, px, x0 + 1, y0), *c = texel(t, px, x0, y0 + 1),
-                *d = texel(t, px, x0 + 1, y0 + 1);
-    for (int k = 0; k < 3; k++)
+    const float *a = texel(t, px, stride, x0, y0), *b = texel(t, px, stride, x0 + 1, y0),
+                *c = texel(t, px, stride, x0, y0 + 1), *d = texel(t, px, stride, x0 + 1, y0 + 1);
+    for (int k = 0; k < stride; k++)
         out[k] = (float)((1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]));
+}
+
+void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3])
+{
+    sample_px(t, t->pixels[space], 3, u, v, out);
+}
+
+float lmb_texture_sample_alpha(const lmb_texture *t, double u, double v)
+{
+    if (!t->alpha)
+        return 1.0f;
+    float a;
+    sample_px(t, t->alpha, 1, u, v, &a);
+    return a;
 }
 
 /*
@@ -406,23 +512,81 @@ void lmb_texture_ref_apply(const lmb_texture_ref *ref, double u, double v, doubl
     *tv = ref->uv[3] * u + ref->uv[4] * v + ref->uv[5];
 }
 
+/* Slot ref's texture UV (its TEXCOORD set through its transform) at barycentrics b of triangle
+ * tri of pr; 0 when the primitive lacks that set. */
+static int slot_uv(const lmb_texture_ref *ref, const lmb_primitive *pr, uint32_t tri, const double b[3], double *tu,
+                   double *tv)
+{
+    const float *uv = ref->texcoord == 0 ? pr->uv0 : ref->texcoord == 1 ? pr->uv1 : NULL;
+    if (!uv)
+        return 0;
+    const uint32_t *ix = pr->indices + 3 * (size_t)tri;
+    double u = 0, v = 0;
+    for (int k = 0; k < 3; k++) {
+        u += b[k] * uv[2 * ix[k]];
+        v += b[k] * uv[2 * ix[k] + 1];
+    }
+    lmb_texture_ref_apply(ref, u, v, tu, tv);
+    return 1;
+}
+
 /* Looks slot ref up at barycentrics (b0, b1, b2) of triangle tri of pr; 0 when it cannot (out left as is). */
 static int sample_slot(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space,
                        const lmb_primitive *pr, uint32_t tri, const double b[3], float out[3])
 {
     const lmb_texture *t = lmb_textures_get(tx, ref, space);
-    const float *uv = ref->texcoord == 0 ? pr->uv0 : ref->texcoord == 1 ? pr->uv1 : NULL;
-    if (!t || !uv)
+    double tu, tv;
+    if (!t || !slot_uv(ref, pr, tri, b, &tu, &tv))
         return 0;
-    const uint32_t *ix = pr->indices + 3 * (size_t)tri;
-    double u = 0, v = 0, tu, tv;
-    for (int k = 0; k < 3; k++) {
-        u += b[k] * uv[2 * ix[k]];
-        v += b[k] * uv[2 * ix[k] + 1];
-    }
-    lmb_texture_ref_apply(ref, u, v, &tu, &tv);
     lmb_texture_sample(t, space, tu, tv, out);
     return 1;
+}
+
+/* COLOR_0 (RGBA) interpolated at barycentrics b; 1 1 1 1 without it. */
+static void vertex_colour(const lmb_primitive *pr, uint32_t tri, const double b[3], double out[4])
+{
+    out[0] = out[1] = out[2] = out[3] = 1.0;
+    if (!pr->colors)
+        return;
+    const uint32_t *ix = pr->indices + 3 * (size_t)tri;
+    for (int c = 0; c < 4; c++)
+        out[c] = b[0] * pr->colors[4 * (size_t)ix[0] + c] + b[1] * pr->colors[4 * (size_t)ix[1] + c] +
+                 b[2] * pr->colors[4 * (size_t)ix[2] + c];
+}
+
+double lmb_material_alpha(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                          double b1, double b2)
+{
+    double b[3] = {1.0 - b1 - b2, b1, b2}, vc[4], tu, tv;
+    vertex_colour(pr, tri, b, vc);
+    double a = m->base_color[3] * vc[3];
+    const lmb_texture_ref *ref = &m->base_color_texture;
+    if (tx && ref->texture >= 0 && (uint32_t)ref->texture < tx->count && tx->t[ref->texture].alpha &&
+        slot_uv(ref, pr, tri, b, &tu, &tv))
+        a *= lmb_texture_sample_alpha(&tx->t[ref->texture], tu, tv);
+    return a;
+}
+
+double lmb_material_transmission(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                                 double b1, double b2)
+{
+    if (!(m->transmission > 0))
+        return 0.0;
+    double b[3] = {1.0 - b1 - b2, b1, b2};
+    float t[3] = {1, 1, 1};
+    sample_slot(tx, &m->transmission_texture, LMB_TEX_DATA, pr, tri, b, t);
+    return m->transmission * t[0];
+}
+
+void lmb_material_base_colour(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                              double b1, double b2, double out[3])
+{
+    double b[3] = {1.0 - b1 - b2, b1, b2}, vc[4];
+    float base[3] = {1, 1, 1};
+    sample_slot(tx, &m->base_color_texture, LMB_TEX_COLOUR, pr, tri, b, base);
+    vertex_colour(pr, tri, b, vc);
+    for (int k = 0; k < 3; k++)
+        out[k] = m->base_color[k] * base[k] * vc[k];
 }
 
 void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
@@ -433,7 +597,9 @@ void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lm
     if (m->unlit)
         return;
     float base[3] = {1, 1, 1};
+    double vc[4];
     sample_slot(tx, &m->base_color_texture, LMB_TEX_COLOUR, pr, tri, b, base);
+    vertex_colour(pr, tri, b, vc);
     double keep; /* the share of base colour that is diffuse */
     if (m->spec_gloss) {
         float sp[3] = {1, 1, 1};
@@ -447,6 +613,7 @@ void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lm
         keep = 1.0 - m->metallic * mr[2];
     }
     keep = keep < 0 ? 0 : keep > 1 ? 1 : keep;
+    keep *= 1.0 - lmb_material_transmission(tx, m, pr, tri, b1, b2); /* glTF: transmission replaces diffuse */
     for (int k = 0; k < 3; k++)
-        albedo[k] = keep * m->base_color[k] * base[k];
+        albedo[k] = keep * m->base_color[k] * base[k] * vc[k];
 }

@@ -28,6 +28,8 @@ enum { LMB_FILTER_NEAREST = 9728 };
 typedef struct lmb_texture {
     uint32_t width, height;
     float *pixels[2]; /* per lmb_tex_space: RGB, rows top to bottom; NULL when not loaded in that space */
+    float *alpha;     /* width x height alpha in [0, 1] when a MASK or BLEND material reads it, else NULL */
+    int has_alpha;    /* its alpha was read (alpha NULL and has_alpha 1: the image has none: opaque) */
     double mean[3];   /* average colour texel, for importance */
     int wrap_s, wrap_t; /* LMB_WRAP_* */
     int nearest;        /* magFilter NEAREST: nearest texel; else bilinear */
@@ -53,6 +55,10 @@ const lmb_texture *lmb_textures_get(const lmb_textures *tx, const lmb_texture_re
  * with the texture's wrap modes and filter, in `space` (which must be loaded). */
 void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3]);
 
+/* The alpha channel at glTF UV (u, v), as lmb_texture_sample filters colour; 1 when the image
+ * has no alpha (or it was not read). */
+float lmb_texture_sample_alpha(const lmb_texture *t, double u, double v);
+
 /* KHR_texture_transform's matrix T(offset) x R(rotation) x S(scale) as the 2 x 3 affine map
  * of lmb_texture_ref.uv (see textures.c for the rotation's direction). */
 void lmb_texture_transform_matrix(const double offset[2], double rotation, const double scale[2], double uv[6]);
@@ -60,10 +66,24 @@ void lmb_texture_transform_matrix(const double offset[2], double rotation, const
 /* Applies ref's UV map to (u, v). */
 void lmb_texture_ref_apply(const lmb_texture_ref *ref, double u, double v, double *tu, double *tv);
 
+/* The alpha of material m on primitive pr at barycentrics (b1, b2) of triangle tri:
+ * baseColorFactor.a x baseColorTexture.a x COLOR_0.a (glTF 2.0 section 3.9.2). */
+double lmb_material_alpha(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                          double b1, double b2);
+
+/* KHR_materials_transmission's factor x texture (red) at the same place; 0 without it. */
+double lmb_material_transmission(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                                 double b1, double b2);
+
+/* The base colour (linear RGB: factor x texture x COLOR_0), the tint of transmitted light. */
+void lmb_material_base_colour(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                              double b1, double b2, double out[3]);
+
 /* The diffuse albedo (linear RGB, what a viewer multiplies the lightmap by, times pi) of
  * material m on primitive pr at barycentrics (b1, b2) of triangle tri:
- *   metal-rough:  baseColorFactor x baseColorTexture x (1 - metallicFactor x metallicTexture.b)
- *   spec-gloss:   diffuseFactor x diffuseTexture x (1 - max(specularFactor x specularTexture.rgb))
+ *   metal-rough:  baseColorFactor x baseColorTexture x COLOR_0 x (1 - metallicFactor x metallicTexture.b)
+ *                 x (1 - transmission)
+ *   spec-gloss:   diffuseFactor x diffuseTexture x COLOR_0 x (1 - max(specularFactor x specularTexture.rgb))
  *   unlit:        0 (its colour does not depend on light; it reflects none)
  * A texture that is missing, not loaded or whose TEXCOORD set the primitive lacks counts as 1. */
 void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,

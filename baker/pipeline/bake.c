@@ -223,14 +223,18 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     }
     if (st == LMB_OK && progress)
         progress(user, "scene set-up", 0, 1); /* ray-tracing scene, textures, lights, bounce cache */
+    if (st == LMB_OK) /* before the ray-tracing scene: alpha and transmission textures decide what rays pass */
+        st = lmb_textures_load(s, &tx, log, err);
     if (st == LMB_OK)
-        st = lmb_rt_build(s, &rt, err);
+        st = lmb_rt_build(s, &tx, &rt, err);
     if (st == LMB_OK && !shard)
         lmb_info(log, "ray tracing: %llu triangles placed, %llu stored (meshes used more than once are Embree "
                  "instances), built in %.2f s", (unsigned long long)rt.placed_triangles,
                  (unsigned long long)rt.stored_triangles, rt.build_seconds);
-    if (st == LMB_OK)
-        st = lmb_textures_load(s, &tx, log, err);
+    if (st == LMB_OK && !shard && (rt.cut_triangles || rt.partial_triangles))
+        lmb_info(log, "materials: %llu placed triangles have alpha cut-outs (alphaMode MASK), %llu let light through "
+                 "in part (alphaMode BLEND, KHR_materials_transmission); every ray sees them as their material says",
+                 (unsigned long long)rt.cut_triangles, (unsigned long long)rt.partial_triangles);
     if (st == LMB_OK)
         st = lmb_emitters_build(s, cfg, &tx, &em, err);
     if (st == LMB_OK)
@@ -253,7 +257,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (dark && !shard)
         lmb_warn(log, "%s: nothing emits light (no KHR_lights_punctual light, no emissive material, no sky): the "
                  "lightmaps are black; no light is computed", s->path);
-    if (st == LMB_OK && !dark && run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path) {
+    /* the validity memo holds what the geometry decides; MASK cut-outs decide it too (from
+     * materials and textures the layout cache does not key on): levels with them test again */
+    if (st == LMB_OK && !dark && run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path && !rt.cut_geoms) {
         st = lmb_point_validity_init(&validity, &l, cfg->texel_samples, err);
         if (st == LMB_OK && lmb_validity_cache_read(s, cfg, run->layout_cache, &validity, log))
             validity_read = lmb_point_validity_known(&validity);

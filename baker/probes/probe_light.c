@@ -74,6 +74,32 @@ static void round_rotation(const probe_job *job, uint32_t i, uint32_t r, double 
     lmb_mat4_from_trs(zero, q, one, m);
 }
 
+/* The light hit h reflects toward the probe at p (0 from a back face): the cache's, or direct light
+ * there for a surface without a lightmap. */
+static void reflected(const probe_job *job, uint32_t i, uint64_t stream, const double p[3], const double w[3],
+                      const lmb_rt_hit *h, double b[3], uint64_t *rays)
+{
+    const lmb_rt *rt = job->cache->rt;
+    b[0] = b[1] = b[2] = 0;
+    if (h->backface)
+        return;
+    double albedo[3], e[3];
+    lmb_hit_kind kind = lmb_cache_lookup(job->cache, h, albedo, e);
+    if (kind == LMB_HIT_UNMAPPED) {
+        lmb_shading_point y;
+        for (int k = 0; k < 3; k++) {
+            y.p[k] = p[k] + h->t * w[k];
+            y.n[k] = y.ng[k] = h->ng[k];
+        }
+        y.eps = 4 * rt->eps;
+        lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, stream);
+        *rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);
+    }
+    if (kind != LMB_HIT_DARK)
+        for (int c = 0; c < 3; c++)
+            b[c] = albedo[c] * e[c];
+}
+
 /* One round: the n lattice directions (rotated by m) traced from probe i, their radiance's SH
  * and the reflected light's cube added to sum and cube (each round weighted 4 pi / n), and the
  * mean radiance of the even and the odd directions (two interleaved half lattices) into half.
@@ -92,28 +118,29 @@ static uint64_t trace_round(const probe_job *job, uint32_t i, uint32_t r, const 
         lmb_sphere_direction(j, n, v);
         lmb_mat4_vector(m, v, w);
         lmb_rt_hit h;
+        lmb_rt_layer layers[LMB_RT_MAX_LAYERS];
+        uint32_t nl;
         rays++;
-        if (!lmb_rt_intersect(rt, p, w, rt->eps, 1e300, &h)) {
-            if (sky)
-                lmb_sky_radiance(sky, w, l);
-        } else if (!h.backface) {
-            double albedo[3], e[3];
-            lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, e);
-            if (kind == LMB_HIT_UNMAPPED) {
-                lmb_shading_point y;
-                for (int k = 0; k < 3; k++) {
-                    y.p[k] = p[k] + h.t * w[k];
-                    y.n[k] = y.ng[k] = h.ng[k];
+        int hit = lmb_rt_intersect_layers(rt, p, w, rt->eps, 1e300, &h, layers, &nl);
+        double through[3] = {1, 1, 1}, hb[3];
+        for (uint32_t q = 0; q <= nl; q++) { /* the surfaces light partly passes, then the opaque hit or the sky */
+            const lmb_rt_hit *at = q < nl ? &layers[q].hit : &h;
+            double cover = q < nl ? layers[q].cover : 1.0;
+            if (q == nl && !hit) {
+                if (sky) {
+                    lmb_sky_radiance(sky, w, hb);
+                    for (int c = 0; c < 3; c++)
+                        l[c] += through[c] * hb[c];
                 }
-                y.eps = 4 * rt->eps;
-                lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, (uint64_t)r * n + j);
-                rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);
+                break;
             }
-            if (kind != LMB_HIT_DARK)
-                for (int c = 0; c < 3; c++)
-                    b[c] = albedo[c] * e[c];
-            for (int c = 0; c < 3; c++) /* emitters' own light: sampled on them below */
-                l[c] = b[c];
+            reflected(job, i, (uint64_t)r * n + j, p, w, at, hb, &rays);
+            for (int c = 0; c < 3; c++) { /* emitters' own light: sampled on them below */
+                b[c] += through[c] * cover * hb[c];
+                l[c] += through[c] * cover * hb[c];
+                if (q < nl)
+                    through[c] *= layers[q].pass[c];
+            }
         }
         double y[9];
         lmb_sh9(w[0], w[1], w[2], y);

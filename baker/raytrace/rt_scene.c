@@ -33,13 +33,19 @@ void lmb_rt_free(lmb_rt *rt)
     if (rt->device)
         rtcReleaseDevice(rt->device);
     free(rt->geoms);
+    free(rt->filters);
     memset(rt, 0, sizeof *rt);
 }
 
+static void intersect_filter(const struct RTCFilterFunctionNArguments *a);
+static void occluded_filter(const struct RTCFilterFunctionNArguments *a);
+
 /* A triangle geometry of primitive p, its vertices through `world` (NULL: object space), attached
- * to `scene` with id `id`; the world bounds grow by its vertices. */
+ * to `scene` with id `id`; the world bounds grow by its vertices. fd: its filter data, whose
+ * surface decides whether it gets filter functions (only where light passes it in part or all). */
 static lmb_status attach_triangles(lmb_rt *rt, RTCScene scene, unsigned id, const lmb_primitive *pr,
-                                   const double *world, double lo[3], double hi[3], lmb_error *err)
+                                   const double *world, double lo[3], double hi[3], lmb_rt_filter_data *fd,
+                                   lmb_error *err)
 {
     RTCGeometry g = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), pr->vertex_count);
@@ -64,6 +70,11 @@ static lmb_status attach_triangles(lmb_rt *rt, RTCScene scene, unsigned id, cons
         }
     }
     memcpy(ix, pr->indices, (size_t)pr->triangle_count * 3 * sizeof(unsigned));
+    if (fd->surface.kind) {
+        rtcSetGeometryUserData(g, fd);
+        rtcSetGeometryIntersectFilterFunction(g, intersect_filter);
+        rtcSetGeometryOccludedFilterFunction(g, occluded_filter);
+    }
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(scene, g, id);
     rtcReleaseGeometry(g);
@@ -82,7 +93,8 @@ static lmb_status mesh_scene(lmb_rt *rt, const lmb_scene *s, uint32_t m, lmb_err
     for (uint32_t p = 0; p < mesh->primitive_count && st == LMB_OK; p++) {
         const lmb_primitive *pr = &s->primitives[mesh->first_primitive + p];
         if (pr->triangle_count) {
-            st = attach_triangles(rt, sc, id++, pr, NULL, NULL, NULL, err);
+            st = attach_triangles(rt, sc, id++, pr, NULL, NULL, NULL, &rt->filters[rt->geom_count + mesh->first_primitive + p],
+                                  err);
             rt->stored_triangles += pr->triangle_count;
         }
     }
@@ -146,7 +158,7 @@ static void normal_matrix(const double w[16], float out[9])
             out[3 * r + c] = (float)(det != 0 ? cof[r][c] / det : 0);
 }
 
-lmb_status lmb_rt_build(const lmb_scene *s, lmb_rt *rt, lmb_error *err)
+lmb_status lmb_rt_build(const lmb_scene *s, const lmb_textures *tx, lmb_rt *rt, lmb_error *err)
 {
     double t0 = lmb_seconds();
     memset(rt, 0, sizeof *rt);
@@ -157,8 +169,14 @@ lmb_status lmb_rt_build(const lmb_scene *s, lmb_rt *rt, lmb_error *err)
     rt->geoms = calloc((size_t)n + 1, sizeof *rt->geoms);
     rt->mesh_scenes = calloc((size_t)s->mesh_count + 1, sizeof *rt->mesh_scenes);
     rt->mesh_count = s->mesh_count;
+    rt->geom_count = n; /* the filters' world part; set again when built */
+    rt->filters = calloc((size_t)n + s->primitive_count + 1, sizeof *rt->filters);
+    for (uint32_t p = 0; rt->filters && p < s->primitive_count; p++) {
+        const lmb_primitive *pr = &s->primitives[p];
+        rt->filters[n + p].surface = lmb_rt_surface_of(pr->material >= 0 ? &s->materials[pr->material] : NULL, pr, tx);
+    }
     rt->device = rtcNewDevice(NULL);
-    if (!uses || !rt->geoms || !rt->mesh_scenes || !rt->device) {
+    if (!uses || !rt->geoms || !rt->mesh_scenes || !rt->device || !rt->filters) {
         free(uses);
         lmb_rt_free(rt);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "ray tracing: cannot create the Embree device");
@@ -184,10 +202,17 @@ lmb_status lmb_rt_build(const lmb_scene *s, lmb_rt *rt, lmb_error *err)
             const lmb_primitive *pr = &s->primitives[m->first_primitive + p];
             if (pr->triangle_count) {
                 lmb_rt_geom *g = &rt->geoms[slot];
+                lmb_rt_filter_data *fd = &rt->filters[n + m->first_primitive + p];
                 if (!instanced) {
-                    st = attach_triangles(rt, rt->scene, slot, pr, in->world, lo, hi, err);
+                    rt->filters[slot].surface = fd->surface;
+                    rt->filters[slot].flips_winding = in->flips_winding;
+                    st = attach_triangles(rt, rt->scene, slot, pr, in->world, lo, hi, &rt->filters[slot], err);
                     rt->stored_triangles += pr->triangle_count;
                 }
+                rt->cut_geoms += (fd->surface.kind & LMB_SURFACE_CUT) != 0;
+                rt->partial_geoms += (fd->surface.kind & LMB_SURFACE_PARTIAL) != 0;
+                rt->cut_triangles += fd->surface.kind & LMB_SURFACE_CUT ? pr->triangle_count : 0;
+                rt->partial_triangles += fd->surface.kind & LMB_SURFACE_PARTIAL ? pr->triangle_count : 0;
                 g->instance = i;
                 g->primitive = m->first_primitive + p;
                 g->first_triangle = first;
@@ -229,35 +254,41 @@ static void make_ray(struct RTCRay *r, const double o[3], const double d[3], dou
     r->flags = 0;
 }
 
-int lmb_rt_occluded(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax)
+/* What a query asks of the surfaces light partly passes (the filters read it). */
+enum { QUERY_PLAIN = 0, QUERY_TRANSMIT = 1, QUERY_LAYERS = 2 };
+
+/* A query's Embree context with what the filters keep: the partly passing surfaces met. */
+typedef struct rt_query {
+    struct RTCIntersectContext ctx; /* first: Embree hands it to the filters */
+    const lmb_rt *rt;
+    int mode;
+    double d[3]; /* the ray's world direction */
+    uint32_t count;
+    lmb_rt_layer layer[LMB_RT_MAX_LAYERS];
+} rt_query;
+
+static void query_init(rt_query *q, const lmb_rt *rt, int mode, const double d[3])
 {
-    struct RTCIntersectContext ctx;
-    struct RTCRay r;
-    rtcInitIntersectContext(&ctx);
-    make_ray(&r, o, d, tmin, tmax);
-    rtcOccluded1(rt->scene, &ctx, &r);
-    return r.tfar < 0; /* Embree sets tfar to -inf on a hit */
+    rtcInitIntersectContext(&q->ctx);
+    q->rt = rt;
+    q->mode = mode;
+    q->count = 0;
+    memcpy(q->d, d, sizeof q->d);
 }
 
-int lmb_rt_intersect(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax, lmb_rt_hit *hit)
+/* A hit's slot, world geometric normal (front side, unit) and side, from what Embree reports: the
+ * slot's normal matrix turns an instanced hit's object-space Ng. */
+static void fill_hit(const lmb_rt *rt, unsigned inst, unsigned geom, unsigned prim, float u, float v, const float ngo[3],
+                     double t, const double d[3], lmb_rt_hit *hit)
 {
-    struct RTCIntersectContext ctx;
-    struct RTCRayHit rh;
-    rtcInitIntersectContext(&ctx);
-    make_ray(&rh.ray, o, d, tmin, tmax);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(rt->scene, &ctx, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-        return 0;
-    hit->t = rh.ray.tfar;
-    int instanced = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID;
-    hit->geom = instanced ? rh.hit.instID[0] + rh.hit.geomID : rh.hit.geomID; /* the slot */
-    hit->prim = rh.hit.primID;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
+    int instanced = inst != RTC_INVALID_GEOMETRY_ID;
+    hit->t = t;
+    hit->geom = instanced ? inst + geom : geom; /* the slot */
+    hit->prim = prim;
+    hit->u = u;
+    hit->v = v;
     const lmb_rt_geom *g = &rt->geoms[hit->geom];
-    double ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}, sg = 1.0;
+    double ng[3] = {ngo[0], ngo[1], ngo[2]}, sg = 1.0;
     if (instanced) { /* Ng in object space: world = M^-T Ng, which also follows a mirrored instance's winding */
         const float *nm = g->normal_matrix;
         double o[3] = {ng[0], ng[1], ng[2]};
@@ -270,5 +301,173 @@ int lmb_rt_intersect(const lmb_rt *rt, const double o[3], const double d[3], dou
     for (int k = 0; k < 3; k++)
         hit->ng[k] = (float)(l > 0 ? sg * ng[k] / l : 0);
     hit->backface = hit->ng[0] * d[0] + hit->ng[1] * d[1] + hit->ng[2] * d[2] > 0;
+}
+
+/*
+ * The filters (Embree calls them for every candidate hit on a geometry that has them, in no set
+ * order). A MASK surface's cut-away part is rejected in every query. A surface light partly passes
+ * is a hit in a plain query; otherwise its hit is kept in the query and rejected, so the ray goes
+ * on: a transmittance query keeps what it lets through (and stops, as occluded, where it lets
+ * nothing through or the list is full), a layers query the nearest LMB_RT_MAX_LAYERS such surfaces
+ * (one that lets nothing through is a hit). Embree may report one triangle more than once, and a
+ * ray through an edge meets both triangles that share it (the scene is built robust, watertight):
+ * a triangle already kept, or another of the same geometry met within the ray offset of it, is
+ * not kept again. What the query returns depends only on the set of
+ * surfaces met, never on the order they came in.
+ */
+/* Embree's RTCHitN / RTCRayN accessors are C++ only: the same structure-of-arrays layout read in C
+ * (rtcore_ray.h: hit Ng_x, Ng_y, Ng_z, u, v as float[N], then primID, geomID, instID[0] as
+ * unsigned[N]; ray org_x .. time as float[N] each, then tfar). */
+#define HIT_F(h, n, field) (((const float *)(h))[(field) * (n)])
+#define HIT_U(h, n, field) (((const unsigned *)(h))[(field) * (n)])
+#define RAY_TFAR(r, n) (((const float *)(r))[8 * (n)])
+
+static void filter(const struct RTCFilterFunctionNArguments *a, int occlusion)
+{
+    if (!a->valid[0])
+        return;
+    const lmb_rt_filter_data *fd = a->geometryUserPtr;
+    rt_query *q = (rt_query *)a->context;
+    unsigned prim = HIT_U(a->hit, a->N, 5);
+    float u = HIT_F(a->hit, a->N, 3), v = HIT_F(a->hit, a->N, 4);
+    if (lmb_rt_surface_cut(&fd->surface, prim, u, v)) {
+        a->valid[0] = 0;
+        return;
+    }
+    if (!(fd->surface.kind & LMB_SURFACE_PARTIAL) || q->mode == QUERY_PLAIN)
+        return;
+    lmb_rt_hit h;
+    const float ng[3] = {HIT_F(a->hit, a->N, 0), HIT_F(a->hit, a->N, 1), HIT_F(a->hit, a->N, 2)};
+    fill_hit(q->rt, HIT_U(a->hit, a->N, 7), HIT_U(a->hit, a->N, 6), prim, u, v, ng, RAY_TFAR(a->ray, a->N), q->d, &h);
+    for (uint32_t k = 0; k < q->count; k++)
+        if (q->layer[k].hit.geom == h.geom &&
+            (q->layer[k].hit.prim == h.prim || fabs(q->layer[k].hit.t - h.t) <= q->rt->eps)) {
+            a->valid[0] = 0; /* met again, or the same crossing on the edge two triangles share */
+            return;
+        }
+    double pass[3], cover;
+    lmb_rt_surface_pass(&fd->surface, prim, u, v, h.backface, pass, &cover);
+    if (!(pass[0] > 0 || pass[1] > 0 || pass[2] > 0))
+        return; /* lets nothing through: a hit */
+    uint32_t at = q->count;
+    if (q->count == LMB_RT_MAX_LAYERS) {
+        if (occlusion || q->mode == QUERY_TRANSMIT)
+            return; /* too many: occluded */
+        at = 0; /* layers: the farthest kept goes, if this one is nearer */
+        for (uint32_t k = 1; k < q->count; k++)
+            if (q->layer[k].hit.t > q->layer[at].hit.t ||
+                (q->layer[k].hit.t == q->layer[at].hit.t && q->layer[k].hit.geom > q->layer[at].hit.geom))
+                at = k;
+        if (!(h.t < q->layer[at].hit.t)) {
+            a->valid[0] = 0;
+            return;
+        }
+    } else {
+        q->count++;
+    }
+    q->layer[at].hit = h;
+    memcpy(q->layer[at].pass, pass, sizeof pass);
+    q->layer[at].cover = cover;
+    a->valid[0] = 0;
+}
+
+static void intersect_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    filter(a, 0);
+}
+
+static void occluded_filter(const struct RTCFilterFunctionNArguments *a)
+{
+    filter(a, 1);
+}
+
+int lmb_rt_occluded(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax)
+{
+    rt_query q;
+    struct RTCRay r;
+    query_init(&q, rt, QUERY_PLAIN, d);
+    make_ray(&r, o, d, tmin, tmax);
+    rtcOccluded1(rt->scene, &q.ctx, &r);
+    return r.tfar < 0; /* Embree sets tfar to -inf on a hit */
+}
+
+/* Layers in a fixed order (distance, then slot and triangle), whatever order they were met in. */
+static int layer_order(const void *pa, const void *pb)
+{
+    const lmb_rt_hit *a = &((const lmb_rt_layer *)pa)->hit, *b = &((const lmb_rt_layer *)pb)->hit;
+    if (a->t != b->t)
+        return a->t < b->t ? -1 : 1;
+    if (a->geom != b->geom)
+        return a->geom < b->geom ? -1 : 1;
+    return (a->prim > b->prim) - (a->prim < b->prim);
+}
+
+int lmb_rt_transmittance(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax,
+                         double pass[3])
+{
+    rt_query q;
+    struct RTCRay r;
+    query_init(&q, rt, rt->partial_geoms ? QUERY_TRANSMIT : QUERY_PLAIN, d);
+    make_ray(&r, o, d, tmin, tmax);
+    rtcOccluded1(rt->scene, &q.ctx, &r);
+    pass[0] = pass[1] = pass[2] = r.tfar < 0 ? 0.0 : 1.0;
+    if (r.tfar < 0 || !q.count)
+        return r.tfar < 0;
+    qsort(q.layer, q.count, sizeof *q.layer, layer_order);
+    for (uint32_t k = 0; k < q.count; k++)
+        for (int c = 0; c < 3; c++)
+            pass[c] *= q.layer[k].pass[c];
+    return 0;
+}
+
+/* Closest hit of a query in mode `mode`; q keeps the layers met. */
+static int intersect(const lmb_rt *rt, rt_query *q, const double o[3], const double d[3], double tmin, double tmax,
+                     lmb_rt_hit *hit)
+{
+    struct RTCRayHit rh;
+    make_ray(&rh.ray, o, d, tmin, tmax);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(rt->scene, &q->ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    const float ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
+    fill_hit(rt, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, ng, rh.ray.tfar, d, hit);
     return 1;
+}
+
+int lmb_rt_intersect(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax, lmb_rt_hit *hit)
+{
+    rt_query q;
+    query_init(&q, rt, QUERY_PLAIN, d);
+    return intersect(rt, &q, o, d, tmin, tmax, hit);
+}
+
+int lmb_rt_intersect_layers(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax,
+                            lmb_rt_hit *hit, lmb_rt_layer *layers, uint32_t *count)
+{
+    rt_query q;
+    query_init(&q, rt, rt->partial_geoms ? QUERY_LAYERS : QUERY_PLAIN, d);
+    int found = intersect(rt, &q, o, d, tmin, tmax, hit);
+    *count = 0;
+    for (uint32_t k = 0; k < q.count; k++)
+        if (!found || q.layer[k].hit.t < hit->t)
+            layers[(*count)++] = q.layer[k];
+    if (*count > 1)
+        qsort(layers, *count, sizeof *layers, layer_order);
+    return found;
+}
+
+int lmb_rt_triangle_cut(const lmb_rt *rt, const lmb_scene *s, uint32_t instance, uint32_t tri, double b1, double b2)
+{
+    if (!rt->cut_geoms)
+        return 0;
+    const lmb_mesh *m = &s->meshes[s->instances[instance].mesh];
+    for (uint32_t p = 0; p < m->primitive_count; p++) {
+        const lmb_primitive *pr = &s->primitives[m->first_primitive + p];
+        if (tri < pr->triangle_count)
+            return lmb_rt_surface_cut(&rt->filters[rt->geom_count + m->first_primitive + p].surface, tri, b1, b2);
+        tri -= pr->triangle_count;
+    }
+    return 0;
 }

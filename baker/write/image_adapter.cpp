@@ -11,6 +11,7 @@ extern "C" {
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
@@ -151,6 +152,51 @@ extern "C" lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes,
     }
 }
 
+extern "C" lmb_status lmb_image_read_alpha(const char *name, const uint8_t *bytes, size_t size, uint32_t factor,
+                                           uint32_t *w, uint32_t *h, float **alpha, lmb_error *err)
+{
+    try {
+        *alpha = nullptr;
+        OIIO::Filesystem::IOMemReader mem(bytes, bytes ? size : 0);
+        auto in = OIIO::ImageInput::open(name, nullptr, bytes ? &mem : nullptr);
+        if (!in)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot read image: %s", name, OIIO::geterror().c_str());
+        const OIIO::ImageSpec &spec = in->spec();
+        int ch = spec.nchannels, a = spec.alpha_channel >= 0 ? spec.alpha_channel : ch == 4 ? 3 : ch == 2 ? 1 : -1;
+        if (spec.width <= 0 || spec.height <= 0 || factor == 0)
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: unusable image size %dx%d", name, spec.width, spec.height);
+        if (a < 0)
+            return LMB_OK;
+        size_t iw = (size_t)spec.width, ih = (size_t)spec.height;
+        size_t ow = (iw + factor - 1) / factor, oh = (ih + factor - 1) / factor;
+        float *out = (float *)std::calloc(ow * oh + 1, sizeof(float));
+        if (!out)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", name);
+        std::vector<float> band(iw * factor);
+        for (size_t oy = 0; oy < oh; oy++) {
+            size_t y0 = oy * factor, y1 = std::min(y0 + factor, ih);
+            if (!in->read_scanlines(0, 0, spec.y + (int)y0, spec.y + (int)y1, 0, a, a + 1, OIIO::TypeDesc::FLOAT,
+                                    band.data())) {
+                std::free(out);
+                return lmb_error_set(err, LMB_ERR_INPUT, "%s: cannot decode alpha: %s", name, in->geterror().c_str());
+            }
+            for (size_t y = 0; y < y1 - y0; y++)
+                for (size_t x = 0; x < iw; x++)
+                    out[oy * ow + x / factor] += band[y * iw + x];
+            for (size_t ox = 0; ox < ow; ox++) {
+                size_t cols = std::min((ox + 1) * factor, iw) - ox * factor;
+                out[oy * ow + ox] /= (float)(cols * (y1 - y0));
+            }
+        }
+        *w = (uint32_t)ow;
+        *h = (uint32_t)oh;
+        *alpha = out;
+        return LMB_OK;
+    } catch (const std::exception &e) {
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: image reader failed: %s", name, e.what());
+    }
+}
+
 struct lmb_image_rows {
     OIIO::Filesystem::IOMemReader mem;
     std::unique_ptr<OIIO::ImageInput> in;
@@ -237,7 +283,7 @@ extern "C" __attribute__((visibility("default"))) const lmb_image_api *lmb_image
     static const lmb_image_api api = {LMB_IMAGE_API_VERSION, lmb_image_write_u8,   lmb_image_write_f32,
                                       lmb_image_size,        lmb_image_read_rgb,   lmb_image_rows_open,
                                       lmb_image_rows_read,   lmb_image_rows_is_u8, lmb_image_rows_read_u8,
-                                      lmb_image_rows_close};
+                                      lmb_image_rows_close,  lmb_image_read_alpha};
     return &api;
 }
 #endif

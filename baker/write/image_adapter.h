@@ -33,6 +33,13 @@ lmb_status lmb_image_size(const char *name, const uint8_t *bytes, size_t size, u
 lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t size, uint32_t *width, uint32_t *height,
                               float **rgb, lmb_error *err);
 
+/* Reads an image's alpha channel (the 4th of RGBA, the 2nd of grey + alpha) as floats in
+ * [0, 1], reduced by a whole `factor` (each value the mean of the up to factor x factor pixels
+ * it covers), read a band of rows at a time. An image without alpha gives *alpha = NULL (it is
+ * opaque) and LMB_OK. The caller frees *alpha. */
+lmb_status lmb_image_read_alpha(const char *name, const uint8_t *bytes, size_t size, uint32_t factor, uint32_t *width,
+                                uint32_t *height, float **alpha, lmb_error *err);
+
 /* A reader that decodes an image a band of rows at a time, so a large texture can be reduced
  * while it is read without holding it whole (load/textures.c). Opened from a file or from
  * memory as lmb_image_read_rgb; bytes, if given, must outlive the reader. */

@@ -113,6 +113,13 @@ lmb_status lmb_image_read_rgb(const char *name, const uint8_t *bytes, size_t siz
     return api ? api->read_rgb(name, bytes, size, width, height, rgb, err) : LMB_ERR_INTERNAL;
 }
 
+lmb_status lmb_image_read_alpha(const char *name, const uint8_t *bytes, size_t size, uint32_t factor, uint32_t *width,
+                                uint32_t *height, float **alpha, lmb_error *err)
+{
+    const lmb_image_api *api = api_or_error(err);
+    return api ? api->read_alpha(name, bytes, size, factor, width, height, alpha, err) : LMB_ERR_INTERNAL;
+}
+
 lmb_status lmb_image_rows_open(const char *name, const uint8_t *bytes, size_t size, lmb_image_rows **out,
                                uint32_t *width, uint32_t *height, lmb_error *err)
 {

@@ -20,7 +20,7 @@ extern "C" {
 
 /* Bumped whenever the table or a signature in image_adapter.h changes: a module from another
  * build is refused by name rather than called through the wrong types. */
-#define LMB_IMAGE_API_VERSION 1u
+#define LMB_IMAGE_API_VERSION 2u
 
 typedef struct lmb_image_api {
     uint32_t version; /* LMB_IMAGE_API_VERSION of the module's build */
@@ -34,6 +34,8 @@ typedef struct lmb_image_api {
     int (*rows_is_u8)(const lmb_image_rows *);
     lmb_status (*rows_read_u8)(lmb_image_rows *, uint32_t, uint32_t, uint8_t *, lmb_error *);
     void (*rows_close)(lmb_image_rows *);
+    lmb_status (*read_alpha)(const char *, const uint8_t *, size_t, uint32_t, uint32_t *, uint32_t *, float **,
+                             lmb_error *);
 } lmb_image_api;
 
 /* The module's one exported symbol (its name as a string for dlsym). */

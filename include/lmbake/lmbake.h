@@ -89,6 +89,7 @@ typedef struct lmb_primitive {
     float *normals;   /* 3 * vertex_count, or NULL (flat normals are used) */
     float *uv0;       /* 2 * vertex_count, or NULL */
     float *uv1;       /* 2 * vertex_count, or NULL (the glTF had no TEXCOORD_1) */
+    float *colors;    /* 4 * vertex_count, COLOR_0 as linear RGBA (alpha 1 for RGB), or NULL */
     uint32_t triangle_count;
     uint32_t *indices;        /* 3 * triangle_count, counter-clockwise front faces */
     uint32_t degenerate_count; /* zero-area triangles (kept in indices, flagged below) */
@@ -129,6 +130,13 @@ typedef struct lmb_texture_ref {
 /* What the baker reads of a glTF material. A KHR_materials_pbrSpecularGlossiness material is
  * mapped onto the same fields: base_color = diffuseFactor, base_color_texture = diffuseTexture,
  * metallic = 0, and its specular part in spec_gloss / specular / specular_texture. */
+/* How a material's alpha covers its surface (glTF alphaMode). */
+typedef enum lmb_alpha_mode {
+    LMB_ALPHA_OPAQUE = 0, /* alpha ignored */
+    LMB_ALPHA_MASK = 1,   /* absent where alpha < alpha_cutoff, opaque elsewhere */
+    LMB_ALPHA_BLEND = 2   /* coverage: 1 - alpha of the light passes */
+} lmb_alpha_mode;
+
 typedef struct lmb_material {
     char *name;
     float base_color[4];                /* linear RGBA factor (spec-gloss: diffuseFactor) */
@@ -143,6 +151,12 @@ typedef struct lmb_material {
     float emissive_strength;            /* the strength alone (1 if absent) */
     lmb_texture_ref emissive_texture;   /* sRGB */
     int double_sided;
+    lmb_alpha_mode alpha_mode;
+    float alpha_cutoff;                 /* MASK: alphaCutoff (0.5 by default) */
+    float transmission;                 /* KHR_materials_transmission factor (0: none) */
+    lmb_texture_ref transmission_texture; /* its texture: transmission in red, linear */
+    int volume;                         /* KHR_materials_volume: a closed mesh, tinted once on entering */
+    float volume_tint[3];               /* volume: attenuationColor^(thicknessFactor / attenuationDistance) */
 } lmb_material;
 
 /* How a light is baked (lights.modes, or the light's extras.lightmap_mode): as engines light

@@ -3,7 +3,7 @@
 EXR lightmaps with the formulas of ../shared/DESIGN.md section 3.
 
 usage: check_analytic.py LMBAKE WORKDIR CASE
-  CASE: point-plane | many-lights | many-lights-drawn | sun-box | sun-bright | disk | disk-textured | disk-transform | sealed-room | box-floor
+  CASE: point-plane | many-lights | many-lights-drawn | sun-box | sun-bright | disk | disk-textured | disk-transform | sealed-room | box-floor | alpha-cards
 
 For each texel the expected value is computed at the same points the baker uses: the
 stratum centres of the texel (samples.texel), each clamped onto the closest triangle of
@@ -38,7 +38,7 @@ DIRECT = {"disk-transform": 1024, "many-lights-drawn": 16}
 # irradiance past half float's 65504 (the EXR must hold it, not Inf)
 SCENE = {"sun-bright": "sun-box", "many-lights-drawn": "many-lights"}
 # the sun here is the hard one of the formula (lights.sun_angle 0); sun-penumbra checks the disc
-EXTRA = {"sun-box": "lights: {sun_angle: 0}\n", "sun-bright": "lights: {intensity_scale: 100, sun_angle: 0}\n"}
+EXTRA = {"sun-box": "lights: {sun_angle: 0}\n", "alpha-cards": "lights: {sun_angle: 0}\n", "sun-bright": "lights: {intensity_scale: 100, sun_angle: 0}\n"}
 
 
 def bake(lmbake, work, case):
@@ -383,6 +383,69 @@ def box_floor(charts, images):
     return ok and under > 10 and halo_checked > 50
 
 
+def card_pass(p):
+    """RGB share of the sun (straight down) that reaches ground point p through the alpha cards
+    (tools/make_scenes.py ALPHA_CARDS): MASK cut where the checker's alpha is 0, BLEND 1 - alpha,
+    transmission the base colour; which card it is under (None: none)."""
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    from make_scenes import ALPHA_CARDS, ALPHA_CHECKER, BLEND_ALPHA, GLASS_TINT
+    for name, x0 in ALPHA_CARDS.items():
+        u, v = p[0] - x0, p[2] + 0.5
+        if 0 <= u < 1 and 0 <= v < 1:
+            if name == "mask":
+                a = ALPHA_CHECKER[int(2 * v)][int(2 * u)][3] / 255.0
+                return (1.0,) * 3 if a < 0.5 else (0.0,) * 3, name
+            if name == "blend":
+                return (1 - BLEND_ALPHA,) * 3, name
+            return GLASS_TINT, name
+    return (1.0,) * 3, None
+
+
+def alpha_cards(charts, images, sun=1000.0):
+    """Under each card the ground's direct light is the sun times what the card lets through, texel
+    by texel (0.5%), and on average: the MASK card's half (1%) with its checker's cells within 2%,
+    BLEND's 1 - alpha (1%), the glass's tint per channel (1%)."""
+    ok, worst, n = True, 0.0, 0
+    sums = {}  # card or (card, cell) -> [sum of measured rgb, sum of expected rgb, texels]
+    for node, v, pts, x, y, _ in texels(charts, images):
+        if node != "ground":
+            continue
+        passes = [card_pass(p) for p in pts]
+        expected = np.mean([q for q, _ in passes], axis=0) * sun
+        n += 1
+        err = np.max(np.abs(v - expected)) / sun
+        worst = max(worst, err)
+        if err > 0.005:
+            ok = False
+            print("  texel", x, y, v, "expected", expected, pts[0])
+        cards = {c for _, c in passes}
+        if len(cards) == 1 and None not in cards:
+            card = cards.pop()
+            keys = [card]
+            if card == "mask":
+                cells = {(int(2 * (p[0] + 2.0)), int(2 * (p[2] + 0.5))) for p in pts}
+                if len(cells) == 1:
+                    keys.append("mask cell %d,%d" % cells.pop())
+            for k in keys:
+                acc = sums.setdefault(k, [np.zeros(3), np.zeros(3), 0])
+                acc[0] += v
+                acc[1] += expected
+                acc[2] += 1
+    print("alpha-cards: %d ground texels, worst error %.3f%% of the sun (bound 0.5%%)" % (n, 100 * worst))
+    for k in sorted(sums):
+        got, want, count = sums[k][0] / sums[k][2], sums[k][1] / sums[k][2], sums[k][2]
+        if want.max() > 0:
+            rel = np.max(np.abs(got - want) / np.maximum(want, 1e-3 * sun))
+        else:
+            rel = got.max() / sun
+        bound = 0.01 if k in ("mask", "blend", "glass") else 0.02
+        good = rel <= bound
+        ok &= good
+        print("  %-16s %4d texels, mean %s lux, expected %s: %.3f%% (bound %.0f%%)  %s" %
+              (k, count, np.round(got, 1), np.round(want, 1), 100 * rel, 100 * bound, "ok" if good else "FAIL"))
+    return ok and n > 500 and {"mask", "blend", "glass"} <= set(sums)
+
+
 def main():
     lmbake, work, case = sys.argv[1:4]
     os.makedirs(work, exist_ok=True)
@@ -390,7 +453,7 @@ def main():
     charts, images = load_output(out)
     check = {"point-plane": point_plane, "many-lights": many_lights,
              "many-lights-drawn": lambda c, i: many_lights(c, i, "drawn by their unshadowed irradiance (16 samples per point, 8 a round)"), "sun-box": sun_box, "sun-bright": lambda c, i: sun_box(c, i, 100000.0), "disk": disk, "disk-textured": disk_textured, "disk-transform": disk_transform, "sealed-room": sealed_room,
-             "box-floor": box_floor}[case]
+             "box-floor": box_floor, "alpha-cards": alpha_cards}[case]
     return 0 if check(charts, images) else 1
 
 

@@ -145,6 +145,24 @@ def cases():
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_diffuse_transmission"]
     yield "required-diffuse-transmission", d
 
+    # alpha that cannot mean anything (glTF 2.0 section 5.19): a cutoff outside [0, 1] or not a
+    # number, an alphaMode that is not one of the three; a MASK material whose base colour
+    # texture names an image that cannot be decoded (its cut-outs are unknown)
+    for name, mat in (("alpha-cutoff-range", {"alphaMode": "MASK", "alphaCutoff": 1.5}),
+                      ("alpha-cutoff-string", {"alphaMode": "MASK", "alphaCutoff": "half"}),
+                      ("alpha-mode-unknown", {"alphaMode": "CUTOUT"})):
+        d = copy.deepcopy(ok)
+        d["materials"] = [dict({"name": "Leaves", "pbrMetallicRoughness": {"metallicFactor": 0}}, **mat)]
+        d["meshes"][0]["primitives"][0]["material"] = 0
+        yield name, d
+    d = copy.deepcopy(ok)
+    d["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(b"\x89PNG not an image").decode()}]
+    d["textures"] = [{"source": 0}]
+    d["materials"] = [{"name": "Leaves", "alphaMode": "MASK",
+                       "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}]
+    d["meshes"][0]["primitives"][0]["material"] = 0
+    yield "alpha-mask-texture-broken", d
+
     # KHR_texture_basisu required: the base colour texture has only a KTX2 image (error), or
     # also a PNG fallback `source` (loads with a warning). The KTX2 bytes are never decoded.
     d = copy.deepcopy(ok)
