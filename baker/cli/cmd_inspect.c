@@ -64,6 +64,14 @@ static void print_material(uint32_t m, const lmb_material *mat)
     }
     if (mat->unlit)
         printf(", unlit (reflects no light in the bake)");
+    if (mat->alpha_mode == LMB_ALPHA_MASK)
+        printf(", alpha MASK (cut away where alpha < %.3g: light passes)", mat->alpha_cutoff);
+    else if (mat->alpha_mode == LMB_ALPHA_BLEND)
+        printf(", alpha BLEND (1 - alpha of the light passes; alpha %.3g%s)", mat->base_color[3],
+               mat->base_color_texture.texture >= 0 ? " x texture" : "");
+    if (mat->transmission > 0)
+        printf(", transmission %.3g%s (light passes tinted by the base colour%s)", mat->transmission,
+               mat->transmission_texture.texture >= 0 ? " x texture" : "", mat->volume ? " and the volume" : "");
     if (lmb_material_is_emissive(mat))
         printf(", emissive (%.4g, %.4g, %.4g) nits (strength %.4g)%s -> area light", mat->emissive[0],
                mat->emissive[1], mat->emissive[2], mat->emissive_strength,

@@ -28,11 +28,11 @@ enum { LMB_FILTER_NEAREST = 9728 };
 typedef struct lmb_texture {
     uint32_t width, height;
     float *pixels[2]; /* per lmb_tex_space: RGB, rows top to bottom; NULL when not loaded in that space */
-    float *alpha;     /* width x height alpha in [0, 1] when a MASK or BLEND material reads it, else NULL */
-    int has_alpha;    /* its alpha was read (alpha NULL and has_alpha 1: the image has none: opaque) */
     double mean[3];   /* average colour texel, for importance */
     int wrap_s, wrap_t; /* LMB_WRAP_* */
     int nearest;        /* magFilter NEAREST: nearest texel; else bilinear */
+    float *alpha;       /* width x height alpha in [0, 1] when a MASK or BLEND material reads it, else NULL */
+    int has_alpha;      /* its alpha was read (alpha NULL and has_alpha 1: the image has none: opaque) */
 } lmb_texture;
 
 typedef struct lmb_textures {

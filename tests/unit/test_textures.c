@@ -8,6 +8,7 @@
 #include "check.h"
 
 #include "load/textures.h"
+#include "raytrace/rt_surface.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -25,7 +26,7 @@ static lmb_texture grid_texture(int wrap_s, int wrap_t, int nearest)
             grid[3 * (4 * y + x) + 1] = (float)y;
             grid[3 * (4 * y + x) + 2] = (float)(10 * x + y);
         }
-    lmb_texture t = {4, 4, {NULL, grid}, {0, 0, 0}, wrap_s, wrap_t, nearest};
+    lmb_texture t = {4, 4, {NULL, grid}, {0, 0, 0}, wrap_s, wrap_t, nearest, NULL, 0};
     return t;
 }
 
@@ -168,9 +169,9 @@ static void test_albedo(void)
     uint32_t idx[3];
     lmb_primitive pr = one_triangle(uv0, idx);
     lmb_texture tex[3] = {
-        {1, 1, {NULL, mr}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0},     /* metallicRoughness (data) */
-        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0}, /* base colour */
-        {1, 1, {spec, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0},   /* specular */
+        {1, 1, {NULL, mr}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0},     /* metallicRoughness (data) */
+        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0}, /* base colour */
+        {1, 1, {spec, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0},   /* specular */
     };
     lmb_textures tx = {3, tex};
     lmb_material m;
@@ -209,8 +210,75 @@ static void test_albedo(void)
     CHECK(a[0] == 0 && a[1] == 0 && a[2] == 0);
 }
 
+/* COLOR_0 multiplies the base colour and its alpha (interpolated over the triangle); alpha is
+ * factor x texture alpha x COLOR_0 alpha; transmission takes its share of the diffuse colour and
+ * passes factor x texture red of the light, tinted by the base colour (raytrace/rt_surface.h). */
+static void test_alpha_colour_transmission(void)
+{
+    float uv0[6], colour[3] = {0.5f, 0.25f, 1.0f}, alpha[1] = {0.4f}, red[3] = {0.5f, 0.0f, 0.0f};
+    float rgba[12] = {1, 0.5f, 0, 1, 1, 0.5f, 0, 0.5f, 0, 0.5f, 1, 0};
+    uint32_t idx[3];
+    lmb_primitive pr = one_triangle(uv0, idx);
+    pr.colors = rgba;
+    lmb_texture tex[2] = {
+        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, alpha, 1}, /* base colour + alpha */
+        {1, 1, {NULL, red}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0},     /* transmission (data) */
+    };
+    lmb_textures tx = {2, tex};
+    lmb_material m;
+    memset(&m, 0, sizeof m);
+    for (int k = 0; k < 4; k++)
+        m.base_color[k] = 0.8f;
+    m.base_color_texture = ref(0, 0);
+    m.metallic_texture = ref(-1, 0);
+    m.specular_texture = ref(-1, 0);
+    m.emissive_texture = ref(-1, 0);
+    m.transmission_texture = ref(-1, 0);
+    /* barycentrics (0.5, 0.25, 0.25) of the corners: COLOR_0 = (0.75, 0.5, 0.25, 0.625) */
+    double a[3], b0 = 0.5, b1 = 0.25, b2 = 0.25;
+    lmb_material_albedo(&tx, &m, &pr, 0, b1, b2, a);
+    CHECK_NEAR(a[0], 0.8 * 0.5 * (b0 * 1 + b1 * 1 + b2 * 0), 1e-6);
+    CHECK_NEAR(a[1], 0.8 * 0.25 * 0.5, 1e-6);
+    CHECK_NEAR(a[2], 0.8 * 1.0 * (b1 * 0 + b2 * 1), 1e-6);
+    CHECK_NEAR(lmb_material_alpha(&tx, &m, &pr, 0, b1, b2), 0.8 * 0.4 * (b0 * 1 + b1 * 0.5 + b2 * 0), 1e-6);
+    /* BLEND: coverage alpha, 1 - alpha passes */
+    m.alpha_mode = LMB_ALPHA_BLEND;
+    lmb_rt_surface sf = lmb_rt_surface_of(&m, &pr, &tx);
+    double pass[3], cover, al = 0.8 * 0.4 * 0.625;
+    lmb_rt_surface_pass(&sf, 0, b1, b2, 0, pass, &cover);
+    CHECK_NEAR(cover, al, 1e-6);
+    CHECK_NEAR(pass[1], 1 - al, 1e-6);
+    /* MASK: cut below the cutoff (alpha 0.2 here), whole above it */
+    m.alpha_mode = LMB_ALPHA_MASK;
+    m.alpha_cutoff = 0.19f;
+    sf = lmb_rt_surface_of(&m, &pr, &tx);
+    CHECK(!lmb_rt_surface_cut(&sf, 0, b1, b2));
+    m.alpha_cutoff = 0.21f;
+    CHECK(lmb_rt_surface_cut(&sf, 0, b1, b2));
+    /* transmission 0.5 x texture red 0.5: a quarter of the light passes, tinted by the base colour
+     * (factor x texture x COLOR_0), and three quarters of the diffuse colour is left */
+    m.alpha_mode = LMB_ALPHA_OPAQUE;
+    m.transmission = 0.5f;
+    m.transmission_texture = ref(1, 0);
+    sf = lmb_rt_surface_of(&m, &pr, &tx);
+    lmb_rt_surface_pass(&sf, 0, b1, b2, 0, pass, &cover);
+    CHECK_NEAR(cover, 1.0, 1e-12);
+    CHECK_NEAR(pass[0], 0.25 * 0.8 * 0.5 * 0.75, 1e-6);
+    CHECK_NEAR(pass[1], 0.25 * 0.8 * 0.25 * 0.5, 1e-6);
+    lmb_material_albedo(&tx, &m, &pr, 0, b1, b2, a);
+    CHECK_NEAR(a[1], 0.75 * 0.8 * 0.25 * 0.5, 1e-6);
+    /* a volume tints once, entering; leaving through a back face passes all */
+    m.volume = 1;
+    m.volume_tint[0] = m.volume_tint[1] = m.volume_tint[2] = 0.5f;
+    lmb_rt_surface_pass(&sf, 0, b1, b2, 0, pass, &cover);
+    CHECK_NEAR(pass[1], 0.5 * 0.25 * 0.8 * 0.25 * 0.5, 1e-6);
+    lmb_rt_surface_pass(&sf, 0, b1, b2, 1, pass, &cover);
+    CHECK_NEAR(pass[1], 1.0, 1e-12);
+}
+
 int main(void)
 {
+    test_alpha_colour_transmission();
     test_wrap_nearest();
     test_wrap_bilinear();
     test_transform();
