@@ -34,7 +34,7 @@ static void hit_point(const lmb_rt *rt, const double o[3], const double w[3], co
 
 /* B leaving hit h toward the gather point: from the cache or (no lightmap) direct light there; 0
  * from a back face. */
-static void hit_radiance(point_rays *pr, const double w[3], const lmb_rt_hit *h, uint32_t sample, double out[3])
+static inline void hit_radiance(point_rays *pr, const double w[3], const lmb_rt_hit *h, uint32_t sample, double out[3])
 {
     const lmb_gather_job *job = pr->job;
     double albedo[3], e[3];
@@ -67,6 +67,17 @@ static double cached_radiance(void *user, const double w[3], uint32_t sample, do
     uint32_t nl;
     out[0] = out[1] = out[2] = 0;
     pr->rays++;
+    if (!job->rt->partial_geoms) { /* nothing light passes in part: the closest hit alone */
+        int hit = lmb_rt_intersect(job->rt, pr->o, w, pr->sp.eps, 1e300, &h);
+        if (sample < pr->cosine_samples) {
+            pr->distances++;
+            pr->inverse_distances += hit && h.t > 0 ? 1.0 / h.t : 0.0;
+        }
+        if (!hit)
+            return INFINITY;
+        hit_radiance(pr, w, &h, sample, out);
+        return h.t;
+    }
     int hit = lmb_rt_intersect_layers(job->rt, pr->o, w, pr->sp.eps, 1e300, &h, layers, &nl);
     double first = nl ? layers[0].hit.t : hit ? h.t : INFINITY;
     if (sample < pr->cosine_samples) {

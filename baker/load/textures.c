@@ -514,7 +514,7 @@ void lmb_texture_ref_apply(const lmb_texture_ref *ref, double u, double v, doubl
 
 /* Slot ref's texture UV (its TEXCOORD set through its transform) at barycentrics b of triangle
  * tri of pr; 0 when the primitive lacks that set. */
-static int slot_uv(const lmb_texture_ref *ref, const lmb_primitive *pr, uint32_t tri, const double b[3], double *tu,
+static inline int slot_uv(const lmb_texture_ref *ref, const lmb_primitive *pr, uint32_t tri, const double b[3], double *tu,
                    double *tv)
 {
     const float *uv = ref->texcoord == 0 ? pr->uv0 : ref->texcoord == 1 ? pr->uv1 : NULL;
@@ -531,7 +531,7 @@ static int slot_uv(const lmb_texture_ref *ref, const lmb_primitive *pr, uint32_t
 }
 
 /* Looks slot ref up at barycentrics (b0, b1, b2) of triangle tri of pr; 0 when it cannot (out left as is). */
-static int sample_slot(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space,
+static inline int sample_slot(const lmb_textures *tx, const lmb_texture_ref *ref, lmb_tex_space space,
                        const lmb_primitive *pr, uint32_t tri, const double b[3], float out[3])
 {
     const lmb_texture *t = lmb_textures_get(tx, ref, space);
@@ -597,9 +597,10 @@ void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lm
     if (m->unlit)
         return;
     float base[3] = {1, 1, 1};
-    double vc[4];
+    double vc[4] = {1, 1, 1, 1};
     sample_slot(tx, &m->base_color_texture, LMB_TEX_COLOUR, pr, tri, b, base);
-    vertex_colour(pr, tri, b, vc);
+    if (pr->colors)
+        vertex_colour(pr, tri, b, vc);
     double keep; /* the share of base colour that is diffuse */
     if (m->spec_gloss) {
         float sp[3] = {1, 1, 1};
@@ -613,7 +614,13 @@ void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lm
         keep = 1.0 - m->metallic * mr[2];
     }
     keep = keep < 0 ? 0 : keep > 1 ? 1 : keep;
-    keep *= 1.0 - lmb_material_transmission(tx, m, pr, tri, b1, b2); /* glTF: transmission replaces diffuse */
+    if (m->transmission > 0) /* glTF: transmission replaces diffuse */
+        keep *= 1.0 - lmb_material_transmission(tx, m, pr, tri, b1, b2);
+    if (!pr->colors) {
+        for (int k = 0; k < 3; k++)
+            albedo[k] = keep * m->base_color[k] * base[k];
+        return;
+    }
     for (int k = 0; k < 3; k++)
         albedo[k] = keep * m->base_color[k] * base[k] * vc[k];
 }

@@ -76,7 +76,7 @@ static void round_rotation(const probe_job *job, uint32_t i, uint32_t r, double 
 
 /* The light hit h reflects toward the probe at p (0 from a back face): the cache's, or direct light
  * there for a surface without a lightmap. */
-static void reflected(const probe_job *job, uint32_t i, uint64_t stream, const double p[3], const double w[3],
+static inline void reflected(const probe_job *job, uint32_t i, uint64_t stream, const double p[3], const double w[3],
                       const lmb_rt_hit *h, double b[3], uint64_t *rays)
 {
     const lmb_rt *rt = job->cache->rt;
@@ -100,6 +100,35 @@ static void reflected(const probe_job *job, uint32_t i, uint64_t stream, const d
             b[c] = albedo[c] * e[c];
 }
 
+/* Radiance l and reflected light b arriving at the probe at p along w through the surfaces light
+ * partly passes (layers) before the hit h (hit: 0 for the sky): each adds what its covered share
+ * reflects, seen through the ones before it. */
+static void layered(const probe_job *job, uint32_t i, uint64_t stream, const double p[3], const double w[3], int hit,
+                    const lmb_rt_hit *h, const lmb_rt_layer *layers, uint32_t nl, const lmb_sky *sky, double l[3],
+                    double b[3], uint64_t *rays)
+{
+    double through[3] = {1, 1, 1}, hb[3];
+    for (uint32_t q = 0; q <= nl; q++) {
+        const lmb_rt_hit *at = q < nl ? &layers[q].hit : h;
+        double cover = q < nl ? layers[q].cover : 1.0;
+        if (q == nl && !hit) {
+            if (sky) {
+                lmb_sky_radiance(sky, w, hb);
+                for (int c = 0; c < 3; c++)
+                    l[c] += through[c] * hb[c];
+            }
+            return;
+        }
+        reflected(job, i, stream, p, w, at, hb, rays);
+        for (int c = 0; c < 3; c++) { /* emitters' own light: sampled on them below */
+            b[c] += through[c] * cover * hb[c];
+            l[c] += through[c] * cover * hb[c];
+            if (q < nl)
+                through[c] *= layers[q].pass[c];
+        }
+    }
+}
+
 /* One round: the n lattice directions (rotated by m) traced from probe i, their radiance's SH
  * and the reflected light's cube added to sum and cube (each round weighted 4 pi / n), and the
  * mean radiance of the even and the odd directions (two interleaved half lattices) into half.
@@ -121,26 +150,18 @@ static uint64_t trace_round(const probe_job *job, uint32_t i, uint32_t r, const 
         lmb_rt_layer layers[LMB_RT_MAX_LAYERS];
         uint32_t nl;
         rays++;
-        int hit = lmb_rt_intersect_layers(rt, p, w, rt->eps, 1e300, &h, layers, &nl);
-        double through[3] = {1, 1, 1}, hb[3];
-        for (uint32_t q = 0; q <= nl; q++) { /* the surfaces light partly passes, then the opaque hit or the sky */
-            const lmb_rt_hit *at = q < nl ? &layers[q].hit : &h;
-            double cover = q < nl ? layers[q].cover : 1.0;
-            if (q == nl && !hit) {
-                if (sky) {
-                    lmb_sky_radiance(sky, w, hb);
-                    for (int c = 0; c < 3; c++)
-                        l[c] += through[c] * hb[c];
-                }
-                break;
+        if (!rt->partial_geoms) { /* nothing light passes in part: the closest hit alone */
+            if (!lmb_rt_intersect(rt, p, w, rt->eps, 1e300, &h)) {
+                if (sky)
+                    lmb_sky_radiance(sky, w, l);
+            } else {
+                reflected(job, i, (uint64_t)r * n + j, p, w, &h, b, &rays);
+                for (int c = 0; c < 3; c++) /* emitters' own light: sampled on them below */
+                    l[c] = b[c];
             }
-            reflected(job, i, (uint64_t)r * n + j, p, w, at, hb, &rays);
-            for (int c = 0; c < 3; c++) { /* emitters' own light: sampled on them below */
-                b[c] += through[c] * cover * hb[c];
-                l[c] += through[c] * cover * hb[c];
-                if (q < nl)
-                    through[c] *= layers[q].pass[c];
-            }
+        } else {
+            int hit = lmb_rt_intersect_layers(rt, p, w, rt->eps, 1e300, &h, layers, &nl);
+            layered(job, i, (uint64_t)r * n + j, p, w, hit, &h, layers, nl, sky, l, b, &rays);
         }
         double y[9];
         lmb_sh9(w[0], w[1], w[2], y);

@@ -273,12 +273,13 @@ static void query_init(rt_query *q, const lmb_rt *rt, int mode, const double d[3
     q->rt = rt;
     q->mode = mode;
     q->count = 0;
-    memcpy(q->d, d, sizeof q->d);
+    if (mode != QUERY_PLAIN) /* only the filters of such queries read it */
+        memcpy(q->d, d, sizeof q->d);
 }
 
 /* A hit's slot, world geometric normal (front side, unit) and side, from what Embree reports: the
  * slot's normal matrix turns an instanced hit's object-space Ng. */
-static void fill_hit(const lmb_rt *rt, unsigned inst, unsigned geom, unsigned prim, float u, float v, const float ngo[3],
+static inline void fill_hit(const lmb_rt *rt, unsigned inst, unsigned geom, unsigned prim, float u, float v, const float ngo[3],
                      double t, const double d[3], lmb_rt_hit *hit)
 {
     int instanced = inst != RTC_INVALID_GEOMETRY_ID;
