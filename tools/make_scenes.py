@@ -20,6 +20,9 @@ usage: make_scenes.py OUTDIR
                       above it facing up (ALPHA_CARDS): alphaMode MASK with a 2 x 2 checker of
                       texture alpha (NEAREST), BLEND with alpha 0.3, and KHR_materials_transmission 1
                       with base colour (0.2, 0.9, 0.2): what light each lets through
+  two-sided-card.gltf 10 x 10 ground (albedo 0.5), a sun straight down (1000 lux), a 2 x 2 card 1 m
+                      above it (albedo 0.8, doubleSided, facing up): the ground under the card is lit
+                      only by the card's underside, which the sunlit ground lights
   many-lights.gltf    10 x 10 plane under 20 point lights (more than are looped: drawn by
                       their unshadowed irradiance at each point)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
@@ -463,6 +466,15 @@ def alpha_cards(out):
     s.write(os.path.join(out, "alpha-cards.gltf"))
 
 
+def two_sided_card(out):
+    s = Scene()
+    s.mesh("ground", plane(10), s.material("ground", (0.5, 0.5, 0.5)))
+    card = s.material("card", (0.8, 0.8, 0.8), double_sided=True)
+    s.mesh("card", quad((-1, 1, 1), (1, 1, 1), (1, 1, -1), (-1, 1, -1)), card)  # faces +y
+    s.light("sun", "directional", 1000.0, rotation=[-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)])
+    s.write(os.path.join(out, "two-sided-card.gltf"))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -474,3 +486,4 @@ if __name__ == "__main__":
     artists(out)
     instanced(out)
     alpha_cards(out)
+    two_sided_card(out)

@@ -161,10 +161,14 @@ lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double 
 {
     e[0] = e[1] = e[2] = 0;
     albedo_over_pi[0] = albedo_over_pi[1] = albedo_over_pi[2] = 0;
-    if (hit->backface)
-        return LMB_HIT_DARK;
     const lmb_rt_geom *g = &c->rt->geoms[hit->geom];
     const lmb_primitive *pr = &c->scene->primitives[g->primitive];
+    if (hit->backface) {
+        if (!c->backs_reflect || pr->material < 0 || !c->scene->materials[pr->material].double_sided)
+            return LMB_HIT_DARK;
+        albedo_at(c, pr, hit->prim, hit->u, hit->v, albedo_over_pi);
+        return LMB_HIT_BACK;
+    }
     albedo_at(c, pr, hit->prim, hit->u, hit->v, albedo_over_pi);
     const lmb_layout_instance *li = &c->layout->instances[g->instance];
     if (!li->lightmapped)

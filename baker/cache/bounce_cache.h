@@ -8,8 +8,10 @@
  * Emission Le is not in the cache: emitters reach every point through the direct stage's
  * area-light sampling, so a gather ray that hits an emitter counts only its reflected light
  * (no light is counted twice).
- * A hit on the back of a surface returns nothing (no lightmap holds the back side; a single-
- * sided glTF surface is seen from behind only from inside geometry). A hit on a surface with
+ * A hit on the back of a surface returns nothing (a single-sided glTF surface is seen from
+ * behind only from inside geometry), but for the back of a doubleSided one, which reflects
+ * as its front does (glTF: both sides are front): no lightmap holds that side, so the caller
+ * estimates its irradiance where the ray met it (lmb_cache_back_irradiance). A hit on a surface with
  * no lightmap (excluded by the config, or with a singular transform) is reported as such: the
  * gather stage then computes direct light at the hit with shadow rays, so those surfaces
  * still bounce their direct light (one bounce; their own indirect light is left out).
@@ -31,6 +33,8 @@ typedef struct lmb_cache {
     const lmb_textures *textures; /* borrowed, may be NULL */
     uint32_t atlas_count;
     uint32_t threads;   /* for dilation; 0: all cores (the bake sets it from the config) */
+    int backs_reflect;  /* 1: a hit on the back of a doubleSided surface is LMB_HIT_BACK, not dark
+                           (materials.reflect_sides; the bake sets it) */
     float **irradiance; /* owned: per atlas width x height x 3, dilated (NULL after lmb_cache_release) */
     uint8_t **state;    /* owned: per atlas width x height LMB_TEXEL_* */
     float **direction;  /* owned, NULL until lmb_cache_store_direction: per atlas width x height x 3,
@@ -42,7 +46,10 @@ typedef struct lmb_cache {
 typedef enum lmb_hit_kind {
     LMB_HIT_DARK = 0,     /* back face: B = 0 */
     LMB_HIT_CACHED = 1,   /* e holds the cached irradiance */
-    LMB_HIT_UNMAPPED = 2  /* a surface without a lightmap: the caller computes E */
+    LMB_HIT_UNMAPPED = 2, /* a surface without a lightmap: the caller computes E */
+    LMB_HIT_BACK = 3      /* the back of a doubleSided surface (materials.reflect_sides material): albedo
+                             set; no lightmap holds that side, the caller computes E there
+                             (lmb_cache_back_irradiance) */
 } lmb_hit_kind;
 
 /* Empty images for every atlas of layout. Free with lmb_cache_free, also after an error. */

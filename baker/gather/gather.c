@@ -1,6 +1,7 @@
 /* The gather stage (see gather.h): cache passes, the path-traced reference, threads. */
 #include "gather.h"
 
+#include "cache/back_light.h"
 #include "gather/guide.h"
 #include "util/lmb_math.h"
 
@@ -42,6 +43,13 @@ static inline void hit_radiance(point_rays *pr, const double w[3], const lmb_rt_
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, h, albedo, e);
     if (kind == LMB_HIT_DARK || (kind == LMB_HIT_UNMAPPED && job->unmapped_dark))
         return;
+    if (kind == LMB_HIT_BACK) { /* a doubleSided back: its light estimated where the ray met it */
+        lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
+        pr->rays += lmb_cache_back_irradiance(job->cache, job->direct, h, pr->o, w, job->direct_at_hits, &rng, e);
+        for (int k = 0; k < 3; k++)
+            out[k] = albedo[k] * e[k];
+        return;
+    }
     if (kind == LMB_HIT_UNMAPPED || job->direct_at_hits) {
         lmb_shading_point y;
         double d[3];
@@ -151,12 +159,15 @@ static void reference(point_rays *pr, double out[3])
             if (!reference_hit(job, o, w, x.eps, &rng, beta, &h, &cover))
                 break;
             double albedo[3], unused[3];
-            if (lmb_cache_lookup(job->cache, &h, albedo, unused) == LMB_HIT_DARK)
+            lmb_hit_kind kind = lmb_cache_lookup(job->cache, &h, albedo, unused);
+            if (kind == LMB_HIT_DARK)
                 break;
             for (int k = 0; k < 3; k++)
                 albedo[k] *= cover;
             lmb_shading_point y;
             hit_point(job->rt, o, w, &h, &y);
+            for (int k = 0; kind == LMB_HIT_BACK && k < 3; k++) /* a doubleSided back: the path goes on from it */
+                y.n[k] = y.ng[k] = -y.ng[k];
             double e[3];
             pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);
             /* cosine sampling: f / p = pi B = pi albedo/pi E, so the path weight gains rho = pi albedo/pi */

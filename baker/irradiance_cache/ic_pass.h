@@ -55,7 +55,8 @@ typedef struct lmb_ic_pass_stats {
                               (curved at the texel's scale: ic_own_texels.c) */
     lmb_ic_points *points; /* when not NULL: receives the records (previous contents freed) */
     double *noise;         /* when not NULL: per atlas, the median relative standard error of its records'
-                              gathers, sqrt(var) / lum(e) (0 when none was estimated): post/denoise.h */
+                              gathers, sqrt(var) / lum(e), each weighted by lum(e) (0 when none was
+                              estimated): post/denoise.h */
 } lmb_ic_pass_stats;
 
 /* Which texels every pass gathers on their own (ic_own_texels.c). They follow from the geometry

@@ -122,6 +122,7 @@ static const key_spec config_keys[] = {
     FLOAT("lights.intensity_scale", OFF(light_intensity_scale), 0, 1e9, 0),
     FLOAT("lights.emissive_scale", OFF(emissive_scale), 0, 1e9, 0),
     ENUM("lights.emission_sides", OFF(emission_sides), emission_sides),
+    ENUM("materials.reflect_sides", OFF(reflect_sides), emission_sides),
     FLOAT("lights.sun_angle", OFF(sun_angle), 0, 30, 0),
     {.path = "lights.modes", .set = set_light_modes, .offset = OFF(light_modes), .count_offset = OFF(light_mode_count),
      .max_items = LMB_MAX_PATTERNS, .items = &light_mode_schema, .item_size = sizeof(lmb_light_mode_rule)},
@@ -249,6 +250,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->light_intensity_scale = 1.0;
     cfg->emissive_scale = 1.0;
     cfg->emission_sides = LMB_EMIT_FRONT; /* docs/artists.md */
+    cfg->reflect_sides = LMB_EMIT_MATERIAL; /* docs/materials.md: glTF's doubleSided, both sides reflect */
     cfg->seam_stitch = 1;
     cfg->firefly_spread = 1;
     cfg->directional = 1; /* docs/artists.md: +5% time on level-single-10 */

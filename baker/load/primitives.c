@@ -80,9 +80,11 @@ static lmb_status read_attribute(const lmb_accessor_ctx *ctx, int32_t accessor, 
 }
 
 /* COLOR_0 (glTF 2.0 section 3.7.2.1: VEC3 or VEC4, float or normalized unsigned byte/short,
- * linear) as RGBA, alpha 1 where the accessor is VEC3; it multiplies the base colour. */
+ * linear) as RGBA, alpha 1 where the accessor is VEC3; it multiplies the base colour. Optional
+ * data: one that cannot be read (no buffer view, a count or value that is wrong) is a warning
+ * naming it, and the primitive is baked without it. */
 static lmb_status read_colors(const lmb_accessor_ctx *ctx, int32_t accessor, const char *what, size_t vertex_count,
-                              float **out, lmb_error *err)
+                              float **out, const lmb_log *log, lmb_error *err)
 {
     char attr[224];
     *out = NULL;
@@ -90,13 +92,16 @@ static lmb_status read_colors(const lmb_accessor_ctx *ctx, int32_t accessor, con
         return LMB_OK;
     snprintf(attr, sizeof attr, "%s COLOR_0", what);
     int comps = (uint32_t)accessor < ctx->view->accessor_count ? ctx->view->accessors[accessor].components : 0;
-    if (comps != 3 && comps != 4)
-        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s must be VEC3 or VEC4 (glTF 2.0 section 3.7.2.1)", ctx->path,
-                             attr);
+    if (comps != 3 && comps != 4) {
+        lmb_warn(log, "%s: %s must be VEC3 or VEC4 (glTF 2.0 section 3.7.2.1); not used", ctx->path, attr);
+        return LMB_OK;
+    }
     float *c = NULL;
-    lmb_status st = read_attribute(ctx, accessor, comps, attr, vertex_count, &c, err);
-    if (st != LMB_OK)
-        return st;
+    lmb_error e;
+    if (read_attribute(ctx, accessor, comps, attr, vertex_count, &c, &e) != LMB_OK) {
+        lmb_warn(log, "%s; the vertex colours are not used", e.message);
+        return LMB_OK;
+    }
     float *rgba = malloc((4 * vertex_count + 1) * sizeof *rgba);
     if (!rgba) {
         free(c);
@@ -224,7 +229,7 @@ lmb_status lmb_load_primitive(const lmb_accessor_ctx *ctx, uint32_t mesh_index, 
     snprintf(attr, sizeof attr, "%s TEXCOORD_1", what);
     if ((st = read_attribute(ctx, gp->texcoord1, 2, attr, nv, &out->uv1, err)) != LMB_OK)
         return st;
-    if ((st = read_colors(ctx, gp->color0, what, nv, &out->colors, err)) != LMB_OK)
+    if ((st = read_colors(ctx, gp->color0, what, nv, &out->colors, log, err)) != LMB_OK)
         return st;
     return build_triangles(ctx, gp, what, out, log, err);
 }

@@ -242,6 +242,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     cache.threads = cfg->threads;
+    cache.backs_reflect = cfg->reflect_sides == LMB_EMIT_MATERIAL;
     if (st == LMB_OK && progress)
         progress(user, "scene set-up", 1, 1);
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH

@@ -21,6 +21,8 @@
 #include "probes.h"
 #include "sphere.h"
 
+#include "cache/back_light.h"
+
 #include "util/lmb_math.h"
 #include "util/mat4.h"
 #include "util/rng.h"
@@ -74,17 +76,19 @@ static void round_rotation(const probe_job *job, uint32_t i, uint32_t r, double 
     lmb_mat4_from_trs(zero, q, one, m);
 }
 
-/* The light hit h reflects toward the probe at p (0 from a back face): the cache's, or direct light
- * there for a surface without a lightmap. */
+/* The light hit h reflects toward the probe at p (0 from the back of a one-sided face): the cache's,
+ * direct light there for a surface without a lightmap, or the back of a doubleSided one's own. */
 static inline void reflected(const probe_job *job, uint32_t i, uint64_t stream, const double p[3], const double w[3],
                       const lmb_rt_hit *h, double b[3], uint64_t *rays)
 {
     const lmb_rt *rt = job->cache->rt;
     b[0] = b[1] = b[2] = 0;
-    if (h->backface)
-        return;
     double albedo[3], e[3];
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, h, albedo, e);
+    if (kind == LMB_HIT_BACK) { /* a doubleSided back: its light estimated where the ray met it */
+        lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, stream);
+        *rays += lmb_cache_back_irradiance(job->cache, job->direct, h, p, w, 0, &rng, e);
+    }
     if (kind == LMB_HIT_UNMAPPED) {
         lmb_shading_point y;
         for (int k = 0; k < 3; k++) {

@@ -354,6 +354,7 @@ typedef struct lmb_config {
     double light_intensity_scale;  /* multiplies punctual lights */
     double emissive_scale;         /* multiplies emissive materials */
     lmb_emission_sides emission_sides; /* front only, or as the material's doubleSided */
+    lmb_emission_sides reflect_sides;  /* materials.reflect_sides: which sides reflect light to the bake's rays */
     uint32_t directional_rays;     /* samples.directional: cosine rays per texel for the indirect light's direction */
     int directional;               /* output.directional: directional lightmaps (lmb_direction.h) */
     int ktx2_format;               /* output.ktx2_format: lmb_ktx2_format (write/ktx2.h) */
