@@ -15,6 +15,7 @@ packages=(
   build-essential cmake pkg-config  # compiler, build
   libyaml-dev                       # bake config (YAML with line numbers for errors)
   libtinygltf-dev                   # glTF 2.0 reading and writing
+  libmeshoptimizer-dev libdraco-dev # decoding EXT_meshopt_compression and KHR_draco_mesh_compression (gltfpack, glTF-Transform)
   libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
   nettle-dev                        # SHA-256 of the staged bake's plan and part files
   libzstd-dev                       # Zstandard supercompression of KTX2 lightmaps
@@ -53,8 +54,9 @@ if ((${#missing[@]})); then
 fi
 
 # npm pieces (package.json): the Khronos glTF validator and ktx-parse (an independent KTX2 reader) for the
-# tests, three.js and playwright-core for the preview, xatlasjs for the unwrap benchmark
-if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ] || [ ! -d node_modules/xatlasjs ]; then
+# tests, three.js and playwright-core for the preview, xatlasjs for the unwrap benchmark, glTF-Transform's
+# CLI and gltfpack for the optimised-level test's inputs
+if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ] || [ ! -d node_modules/xatlasjs ] || [ ! -d node_modules/@gltf-transform/cli ] || [ ! -d node_modules/gltfpack ]; then
   echo "setup: installing npm packages (package.json)"
   npm install --no-audit --no-fund --silent >/dev/null 2>&1 || { echo "setup: npm install failed"; exit 1; }
 fi

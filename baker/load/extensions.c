@@ -2,9 +2,9 @@
  * The extension table. The rule: lmbake bakes diffuse irradiance, so an extension that only
  * changes specular reflection, layers on top of the base (sheen, clear coat), refraction,
  * animation or metadata changes nothing the bake reads, and a file requiring it is baked with
- * a warning naming the file and the extension. One that changes geometry (Draco, meshopt),
- * the diffuse colour in a way lmbake does not model (KHR_materials_diffuse_transmission) is not
- * listed: requiring it is an error. EXT_lights_image_based is the sky when the config sets none
+ * a warning naming the file and the extension. Compressed geometry (Draco, meshopt) is decoded
+ * before the file is read (decompress.h). One that changes the diffuse colour in a way lmbake
+ * does not model (KHR_materials_diffuse_transmission) is not listed: requiring it is an error. EXT_lights_image_based is the sky when the config sets none
  * (lights/sky.c: its irradiance spherical harmonics; its specular cube maps are not read).
  * Choices worth knowing:
  *   - KHR_materials_unlit: an unlit surface shows its base colour whatever the light, so it
@@ -25,6 +25,8 @@ static const lmb_extension_info table[] = {
     {"KHR_materials_emissive_strength", LMB_EXT_SUPPORTED, NULL},
     {"EXT_mesh_gpu_instancing", LMB_EXT_SUPPORTED, NULL},
     {"KHR_mesh_quantization", LMB_EXT_SUPPORTED, NULL},
+    {"EXT_meshopt_compression", LMB_EXT_SUPPORTED, NULL},    /* decoded before loading: decompress.h */
+    {"KHR_draco_mesh_compression", LMB_EXT_SUPPORTED, NULL}, /* decoded before loading: decompress.h */
     {"KHR_texture_transform", LMB_EXT_SUPPORTED, NULL},
     {"KHR_materials_pbrSpecularGlossiness", LMB_EXT_SUPPORTED, NULL},
     {"KHR_materials_sheen", LMB_EXT_IGNORED, "the sheen layer is not baked; the base colour is the albedo"},
@@ -42,7 +44,7 @@ static const lmb_extension_info table[] = {
     {"KHR_animation_pointer", LMB_EXT_IGNORED, "animations are not baked; the static values are"},
     {"KHR_xmp_json_ld", LMB_EXT_IGNORED, "metadata only"},
     {"KHR_texture_basisu", LMB_EXT_IMAGE, "KTX2 images are not decoded; textures use their fallback image"},
-    {"EXT_texture_webp", LMB_EXT_IMAGE, "textures use their fallback (PNG or JPEG) image"},
+    {"EXT_texture_webp", LMB_EXT_SUPPORTED, NULL}, /* WebP through OpenImageIO; its source where there is no core one */
     {"EXT_texture_avif", LMB_EXT_IMAGE, "textures use their fallback (PNG or JPEG) image"},
     {"MSFT_texture_dds", LMB_EXT_IMAGE, "textures use their fallback (PNG or JPEG) image"},
 };

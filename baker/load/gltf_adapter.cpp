@@ -341,7 +341,9 @@ void fill_materials(lmb_gltf_doc &d)
 void fill_textures(lmb_gltf_doc &d)
 {
     for (const auto &t : d.model.textures) {
-        lmb_gltf_texture c{t.source, t.sampler, TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT, -1};
+        /* EXT_texture_webp: its image where the texture has no core `source` (glTF-Transform writes none) */
+        int32_t source = t.source >= 0 ? t.source : int_member(extension(t.extensions, "EXT_texture_webp"), "source", -1);
+        lmb_gltf_texture c{source, t.sampler, TINYGLTF_TEXTURE_WRAP_REPEAT, TINYGLTF_TEXTURE_WRAP_REPEAT, -1};
         if (t.sampler >= 0 && (size_t)t.sampler < d.model.samplers.size()) {
             const auto &s = d.model.samplers[(size_t)t.sampler];
             c.wrap_s = s.wrapS;
@@ -519,8 +521,9 @@ bool is_glb(const char *path)
 
 } // namespace
 
-extern "C" lmb_status lmb_gltf_open(const char *path, const char *extras_key, lmb_gltf_doc **out,
-                                    const lmb_log *log, lmb_error *err)
+/* Parses path, or the .glb bytes given for it (load/decompress.h), with tinygltf. */
+static lmb_status open_doc(const char *path, const uint8_t *glb, size_t size, const char *extras_key,
+                           lmb_gltf_doc **out, const lmb_log *log, lmb_error *err)
 {
     *out = nullptr;
     FILE *probe = std::fopen(path, "rb");
@@ -538,8 +541,9 @@ extern "C" lmb_status lmb_gltf_open(const char *path, const char *extras_key, lm
             fs_root.folder = "/";
         loader.SetFsCallbacks(tinygltf::FsCallbacks{confined_exists, no_expansion, confined_read, no_write, &fs_root});
         std::string terr, twarn;
-        bool ok = is_glb(path) ? loader.LoadBinaryFromFile(&d->model, &terr, &twarn, path)
-                               : loader.LoadASCIIFromFile(&d->model, &terr, &twarn, path);
+        bool ok = glb    ? loader.LoadBinaryFromMemory(&d->model, &terr, &twarn, glb, (unsigned int)size, fs_root.folder)
+                  : is_glb(path) ? loader.LoadBinaryFromFile(&d->model, &terr, &twarn, path)
+                                 : loader.LoadASCIIFromFile(&d->model, &terr, &twarn, path);
         if (!ok)
             return lmb_error_set(err, LMB_ERR_INPUT, "%s: not a loadable glTF: %s", path,
                                  first_line(terr.empty() ? twarn : terr).c_str());
@@ -553,6 +557,18 @@ extern "C" lmb_status lmb_gltf_open(const char *path, const char *extras_key, lm
     } catch (const std::exception &e) {
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: glTF parser failed: %s", path, e.what());
     }
+}
+
+extern "C" lmb_status lmb_gltf_open(const char *path, const char *extras_key, lmb_gltf_doc **out,
+                                    const lmb_log *log, lmb_error *err)
+{
+    return open_doc(path, nullptr, 0, extras_key, out, log, err);
+}
+
+extern "C" lmb_status lmb_gltf_open_glb(const char *path, const uint8_t *glb, size_t size, const char *extras_key,
+                                        lmb_gltf_doc **out, const lmb_log *log, lmb_error *err)
+{
+    return open_doc(path, glb, size, extras_key, out, log, err);
 }
 
 extern "C" const lmb_gltf_view *lmb_gltf_get_view(const lmb_gltf_doc *doc)

@@ -169,6 +169,11 @@ typedef struct lmb_gltf_view {
 lmb_status lmb_gltf_open(const char *path, const char *extras_key, lmb_gltf_doc **out,
                          const lmb_log *log, lmb_error *err);
 
+/* The same from .glb bytes that stand for path (its decompressed form: load/decompress.h);
+ * external files resolve against path's folder. */
+lmb_status lmb_gltf_open_glb(const char *path, const uint8_t *glb, size_t size, const char *extras_key,
+                             lmb_gltf_doc **out, const lmb_log *log, lmb_error *err);
+
 const lmb_gltf_view *lmb_gltf_get_view(const lmb_gltf_doc *doc);
 
 void lmb_gltf_close(lmb_gltf_doc *doc);

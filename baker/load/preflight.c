@@ -6,8 +6,7 @@
  *   - extensionsRequired must only name extensions lmbake implements or can bake without
  *     (extensions.c); an alternative image format (KHR_texture_basisu, EXT_texture_webp, ...)
  *     only if every texture lmbake reads keeps a fallback `source` image;
- *   - compressed geometry (KHR_draco_mesh_compression on a primitive,
- *     EXT_meshopt_compression on a buffer view) is refused, naming the mesh or view;
+ *   - (compressed geometry is decoded after this, before tinygltf: decompress.h);
  *   - alphaMode must be OPAQUE, MASK or BLEND and alphaCutoff a number in [0, 1], naming the
  *     material (tinygltf reads a malformed cutoff as 0.5 without a word);
  *   - a buffer's uri must name a file inside the input's folder (uri.h).
@@ -152,41 +151,6 @@ static lmb_status check_required(const char *path, const cJSON *root, lmb_error 
     return LMB_OK;
 }
 
-static lmb_status check_compression(const char *path, const cJSON *root, lmb_error *err)
-{
-    const cJSON *mesh, *prim, *view;
-    uint32_t mi = 0;
-    char label[160];
-    cJSON_ArrayForEach(mesh, cJSON_GetObjectItemCaseSensitive(root, "meshes"))
-    {
-        uint32_t pi = 0;
-        const cJSON *name = cJSON_GetObjectItemCaseSensitive(mesh, "name");
-        cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives"))
-        {
-            const cJSON *ext = cJSON_GetObjectItemCaseSensitive(prim, "extensions");
-            if (cJSON_GetObjectItemCaseSensitive(ext, "KHR_draco_mesh_compression"))
-                return lmb_error_set(err, LMB_ERR_INPUT,
-                                     "%s: %s primitive %u is compressed with KHR_draco_mesh_compression, which lmbake "
-                                     "does not decode; export the level uncompressed",
-                                     path, lmb_object_label(label, "mesh", mi, cJSON_IsString(name) ? name->valuestring : NULL), pi);
-            pi++;
-        }
-        mi++;
-    }
-    uint32_t vi = 0;
-    cJSON_ArrayForEach(view, cJSON_GetObjectItemCaseSensitive(root, "bufferViews"))
-    {
-        const cJSON *ext = cJSON_GetObjectItemCaseSensitive(view, "extensions");
-        if (cJSON_GetObjectItemCaseSensitive(ext, "EXT_meshopt_compression"))
-            return lmb_error_set(err, LMB_ERR_INPUT,
-                                 "%s: bufferView %u is compressed with EXT_meshopt_compression, which lmbake does not "
-                                 "decode; export the level uncompressed",
-                                 path, vi);
-        vi++;
-    }
-    return LMB_OK;
-}
-
 /* alphaMode and alphaCutoff as written (glTF 2.0 section 5.19): tinygltf would read a cutoff
  * that is not a number as the default 0.5, silently; here it is named. */
 static lmb_status check_alpha(const char *path, const cJSON *root, lmb_error *err)
@@ -289,8 +253,6 @@ lmb_status lmb_preflight(const char *path, lmb_error *err)
     st = check_version(path, root, err);
     if (st == LMB_OK)
         st = check_required(path, root, err);
-    if (st == LMB_OK)
-        st = check_compression(path, root, err);
     if (st == LMB_OK)
         st = check_alpha(path, root, err);
     if (st == LMB_OK)

@@ -8,6 +8,7 @@
 #include "extensions.h"
 #include "load_internal.h"
 #include "preflight.h"
+#include "decompress.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -110,8 +111,18 @@ lmb_status lmb_scene_load(const char *path, const lmb_config *cfg, lmb_scene **o
     if (!s)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
     lmb_status st = lmb_preflight(path, err);
+    lmb_decompressed dc = {NULL, 0, 0, 0};
     if (st == LMB_OK)
+        st = lmb_decompress(path, &dc, err);
+    if (st == LMB_OK && dc.glb) {
+        lmb_info(log, "%s: compressed geometry decoded (%u EXT_meshopt_compression buffer views, %u "
+                 "KHR_draco_mesh_compression primitives); the output is written uncompressed", path, dc.meshopt_views,
+                 dc.draco_primitives);
+        st = lmb_gltf_open_glb(path, dc.glb, dc.size, extras_key, &s->doc, log, err);
+    } else if (st == LMB_OK) {
         st = lmb_gltf_open(path, extras_key, &s->doc, log, err);
+    }
+    free(dc.glb);
     if (st == LMB_OK && !(s->path = lmb_strdup(path)))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", path);
     if (st == LMB_OK) {

@@ -110,9 +110,11 @@ def lightmap_uv(node, uv):
     return uv * np.array(so[:2]) + np.array(so[2:])
 
 
-def object_means(out):
+def object_means(out, by="node"):
     """{node name: (mean rgb over its valid texels, texel count)} for the bake in folder out,
-    plus its "all" entry (every valid texel of every node). Needs output.formats exr and mask."""
+    plus its "all" entry (every valid texel of every node). Needs output.formats exr and mask.
+    by="material": keyed by the primitives' material names instead (what survives a glTF
+    optimiser that joins or renames nodes)."""
     name = [f for f in os.listdir(out) if f.endswith(".gltf")][0]
     doc = json.load(open(os.path.join(out, name)))
     bins = [open(os.path.join(out, b["uri"]), "rb").read() for b in doc["buffers"]]
@@ -132,9 +134,10 @@ def object_means(out):
                 mask = _image(os.path.join(out, png[:-4] + "-mask.png"))[..., 0]
                 atlases[tex] = (exr, mask > 0.99)
                 tris[tex] = []
-            if node["name"] not in nodes:
-                nodes.append(node["name"])
-            label = nodes.index(node["name"]) + 1
+            key = node["name"] if by == "node" else doc["materials"][prim["material"]].get("name", "")
+            if key not in nodes:
+                nodes.append(key)
+            label = nodes.index(key) + 1
             uv = lightmap_uv(node, _accessor(doc, bins, prim["attributes"]["TEXCOORD_1"]))
             idx = _accessor(doc, bins, prim["indices"]).reshape(-1).astype(int)
             tris[tex].append((uv[idx].reshape(-1, 3, 2), label))

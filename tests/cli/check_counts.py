@@ -15,11 +15,6 @@ import subprocess
 import sys
 
 EXPECTED_FAILURES = {
-    "BoxDraco.gltf": "Draco-compressed primitive, no uncompressed fallback",
-    "BoxMeshopt.glb": "requires EXT_meshopt_compression",
-    "BoxMeshopt.gltf": "requires EXT_meshopt_compression",
-    "DracoSparseMesh.gltf": "requires KHR_draco_mesh_compression",
-    "glTF-Draco/Box.gltf": "requires KHR_draco_mesh_compression",
     "buffer-invalid-short-size.glb": "buffer shorter than its byteLength",
     "buffer-invalid-short-size.gltf": "buffer shorter than its byteLength",
     "invalid-uri.gltf": "undecodable data URI",

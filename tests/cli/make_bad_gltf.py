@@ -138,8 +138,8 @@ def cases():
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "KHR_materials_clearcoat"]
     yield "required-sheen", d
     d = copy.deepcopy(d)
-    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "EXT_meshopt_compression"]
-    yield "required-sheen-meshopt", d
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "KHR_materials_diffuse_transmission"]
+    yield "required-sheen-unsupported", d
     # a required extension that changes the diffuse colour in a way lmbake does not model: refused
     d = copy.deepcopy(ok)
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_diffuse_transmission"]
@@ -210,11 +210,33 @@ def gpu_cases(ok):
     yield "gpu-zero-scale", gpu_instanced(ok, [(0, 0, 0), (2, 0, 0), (4, 0, 0)], [(1, 1, 1), (0, 0, 0), (1, 1, 1)])
 
 
+def compressed_cases():
+    """glTF-Transform's compressed boxes (tests/data) with their compressed streams broken: each
+    stream's first byte (meshopt's codec header, Draco's magic) zeroed; buffers as data URIs."""
+    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data",
+                          "compressed-meshopt-draco-gltf-transform")
+    for name, gltf in (("meshopt-corrupt", "BoxMeshopt.gltf"), ("draco-corrupt", "BoxDraco.gltf")):
+        d = json.load(open(os.path.join(folder, gltf)))
+        blob = bytearray(open(os.path.join(folder, d["buffers"][0]["uri"]), "rb").read())
+        for v in d["bufferViews"]:
+            ext = v.get("extensions", {}).get("EXT_meshopt_compression")
+            if ext:
+                blob[ext.get("byteOffset", 0)] = 0
+        for m in d["meshes"]:
+            for p in m["primitives"]:
+                ext = p.get("extensions", {}).get("KHR_draco_mesh_compression")
+                if ext:
+                    at = d["bufferViews"][ext["bufferView"]].get("byteOffset", 0)
+                    blob[at:at + 8] = bytes(8)
+        d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(bytes(blob)).decode()
+        yield name, d
+
+
 def main():
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
     ok = base_doc(QUAD, QUAD_IDX)
-    for name, doc in list(cases()) + list(gpu_cases(ok)):
+    for name, doc in list(cases()) + list(gpu_cases(ok)) + list(compressed_cases()):
         with open(os.path.join(out, name + ".gltf"), "w") as f:
             f.write(doc if isinstance(doc, str) else json.dumps(doc, indent=1))
 
