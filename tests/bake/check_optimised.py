@@ -36,7 +36,7 @@ TOOLS = {
 }
 DECODED = {"optimize": "EXT_meshopt_compression buffer views", "gltfpack": "EXT_meshopt_compression buffer views",
            "draco": "KHR_draco_mesh_compression primitives"}
-CONFIG = "texel_density: 24\nlights: {sun_angle: 0}\noutput: {formats: [exr, mask]}\nseed: 3\n"
+CONFIG = "texel_density: 12\nlights: {sun_angle: 0}\noutput: {formats: [exr, mask]}\nseed: 3\n"
 
 
 def bake(lmbake, work, scene, name):
