@@ -23,6 +23,10 @@ usage: make_scenes.py OUTDIR
   two-sided-card.gltf 10 x 10 ground (albedo 0.5), a sun straight down (1000 lux), a 2 x 2 card 1 m
                       above it (albedo 0.8, doubleSided, facing up): the ground under the card is lit
                       only by the card's underside, which the sunlit ground lights
+  moving.gltf         10 x 10 ground under a sun straight down, and boxes floating 0.5-1.5 m above it
+                      (MOVING): a skinned character, a mesh with a morph target, a Crate_LOD0 with its
+                      sibling Crate_LOD1, a Rock whose MSFT_lod names RockFar; moving-static.gltf: the
+                      same with the character's extras.lightmap true
   many-lights.gltf    10 x 10 plane under 20 point lights (more than are looped: drawn by
                       their unshadowed irradiance at each point)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
@@ -475,6 +479,39 @@ def two_sided_card(out):
     s.write(os.path.join(out, "two-sided-card.gltf"))
 
 
+# moving.gltf: node name -> (x, z) of its floating 1 x 1 box's centre, and whether it is static
+# scenery (lightmapped, casts baked shadows)
+MOVING = {"Character": ((-2.5, 0.0), False), "Blob": ((-2.5, 2.5), False), "Crate_LOD0": ((2.5, 0.0), True),
+          "Crate_LOD1": ((2.5, -2.5), False), "Rock": ((0.0, 2.5), True), "RockFar": ((0.0, -2.5), False)}
+
+
+def moving(out, character_static=False):
+    s = Scene()
+    grey = s.material("grey", (0.5, 0.5, 0.5))
+    s.mesh("ground", plane(10), grey)
+    for name, ((x, z), _) in MOVING.items():
+        s.mesh(name, box(x - 0.5, 0.5, z - 0.5, x + 0.5, 1.5, z + 0.5), grey)
+    nodes = {n["name"]: k for k, n in enumerate(s.doc["nodes"])}
+    prim = s.doc["meshes"][s.doc["nodes"][nodes["Character"]]["mesh"]]["primitives"][0]
+    count = s.doc["accessors"][prim["attributes"]["POSITION"]]["count"]
+    prim["attributes"]["JOINTS_0"] = s.byte_accessor([(0, 0, 0, 0)] * count)
+    s.doc["accessors"][prim["attributes"]["JOINTS_0"]].pop("normalized")
+    prim["attributes"]["WEIGHTS_0"] = s._accessor([(1.0, 0.0, 0.0, 0.0)] * count, 4)
+    s.doc["nodes"].append({"name": "Hips", "translation": [-2.5, 1.0, 0.0]})
+    s.doc["scenes"][0]["nodes"].append(len(s.doc["nodes"]) - 1)
+    s.doc["skins"] = [{"joints": [len(s.doc["nodes"]) - 1]}]
+    s.doc["nodes"][nodes["Character"]]["skin"] = 0
+    if character_static:
+        s.doc["nodes"][nodes["Character"]]["extras"] = {"lightmap": True}
+    blob = s.doc["meshes"][s.doc["nodes"][nodes["Blob"]]["mesh"]]["primitives"][0]
+    blob["targets"] = [{"POSITION": s._accessor([(0.0, 0.1, 0.0)] * count, 3)}]
+    s.doc["meshes"][s.doc["nodes"][nodes["Blob"]]["mesh"]]["weights"] = [0.0]
+    s.doc["nodes"][nodes["Rock"]]["extensions"] = {"MSFT_lod": {"ids": [nodes["RockFar"]]}}
+    s._use("MSFT_lod")
+    s.light("sun", "directional", 1000.0, rotation=[-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)])
+    s.write(os.path.join(out, "moving-static.gltf" if character_static else "moving.gltf"))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -487,3 +524,5 @@ if __name__ == "__main__":
     instanced(out)
     alpha_cards(out)
     two_sided_card(out)
+    moving(out)
+    moving(out, character_static=True)

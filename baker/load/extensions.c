@@ -25,6 +25,7 @@ static const lmb_extension_info table[] = {
     {"KHR_materials_emissive_strength", LMB_EXT_SUPPORTED, NULL},
     {"EXT_mesh_gpu_instancing", LMB_EXT_SUPPORTED, NULL},
     {"KHR_mesh_quantization", LMB_EXT_SUPPORTED, NULL},
+    {"MSFT_lod", LMB_EXT_SUPPORTED, NULL}, /* lower levels of detail: lit by the probes (select.c) */
     {"EXT_meshopt_compression", LMB_EXT_SUPPORTED, NULL},    /* decoded before loading: decompress.h */
     {"KHR_draco_mesh_compression", LMB_EXT_SUPPORTED, NULL}, /* decoded before loading: decompress.h */
     {"KHR_texture_transform", LMB_EXT_SUPPORTED, NULL},

@@ -240,6 +240,11 @@ void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
     c.gpu_translation = int_member(attrs, "TRANSLATION", -1);
     c.gpu_rotation = int_member(attrs, "ROTATION", -1);
     c.gpu_scale = int_member(attrs, "SCALE", -1);
+    c.skinned = n.skin >= 0;
+    c.morphing = 0;
+    if (n.mesh >= 0 && (size_t)n.mesh < d.model.meshes.size())
+        for (const auto &p : d.model.meshes[(size_t)n.mesh].primitives)
+            c.morphing |= !p.targets.empty();
 }
 
 double number_member(const tinygltf::Value *obj, const char *key, double fallback)
@@ -454,6 +459,19 @@ void build_view(lmb_gltf_doc &d)
     fill_buffers(d);
     fill_meshes(d);
     d.nodes.resize(d.model.nodes.size());
+    for (size_t i = 0; i < d.model.nodes.size(); i++)
+        d.nodes[i].lod_of = -1;
+    /* MSFT_lod: a node's `ids` are its lower levels of detail, nearest first */
+    for (size_t i = 0; i < d.model.nodes.size(); i++) {
+        const tinygltf::Value *lod = extension(d.model.nodes[i].extensions, "MSFT_lod");
+        const tinygltf::Value *ids = lod ? member(*lod, "ids") : nullptr;
+        for (int k = 0; ids && ids->IsArray() && k < (int)ids->ArrayLen(); k++) {
+            const tinygltf::Value &id = ids->Get(k);
+            int64_t j = id.IsNumber() ? (int64_t)id.GetNumberAsDouble() : -1;
+            if (j >= 0 && (size_t)j < d.model.nodes.size() && (size_t)j != i)
+                d.nodes[(size_t)j].lod_of = (int32_t)i;
+        }
+    }
     for (size_t i = 0; i < d.model.nodes.size(); i++)
         fill_node(d, d.model.nodes[i], d.nodes[i]);
     fill_materials(d);

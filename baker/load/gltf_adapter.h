@@ -66,6 +66,9 @@ typedef struct lmb_gltf_node {
     int has_gpu_instancing;
     const char *lightmap_mode; /* extras.lightmap_mode as written ("" absent, "?" not a string): the mode of its light */
     int32_t lightmap_probes[3]; /* extras.lightmap_probes: a volume's resolution; 0 0 0 absent, -1 -1 -1 malformed */
+    int skinned;      /* node.skin is set */
+    int morphing;     /* its mesh has morph targets */
+    int32_t lod_of;   /* a lower level of detail (MSFT_lod) of this node, or -1 */
 } lmb_gltf_node;
 
 /* A glTF textureInfo with its KHR_texture_transform, as written (defaults filled in). */

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 typedef struct walk {
     const lmb_accessor_ctx *ctx;
@@ -92,6 +93,24 @@ static void *grow(void *p, uint32_t *cap, uint32_t need, size_t elem)
     return q;
 }
 
+/* A NAME_LOD<n> node (n >= 1, "_lod" in any case) when a node NAME_LOD0 exists: a lower level of
+ * detail kept as a sibling, as DCC exports and Unity's LOD groups name them. Only such names
+ * scan the nodes. */
+static int lower_lod_by_name(const lmb_gltf_view *v, const char *name)
+{
+    size_t n = name ? strlen(name) : 0, k = n;
+    while (k > 0 && name[k - 1] >= '0' && name[k - 1] <= '9')
+        k--;
+    if (k == n || k < 5 || strncasecmp(name + k - 4, "_lod", 4) || atoi(name + k) < 1)
+        return 0;
+    for (uint32_t i = 0; i < v->node_count; i++) {
+        const char *o = v->nodes[i].name;
+        if (o && strlen(o) == k + 1 && !strncmp(o, name, k) && o[k] == '0')
+            return 1;
+    }
+    return 0;
+}
+
 static lmb_status add_instance(walk *w, uint32_t node, int32_t gpu, const double world[16], lmb_error *err)
 {
     lmb_scene *s = w->scene;
@@ -121,6 +140,10 @@ static lmb_status add_instance(walk *w, uint32_t node, int32_t gpu, const double
     memcpy(in->world, world, sizeof in->world);
     in->flips_winding = lmb_mat4_det3(world) < 0.0;
     in->extras_lightmap = n->extras_lightmap;
+    in->motion = n->skinned ? LMB_SKINNED : n->morphing ? LMB_MORPHING
+               : n->lod_of >= 0 || lower_lod_by_name(w->ctx->view, n->name) ? LMB_LOWER_LOD
+                                                                             : LMB_STATIC;
+    in->occludes = in->motion == LMB_STATIC || in->extras_lightmap == 1; /* as lmb_scene_select_lightmapped says */
     if (!lmb_mat4_is_finite(world) || fabs(lmb_mat4_det3(world)) < 1e-30)
         lmb_warn(w->log, "%s: %s has a singular or non-finite transform; it will not be lightmapped", w->ctx->path, name);
     return LMB_OK;

@@ -4,7 +4,10 @@
  *   2. a name matching an `exclude` glob removes it;
  *   3. a name matching an `include` glob keeps it (default "*": everything);
  * and whatever the rules say, an instance without usable triangles or with a singular
- * transform is skipped, with the reason recorded for `lmbake inspect`. EXT_mesh_gpu_instancing
+ * transform is skipped, with the reason recorded for `lmbake inspect`. Before all of them, what
+ * moves or stands in for something else (a skinned mesh, morph targets, a lower level of
+ * detail: lmb_motion) is neither lightmapped nor an occluder unless its extras flag is true:
+ * the light probes light it (Unity, Godot and Unreal bake only static scenery the same way). EXT_mesh_gpu_instancing
  * copies are lightmapped like nodes: they share one TEXCOORD_1 layout, each with its own
  * rectangle of the atlas (pack/rect_instances.c).
  */
@@ -34,8 +37,14 @@ void lmb_scene_select_lightmapped(lmb_scene *s, const lmb_config *cfg)
         const lmb_mesh *mesh = &s->meshes[in->mesh];
         const char *name = in->name, *hit = NULL;
         in->lightmapped = 0;
+        in->occludes = 1;
         in->skip_reason[0] = '\0';
-        if (mesh->triangle_count == mesh->degenerate_count)
+        if (in->motion != LMB_STATIC && in->extras_lightmap != 1) {
+            static const char *const why[] = {"", "skinned", "morph targets", "a lower level of detail"};
+            snprintf(in->skip_reason, sizeof in->skip_reason, "%s: lit by the probes, casts no baked shadow",
+                     why[in->motion]);
+            in->occludes = 0;
+        } else if (mesh->triangle_count == mesh->degenerate_count)
             snprintf(in->skip_reason, sizeof in->skip_reason, "%s",
                      mesh->triangle_count ? "every triangle has zero area" : "no triangles");
         else if (!lmb_mat4_is_finite(in->world) || fabs(lmb_mat4_det3(in->world)) < 1e-30)

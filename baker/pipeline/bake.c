@@ -231,6 +231,13 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_info(log, "ray tracing: %llu triangles placed, %llu stored (meshes used more than once are Embree "
                  "instances), built in %.2f s", (unsigned long long)rt.placed_triangles,
                  (unsigned long long)rt.stored_triangles, rt.build_seconds);
+    uint32_t moving[4] = {0, 0, 0, 0};
+    for (uint32_t i = 0; i < s->instance_count; i++)
+        moving[s->instances[i].motion] += !s->instances[i].occludes;
+    if (st == LMB_OK && !shard && (moving[LMB_SKINNED] || moving[LMB_MORPHING] || moving[LMB_LOWER_LOD]))
+        lmb_info(log, "what moves: %u skinned, %u morphing and %u lower-LOD instance(s) are not lightmapped and cast no "
+                 "baked shadow; the light probes light them (a node's extras.%s: true makes it static scenery)",
+                 moving[LMB_SKINNED], moving[LMB_MORPHING], moving[LMB_LOWER_LOD], cfg->extras_key);
     if (st == LMB_OK && !shard && (rt.cut_triangles || rt.partial_triangles))
         lmb_info(log, "materials: %llu placed triangles have alpha cut-outs (alphaMode MASK), %llu let light through "
                  "in part (alphaMode BLEND, KHR_materials_transmission); every ray sees them as their material says",

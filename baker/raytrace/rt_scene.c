@@ -163,8 +163,8 @@ lmb_status lmb_rt_build(const lmb_scene *s, const lmb_textures *tx, lmb_rt *rt, 
     double t0 = lmb_seconds();
     memset(rt, 0, sizeof *rt);
     uint32_t n = 0;
-    for (uint32_t i = 0; i < s->instance_count; i++)
-        n += s->meshes[s->instances[i].mesh].primitive_count;
+    for (uint32_t i = 0; i < s->instance_count; i++) /* what moves is not in it (lmb_instance.occludes) */
+        n += s->instances[i].occludes ? s->meshes[s->instances[i].mesh].primitive_count : 0;
     uint32_t *uses = calloc((size_t)s->mesh_count + 1, sizeof *uses);
     rt->geoms = calloc((size_t)n + 1, sizeof *rt->geoms);
     rt->mesh_scenes = calloc((size_t)s->mesh_count + 1, sizeof *rt->mesh_scenes);
@@ -185,13 +185,15 @@ lmb_status lmb_rt_build(const lmb_scene *s, const lmb_textures *tx, lmb_rt *rt, 
     rtcSetSceneFlags(rt->scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(rt->scene, RTC_BUILD_QUALITY_MEDIUM);
     for (uint32_t i = 0; i < s->instance_count; i++)
-        uses[s->instances[i].mesh]++;
+        uses[s->instances[i].mesh] += s->instances[i].occludes != 0;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     lmb_status st = LMB_OK;
     uint32_t slot = 0;
     for (uint32_t i = 0; i < s->instance_count && st == LMB_OK; i++) {
         const lmb_instance *in = &s->instances[i];
         const lmb_mesh *m = &s->meshes[in->mesh];
+        if (!in->occludes)
+            continue;
         int instanced = uses[in->mesh] >= 2;
         if (instanced && !rt->mesh_scenes[in->mesh])
             st = mesh_scene(rt, s, in->mesh, err);

@@ -1,5 +1,6 @@
 /*
- * The ray-tracing scene: every instance of the level (lightmapped or not) in one Embree 3
+ * The ray-tracing scene: every instance of the level that occludes (lightmapped or not; what
+ * moves, lmb_instance.occludes 0, is left out) in one Embree 3
  * scene, committed once and then shared read-only by all threads. A mesh used once is stored
  * as world-space triangles; a mesh several instances use (EXT_mesh_gpu_instancing copies, a
  * mesh on several nodes) is stored once, in object space, and placed by Embree instances, so

@@ -106,6 +106,16 @@ typedef struct lmb_mesh {
     uint32_t skipped_triangles;  /* triangles the no-POSITION ones would have had (not in triangle_count) */
 } lmb_mesh;
 
+/* Why a placement is not static scenery (docs/input.md#what-moves-and-levels-of-detail): it is
+ * neither lightmapped nor an occluder of baked light, and the light probes light it, unless its
+ * node's extras flag (lightmap: true) makes it static. */
+typedef enum lmb_motion {
+    LMB_STATIC = 0,
+    LMB_SKINNED = 1,   /* node.skin: drawn at poses the bake does not know */
+    LMB_MORPHING = 2,  /* morph targets */
+    LMB_LOWER_LOD = 3  /* a lower level of detail: MSFT_lod ids, or a NAME_LOD<n> (n >= 1) beside NAME_LOD0 */
+} lmb_motion;
+
 /* One placement of a mesh in the world: a node, or one EXT_mesh_gpu_instancing copy. */
 typedef struct lmb_instance {
     char *name;            /* node name or "node N"; GPU copies get "#k" appended */
@@ -117,6 +127,8 @@ typedef struct lmb_instance {
     int lightmapped;       /* decided by lmb_scene_select_lightmapped */
     char skip_reason[96];  /* why not lightmapped, "" if it is */
     int extras_lightmap;   /* node extras flag: -1 absent, 0 false, 1 true */
+    lmb_motion motion;     /* what makes it not scenery (a skin, morph targets, a lower LOD), or LMB_STATIC */
+    int occludes;          /* in the bake's ray-tracing scene (decided by lmb_scene_select_lightmapped) */
 } lmb_instance;
 
 /* A material's texture slot: which glTF texture, read through which TEXCOORD_n set, and the
