@@ -27,6 +27,10 @@ usage: make_scenes.py OUTDIR
                       (MOVING): a skinned character, a mesh with a morph target, a Crate_LOD0 with its
                       sibling Crate_LOD1, a Rock whose MSFT_lod names RockFar; moving-static.gltf: the
                       same with the character's extras.lightmap true
+  checker-bounce.gltf a 4 x 4 floor whose base colour texture is a black and white checker of 1 cm
+                      cells (400 x 400, mean albedo 0.5), a 4 x 4 ceiling of albedo 0 2 m above it and a
+                      100 cd point light between them: the ceiling's indirect light is the floor's
+                      bounce; flat-bounce.gltf: the floor's albedo 0.5 flat; dark-bounce.gltf: 0
   many-lights.gltf    10 x 10 plane under 20 point lights (more than are looped: drawn by
                       their unshadowed irradiance at each point)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
@@ -512,6 +516,20 @@ def moving(out, character_static=False):
     s.write(os.path.join(out, "moving-static.gltf" if character_static else "moving.gltf"))
 
 
+def checker_bounce(out):
+    for name in ("checker", "flat", "dark"):
+        s = Scene()
+        floor = s.material("floor", (0.0, 0.0, 0.0) if name == "dark" else (1.0, 1.0, 1.0) if name == "checker" else
+                           (0.5, 0.5, 0.5))
+        if name == "checker":
+            rows = [[(255, 255, 255) if (x + y) % 2 else (0, 0, 0) for x in range(400)] for y in range(400)]
+            s.doc["materials"][floor]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": s.texture_pixels(rows)}
+        s.mesh("floor", plane(4), floor, uv_sets=[lambda p: ((p[0] + 2) / 4, (p[2] + 2) / 4)])
+        s.mesh("ceiling", [(a, c, b) for a, b, c in plane(4, 2.0)], s.material("ceiling", (0.0, 0.0, 0.0)))
+        s.light("lamp", "point", 100.0, translation=(0.0, 1.0, 0.0))
+        s.write(os.path.join(out, "%s-bounce.gltf" % name))
+
+
 if __name__ == "__main__":
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
@@ -526,3 +544,4 @@ if __name__ == "__main__":
     two_sided_card(out)
     moving(out)
     moving(out, character_static=True)
+    checker_bounce(out)

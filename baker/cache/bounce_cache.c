@@ -3,6 +3,7 @@
 
 #include "post/dilate.h"
 #include "util/lmb_math.h"
+#include "util/mat4.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -125,15 +126,20 @@ lmb_status lmb_cache_store_shadowmask(lmb_cache *c, uint32_t a, const lmb_texels
     return s;
 }
 
-/* Diffuse albedo / pi of primitive pr's material at barycentrics (b1, b2) of triangle f. */
-static void albedo_at(const lmb_cache *c, const lmb_primitive *pr, uint32_t f, double b1, double b2, double out[3])
+/* Diffuse albedo / pi of primitive pr's material at barycentrics (b1, b2) of triangle f, its
+ * texture averaged over the footprint of a ray that met it at distance t (ray_spread) on
+ * instance i. */
+static void albedo_at(const lmb_cache *c, const lmb_primitive *pr, uint32_t f, double b1, double b2, double t,
+                      uint32_t i, double out[3])
 {
     if (pr->material < 0) { /* glTF default material: fully metallic, no diffuse, unless materials.default.albedo */
         for (int j = 0; j < 3; j++)
             out[j] = c->scene->default_albedo[j] * LMB_INV_PI;
         return;
     }
-    lmb_material_albedo(c->textures, &c->scene->materials[pr->material], pr, f, b1, b2, out);
+    double footprint = c->ray_spread > 0 && isfinite(t) ? t * c->ray_spread : 0;
+    double scale = footprint > 0 ? cbrt(fabs(lmb_mat4_det3(c->scene->instances[i].world))) : 1.0;
+    lmb_material_albedo_over(c->textures, &c->scene->materials[pr->material], pr, f, b1, b2, footprint, scale, out);
     for (int j = 0; j < 3; j++)
         out[j] *= LMB_INV_PI;
 }
@@ -166,10 +172,10 @@ lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double 
     if (hit->backface) {
         if (!c->backs_reflect || pr->material < 0 || !c->scene->materials[pr->material].double_sided)
             return LMB_HIT_DARK;
-        albedo_at(c, pr, hit->prim, hit->u, hit->v, albedo_over_pi);
+        albedo_at(c, pr, hit->prim, hit->u, hit->v, hit->t, g->instance, albedo_over_pi);
         return LMB_HIT_BACK;
     }
-    albedo_at(c, pr, hit->prim, hit->u, hit->v, albedo_over_pi);
+    albedo_at(c, pr, hit->prim, hit->u, hit->v, hit->t, g->instance, albedo_over_pi);
     const lmb_layout_instance *li = &c->layout->instances[g->instance];
     if (!li->lightmapped)
         return LMB_HIT_UNMAPPED;

@@ -33,6 +33,9 @@ typedef struct lmb_cache {
     const lmb_textures *textures; /* borrowed, may be NULL */
     uint32_t atlas_count;
     uint32_t threads;   /* for dilation; 0: all cores (the bake sets it from the config) */
+    double ray_spread;  /* a gather ray's angular width (radians): the albedo texture is averaged over
+                           hit distance x this (sqrt(pi / samples.gather), the share of the cosine
+                           lobe's projected solid angle one ray stands for); 0: point lookups */
     int backs_reflect;  /* 1: a hit on the back of a doubleSided surface is LMB_HIT_BACK, not dark
                            (materials.reflect_sides; the bake sets it) */
     float **irradiance; /* owned: per atlas width x height x 3, dilated (NULL after lmb_cache_release) */

@@ -17,6 +17,8 @@ void lmb_textures_free(lmb_textures *t)
         free(t->t[i].pixels[LMB_TEX_COLOUR]);
         free(t->t[i].pixels[LMB_TEX_DATA]);
         free(t->t[i].alpha);
+        for (uint32_t k = 0; k < t->t[i].mips; k++)
+            free(t->t[i].mip[k]);
     }
     free(t->t);
     memset(t, 0, sizeof *t);
@@ -227,6 +229,36 @@ static int wrap_mode(int32_t gl, const char *axis, const lmb_scene *s, uint32_t 
     return LMB_WRAP_REPEAT;
 }
 
+/* The colour image's mip chain: each level the mean of 2 x 2 texels of the one above (an odd
+ * edge's last texel counted once), linear light, down to 1 x 1. Out of memory: fewer levels. */
+static void build_mips(lmb_texture *t)
+{
+    const float *src = t->pixels[LMB_TEX_COLOUR];
+    uint32_t w = t->width, h = t->height;
+    t->mips = 0;
+    while ((w > 1 || h > 1) && t->mips < LMB_TEXTURE_MIPS) {
+        uint32_t nw = (w + 1) / 2, nh = (h + 1) / 2;
+        float *dst = malloc(3 * (size_t)nw * nh * sizeof *dst + 1);
+        if (!dst)
+            return;
+        for (uint32_t y = 0; y < nh; y++)
+            for (uint32_t x = 0; x < nw; x++) {
+                uint32_t x1 = 2 * x + 1 < w ? 2 * x + 1 : 2 * x, y1 = 2 * y + 1 < h ? 2 * y + 1 : 2 * y;
+                for (int c = 0; c < 3; c++)
+                    dst[3 * ((size_t)y * nw + x) + (size_t)c] =
+                        0.25f * (src[3 * ((size_t)(2 * y) * w + 2 * x) + (size_t)c] + src[3 * ((size_t)(2 * y) * w + x1) + (size_t)c] +
+                                 src[3 * ((size_t)y1 * w + 2 * x) + (size_t)c] + src[3 * ((size_t)y1 * w + x1) + (size_t)c]);
+            }
+        t->mip[t->mips] = dst;
+        t->mip_w[t->mips] = nw;
+        t->mip_h[t->mips] = nh;
+        t->mips++;
+        src = dst;
+        w = nw;
+        h = nh;
+    }
+}
+
 /* Makes texture tex available in `space` (decoding the image once per space). */
 static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t tex, lmb_tex_space space,
                            lmb_texture *out, int *fatal, const lmb_log *log, lmb_error *err)
@@ -250,6 +282,8 @@ static lmb_status load_one(const lmb_scene *s, const lmb_gltf_view *v, uint32_t 
     out->width = w;
     out->height = h;
     out->pixels[space] = px;
+    if (space == LMB_TEX_COLOUR)
+        build_mips(out);
     const lmb_gltf_texture *gt = &v->textures[tex];
     out->wrap_s = wrap_mode(gt->wrap_s, "wrapS", s, tex, log);
     out->wrap_t = wrap_mode(gt->wrap_t, "wrapT", s, tex, log);
@@ -422,11 +456,11 @@ static long wrap(long i, long n, int mode)
     return m + (m < 0 ? n : 0);
 }
 
-static const float *texel(const lmb_texture *t, const float *px, int stride, long x, long y)
+static const float *texel(const lmb_texture *t, const float *px, uint32_t w, uint32_t h, int stride, long x, long y)
 {
-    x = wrap(x, (long)t->width, t->wrap_s);
-    y = wrap(y, (long)t->height, t->wrap_t);
-    return px + (size_t)stride * ((size_t)y * t->width + (size_t)x);
+    x = wrap(x, (long)w, t->wrap_s);
+    y = wrap(y, (long)h, t->wrap_t);
+    return px + (size_t)stride * ((size_t)y * w + (size_t)x);
 }
 
 /* Texel coordinates beyond this are folded back by whole periods first (REPEAT and
@@ -442,21 +476,22 @@ static double fold(double x, long n)
 
 /* `stride` channels per texel of px, the first `stride` of them looked up at glTF UV (u, v)
  * with t's wrap modes and filter. */
-static void sample_px(const lmb_texture *t, const float *px, int stride, double u, double v, float *out)
+static void sample_px(const lmb_texture *t, const float *px, uint32_t w, uint32_t h, int stride, double u, double v,
+                      float *out)
 {
-    double x = u * t->width, y = v * t->height;
+    double x = u * w, y = v * h;
     if (!isfinite(x) || !isfinite(y)) /* a broken UV or transform reads texel (0, 0) */
         x = y = 0;
     if (t->wrap_s == LMB_WRAP_CLAMP_TO_EDGE)
-        x = fmax(-1.0, fmin(x, (double)t->width + 1.0));
+        x = fmax(-1.0, fmin(x, (double)w + 1.0));
     else
-        x = fold(x, (long)t->width);
+        x = fold(x, (long)w);
     if (t->wrap_t == LMB_WRAP_CLAMP_TO_EDGE)
-        y = fmax(-1.0, fmin(y, (double)t->height + 1.0));
+        y = fmax(-1.0, fmin(y, (double)h + 1.0));
     else
-        y = fold(y, (long)t->height);
+        y = fold(y, (long)h);
     if (t->nearest) {
-        const float *a = texel(t, px, stride, (long)floor(x), (long)floor(y));
+        const float *a = texel(t, px, w, h, stride, (long)floor(x), (long)floor(y));
         for (int k = 0; k < stride; k++)
             out[k] = a[k];
         return;
@@ -465,15 +500,44 @@ static void sample_px(const lmb_texture *t, const float *px, int stride, double 
     y -= 0.5;
     double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
     long x0 = (long)fx, y0 = (long)fy;
-    const float *a = texel(t, px, stride, x0, y0), *b = texel(t, px, stride, x0 + 1, y0),
-                *c = texel(t, px, stride, x0, y0 + 1), *d = texel(t, px, stride, x0 + 1, y0 + 1);
+    const float *a = texel(t, px, w, h, stride, x0, y0), *b = texel(t, px, w, h, stride, x0 + 1, y0),
+                *c = texel(t, px, w, h, stride, x0, y0 + 1), *d = texel(t, px, w, h, stride, x0 + 1, y0 + 1);
     for (int k = 0; k < stride; k++)
         out[k] = (float)((1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]));
 }
 
 void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3])
 {
-    sample_px(t, t->pixels[space], 3, u, v, out);
+    sample_px(t, t->pixels[space], t->width, t->height, 3, u, v, out);
+}
+
+/* Level k of the colour chain: 0 the image, k > 0 mip[k - 1]. */
+static void level_sample(const lmb_texture *t, uint32_t k, double u, double v, float out[3])
+{
+    if (k == 0)
+        sample_px(t, t->pixels[LMB_TEX_COLOUR], t->width, t->height, 3, u, v, out);
+    else
+        sample_px(t, t->mip[k - 1], t->mip_w[k - 1], t->mip_h[k - 1], 3, u, v, out);
+}
+
+void lmb_texture_sample_footprint(const lmb_texture *t, double u, double v, double texels, float out[3])
+{
+    double lod = texels > 1 ? log2(texels) : 0;
+    if (!(lod > 0) || !t->mips) {
+        level_sample(t, 0, u, v, out);
+        return;
+    }
+    if (lod >= t->mips) {
+        level_sample(t, t->mips, u, v, out);
+        return;
+    }
+    uint32_t k = (uint32_t)lod;
+    float a[3], b[3];
+    double f = lod - k;
+    level_sample(t, k, u, v, a);
+    level_sample(t, k + 1, u, v, b);
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)((1 - f) * a[c] + f * b[c]);
 }
 
 float lmb_texture_sample_alpha(const lmb_texture *t, double u, double v)
@@ -481,7 +545,7 @@ float lmb_texture_sample_alpha(const lmb_texture *t, double u, double v)
     if (!t->alpha)
         return 1.0f;
     float a;
-    sample_px(t, t->alpha, 1, u, v, &a);
+    sample_px(t, t->alpha, t->width, t->height, 1, u, v, &a);
     return a;
 }
 
@@ -589,8 +653,38 @@ void lmb_material_base_colour(const lmb_textures *tx, const lmb_material *m, con
         out[k] = m->base_color[k] * base[k] * vc[k];
 }
 
+/* Texture texels per object unit on triangle tri of pr through slot ref (its UV set, transform
+ * and the image's size): sqrt of the triangle's area in texels over its area; 0 when unknown. */
+static double texels_per_unit(const lmb_texture *t, const lmb_texture_ref *ref, const lmb_primitive *pr, uint32_t tri)
+{
+    const float *uv = ref->texcoord == 0 ? pr->uv0 : ref->texcoord == 1 ? pr->uv1 : NULL;
+    if (!uv)
+        return 0;
+    const uint32_t *ix = pr->indices + 3 * (size_t)tri;
+    double q[3][2], e[2][3];
+    for (int k = 0; k < 3; k++) {
+        lmb_texture_ref_apply(ref, uv[2 * ix[k]], uv[2 * ix[k] + 1], &q[k][0], &q[k][1]);
+        q[k][0] *= t->width;
+        q[k][1] *= t->height;
+    }
+    for (int d = 0; d < 3; d++) {
+        e[0][d] = (double)pr->positions[3 * ix[1] + d] - pr->positions[3 * ix[0] + d];
+        e[1][d] = (double)pr->positions[3 * ix[2] + d] - pr->positions[3 * ix[0] + d];
+    }
+    double tex = fabs((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]));
+    double cx = e[0][1] * e[1][2] - e[0][2] * e[1][1], cy = e[0][2] * e[1][0] - e[0][0] * e[1][2],
+           cz = e[0][0] * e[1][1] - e[0][1] * e[1][0], geo = sqrt(cx * cx + cy * cy + cz * cz);
+    return geo > 0 && tex > 0 ? sqrt(tex / geo) : 0;
+}
+
 void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
                          double b1, double b2, double albedo[3])
+{
+    lmb_material_albedo_over(tx, m, pr, tri, b1, b2, 0.0, 1.0, albedo);
+}
+
+void lmb_material_albedo_over(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                              double b1, double b2, double footprint, double scale, double albedo[3])
 {
     double b[3] = {1.0 - b1 - b2, b1, b2};
     albedo[0] = albedo[1] = albedo[2] = 0;
@@ -598,7 +692,12 @@ void lmb_material_albedo(const lmb_textures *tx, const lmb_material *m, const lm
         return;
     float base[3] = {1, 1, 1};
     double vc[4] = {1, 1, 1, 1};
-    sample_slot(tx, &m->base_color_texture, LMB_TEX_COLOUR, pr, tri, b, base);
+    const lmb_texture *bt = footprint > 0 ? lmb_textures_get(tx, &m->base_color_texture, LMB_TEX_COLOUR) : NULL;
+    double tu, tv, per_unit = bt && bt->mips ? texels_per_unit(bt, &m->base_color_texture, pr, tri) : 0;
+    if (per_unit > 0 && slot_uv(&m->base_color_texture, pr, tri, b, &tu, &tv))
+        lmb_texture_sample_footprint(bt, tu, tv, footprint * per_unit / (scale > 0 ? scale : 1.0), base);
+    else
+        sample_slot(tx, &m->base_color_texture, LMB_TEX_COLOUR, pr, tri, b, base);
     if (pr->colors)
         vertex_colour(pr, tri, b, vc);
     double keep; /* the share of base colour that is diffuse */

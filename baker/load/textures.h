@@ -25,6 +25,8 @@ typedef enum lmb_tex_space {
 enum { LMB_WRAP_REPEAT = 10497, LMB_WRAP_MIRRORED_REPEAT = 33648, LMB_WRAP_CLAMP_TO_EDGE = 33071 };
 enum { LMB_FILTER_NEAREST = 9728 };
 
+#define LMB_TEXTURE_MIPS 13 /* down to 1 x 1 from 4096 */
+
 typedef struct lmb_texture {
     uint32_t width, height;
     float *pixels[2]; /* per lmb_tex_space: RGB, rows top to bottom; NULL when not loaded in that space */
@@ -33,6 +35,9 @@ typedef struct lmb_texture {
     int nearest;        /* magFilter NEAREST: nearest texel; else bilinear */
     float *alpha;       /* width x height alpha in [0, 1] when a MASK or BLEND material reads it, else NULL */
     int has_alpha;      /* its alpha was read (alpha NULL and has_alpha 1: the image has none: opaque) */
+    uint32_t mips;      /* colour mip levels below the image (each the 2 x 2 mean of the one above), 0: none */
+    float *mip[LMB_TEXTURE_MIPS];        /* owned: level k + 1's RGB, linear */
+    uint32_t mip_w[LMB_TEXTURE_MIPS], mip_h[LMB_TEXTURE_MIPS];
 } lmb_texture;
 
 typedef struct lmb_textures {
@@ -54,6 +59,11 @@ const lmb_texture *lmb_textures_get(const lmb_textures *tx, const lmb_texture_re
 /* Lookup at glTF UV (u, v) ((0, 0) = the image's top-left corner, (1, 1) its bottom-right),
  * with the texture's wrap modes and filter, in `space` (which must be loaded). */
 void lmb_texture_sample(const lmb_texture *t, lmb_tex_space space, double u, double v, float out[3]);
+
+/* The colour at glTF UV (u, v) averaged over a square of `texels` image texels a side (a ray's
+ * footprint): trilinear between the mip levels around log2(texels); at most 1 texel, the plain
+ * lookup. */
+void lmb_texture_sample_footprint(const lmb_texture *t, double u, double v, double texels, float out[3]);
 
 /* The alpha channel at glTF UV (u, v), as lmb_texture_sample filters colour; 1 when the image
  * has no alpha (or it was not read). */
@@ -78,6 +88,12 @@ double lmb_material_transmission(const lmb_textures *tx, const lmb_material *m, 
 /* The base colour (linear RGB: factor x texture x COLOR_0), the tint of transmitted light. */
 void lmb_material_base_colour(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
                               double b1, double b2, double out[3]);
+
+/* lmb_material_albedo with the base colour texture averaged over `footprint` world units around
+ * the point (a bounce ray's footprint at its hit, mapped into the texture by the triangle's UV
+ * density; `scale`: world units per object unit of the instance); footprint 0: a point lookup. */
+void lmb_material_albedo_over(const lmb_textures *tx, const lmb_material *m, const lmb_primitive *pr, uint32_t tri,
+                              double b1, double b2, double footprint, double scale, double albedo[3]);
 
 /* The diffuse albedo (linear RGB, what a viewer multiplies the lightmap by, times pi) of
  * material m on primitive pr at barycentrics (b1, b2) of triangle tri:

@@ -250,6 +250,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     cache.threads = cfg->threads;
     cache.backs_reflect = cfg->reflect_sides == LMB_EMIT_MATERIAL;
+    cache.ray_spread = sqrt(LMB_PI / (cfg->gather_rays ? cfg->gather_rays : 1));
     if (st == LMB_OK && progress)
         progress(user, "scene set-up", 1, 1);
     lmb_steps_mode mode = run->mode == LMB_FARM_STEP ? LMB_STEPS_SHARD : run->mode == LMB_FARM_FINISH ? LMB_STEPS_FINISH

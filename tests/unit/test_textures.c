@@ -26,7 +26,7 @@ static lmb_texture grid_texture(int wrap_s, int wrap_t, int nearest)
             grid[3 * (4 * y + x) + 1] = (float)y;
             grid[3 * (4 * y + x) + 2] = (float)(10 * x + y);
         }
-    lmb_texture t = {4, 4, {NULL, grid}, {0, 0, 0}, wrap_s, wrap_t, nearest, NULL, 0};
+    lmb_texture t = {4, 4, {NULL, grid}, {0, 0, 0}, wrap_s, wrap_t, nearest, NULL, 0, 0, {NULL}, {0}, {0}};
     return t;
 }
 
@@ -169,9 +169,9 @@ static void test_albedo(void)
     uint32_t idx[3];
     lmb_primitive pr = one_triangle(uv0, idx);
     lmb_texture tex[3] = {
-        {1, 1, {NULL, mr}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0},     /* metallicRoughness (data) */
-        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0}, /* base colour */
-        {1, 1, {spec, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0},   /* specular */
+        {1, 1, {NULL, mr}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0, 0, {NULL}, {0}, {0}},     /* metallicRoughness (data) */
+        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0, 0, {NULL}, {0}, {0}}, /* base colour */
+        {1, 1, {spec, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0, 0, {NULL}, {0}, {0}},   /* specular */
     };
     lmb_textures tx = {3, tex};
     lmb_material m;
@@ -221,8 +221,8 @@ static void test_alpha_colour_transmission(void)
     lmb_primitive pr = one_triangle(uv0, idx);
     pr.colors = rgba;
     lmb_texture tex[2] = {
-        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, alpha, 1}, /* base colour + alpha */
-        {1, 1, {NULL, red}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0},     /* transmission (data) */
+        {1, 1, {colour, NULL}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, alpha, 1, 0, {NULL}, {0}, {0}}, /* base colour + alpha */
+        {1, 1, {NULL, red}, {0, 0, 0}, LMB_WRAP_REPEAT, LMB_WRAP_REPEAT, 0, NULL, 0, 0, {NULL}, {0}, {0}},     /* transmission (data) */
     };
     lmb_textures tx = {2, tex};
     lmb_material m;
