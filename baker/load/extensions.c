@@ -3,8 +3,9 @@
  * changes specular reflection, layers on top of the base (sheen, clear coat), refraction,
  * animation or metadata changes nothing the bake reads, and a file requiring it is baked with
  * a warning naming the file and the extension. Compressed geometry (Draco, meshopt) is decoded
- * before the file is read (decompress.h). One that changes the diffuse colour in a way lmbake
- * does not model (KHR_materials_diffuse_transmission) is not listed: requiring it is an error. EXT_lights_image_based is the sky when the config sets none
+ * before the file is read (decompress.h). KHR_materials_diffuse_transmission is baked with a
+ * warning as an opaque surface (its diffusely transmitted light is not modelled yet). One
+ * lmbake does not know is not listed: requiring it is an error. EXT_lights_image_based is the sky when the config sets none
  * (lights/sky.c: its irradiance spherical harmonics; its specular cube maps are not read).
  * Choices worth knowing:
  *   - KHR_materials_unlit: an unlit surface shows its base colour whatever the light, so it
@@ -39,6 +40,9 @@ static const lmb_extension_info table[] = {
     {"KHR_materials_dispersion", LMB_EXT_IGNORED, "it changes refraction only, which a diffuse bake ignores"},
     {"KHR_materials_transmission", LMB_EXT_SUPPORTED, NULL},
     {"KHR_materials_volume", LMB_EXT_SUPPORTED, NULL},
+    {"KHR_materials_diffuse_transmission", LMB_EXT_IGNORED,
+     "the light it lets through diffusely (leaves lit from behind) is not baked: the surface blocks light and "
+     "reflects its base colour"},
     {"KHR_materials_variants", LMB_EXT_IGNORED, "each primitive is baked with its default material, not the variants"},
     {"KHR_materials_unlit", LMB_EXT_IGNORED,
      "unlit materials reflect no light in the bake (their colour does not depend on light) but still block it"},

@@ -138,9 +138,13 @@ def cases():
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "KHR_materials_clearcoat"]
     yield "required-sheen", d
     d = copy.deepcopy(d)
-    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "KHR_materials_diffuse_transmission"]
+    d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_sheen", "ADOBE_materials_thin_transparency"]
     yield "required-sheen-unsupported", d
     # a required extension that changes the diffuse colour in a way lmbake does not model: refused
+    d = copy.deepcopy(ok)
+    d["extensionsUsed"] = d["extensionsRequired"] = ["ADOBE_materials_thin_transparency"]
+    yield "required-unknown", d
+    # a required extension lmbake knows but does not model: baked with a warning saying what is done
     d = copy.deepcopy(ok)
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_diffuse_transmission"]
     yield "required-diffuse-transmission", d
