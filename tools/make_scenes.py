@@ -31,6 +31,8 @@ usage: make_scenes.py OUTDIR
                       cells (400 x 400, mean albedo 0.5), a 4 x 4 ceiling of albedo 0 2 m above it and a
                       100 cd point light between them: the ceiling's indirect light is the floor's
                       bounce; flat-bounce.gltf: the floor's albedo 0.5 flat; dark-bounce.gltf: 0
+  translucent-card.gltf the card over a black ground, KHR_materials_diffuse_transmission 1 (white):
+                      the ground under it gets 1000 lux x the card's view factor
   many-lights.gltf    10 x 10 plane under 20 point lights (more than are looped: drawn by
                       their unshadowed irradiance at each point)
   disk-textured.gltf  the same disk with an emissive texture of sRGB 128/255 (linear 0.2159)
@@ -474,7 +476,21 @@ def alpha_cards(out):
     s.write(os.path.join(out, "alpha-cards.gltf"))
 
 
+def translucent_card(out):
+    """The card of two-sided-card transmitting all its diffuse light (KHR_materials_diffuse_transmission
+    1, white) over a black ground: the ground under it gets the sun through it, diffusely."""
+    s = Scene()
+    s.mesh("ground", plane(10), s.material("ground", (0.0, 0.0, 0.0)))
+    card = s.material("card", (0.8, 0.8, 0.8))
+    s.doc["materials"][card]["extensions"] = {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0}}
+    s.require("KHR_materials_diffuse_transmission")
+    s.mesh("card", quad((-1, 1, 1), (1, 1, 1), (1, 1, -1), (-1, 1, -1)), card)  # faces +y
+    s.light("sun", "directional", 1000.0, rotation=[-math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5)])
+    s.write(os.path.join(out, "translucent-card.gltf"))
+
+
 def two_sided_card(out):
+    translucent_card(out)
     s = Scene()
     s.mesh("ground", plane(10), s.material("ground", (0.5, 0.5, 0.5)))
     card = s.material("card", (0.8, 0.8, 0.8), double_sided=True)

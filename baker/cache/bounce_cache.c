@@ -37,6 +37,8 @@ lmb_status lmb_cache_init(lmb_cache *c, const lmb_scene *scene, const lmb_layout
     c->rt = rt;
     c->textures = textures;
     c->atlas_count = layout->atlas_count;
+    for (uint32_t m = 0; m < scene->material_count; m++)
+        c->diffuse_through |= scene->materials[m].diffuse_transmission > 0;
     c->irradiance = calloc((size_t)c->atlas_count + 1, sizeof *c->irradiance);
     c->state = calloc((size_t)c->atlas_count + 1, sizeof *c->state);
     if (!c->irradiance || !c->state)
@@ -163,26 +165,47 @@ static void bilinear(const float *img, uint32_t w, uint32_t h, double x, double 
         }
 }
 
+/* The cached irradiance of the front at the hit (its lightmap, bilinear). */
+static void front_light(const lmb_cache *c, const lmb_rt_geom *g, const lmb_rt_hit *hit, double e[3])
+{
+    const lmb_layout_instance *li = &c->layout->instances[g->instance];
+    double uv[6];
+    lmb_layout_uv(c->layout, g->instance, (size_t)g->first_triangle + hit->prim, uv);
+    double b1 = hit->u, b2 = hit->v, b0 = 1.0 - b1 - b2;
+    double x = b0 * uv[0] + b1 * uv[2] + b2 * uv[4], y = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
+    bilinear(c->irradiance[li->atlas], c->layout->width[li->atlas], c->layout->height[li->atlas], x, y, e);
+}
+
 lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double albedo_over_pi[3], double e[3])
 {
     e[0] = e[1] = e[2] = 0;
     albedo_over_pi[0] = albedo_over_pi[1] = albedo_over_pi[2] = 0;
     const lmb_rt_geom *g = &c->rt->geoms[hit->geom];
     const lmb_primitive *pr = &c->scene->primitives[g->primitive];
+    const lmb_material *m = pr->material >= 0 ? &c->scene->materials[pr->material] : NULL;
+    const lmb_layout_instance *li = &c->layout->instances[g->instance];
     if (hit->backface) {
-        if (!c->backs_reflect || pr->material < 0 || !c->scene->materials[pr->material].double_sided)
+        int through = m && m->diffuse_transmission > 0;
+        if (!through && (!c->backs_reflect || !m || !m->double_sided))
             return LMB_HIT_DARK;
         albedo_at(c, pr, hit->prim, hit->u, hit->v, hit->t, g->instance, albedo_over_pi);
+        if (through && li->lightmapped) /* the front's light, which it lets through to the back */
+            front_light(c, g, hit, e);
         return LMB_HIT_BACK;
     }
     albedo_at(c, pr, hit->prim, hit->u, hit->v, hit->t, g->instance, albedo_over_pi);
-    const lmb_layout_instance *li = &c->layout->instances[g->instance];
     if (!li->lightmapped)
         return LMB_HIT_UNMAPPED;
-    double uv[6];
-    lmb_layout_uv(c->layout, g->instance, (size_t)g->first_triangle + hit->prim, uv);
-    double b1 = hit->u, b2 = hit->v, b0 = 1.0 - b1 - b2;
-    double x = b0 * uv[0] + b1 * uv[2] + b2 * uv[4], y = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
-    bilinear(c->irradiance[li->atlas], c->layout->width[li->atlas], c->layout->height[li->atlas], x, y, e);
+    front_light(c, g, hit, e);
     return LMB_HIT_CACHED;
+}
+
+double lmb_cache_diffuse_through(const lmb_cache *c, const lmb_rt_hit *hit, double out_over_pi[3])
+{
+    const lmb_primitive *pr = &c->scene->primitives[c->rt->geoms[hit->geom].primitive];
+    const lmb_material *m = pr->material >= 0 ? &c->scene->materials[pr->material] : NULL;
+    double f = m ? m->diffuse_transmission : 0.0;
+    for (int k = 0; k < 3; k++)
+        out_over_pi[k] = f > 0 ? f * m->diffuse_transmission_color[k] * LMB_INV_PI : 0.0;
+    return f;
 }

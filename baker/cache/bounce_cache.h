@@ -36,6 +36,7 @@ typedef struct lmb_cache {
     double ray_spread;  /* a gather ray's angular width (radians): the albedo texture is averaged over
                            hit distance x this (sqrt(pi / samples.gather), the share of the cosine
                            lobe's projected solid angle one ray stands for); 0: point lookups */
+    int diffuse_through; /* some material transmits diffusely (KHR_materials_diffuse_transmission) */
     int backs_reflect;  /* 1: a hit on the back of a doubleSided surface is LMB_HIT_BACK, not dark
                            (materials.reflect_sides; the bake sets it) */
     float **irradiance; /* owned: per atlas width x height x 3, dilated (NULL after lmb_cache_release) */
@@ -74,7 +75,13 @@ lmb_status lmb_cache_store_direction(lmb_cache *c, uint32_t a, const lmb_texels 
 /* Atlas a's shadowmask image := v (4 floats per listed texel of t), dilated as the irradiance. */
 lmb_status lmb_cache_store_shadowmask(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *v, lmb_error *err);
 
-/* At a ray hit: albedo / pi (RGB) and, for LMB_HIT_CACHED, the irradiance E (RGB). */
+/* At a ray hit: albedo / pi (RGB, the reflected share) and, for LMB_HIT_CACHED, the irradiance E
+ * (RGB); for LMB_HIT_BACK of a surface that transmits diffusely, E holds the front's (which it
+ * lets through to the back). */
 lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double albedo_over_pi[3], double e[3]);
+
+/* KHR_materials_diffuse_transmission at a hit: its factor f (returned; 0: none) and
+ * f x colour / pi into out_over_pi: the radiance leaving one side per lux on the other. */
+double lmb_cache_diffuse_through(const lmb_cache *c, const lmb_rt_hit *hit, double out_over_pi[3]);
 
 #endif

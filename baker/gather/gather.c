@@ -43,11 +43,16 @@ static inline void hit_radiance(point_rays *pr, const double w[3], const lmb_rt_
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, h, albedo, e);
     if (kind == LMB_HIT_DARK || (kind == LMB_HIT_UNMAPPED && job->unmapped_dark))
         return;
-    if (kind == LMB_HIT_BACK) { /* a doubleSided back: its light estimated where the ray met it */
+    double through[3];
+    if (kind == LMB_HIT_BACK) { /* a back that reflects: its light estimated where the ray met it */
+        double front[3] = {e[0], e[1], e[2]};
         lmb_rng rng = lmb_rng_make(job->seed, pr->key, ((uint64_t)job->pass << 32) | sample);
         pr->rays += lmb_cache_back_irradiance(job->cache, job->direct, h, pr->o, w, job->direct_at_hits, &rng, e);
         for (int k = 0; k < 3; k++)
             out[k] = albedo[k] * e[k];
+        if (job->cache->diffuse_through && lmb_cache_diffuse_through(job->cache, h, through) > 0)
+            for (int k = 0; k < 3; k++) /* and the front's light it lets through */
+                out[k] += through[k] * front[k];
         return;
     }
     if (kind == LMB_HIT_UNMAPPED || job->direct_at_hits) {
@@ -61,6 +66,13 @@ static inline void hit_radiance(point_rays *pr, const double w[3], const lmb_rt_
     }
     for (int k = 0; k < 3; k++)
         out[k] = albedo[k] * e[k];
+    if (kind == LMB_HIT_CACHED && job->cache->diffuse_through && lmb_cache_diffuse_through(job->cache, h, through) > 0) {
+        double back[3]; /* the back's light it lets through to the front, estimated there */
+        lmb_rng rng = lmb_rng_make(job->seed, pr->key ^ 0x444946465553ull, ((uint64_t)job->pass << 32) | sample);
+        pr->rays += lmb_cache_back_irradiance(job->cache, job->direct, h, pr->o, w, job->direct_at_hits, &rng, back);
+        for (int k = 0; k < 3; k++)
+            out[k] += through[k] * back[k];
+    }
 }
 
 /* Radiance arriving from w: B at the first opaque hit, seen through the surfaces light partly
@@ -166,7 +178,19 @@ static void reference(point_rays *pr, double out[3])
                 albedo[k] *= cover;
             lmb_shading_point y;
             hit_point(job->rt, o, w, &h, &y);
-            for (int k = 0; kind == LMB_HIT_BACK && k < 3; k++) /* a doubleSided back: the path goes on from it */
+            int back = kind == LMB_HIT_BACK; /* a back that reflects: the path goes on from it */
+            double through[3];
+            if (job->cache->diffuse_through && lmb_cache_diffuse_through(job->cache, &h, through) > 0) {
+                /* reflect or go through, by their weights (each then divided by its probability) */
+                double lr = lmb_luminance(albedo), lt = lmb_luminance(through), q = lr / (lr + lt);
+                if (!(lr + lt > 0))
+                    break;
+                int reflect = lmb_rng_next(&rng) < q;
+                for (int k = 0; k < 3; k++)
+                    albedo[k] = reflect ? albedo[k] / q : cover * through[k] / (1 - q);
+                back ^= !reflect;
+            }
+            for (int k = 0; back && k < 3; k++)
                 y.n[k] = y.ng[k] = -y.ng[k];
             double e[3];
             pr->rays += lmb_direct_at(job->direct, &y, 1, &rng, e, NULL);

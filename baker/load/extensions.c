@@ -40,9 +40,7 @@ static const lmb_extension_info table[] = {
     {"KHR_materials_dispersion", LMB_EXT_IGNORED, "it changes refraction only, which a diffuse bake ignores"},
     {"KHR_materials_transmission", LMB_EXT_SUPPORTED, NULL},
     {"KHR_materials_volume", LMB_EXT_SUPPORTED, NULL},
-    {"KHR_materials_diffuse_transmission", LMB_EXT_IGNORED,
-     "the light it lets through diffusely (leaves lit from behind) is not baked: the surface blocks light and "
-     "reflects its base colour"},
+    {"KHR_materials_diffuse_transmission", LMB_EXT_SUPPORTED, NULL}, /* cache/back_light.h */
     {"KHR_materials_variants", LMB_EXT_IGNORED, "each primitive is baked with its default material, not the variants"},
     {"KHR_materials_unlit", LMB_EXT_IGNORED,
      "unlit materials reflect no light in the bake (their colour does not depend on light) but still block it"},

@@ -339,6 +339,10 @@ void fill_materials(lmb_gltf_doc &d)
         c.attenuation_distance = number_member(vol, "attenuationDistance", INFINITY);
         c.attenuation_color[0] = c.attenuation_color[1] = c.attenuation_color[2] = 1.0;
         number_array(vol, "attenuationColor", c.attenuation_color, 3);
+        const tinygltf::Value *dt = extension(m.extensions, "KHR_materials_diffuse_transmission");
+        c.diffuse_transmission = number_member(dt, "diffuseTransmissionFactor", 0.0);
+        c.diffuse_transmission_color[0] = c.diffuse_transmission_color[1] = c.diffuse_transmission_color[2] = 1.0;
+        number_array(dt, "diffuseTransmissionColorFactor", c.diffuse_transmission_color, 3);
         d.materials.push_back(c);
     }
 }

@@ -107,6 +107,8 @@ typedef struct lmb_gltf_material {
      * (INFINITY when absent) and attenuationColor */
     int has_volume;
     double thickness, attenuation_distance, attenuation_color[3];
+    /* KHR_materials_diffuse_transmission: factor 0 and colour 1 1 1 by default */
+    double diffuse_transmission, diffuse_transmission_color[3];
 } lmb_gltf_material;
 
 /* A glTF texture and its sampler (glTF defaults when it has none). */

@@ -49,6 +49,17 @@ static lmb_status load_passage(const char *path, const lmb_gltf_material *g, con
     m->alpha_cutoff = (float)g->alpha_cutoff;
     m->transmission_texture.texture = -1;
     m->volume_tint[0] = m->volume_tint[1] = m->volume_tint[2] = 1.0f;
+    if (!(g->diffuse_transmission >= 0.0 && g->diffuse_transmission <= 1.0))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: KHR_materials_diffuse_transmission diffuseTransmissionFactor %g "
+                             "must be a number in [0, 1]", path, label, g->diffuse_transmission);
+    m->diffuse_transmission = (float)g->diffuse_transmission;
+    for (int c = 0; c < 3; c++) {
+        if (!(g->diffuse_transmission_color[c] >= 0.0 && g->diffuse_transmission_color[c] <= 1.0))
+            return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s: KHR_materials_diffuse_transmission "
+                                 "diffuseTransmissionColorFactor[%d] %g must be in [0, 1]", path, label, c,
+                                 g->diffuse_transmission_color[c]);
+        m->diffuse_transmission_color[c] = (float)g->diffuse_transmission_color[c];
+    }
     if (!g->has_transmission)
         return LMB_OK;
     if (!(g->transmission >= 0.0 && g->transmission <= 1.0))

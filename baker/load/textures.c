@@ -715,6 +715,8 @@ void lmb_material_albedo_over(const lmb_textures *tx, const lmb_material *m, con
     keep = keep < 0 ? 0 : keep > 1 ? 1 : keep;
     if (m->transmission > 0) /* glTF: transmission replaces diffuse */
         keep *= 1.0 - lmb_material_transmission(tx, m, pr, tri, b1, b2);
+    if (m->diffuse_transmission > 0) /* KHR_materials_diffuse_transmission: its share goes through */
+        keep *= 1.0 - m->diffuse_transmission;
     if (!pr->colors) {
         for (int k = 0; k < 3; k++)
             albedo[k] = keep * m->base_color[k] * base[k];

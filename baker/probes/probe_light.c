@@ -85,9 +85,14 @@ static inline void reflected(const probe_job *job, uint32_t i, uint64_t stream, 
     b[0] = b[1] = b[2] = 0;
     double albedo[3], e[3];
     lmb_hit_kind kind = lmb_cache_lookup(job->cache, h, albedo, e);
-    if (kind == LMB_HIT_BACK) { /* a doubleSided back: its light estimated where the ray met it */
+    double through[3], other[3] = {e[0], e[1], e[2]}; /* a back hit's: the front's light */
+    int passes = job->cache->diffuse_through && lmb_cache_diffuse_through(job->cache, h, through) > 0;
+    if (kind == LMB_HIT_BACK) { /* a back that reflects: its light estimated where the ray met it */
         lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x50524f42ull ^ i, stream);
         *rays += lmb_cache_back_irradiance(job->cache, job->direct, h, p, w, 0, &rng, e);
+    } else if (kind == LMB_HIT_CACHED && passes) { /* the back's light it lets through, estimated there */
+        lmb_rng rng = lmb_rng_make(job->cfg->seed, 0x44494646ull ^ i, stream);
+        *rays += lmb_cache_back_irradiance(job->cache, job->direct, h, p, w, 0, &rng, other);
     }
     if (kind == LMB_HIT_UNMAPPED) {
         lmb_shading_point y;
@@ -101,7 +106,7 @@ static inline void reflected(const probe_job *job, uint32_t i, uint64_t stream, 
     }
     if (kind != LMB_HIT_DARK)
         for (int c = 0; c < 3; c++)
-            b[c] = albedo[c] * e[c];
+            b[c] = albedo[c] * e[c] + (passes && kind != LMB_HIT_UNMAPPED ? through[c] * other[c] : 0.0);
 }
 
 /* Radiance l and reflected light b arriving at the probe at p along w through the surfaces light

@@ -169,6 +169,8 @@ typedef struct lmb_material {
     lmb_texture_ref transmission_texture; /* its texture: transmission in red, linear */
     int volume;                         /* KHR_materials_volume: a closed mesh, tinted once on entering */
     float volume_tint[3];               /* volume: attenuationColor^(thicknessFactor / attenuationDistance) */
+    float diffuse_transmission;         /* KHR_materials_diffuse_transmission factor (0: none) */
+    float diffuse_transmission_color[3]; /* its colour factor (textures not read) */
 } lmb_material;
 
 /* How a light is baked (lights.modes, or the light's extras.lightmap_mode): as engines light

@@ -144,7 +144,7 @@ def cases():
     d = copy.deepcopy(ok)
     d["extensionsUsed"] = d["extensionsRequired"] = ["ADOBE_materials_thin_transparency"]
     yield "required-unknown", d
-    # a required extension lmbake knows but does not model: baked with a warning saying what is done
+    # KHR_materials_diffuse_transmission required: implemented, it loads
     d = copy.deepcopy(ok)
     d["extensionsUsed"] = d["extensionsRequired"] = ["KHR_materials_diffuse_transmission"]
     yield "required-diffuse-transmission", d

@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""A surface that transmits diffusely (KHR_materials_diffuse_transmission) lights what is behind it.
+
+usage: check_translucent.py LMBAKE WORKDIR
+
+tools/make_scenes.py translucent-card: a 2 x 2 card 1 m above a black ground, a 1000-lux sun
+straight down, the card's diffuseTransmissionFactor 1 (white): its top's 1000 lux leave its
+underside as radiance 1000 / pi, so a ground point gets 1000 x F, F its view factor of the card
+(a differential area under a parallel rectangle: four corner rectangles, Howell's catalogue
+C-11). The ground's mean within 0.5 m of the point under the centre, baked at the defaults,
+against F's mean there (numerical): within 2%. Before, the file was refused; then baked opaque
+(0 lux under the card).
+"""
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+from check_two_sided import ground_mean  # noqa: E402
+
+
+def corner(a, b, h):
+    """View factor from a point to a parallel a x b rectangle at height h with a corner above it."""
+    x, y = a / h, b / h
+    return (x / math.sqrt(1 + x * x) * math.atan(y / math.sqrt(1 + x * x)) +
+            y / math.sqrt(1 + y * y) * math.atan(x / math.sqrt(1 + y * y))) / (2 * math.pi)
+
+
+def view_factor(px, pz, half=1.0, h=1.0):
+    return sum(corner(abs(sx - px), abs(sz - pz), h) for sx in (-half, half) for sz in (-half, half))
+
+
+def main():
+    lmbake, work = sys.argv[1], sys.argv[2]
+    os.makedirs(work, exist_ok=True)
+    scenes = os.path.join(work, "scenes")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
+                   stdout=subprocess.DEVNULL)
+    cfg = os.path.join(work, "c.yaml")
+    with open(cfg, "w") as f:
+        f.write("lights: {sun_angle: 0}\noutput: {formats: [exr]}\n")
+    out = os.path.join(work, "out")
+    p = subprocess.run([lmbake, "bake", os.path.join(scenes, "translucent-card.gltf"), "-c", cfg, "-o", out, "-q"],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        sys.exit("bake failed (%d): %s" % (p.returncode, p.stderr))
+    got, n = ground_mean(out)
+    g = (np.arange(200) + 0.5) / 200 - 0.5
+    want = 1000.0 * np.mean([view_factor(x, z) for x in g[::4] for z in g[::4]])
+    rel = got / want - 1
+    ok = abs(rel) <= 0.02
+    print("translucent card: ground under it, mean E %.2f lux (%d texels), 1000 lux x its view factor %.2f lux: "
+          "%+.2f%% (bound 2%%)  %s" % (got, n, want, 100 * rel, "ok" if ok else "FAIL"))
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
