@@ -343,6 +343,8 @@ void fill_materials(lmb_gltf_doc &d)
         c.diffuse_transmission = number_member(dt, "diffuseTransmissionFactor", 0.0);
         c.diffuse_transmission_color[0] = c.diffuse_transmission_color[1] = c.diffuse_transmission_color[2] = 1.0;
         number_array(dt, "diffuseTransmissionColorFactor", c.diffuse_transmission_color, 3);
+        c.diffuse_transmission_textures = (dt && member(*dt, "diffuseTransmissionTexture") ? 1 : 0) +
+                                          (dt && member(*dt, "diffuseTransmissionColorTexture") ? 1 : 0);
         d.materials.push_back(c);
     }
 }

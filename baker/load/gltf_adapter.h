@@ -109,6 +109,7 @@ typedef struct lmb_gltf_material {
     double thickness, attenuation_distance, attenuation_color[3];
     /* KHR_materials_diffuse_transmission: factor 0 and colour 1 1 1 by default */
     double diffuse_transmission, diffuse_transmission_color[3];
+    int diffuse_transmission_textures; /* its textures given (diffuseTransmissionTexture, ...ColorTexture) */
 } lmb_gltf_material;
 
 /* A glTF texture and its sampler (glTF defaults when it has none). */

@@ -130,6 +130,15 @@ lmb_status lmb_scene_load(const char *path, const lmb_config *cfg, lmb_scene **o
         lmb_accessor_ctx ctx = {v, path};
         s->node_count = v->node_count;
         warn_ignored_extensions(path, v, log);
+        for (uint32_t m = 0; m < v->material_count; m++)
+            if (v->materials[m].diffuse_transmission_textures) {
+                char label[160];
+                lmb_warn(log, "%s: %s: KHR_materials_diffuse_transmission's textures are not read; its factors are "
+                         "(transmission %g, colour %g %g %g)", path,
+                         lmb_object_label(label, "material", m, v->materials[m].name),
+                         v->materials[m].diffuse_transmission, v->materials[m].diffuse_transmission_color[0],
+                         v->materials[m].diffuse_transmission_color[1], v->materials[m].diffuse_transmission_color[2]);
+            }
         st = lmb_load_materials(path, v, s, err);
         if (st == LMB_OK)
             st = load_meshes(&ctx, s, log, err);
