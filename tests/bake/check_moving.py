@@ -26,6 +26,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+import bake_cli  # noqa: E402
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from check_analytic import load_output, texels  # noqa: E402
 from make_scenes import MOVING  # noqa: E402
@@ -71,9 +72,7 @@ def probes(out):
 def main():
     lmbake, work = sys.argv[1], sys.argv[2]
     os.makedirs(work, exist_ok=True)
-    scenes = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
-                   stdout=subprocess.DEVNULL)
+    scenes = bake_cli.scenes(work)
     with open(os.path.join(work, "c.yaml"), "w") as f:
         f.write(CONFIG)
     ok = True

@@ -25,6 +25,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+import bake_cli  # noqa: E402
 from object_means import luminance, object_means  # noqa: E402
 
 BIN = os.path.join(ROOT, "node_modules", ".bin")
@@ -51,9 +52,7 @@ def bake(lmbake, work, scene, name):
 def main():
     lmbake, work = sys.argv[1], sys.argv[2]
     os.makedirs(work, exist_ok=True)
-    scenes = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
-                   stdout=subprocess.DEVNULL)
+    scenes = bake_cli.scenes(work)
     with open(os.path.join(work, "bake.yaml"), "w") as f:
         f.write(CONFIG)
     ok = True

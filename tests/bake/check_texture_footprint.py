@@ -22,6 +22,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+import bake_cli  # noqa: E402
 from object_means import _image  # noqa: E402
 
 CONFIG = ("texel_density: 16\nbounces: 1\nirradiance_cache: {error: 0}\ndenoise: {indirect: false, direct: false}\n"
@@ -56,9 +57,7 @@ def noise(e, valid):
 def main():
     lmbake, work = sys.argv[1], sys.argv[2]
     os.makedirs(work, exist_ok=True)
-    scenes = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
-                   stdout=subprocess.DEVNULL)
+    scenes = bake_cli.scenes(work)
     with open(os.path.join(work, "c.yaml"), "w") as f:
         f.write(CONFIG)
     dark, mask = ceiling(lmbake, work, scenes, "dark")

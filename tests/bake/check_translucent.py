@@ -23,6 +23,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
+import bake_cli  # noqa: E402
 from check_two_sided import ground_mean  # noqa: E402
 
 
@@ -41,9 +42,7 @@ def main():
     lmbake, work = sys.argv[1], sys.argv[2]
     budget = "atlas: {texels: %s}\n" % sys.argv[3] if len(sys.argv) > 3 else ""
     os.makedirs(work, exist_ok=True)
-    scenes = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
-                   stdout=subprocess.DEVNULL)
+    scenes = bake_cli.scenes(work)
     cfg = os.path.join(work, "c.yaml")
     with open(cfg, "w") as f:
         f.write("lights: {sun_angle: 0}\noutput: {formats: [exr]}\n" + budget)

@@ -27,6 +27,8 @@ import OpenImageIO as oiio
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+import bake_cli  # noqa: E402
 
 
 def accessor(doc, bins, index):
@@ -83,9 +85,7 @@ def bake(lmbake, work, scene, name, config, args=()):
 
 def main():
     lmbake, work = sys.argv[1], sys.argv[2]
-    scenes = os.path.join(work, "scenes")
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
-                   stdout=subprocess.DEVNULL)
+    scenes = bake_cli.scenes(work)
     scene = os.path.join(scenes, "two-sided-card.gltf")
     got, n = bake(lmbake, work, scene, "defaults", "")
     ref, m = bake(lmbake, work, scene, "reference", "texel_density: 8\n", ("--reference", "--rays", "2048"))
