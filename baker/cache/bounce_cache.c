@@ -20,7 +20,10 @@ void lmb_cache_free(lmb_cache *c)
             free(c->direction[a]);
         if (c->shadowmask)
             free(c->shadowmask[a]);
+        if (c->sides)
+            lmb_texel_sides_free(&c->sides[a]);
     }
+    free(c->sides);
     free(c->irradiance);
     free(c->state);
     free(c->direction);
@@ -41,7 +44,8 @@ lmb_status lmb_cache_init(lmb_cache *c, const lmb_scene *scene, const lmb_layout
         c->diffuse_through |= scene->materials[m].diffuse_transmission > 0;
     c->irradiance = calloc((size_t)c->atlas_count + 1, sizeof *c->irradiance);
     c->state = calloc((size_t)c->atlas_count + 1, sizeof *c->state);
-    if (!c->irradiance || !c->state)
+    c->sides = calloc((size_t)c->atlas_count + 1, sizeof *c->sides);
+    if (!c->irradiance || !c->state || !c->sides)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory");
     for (uint32_t a = 0; a < c->atlas_count; a++) {
         size_t n = (size_t)layout->width[a] * layout->height[a];
@@ -77,6 +81,11 @@ void lmb_cache_release(lmb_cache *c)
 
 lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err)
 {
+    if (!c->sides[a].near && t->edge) {
+        lmb_status st = lmb_texel_sides_build(&c->sides[a], t, c->layout->width[a], c->layout->height[a], err);
+        if (st != LMB_OK)
+            return st;
+    }
     if (!c->irradiance[a])
         c->irradiance[a] = malloc((3 * (size_t)c->layout->width[a] * c->layout->height[a] + 1) * sizeof **c->irradiance);
     if (!c->irradiance[a])
@@ -146,8 +155,9 @@ static void albedo_at(const lmb_cache *c, const lmb_primitive *pr, uint32_t f, d
         out[j] *= LMB_INV_PI;
 }
 
-/* Bilinear lookup at atlas texel coordinates (x, y) (texel centres at half integers), clamped. */
-static void bilinear(const float *img, uint32_t w, uint32_t h, double x, double y, double out[3])
+/* The 2 x 2 texels a bilinear lookup at atlas texel coordinates (x, y) reads (texel centres at
+ * half integers, clamped to the atlas) and their weights. */
+static void footprint(uint32_t w, uint32_t h, double x, double y, uint32_t texel[4], double weight[4])
 {
     x -= 0.5;
     y -= 0.5;
@@ -156,16 +166,16 @@ static void bilinear(const float *img, uint32_t w, uint32_t h, double x, double 
     long xs[2] = {x0 < 0 ? 0 : x0 >= (long)w ? (long)w - 1 : x0, x0 + 1 < 0 ? 0 : x0 + 1 >= (long)w ? (long)w - 1 : x0 + 1};
     long ys[2] = {y0 < 0 ? 0 : y0 >= (long)h ? (long)h - 1 : y0, y0 + 1 < 0 ? 0 : y0 + 1 >= (long)h ? (long)h - 1 : y0 + 1};
     double wx[2] = {1 - ax, ax}, wy[2] = {1 - ay, ay};
-    out[0] = out[1] = out[2] = 0;
     for (int j = 0; j < 2; j++)
         for (int i = 0; i < 2; i++) {
-            const float *p = img + 3 * ((size_t)ys[j] * w + (size_t)xs[i]);
-            for (int k = 0; k < 3; k++)
-                out[k] += wx[i] * wy[j] * p[k];
+            texel[2 * j + i] = (uint32_t)((size_t)ys[j] * w + (size_t)xs[i]);
+            weight[2 * j + i] = wx[i] * wy[j];
         }
 }
 
-/* The cached irradiance of the front at the hit (its lightmap, bilinear). */
+/* The cached irradiance of the front at the hit (its lightmap, bilinear). Where the footprint
+ * holds a texel beside a wall, texels across it and dilated ones weigh nothing and the others
+ * are renormalised (texel_sides.h); none left: 0. */
 static void front_light(const lmb_cache *c, const lmb_rt_geom *g, const lmb_rt_hit *hit, double e[3])
 {
     const lmb_layout_instance *li = &c->layout->instances[g->instance];
@@ -173,7 +183,31 @@ static void front_light(const lmb_cache *c, const lmb_rt_geom *g, const lmb_rt_h
     lmb_layout_uv(c->layout, g->instance, (size_t)g->first_triangle + hit->prim, uv);
     double b1 = hit->u, b2 = hit->v, b0 = 1.0 - b1 - b2;
     double x = b0 * uv[0] + b1 * uv[2] + b2 * uv[4], y = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
-    bilinear(c->irradiance[li->atlas], c->layout->width[li->atlas], c->layout->height[li->atlas], x, y, e);
+    uint32_t a = li->atlas, texel[4];
+    double weight[4];
+    footprint(c->layout->width[a], c->layout->height[a], x, y, texel, weight);
+    const lmb_texel_sides *s = &c->sides[a];
+    int beside = 0;
+    for (int k = 0; k < 4 && s->near; k++)
+        beside |= s->near[texel[k]];
+    double sum = 0;
+    if (beside)
+        for (int k = 0; k < 4; k++) {
+            if (weight[k] > 0 && (c->state[a][texel[k]] != LMB_TEXEL_VALID ||
+                                  !lmb_texel_sides_in_sight(s, c->rt, texel[k], hit->p, hit->ng)))
+                weight[k] = 0;
+            sum += weight[k];
+        }
+    e[0] = e[1] = e[2] = 0;
+    if (beside && !(sum > 0))
+        return;
+    const float *img = c->irradiance[a];
+    for (int k = 0; k < 4; k++)
+        for (int ch = 0; ch < 3; ch++)
+            e[ch] += weight[k] * img[3 * (size_t)texel[k] + ch];
+    if (beside)
+        for (int ch = 0; ch < 3; ch++)
+            e[ch] /= sum;
 }
 
 lmb_hit_kind lmb_cache_lookup(const lmb_cache *c, const lmb_rt_hit *hit, double albedo_over_pi[3], double e[3])

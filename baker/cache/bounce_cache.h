@@ -25,6 +25,7 @@
 #include "load/textures.h"
 #include "pack/layout.h"
 #include "texels/texels.h"
+#include "cache/texel_sides.h"
 
 typedef struct lmb_cache {
     const lmb_scene *scene;       /* borrowed */
@@ -41,6 +42,8 @@ typedef struct lmb_cache {
                            (materials.reflect_sides; the bake sets it) */
     float **irradiance; /* owned: per atlas width x height x 3, dilated (NULL after lmb_cache_release) */
     uint8_t **state;    /* owned: per atlas width x height LMB_TEXEL_* */
+    lmb_texel_sides *sides; /* owned: per atlas, the texels beside walls a lookup checks the side of
+                               (built by the first lmb_cache_store of the atlas) */
     float **direction;  /* owned, NULL until lmb_cache_store_direction: per atlas width x height x 3,
                            the light's mean direction (directional lightmaps), dilated */
     float **shadowmask; /* owned, NULL until lmb_cache_store_shadowmask: per atlas width x height x 4,

@@ -177,6 +177,7 @@ static lmb_status uncovered_again(pass_ctx *c, uint32_t slot, uint32_t *cand, ui
     const double *then = c->tested_reach[slot];
     lmb_ic_records shrunk;
     lmb_ic_records_init(&shrunk, c->records.error);
+    shrunk.rt = c->records.rt;
     lmb_status st = LMB_OK;
     for (uint32_t i = 0; i < c->tested_count[slot] && st == LMB_OK; i++)
         if (c->records.rec[i].r < then[i]) {
@@ -501,6 +502,7 @@ lmb_status lmb_ic_gather_pass(const lmb_gather_job *job, const lmb_ic_options *o
         c.records = *shared;
         lmb_ic_records_init(shared, opt->error);
     }
+    c.records.rt = job->rt; /* records serve no point across geometry (records.c, across_geometry) */
     lmb_status st = LMB_OK;
     c.is_record = calloc((size_t)atlas_count + 1, sizeof *c.is_record);
     c.first_id = calloc((size_t)atlas_count + 1, sizeof *c.first_id);

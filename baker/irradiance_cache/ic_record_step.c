@@ -3,6 +3,8 @@
 #include "ic_pass_internal.h"
 
 #include "gather/guide.h"
+#include "raytrace/rt_sight.h"
+#include "util/frame.h"
 
 #include <omp.h>
 #include <stddef.h>
@@ -32,6 +34,30 @@ static int reserve_mix(pass_ctx *c, uint32_t n)
     return 1;
 }
 
+/* The nearest geometry along the record's surface (lmb_ic_record.clear): 8 rays in the tangent
+ * plane of its gather point's geometric normal, lifted as a sight test lifts it. */
+static void record_clearance(const pass_ctx *c, texel_at x, lmb_ic_record *r)
+{
+    const lmb_texels *t = c->t[x.atlas];
+    lmb_gather_point g;
+    lmb_texels_point(t, x.index, t->gather_at[x.index], &g);
+    double ng[3] = {g.ng[0], g.ng[1], g.ng[2]}, t1[3], t2[3], o[3];
+    lmb_frame(ng, t1, t2);
+    r->lift = (float)(LMB_SIGHT_LIFT * t->texel_size[x.index]);
+    for (int k = 0; k < 3; k++)
+        o[k] = r->p[k] + r->lift * ng[k];
+    double reach = LMB_IC_CLEAR_REACH * r->r_max, nearest = INFINITY;
+    for (int j = 0; j < 8; j++) {
+        double a = j * (LMB_PI / 4), d[3];
+        for (int k = 0; k < 3; k++)
+            d[k] = cos(a) * t1[k] + sin(a) * t2[k];
+        lmb_rt_hit h;
+        if (lmb_rt_intersect(c->job->rt, o, d, 0.0, reach, &h) && h.t < nearest)
+            nearest = h.t;
+    }
+    r->clear = (float)nearest;
+}
+
 /* Record from a gather at texel x: reach clamps from the texel's size, the rotation gradient
  * bounded like the translation one (at most E over the largest normal difference served). */
 static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_result *g, lmb_ic_record *r)
@@ -56,13 +82,17 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     }
     r->atlas = x.atlas;
     r->texel = x.index;
+    if (c->own_level) /* a texel gathered on its own serves no other */
+        r->clear = INFINITY;
+    else
+        record_clearance(c, x, r);
 }
 
-/* A record's bytes in a step (steps/runner.h): p and n (6 doubles), then its floats e .. var (26,
+/* A record's bytes in a step (steps/runner.h): p and n (6 doubles), then its floats e .. lift (28,
  * contiguous), atlas, texel. */
-#define RECORD_FLOATS 26
-_Static_assert(offsetof(lmb_ic_record, var) - offsetof(lmb_ic_record, e) == (RECORD_FLOATS - 1) * sizeof(float),
-               "lmb_ic_record: e .. var are contiguous floats");
+#define RECORD_FLOATS 28
+_Static_assert(offsetof(lmb_ic_record, lift) - offsetof(lmb_ic_record, e) == (RECORD_FLOATS - 1) * sizeof(float),
+               "lmb_ic_record: e .. lift are contiguous floats");
 
 static lmb_status put_record(lmb_buf *out, const lmb_ic_record *r, lmb_error *err)
 {

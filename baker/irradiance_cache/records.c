@@ -1,6 +1,8 @@
 /* Irradiance-cache records: weights, the k-d tree, interpolation, clamps, gradients (records.h). */
 #include "records.h"
 
+#include "raytrace/rt_sight.h"
+
 #include "util/frame.h"
 
 #include <float.h>
@@ -263,6 +265,23 @@ int64_t lmb_ic_records_nearest(const lmb_ic_records *s, const double p[3], const
 
 /* ---- weights and interpolation -------------------------------------------------------- */
 
+/*
+ * Whether record r may serve point p (normal n) across geometry (docs/leaks.md): a wall standing
+ * between them on their surface (a floor chart running under a wall between two rooms). Only a
+ * record whose tangent rays met geometry nearer than LMB_IC_CLEAR_SLACK x |p - p_i| can have one
+ * in between (a straight wall crossing the segment at distance s is at most s from the record,
+ * and the nearest of its 8 rays meets it within 1.0824 s), so only those pairs trace a ray.
+ */
+static int across_geometry(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3])
+{
+    if (!s->rt || !isfinite(r->clear))
+        return 0;
+    double d[3] = {p[0] - r->p[0], p[1] - r->p[1], p[2] - r->p[2]};
+    if (LMB_IC_CLEAR_SLACK * sqrt(lmb_dot3(d, d)) < r->clear)
+        return 0;
+    return !lmb_rt_in_sight(s->rt, r->p, r->n, p, n, r->lift);
+}
+
 double lmb_ic_weight(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3])
 {
     double c = lmb_dot3(n, r->n);
@@ -291,7 +310,7 @@ static void interp_visit(void *user, uint32_t k)
     interp_ctx *c = user;
     const lmb_ic_record *r = &c->s->rec[k];
     double w = lmb_ic_weight(c->s, r, c->p, c->n);
-    if (!(w > 0))
+    if (!(w > 0) || across_geometry(c->s, r, c->p, c->n))
         return;
     c->sum += w;
     if (!c->want_e)
@@ -327,7 +346,7 @@ static void share_visit(void *user, uint32_t k)
 {
     share_ctx *c = user;
     double w = lmb_ic_weight(c->s, &c->s->rec[k], c->p, c->n);
-    if (!(w > 0))
+    if (!(w > 0) || across_geometry(c->s, &c->s->rec[k], c->p, c->n))
         return;
     uint64_t part = (uint64_t)llround(w / c->sum * LMB_IC_SHARE_ONE);
 #pragma omp atomic

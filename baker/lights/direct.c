@@ -43,6 +43,11 @@ const lmb_config *lmb_direct_config(const lmb_direct *d)
     return d->cfg;
 }
 
+const lmb_rt *lmb_direct_rt(const lmb_direct *d)
+{
+    return d->rt;
+}
+
 int lmb_direct_any_light(const lmb_direct *d)
 {
     return (d->lights.local_count + d->lights.directional_count > 0 && d->cfg->light_intensity_scale > 0) ||
@@ -379,8 +384,9 @@ static void area_lights(point_ctx *c, double e[3])
     }
 }
 
-/* How many of VALIDITY_RAYS hemisphere rays hit back faces (inside geometry: more than half). */
-static int back_face_hits(point_ctx *c, lmb_rng *rng)
+/* How many of VALIDITY_RAYS hemisphere rays hit back faces (inside geometry: more than half);
+ * *nearest: the closest hit's distance (INFINITY: none). */
+static int back_face_hits(point_ctx *c, lmb_rng *rng, double *nearest)
 {
     double t1[3], t2[3], a[3] = {fabs(c->ng[0]) < 0.9 ? 1 : 0, fabs(c->ng[0]) < 0.9 ? 0 : 1, 0};
     t1[0] = a[1] * c->ng[2] - a[2] * c->ng[1];
@@ -393,6 +399,7 @@ static int back_face_hits(point_ctx *c, lmb_rng *rng)
     t2[1] = c->ng[2] * t1[0] - c->ng[0] * t1[2];
     t2[2] = c->ng[0] * t1[1] - c->ng[1] * t1[0];
     int back = 0;
+    *nearest = INFINITY;
     for (int r = 0; r < VALIDITY_RAYS; r++) {
         double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng), rr = sqrt(u1), phi = 2 * LMB_PI * u2;
         double x = rr * cos(phi), y = rr * sin(phi), z = sqrt(fmax(0, 1 - u1)), d[3];
@@ -400,8 +407,10 @@ static int back_face_hits(point_ctx *c, lmb_rng *rng)
             d[k] = x * t1[k] + y * t2[k] + z * c->ng[k];
         lmb_rt_hit h;
         c->rays++;
-        if (lmb_rt_intersect(c->d->rt, c->o, d, c->eps, 1e300, &h) && h.backface)
-            back++;
+        if (lmb_rt_intersect(c->d->rt, c->o, d, c->eps, 1e300, &h)) {
+            back += h.backface;
+            *nearest = h.t < *nearest ? h.t : *nearest;
+        }
     }
     return back;
 }
@@ -465,7 +474,7 @@ uint32_t lmb_direct_eval(const lmb_direct *d, const lmb_shading_point *sp, const
 }
 
 int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, uint32_t atlas, uint32_t texel,
-                              uint32_t k, lmb_rng *rng, uint32_t *rays, int *sees_back)
+                              uint32_t k, lmb_rng *rng, uint32_t *rays, lmb_point_sight *sight)
 {
     const lmb_point_validity *v = d->validity;
     uint8_t *memo = NULL;
@@ -473,17 +482,22 @@ int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, 
         memo = &v->entry[atlas][(uint64_t)texel * v->samples + k];
     if (memo && *memo != LMB_VALIDITY_UNKNOWN) {
         rng->counter += 2 * VALIDITY_RAYS; /* the draws back_face_hits takes */
-        *sees_back = *memo != LMB_VALIDITY_CLEAR;
-        return *memo == LMB_VALIDITY_INSIDE;
+        uint8_t state = *memo & LMB_VALIDITY_STATE;
+        sight->sees_back = state != LMB_VALIDITY_CLEAR;
+        sight->near = (*memo & LMB_VALIDITY_NEAR) != 0;
+        return state == LMB_VALIDITY_INSIDE;
     }
     point_ctx c;
     lmb_point_init(&c, d, sp);
-    int back = back_face_hits(&c, rng);
+    double nearest;
+    int back = back_face_hits(&c, rng, &nearest);
     *rays += (uint32_t)c.rays;
-    *sees_back = back > 0;
+    sight->sees_back = back > 0;
+    sight->near = nearest <= sight->near_range;
     int inside = 2 * back > VALIDITY_RAYS;
     if (memo) /* one thread owns a texel's points */
-        *memo = inside ? LMB_VALIDITY_INSIDE : back ? LMB_VALIDITY_NEAR_BACK : LMB_VALIDITY_CLEAR;
+        *memo = (uint8_t)((inside ? LMB_VALIDITY_INSIDE : back ? LMB_VALIDITY_NEAR_BACK : LMB_VALIDITY_CLEAR) |
+                          (sight->near ? LMB_VALIDITY_NEAR : 0));
     return inside;
 }
 

@@ -86,13 +86,22 @@ uint32_t lmb_direct_shadowmask_channels(const lmb_direct *d);
 uint32_t lmb_shadowmask_at(const lmb_direct *d, const lmb_shading_point *sp, lmb_rng *rng,
                            double vis[LMB_SHADOWMASK_CHANNELS]);
 
+/* What a gather point's hemisphere rays saw besides whether it is inside geometry: near_range
+ * (in) the distance within which a hit makes the point `near` (out: a wall or contact close
+ * enough that the texel may straddle it; texel_direct.c then checks which of its points see
+ * each other), sees_back (out: some ray hit a back face: the point is near geometry's inside,
+ * in a gap, at a contact). */
+typedef struct lmb_point_sight {
+    double near_range;
+    int near, sees_back;
+} lmb_point_sight;
+
 /* 1 when sp, gather point k of texel `texel` (y x width + x) of atlas `atlas`, lies inside
- * geometry (most of its hemisphere rays hit back faces); adds to *rays; *sees_back: any of them
- * hit a back face (sp is near geometry's inside: in a gap, at a contact). With a validity memo
- * (lmb_direct_set_validity) a point tested before is read from it, and rng moves past the draws
- * the test takes, so what follows draws the same numbers either way. */
+ * geometry (most of its hemisphere rays hit back faces); adds to *rays; fills *sight. With a
+ * validity memo (lmb_direct_set_validity) a point tested before is read from it, and rng moves
+ * past the draws the test takes, so what follows draws the same numbers either way. */
 int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, uint32_t atlas, uint32_t texel,
-                              uint32_t k, lmb_rng *rng, uint32_t *rays, int *sees_back);
+                              uint32_t k, lmb_rng *rng, uint32_t *rays, lmb_point_sight *sight);
 
 /* Gives d a gather points' validity memo (point_validity.h; borrowed, NULL: none) for the
  * layout its texels come from. */
@@ -101,6 +110,7 @@ void lmb_direct_set_validity(lmb_direct *d, struct lmb_point_validity *validity)
 
 /* The config the lights were made with (borrowed). */
 const lmb_config *lmb_direct_config(const lmb_direct *d);
+const lmb_rt *lmb_direct_rt(const lmb_direct *d);
 
 /* Gather point k of listed texel i of t as a shading point (offset scaled to the texel). */
 void lmb_texel_shading_point(const lmb_direct *d, const lmb_texels *t, uint32_t i, uint32_t k, lmb_shading_point *sp);

@@ -98,7 +98,7 @@ static double plan_rounds(const lmb_config *cfg, const lmb_direct_atlas *da, con
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : sum, refined, capped)
     for (uint32_t i = 0; i < da->t.count; i++) {
         rounds[i] = 0;
-        if (!da->t.valid[i] || !(da->variance[i] > 0) || da->t.partly_covered[i])
+        if (!da->t.valid[i] || !(da->variance[i] > 0) || (da->t.edge[i] & LMB_EDGE_COVERED))
             continue;
         int was_capped;
         rounds[i] = rounds_needed(cfg, k, mean_var[i], mean_lum[i], &was_capped);

@@ -93,7 +93,7 @@ static void put_band(const lmb_texels *t, const band_light *l, uint8_t *dst)
     memcpy(dst, &t->count, 4);
     dst += 4;
     for (uint32_t i = 0; i < t->count; i++) {
-        uint8_t flags[2] = {t->valid[i], t->partly_covered[i]};
+        uint8_t flags[2] = {t->valid[i], t->edge[i]};
         memcpy(dst, &t->texel[i], 4);
         memcpy(dst + 4, &t->texel_size[i], 4);
         memcpy(dst + 8, &t->refs[(size_t)i * t->samples + t->gather_at[i]], sizeof(lmb_point_ref));
@@ -218,7 +218,7 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     band.texel_size = malloc(((size_t)n + 1) * sizeof *band.texel_size);
     band.refs = malloc(((size_t)n + 1) * sizeof *band.refs);
     band.valid = malloc((size_t)n + 1);
-    band.partly_covered = malloc((size_t)n + 1);
+    band.edge = malloc((size_t)n + 1);
     band.gather_at = calloc((size_t)n + 1, 1);
     size_t total = (size_t)out->t.count + n;
     float *d = realloc(out->direct, (3 * total + 1) * sizeof *d);
@@ -231,7 +231,7 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     if (dd)
         out->direction = dd;
     lmb_status st = LMB_OK;
-    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.partly_covered || !band.gather_at || !d || !nz ||
+    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.edge || !band.gather_at || !d || !nz ||
         (directional && !dd))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
     for (uint32_t i = 0; i < n && st == LMB_OK; i++) {
@@ -241,7 +241,7 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
         lmb_buf_take(in, &band.refs[i], sizeof band.refs[i]);
         lmb_buf_take(in, flags, 2);
         band.valid[i] = flags[0];
-        band.partly_covered[i] = flags[1];
+        band.edge[i] = flags[1];
     }
     if (st == LMB_OK && ((has_deferred && !grow_floats(&out->deferred, total, 3)) ||
                          (has_mask && !grow_floats(&out->shadowmask, total, LMB_SHADOWMASK_CHANNELS))))

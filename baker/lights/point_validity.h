@@ -18,9 +18,11 @@
 
 #include <lmbake/lmbake.h>
 
-/* A point's entry: not yet tested, usable (no hemisphere ray hit a back face), usable but near
- * the inside of geometry (some did), inside geometry. */
+/* A point's entry: its state (the low two bits: not yet tested, usable (no hemisphere ray hit a
+ * back face), usable but near the inside of geometry (some did), inside geometry), and NEAR when
+ * some hemisphere ray hit within LMB_NEAR_TEXELS texels (lmb_point_sight.near). */
 enum { LMB_VALIDITY_UNKNOWN = 0, LMB_VALIDITY_CLEAR = 1, LMB_VALIDITY_NEAR_BACK = 2, LMB_VALIDITY_INSIDE = 3 };
+enum { LMB_VALIDITY_STATE = 3, LMB_VALIDITY_NEAR = 4 };
 
 typedef struct lmb_point_validity {
     uint32_t atlas_count;

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../raytrace/rt_sight.h"
 #include "../util/lmb_math.h"
 #include "../util/rng.h"
 
@@ -20,6 +21,7 @@
  * the luminance of each round's estimate, for the variance). */
 typedef struct point_sum {
     lmb_shading_point sp;
+    uint32_t k;                                  /* the point's index in its texel */
     lmb_rng rng;
     uint64_t sequence;
     double e[3], dir[3], deferred[3];            /* exact part */
@@ -47,6 +49,49 @@ uint32_t lmb_direct_round_samples(const lmb_config *cfg)
 }
 
 /*
+ * The points of a texel near geometry that lie on its own side of it: a texel split by a wall's
+ * foot takes light from one room only. The first usable point is the anchor; the points not in
+ * its sight along the surface (raytrace/rt_sight.h) are across a wall. When those are the
+ * majority, the first of them becomes the anchor instead (the texel belongs where most of it
+ * lies; a tie keeps the first). Keeps the anchor's side in ps[0..kept), the anchor first and the
+ * rest in point order, and returns how many. Adds the rays traced to *rays.
+ */
+static uint32_t keep_own_side(const lmb_direct *d, point_sum *ps, uint32_t used, double texel_size, uint32_t *rays)
+{
+    const lmb_rt *rt = lmb_direct_rt(d);
+    double lift = LMB_SIGHT_LIFT * texel_size;
+    uint8_t seen[256];
+    uint32_t anchor = 0, count = 0;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        count = 0;
+        for (uint32_t j = 0; j < used; j++) {
+            seen[j] = j == anchor || lmb_rt_in_sight(rt, ps[anchor].sp.p, ps[anchor].sp.ng, ps[j].sp.p, ps[j].sp.ng, lift);
+            *rays += j != anchor;
+            count += seen[j];
+        }
+        if (2 * count >= used)
+            break;
+        for (uint32_t j = 0; j < used; j++)
+            if (!seen[j]) {
+                anchor = j;
+                break;
+            }
+    }
+    if (count == used)
+        return used;
+    uint32_t kept = 0, at = 0;
+    for (uint32_t j = 0; j < used; j++)
+        if (seen[j]) {
+            at = j == anchor ? kept : at;
+            ps[kept++] = ps[j]; /* kept <= j: in place */
+        }
+    point_sum a = ps[at];
+    memmove(ps + 1, ps, at * sizeof *ps);
+    ps[0] = a;
+    return kept;
+}
+
+/*
  * Direct light of listed texel i with `rounds` (>= 2) rounds of the sampled lights. Each usable
  * point evaluates its exact lights once and its sampled lights (area lights, sun discs, many
  * lights, the sky) in rounds of half samples.direct (and half sky.samples) along one scrambled
@@ -64,35 +109,41 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
     const lmb_config *cfg = lmb_direct_config(job->direct);
     double mask_sum[LMB_SHADOWMASK_CHANNELS] = {0};
     uint32_t used = 0, r = 0;
-    int near_back = 0;
+    int near_back = 0, near = 0;
     uint64_t key = ((uint64_t)job->atlas << 32) | t->texel[i];
-    t->gather_at[i] = 0;
     for (uint32_t k = 0; k < t->points_in[i]; k++) {
         point_sum *p = &ps[used];
         memset(p, 0, sizeof *p);
+        p->k = k;
         lmb_texel_shading_point(job->direct, t, i, k, &p->sp);
         p->rng = lmb_rng_make(cfg->seed, key, k);
-        int sees_back;
         if (lmb_texel_point_cut(job->direct, t, i, k))
             continue;
-        if (lmb_point_inside_geometry(job->direct, &p->sp, job->atlas, t->texel[i], k, &p->rng, &r, &sees_back))
+        lmb_point_sight sight = {LMB_NEAR_TEXELS * t->texel_size[i], 0, 0};
+        int inside = lmb_point_inside_geometry(job->direct, &p->sp, job->atlas, t->texel[i], k, &p->rng, &r, &sight);
+        near |= sight.near;
+        if (inside)
             continue;
-        near_back |= sees_back;
-        if (!used)
-            t->gather_at[i] = (uint8_t)k;
+        near_back |= sight.sees_back;
+        used++;
+    }
+    if (near && used > 1)
+        used = keep_own_side(job->direct, ps, used, t->texel_size[i], &r);
+    t->gather_at[i] = used ? (uint8_t)ps[0].k : 0;
+    for (uint32_t j = 0; j < used; j++) {
+        point_sum *p = &ps[j];
         p->sequence = lmb_mix64(p->rng.key ^ 0x51u);
         lmb_direct_draw exact = {LMB_DIRECT_EXACT, 0, 0, p->sequence, 0};
         r += lmb_direct_eval(job->direct, &p->sp, &exact, &p->rng, p->e, p->dir, p->deferred);
         if (first) /* the refinement's own stream for the sky and many lights (drawn by power past 256) */
-            p->rng = lmb_rng_make(cfg->seed, key, 0x6000u + k);
+            p->rng = lmb_rng_make(cfg->seed, key, 0x6000u + p->k);
         if (job->shadowmask) { /* a stream of its own: the lightmap does not change with output.shadowmask */
-            lmb_rng mask_rng = lmb_rng_make(cfg->seed, key, 0x5000u + k);
+            lmb_rng mask_rng = lmb_rng_make(cfg->seed, key, 0x5000u + p->k);
             double vis[LMB_SHADOWMASK_CHANNELS];
             r += lmb_shadowmask_at(job->direct, &p->sp, &mask_rng, vis);
             for (int c = 0; c < LMB_SHADOWMASK_CHANNELS; c++)
                 mask_sum[c] += vis[c];
         }
-        used++;
     }
     uint32_t per_round = lmb_direct_round_samples(cfg);
     uint32_t sky_round = cfg->sky_samples > 1 ? (cfg->sky_samples + 1) / 2 : 1;
@@ -124,7 +175,8 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
             deferred_sum[d] += ps[k].deferred[d] + (rounds ? ps[k].sdeferred[d] / rounds : 0);
         }
     t->valid[i] = used > 0;
-    t->partly_covered[i] = used > 0 && (used < t->points_in[i] || near_back);
+    t->edge[i] = (uint8_t)((used > 0 && (used < t->points_in[i] || near_back) ? LMB_EDGE_COVERED : 0) |
+                           (near ? LMB_EDGE_NEAR : 0));
     for (int d = 0; d < 3; d++) {
         out[3 * i + d] = used ? (float)(sum[d] / used) : 0.0f;
         if (job->direction)

@@ -60,7 +60,8 @@ lmb_status lmb_dilate(float *rgb, const uint8_t *kind, uint32_t w, uint32_t h, i
 #pragma omp parallel for num_threads(threads) schedule(static) if (nr > 4096)
         for (size_t r = 0; r < nr; r++) {
             uint32_t i = ring[r], x = i % w, y = i / w, cnt = 0;
-            float s[3] = {0, 0, 0};
+            int darkest = kind[i] == LMB_TEXEL_INSIDE;
+            float s[3] = {0, 0, 0}, least = 0;
             for (int dy = -1; dy <= 1; dy++)
                 for (int dx = -1; dx <= 1; dx++) {
                     long xx = (long)x + dx, yy = (long)y + dy;
@@ -69,8 +70,18 @@ lmb_status lmb_dilate(float *rgb, const uint8_t *kind, uint32_t w, uint32_t h, i
                     size_t j = (size_t)yy * w + (size_t)xx;
                     if (state[j] != 1)
                         continue;
+                    const float *v = rgb + 3 * j;
+                    float lum = 0.2126f * v[0] + 0.7152f * v[1] + 0.0722f * v[2];
+                    if (darkest) { /* the first of the darkest, in scan order */
+                        if (!cnt || lum < least)
+                            for (int c = 0; c < 3; c++)
+                                s[c] = v[c];
+                        least = !cnt || lum < least ? lum : least;
+                        cnt = 1;
+                        continue;
+                    }
                     for (int c = 0; c < 3; c++)
-                        s[c] += rgb[3 * j + c];
+                        s[c] += v[c];
                     cnt++;
                 }
             for (int c = 0; c < 3; c++)

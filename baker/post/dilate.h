@@ -4,7 +4,10 @@
  * triangle touches) is filled all the way, so bilinear filtering and mipmaps never pull in
  * black; texels whose points lie inside geometry (under a wall or a box) are filled only
  * within LMB_DILATE_INSIDE_RINGS rings of a valid texel, enough for filtering at the
- * contact line, and stay 0 deeper in, so no light appears under geometry.
+ * contact line, and stay 0 deeper in, so no light appears under geometry. Such a texel takes
+ * its darkest filled neighbour (luminance), not their average: under a wall between a lit and
+ * a dark room, the lit room's light does not cross into the dark room's filtering (the lit
+ * side gets a contact shadow one texel wide instead, docs/leaks.md).
  */
 #ifndef LMBAKE_DILATE_H
 #define LMBAKE_DILATE_H

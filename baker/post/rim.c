@@ -24,7 +24,7 @@ lmb_status lmb_rim_limit(const lmb_texels *t, float *rgb, lmb_rim_stats *stats, 
     /* limits come from uncovered texels only, which this loop never changes: the result does
      * not depend on the order */
     for (uint32_t i = 0; i < t->count; i++) {
-        if (!t->valid[i] || !t->partly_covered[i])
+        if (!t->valid[i] || !(t->edge[i] & LMB_EDGE_COVERED))
             continue;
         long x = (long)(t->texel[i] % t->width), y = (long)(t->texel[i] / t->width);
         double limit = -1;
@@ -34,7 +34,7 @@ lmb_status lmb_rim_limit(const lmb_texels *t, float *rgb, lmb_rim_stats *stats, 
                 if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= (long)t->width || yy >= (long)t->height)
                     continue;
                 int64_t j = listed[(size_t)yy * t->width + (size_t)xx];
-                if (j < 0 || !t->valid[j] || t->partly_covered[j])
+                if (j < 0 || !t->valid[j] || (t->edge[j] & LMB_EDGE_COVERED))
                     continue;
                 double l = luminance(rgb + 3 * (size_t)j);
                 limit = l > limit ? l : limit;

@@ -264,28 +264,32 @@ typedef struct rt_query {
     struct RTCIntersectContext ctx; /* first: Embree hands it to the filters */
     const lmb_rt *rt;
     int mode;
-    double d[3]; /* the ray's world direction */
+    double o[3], d[3]; /* the ray's world origin and direction */
     uint32_t count;
     lmb_rt_layer layer[LMB_RT_MAX_LAYERS];
 } rt_query;
 
-static void query_init(rt_query *q, const lmb_rt *rt, int mode, const double d[3])
+static void query_init(rt_query *q, const lmb_rt *rt, int mode, const double o[3], const double d[3])
 {
     rtcInitIntersectContext(&q->ctx);
     q->rt = rt;
     q->mode = mode;
     q->count = 0;
-    if (mode != QUERY_PLAIN) /* only the filters of such queries read it */
+    if (mode != QUERY_PLAIN) { /* only the filters of such queries read them */
+        memcpy(q->o, o, sizeof q->o);
         memcpy(q->d, d, sizeof q->d);
+    }
 }
 
 /* A hit's slot, world geometric normal (front side, unit) and side, from what Embree reports: the
  * slot's normal matrix turns an instanced hit's object-space Ng. */
 static inline void fill_hit(const lmb_rt *rt, unsigned inst, unsigned geom, unsigned prim, float u, float v, const float ngo[3],
-                     double t, const double d[3], lmb_rt_hit *hit)
+                     double t, const double o[3], const double d[3], lmb_rt_hit *hit)
 {
     int instanced = inst != RTC_INVALID_GEOMETRY_ID;
     hit->t = t;
+    for (int k = 0; k < 3; k++)
+        hit->p[k] = o[k] + t * d[k];
     hit->geom = instanced ? inst + geom : geom; /* the slot */
     hit->prim = prim;
     hit->u = u;
@@ -341,7 +345,7 @@ static void filter(const struct RTCFilterFunctionNArguments *a, int occlusion)
         return;
     lmb_rt_hit h;
     const float ng[3] = {HIT_F(a->hit, a->N, 0), HIT_F(a->hit, a->N, 1), HIT_F(a->hit, a->N, 2)};
-    fill_hit(q->rt, HIT_U(a->hit, a->N, 7), HIT_U(a->hit, a->N, 6), prim, u, v, ng, RAY_TFAR(a->ray, a->N), q->d, &h);
+    fill_hit(q->rt, HIT_U(a->hit, a->N, 7), HIT_U(a->hit, a->N, 6), prim, u, v, ng, RAY_TFAR(a->ray, a->N), q->o, q->d, &h);
     for (uint32_t k = 0; k < q->count; k++)
         if (q->layer[k].hit.geom == h.geom &&
             (q->layer[k].hit.prim == h.prim || fabs(q->layer[k].hit.t - h.t) <= q->rt->eps)) {
@@ -388,7 +392,7 @@ int lmb_rt_occluded(const lmb_rt *rt, const double o[3], const double d[3], doub
 {
     rt_query q;
     struct RTCRay r;
-    query_init(&q, rt, QUERY_PLAIN, d);
+    query_init(&q, rt, QUERY_PLAIN, o, d);
     make_ray(&r, o, d, tmin, tmax);
     rtcOccluded1(rt->scene, &q.ctx, &r);
     return r.tfar < 0; /* Embree sets tfar to -inf on a hit */
@@ -410,7 +414,7 @@ int lmb_rt_transmittance(const lmb_rt *rt, const double o[3], const double d[3],
 {
     rt_query q;
     struct RTCRay r;
-    query_init(&q, rt, rt->partial_geoms ? QUERY_TRANSMIT : QUERY_PLAIN, d);
+    query_init(&q, rt, rt->partial_geoms ? QUERY_TRANSMIT : QUERY_PLAIN, o, d);
     make_ray(&r, o, d, tmin, tmax);
     rtcOccluded1(rt->scene, &q.ctx, &r);
     pass[0] = pass[1] = pass[2] = r.tfar < 0 ? 0.0 : 1.0;
@@ -435,14 +439,14 @@ static int intersect(const lmb_rt *rt, rt_query *q, const double o[3], const dou
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     const float ng[3] = {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z};
-    fill_hit(rt, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, ng, rh.ray.tfar, d, hit);
+    fill_hit(rt, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, ng, rh.ray.tfar, o, d, hit);
     return 1;
 }
 
 int lmb_rt_intersect(const lmb_rt *rt, const double o[3], const double d[3], double tmin, double tmax, lmb_rt_hit *hit)
 {
     rt_query q;
-    query_init(&q, rt, QUERY_PLAIN, d);
+    query_init(&q, rt, QUERY_PLAIN, o, d);
     return intersect(rt, &q, o, d, tmin, tmax, hit);
 }
 
@@ -450,7 +454,7 @@ int lmb_rt_intersect_layers(const lmb_rt *rt, const double o[3], const double d[
                             lmb_rt_hit *hit, lmb_rt_layer *layers, uint32_t *count)
 {
     rt_query q;
-    query_init(&q, rt, rt->partial_geoms ? QUERY_LAYERS : QUERY_PLAIN, d);
+    query_init(&q, rt, rt->partial_geoms ? QUERY_LAYERS : QUERY_PLAIN, o, d);
     int found = intersect(rt, &q, o, d, tmin, tmax, hit);
     *count = 0;
     for (uint32_t k = 0; k < q.count; k++)

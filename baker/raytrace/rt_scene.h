@@ -53,6 +53,7 @@ typedef struct lmb_rt {
 
 typedef struct lmb_rt_hit {
     double t;
+    double p[3];      /* the hit point, world: origin + t direction */
     uint32_t geom, prim;
     float u, v;       /* Embree barycentrics of corners 1 and 2 */
     float ng[3];      /* geometric normal of the hit, world, front side, unit */

@@ -40,8 +40,8 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
     if (valid) dst->valid = valid;
     uint8_t *gather_at = realloc(dst->gather_at, (size_t)n + 1);
     if (gather_at) dst->gather_at = gather_at;
-    uint8_t *partly = realloc(dst->partly_covered, (size_t)n + 1);
-    if (partly) dst->partly_covered = partly;
+    uint8_t *partly = realloc(dst->edge, (size_t)n + 1);
+    if (partly) dst->edge = partly;
     if (!texel || !points_in || !size || !refs || !valid || !gather_at || !partly)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", n);
     copy_band(dst, band);
@@ -58,7 +58,7 @@ static void copy_band(lmb_texels *dst, const lmb_texels *band)
         dst->refs[j] = band->refs[(size_t)i * band->samples + band->gather_at[i]];
         dst->valid[j] = band->valid[i];
         dst->gather_at[j] = 0;
-        dst->partly_covered[j] = band->partly_covered[i];
+        dst->edge[j] = band->edge[i];
     }
     dst->width = band->width;
     dst->height = band->height;
@@ -77,7 +77,7 @@ void lmb_texels_free(lmb_texels *t)
     free(t->refs);
     free(t->valid);
     free(t->gather_at);
-    free(t->partly_covered);
+    free(t->edge);
     memset(t, 0, sizeof *t);
 }
 
@@ -382,9 +382,9 @@ lmb_status lmb_texels_build_rows(const lmb_scene *s, const lmb_layout *l, uint32
     out->layout = l;
     out->valid = malloc((size_t)out->count + 1);
     out->gather_at = calloc((size_t)out->count + 1, 1);
-    out->partly_covered = calloc((size_t)out->count + 1, 1);
+    out->edge = calloc((size_t)out->count + 1, 1);
     if (!out->texel || !out->points_in || !out->texel_size || !out->points || !out->refs || !out->valid ||
-        !out->gather_at || !out->partly_covered) {
+        !out->gather_at || !out->edge) {
         free(b);
         lmb_texels_free(out);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", out->count);

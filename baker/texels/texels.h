@@ -28,6 +28,14 @@ typedef struct lmb_point_ref {
     float b1, b2; /* barycentrics of corners 1 and 2 */
 } lmb_point_ref;
 
+/* A texel's edge flags. COVERED: valid but some of its points are inside geometry, see a back face
+ * or lie across geometry from its gather point (post/rim.c limits these). NEAR: geometry within
+ * LMB_NEAR_TEXELS texels of its points (a wall's foot, a contact): a lookup from a hit may read
+ * this texel across that geometry, so the bounce cache checks the texel's gather point is in
+ * sight (cache/texel_sides.h). */
+enum { LMB_EDGE_COVERED = 1, LMB_EDGE_NEAR = 2 };
+#define LMB_NEAR_TEXELS 3.0
+
 typedef struct lmb_texels {
     uint32_t width, height, samples;
     uint32_t count;            /* texels that hold at least one point */
@@ -42,9 +50,7 @@ typedef struct lmb_texels {
     uint8_t *valid;            /* per listed texel: 1, or 0 when inside geometry (set by the lights stage) */
     uint8_t *gather_at;        /* per listed texel: its first point outside geometry, where indirect
                                   light is gathered (set by the lights stage) */
-    uint8_t *partly_covered;   /* per listed texel: 1 when valid but some of its points are inside
-                                  geometry or see a back face (set by the lights stage; post/rim.c
-                                  limits these) */
+    uint8_t *edge;             /* per listed texel: LMB_EDGE_* flags (set by the lights stage) */
 } lmb_texels;
 
 /* Gather points for atlas `atlas` of layout l. `samples` per texel, 1..256. */

@@ -12,7 +12,7 @@
 #include <zstd.h>
 
 #define MAGIC "LMBVALID"
-#define FORMAT 2u
+#define FORMAT 3u /* 3: entries carry LMB_VALIDITY_NEAR */
 
 /* The memo's file: the layout's file name with .lmbp replaced by -seedN.lmbv. */
 static int memo_path(const lmb_scene *scene, const lmb_config *cfg, const char *dir, char *path, size_t size)

@@ -1,0 +1,28 @@
+/*
+ * Whether two points on the level's surfaces are in sight of each other along those surfaces: the
+ * test that keeps light on its own side of a wall (docs/leaks.md). A texel whose points straddle
+ * a wall's foot, an irradiance-cache record and a texel it would serve, a hit and the texel its
+ * bilinear lookup reads: each pair lies on one surface (or two nearly parallel ones) within a
+ * few texels, and a wall standing between them blocks the segment joining them.
+ *
+ * Both points are lifted off their surfaces by `lift` along their geometric normals before the
+ * segment is traced, so the surfaces themselves do not block it, nor does a curved surface's chord
+ * dip under it (the chord of two points 1.4 texels apart on a surface turning by 18 degrees sinks
+ * 0.054 texels; callers lift by LMB_SIGHT_LIFT texels). Pairs whose geometric normals differ by
+ * more than that (a chart folded over a box's edge, whose segment would cut through the box) are
+ * in sight by definition: a wall's two sides are not one surface.
+ */
+#ifndef LMBAKE_RT_SIGHT_H
+#define LMBAKE_RT_SIGHT_H
+
+#include "rt_scene.h"
+
+#define LMB_SIGHT_LIFT 0.1        /* texels */
+#define LMB_SIGHT_SAME_PLANE 0.95 /* the cosine above which two points' surfaces are compared */
+
+/* 1 when nothing blocks the segment from a + lift ng_a to b + lift ng_b, or when ng_a . ng_b is
+ * below LMB_SIGHT_SAME_PLANE (ng: unit geometric normals, front side). */
+int lmb_rt_in_sight(const lmb_rt *rt, const double a[3], const double ng_a[3], const double b[3], const double ng_b[3],
+                    double lift);
+
+#endif
