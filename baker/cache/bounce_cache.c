@@ -82,7 +82,8 @@ void lmb_cache_release(lmb_cache *c)
 lmb_status lmb_cache_store(lmb_cache *c, uint32_t a, const lmb_texels *t, const float *e, lmb_error *err)
 {
     if (!c->sides[a].near && t->edge) {
-        lmb_status st = lmb_texel_sides_build(&c->sides[a], t, c->layout->width[a], c->layout->height[a], err);
+        lmb_status st = lmb_texel_sides_build(&c->sides[a], t, c->rt, c->layout->width[a], c->layout->height[a],
+                                              (int)c->threads, err);
         if (st != LMB_OK)
             return st;
     }
@@ -194,7 +195,7 @@ static void front_light(const lmb_cache *c, const lmb_rt_geom *g, const lmb_rt_h
     if (beside)
         for (int k = 0; k < 4; k++) {
             if (weight[k] > 0 && (c->state[a][texel[k]] != LMB_TEXEL_VALID ||
-                                  !lmb_texel_sides_in_sight(s, c->rt, texel[k], hit->p, hit->ng)))
+                                  !lmb_texel_sides_in_sight(s, texel[k], hit->p)))
                 weight[k] = 0;
             sum += weight[k];
         }

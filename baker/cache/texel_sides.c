@@ -2,9 +2,62 @@
 #include "texel_sides.h"
 
 #include "raytrace/rt_sight.h"
+#include "util/frame.h"
+#include "util/lmb_math.h"
 
+#include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The planes of the nearest faces 8 tangent rays from texel i's gather point meet (lifted as a
+ * sight test lifts, 1.0824 x LMB_BESIDE_TEXELS texels long, as texel_direct.c looked), each
+ * turned to face the point; a second plane only where its face turns by more than 25 degrees
+ * from the first (a corner), so a wall's face counts once. */
+static void texel_planes(const lmb_texels *t, uint32_t i, const lmb_rt *rt, lmb_texel_anchor *a)
+{
+    lmb_gather_point g;
+    lmb_texels_point(t, i, t->gather_at[i], &g);
+    double ng[3] = {g.ng[0], g.ng[1], g.ng[2]}, t1[3], t2[3], o[3];
+    double size = t->texel_size[i], reach = 1.0824 * LMB_BESIDE_TEXELS * size;
+    lmb_frame(ng, t1, t2);
+    for (int k = 0; k < 3; k++)
+        o[k] = g.p[k] + LMB_SIGHT_LIFT * size * ng[k];
+    lmb_rt_hit hit[8];
+    int got[8] = {0};
+    for (int j = 0; j < 8; j++) {
+        double ang = j * (LMB_PI / 4), w[3];
+        for (int k = 0; k < 3; k++)
+            w[k] = cos(ang) * t1[k] + sin(ang) * t2[k];
+        got[j] = lmb_rt_intersect(rt, o, w, 0.0, reach, &hit[j]);
+    }
+    a->planes = 0;
+    for (int pick = 0; pick < LMB_SIDE_PLANES; pick++) {
+        int best = -1;
+        for (int j = 0; j < 8; j++) {
+            if (!got[j] || (best >= 0 && !(hit[j].t < hit[best].t)))
+                continue;
+            int same = 0; /* a face already taken, or one turned less than 25 degrees from it */
+            for (uint32_t q = 0; q < a->planes; q++) {
+                const float *m = a->plane[q].m;
+                same |= fabs(m[0] * hit[j].ng[0] + m[1] * hit[j].ng[1] + m[2] * hit[j].ng[2]) > 0.906;
+            }
+            if (!same)
+                best = j;
+        }
+        if (best < 0)
+            break;
+        lmb_side_plane *pl = &a->plane[a->planes++];
+        double side = 0;
+        for (int k = 0; k < 3; k++)
+            side += (o[k] - hit[best].p[k]) * hit[best].ng[k];
+        for (int k = 0; k < 3; k++) {
+            pl->q[k] = (float)hit[best].p[k];
+            pl->m[k] = side < 0 ? -hit[best].ng[k] : hit[best].ng[k];
+        }
+        got[best] = 0;
+    }
+}
 
 static int by_texel(const void *a, const void *b)
 {
@@ -12,7 +65,8 @@ static int by_texel(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-lmb_status lmb_texel_sides_build(lmb_texel_sides *s, const lmb_texels *t, uint32_t w, uint32_t h, lmb_error *err)
+lmb_status lmb_texel_sides_build(lmb_texel_sides *s, const lmb_texels *t, const lmb_rt *rt, uint32_t w, uint32_t h,
+                                 int threads, lmb_error *err)
 {
     memset(s, 0, sizeof *s);
     uint32_t n = 0;
@@ -20,29 +74,33 @@ lmb_status lmb_texel_sides_build(lmb_texel_sides *s, const lmb_texels *t, uint32
         n += t->valid[i] && (t->edge[i] & LMB_EDGE_NEAR);
     s->near = calloc((size_t)w * h + 1, 1);
     s->anchors = malloc(((size_t)n + 1) * sizeof *s->anchors);
-    if (!s->near || !s->anchors) {
+    uint32_t *list = malloc(((size_t)n + 1) * sizeof *list);
+    if (!s->near || !s->anchors || !list) {
+        free(list);
         lmb_texel_sides_free(s);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for %u texels beside walls", n);
     }
-    for (uint32_t i = 0; i < t->count; i++) {
-        if (!t->valid[i] || !(t->edge[i] & LMB_EDGE_NEAR))
-            continue;
-        lmb_gather_point g;
-        lmb_texels_point(t, i, t->gather_at[i], &g);
-        lmb_texel_anchor *a = &s->anchors[s->count++];
-        a->texel = t->texel[i];
-        a->lift = (float)(LMB_SIGHT_LIFT * t->texel_size[i]);
-        for (int k = 0; k < 3; k++) {
-            a->p[k] = g.p[k];
-            a->ng[k] = g.ng[k];
+    for (uint32_t i = 0; i < t->count; i++)
+        if (t->valid[i] && (t->edge[i] & LMB_EDGE_NEAR))
+            list[s->count++] = i;
+    int64_t count = s->count;
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
+    {
+        lmb_rt_thread_init();
+#pragma omp for schedule(dynamic, 256)
+        for (int64_t k = 0; k < count; k++) {
+            s->anchors[k].texel = t->texel[list[k]];
+            texel_planes(t, list[k], rt, &s->anchors[k]);
         }
-        s->near[t->texel[i]] = 1;
     }
+    free(list);
     int sorted = 1;
     for (uint32_t k = 1; k < s->count; k++)
         sorted &= s->anchors[k].texel > s->anchors[k - 1].texel;
     if (!sorted)
         qsort(s->anchors, s->count, sizeof *s->anchors, by_texel);
+    for (uint32_t k = 0; k < s->count; k++)
+        s->near[s->anchors[k].texel] = s->anchors[k].planes > 0;
     return LMB_OK;
 }
 
@@ -53,8 +111,7 @@ void lmb_texel_sides_free(lmb_texel_sides *s)
     memset(s, 0, sizeof *s);
 }
 
-int lmb_texel_sides_in_sight(const lmb_texel_sides *s, const lmb_rt *rt, uint32_t texel, const double p[3],
-                             const float ng[3])
+int lmb_texel_sides_in_sight(const lmb_texel_sides *s, uint32_t texel, const double p[3])
 {
     if (!s->near || !s->near[texel])
         return 1;
@@ -69,6 +126,11 @@ int lmb_texel_sides_in_sight(const lmb_texel_sides *s, const lmb_rt *rt, uint32_
     if (lo >= s->count || s->anchors[lo].texel != texel)
         return 1;
     const lmb_texel_anchor *a = &s->anchors[lo];
-    double n[3] = {ng[0], ng[1], ng[2]};
-    return lmb_rt_in_sight(rt, p, n, a->p, a->ng, a->lift);
+    for (uint32_t q = 0; q < a->planes; q++) {
+        const lmb_side_plane *pl = &a->plane[q];
+        double d = (p[0] - pl->q[0]) * pl->m[0] + (p[1] - pl->q[1]) * pl->m[1] + (p[2] - pl->q[2]) * pl->m[2];
+        if (d < 0)
+            return 0;
+    }
+    return 1;
 }

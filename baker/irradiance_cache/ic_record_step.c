@@ -34,9 +34,10 @@ static int reserve_mix(pass_ctx *c, uint32_t n)
     return 1;
 }
 
-/* The nearest geometry along the record's surface (lmb_ic_record.clear): 8 rays in the tangent
- * plane of its gather point's geometric normal, lifted as a sight test lifts it. */
-static void record_clearance(const pass_ctx *c, texel_at x, lmb_ic_record *r)
+/* The faces beside the record along its surface (lmb_ic_record.side): 8 rays in the tangent plane
+ * of its gather point's geometric normal, lifted as a sight test lifts it; the nearest face, and
+ * the nearest turned more than 25 degrees from it (a corner's second wall). */
+static void record_sides(const pass_ctx *c, texel_at x, lmb_ic_record *r)
 {
     const lmb_texels *t = c->t[x.atlas];
     lmb_gather_point g;
@@ -46,21 +47,42 @@ static void record_clearance(const pass_ctx *c, texel_at x, lmb_ic_record *r)
     r->lift = (float)(LMB_SIGHT_LIFT * t->texel_size[x.index]);
     for (int k = 0; k < 3; k++)
         o[k] = r->p[k] + r->lift * ng[k];
-    double reach = LMB_IC_CLEAR_REACH * r->r_max, nearest = INFINITY;
+    double reach = LMB_IC_CLEAR_REACH * r->r_max;
+    lmb_rt_hit hit[8];
+    int got[8];
     for (int j = 0; j < 8; j++) {
         double a = j * (LMB_PI / 4), d[3];
         for (int k = 0; k < 3; k++)
             d[k] = cos(a) * t1[k] + sin(a) * t2[k];
-        lmb_rt_hit h;
-        if (lmb_rt_intersect(c->job->rt, o, d, 0.0, reach, &h) && h.t < nearest)
-            nearest = h.t;
+        got[j] = lmb_rt_intersect(c->job->rt, o, d, 0.0, reach, &hit[j]);
     }
-    r->clear = (float)nearest;
+    for (int pick = 0; pick < 2; pick++) {
+        int best = -1;
+        for (int j = 0; j < 8; j++) {
+            if (!got[j] || (best >= 0 && !(hit[j].t < hit[best].t)))
+                continue;
+            const float *m = r->side[0];
+            if (pick && fabs(m[0] * hit[j].ng[0] + m[1] * hit[j].ng[1] + m[2] * hit[j].ng[2]) > 0.906)
+                continue;
+            best = j;
+        }
+        if (best < 0)
+            break;
+        double side = 0, m[3];
+        for (int k = 0; k < 3; k++)
+            side += (o[k] - hit[best].p[k]) * hit[best].ng[k];
+        for (int k = 0; k < 3; k++)
+            m[k] = side < 0 ? -hit[best].ng[k] : hit[best].ng[k];
+        for (int k = 0; k < 3; k++)
+            r->side[pick][k] = (float)m[k];
+        r->side[pick][3] = (float)(m[0] * hit[best].p[0] + m[1] * hit[best].p[1] + m[2] * hit[best].p[2]);
+        got[best] = 0;
+    }
 }
 
 /* Record from a gather at texel x: reach clamps from the texel's size, the rotation gradient
  * bounded like the translation one (at most E over the largest normal difference served). */
-static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_result *g, lmb_ic_record *r)
+static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_result *g, int again, lmb_ic_record *r)
 {
     memset(r, 0, sizeof *r);
     memcpy(r->p, g->p, sizeof r->p);
@@ -82,15 +104,14 @@ static void make_record(const pass_ctx *c, texel_at x, const lmb_gather_point_re
     }
     r->atlas = x.atlas;
     r->texel = x.index;
-    if (c->own_level) /* a texel gathered on its own serves no other */
-        r->clear = INFINITY;
-    else
-        record_clearance(c, x, r);
+    if (!c->own_level && !again) /* a texel gathered on its own serves no other; a record gathered
+                                    again keeps its sides (only its light is taken) */
+        record_sides(c, x, r);
 }
 
-/* A record's bytes in a step (steps/runner.h): p and n (6 doubles), then its floats e .. lift (28,
+/* A record's bytes in a step (steps/runner.h): p and n (6 doubles), then its floats e .. lift (35,
  * contiguous), atlas, texel. */
-#define RECORD_FLOATS 28
+#define RECORD_FLOATS 35
 _Static_assert(offsetof(lmb_ic_record, lift) - offsetof(lmb_ic_record, e) == (RECORD_FLOATS - 1) * sizeof(float),
                "lmb_ic_record: e .. lift are contiguous floats");
 
@@ -237,7 +258,7 @@ static lmb_status gather_records_range(void *user, uint64_t first, uint64_t last
                 }
                 if (c->guided)
                     mix[k - start] = by ? guide : g.learned;
-                make_record(c, x, &g, &rec[k - start]);
+                make_record(c, x, &g, rs->slots != NULL, &rec[k - start]);
             }
             lmb_estimator_scratch_free(&scratch);
             rays += gs.rays;

@@ -267,19 +267,21 @@ int64_t lmb_ic_records_nearest(const lmb_ic_records *s, const double p[3], const
 
 /*
  * Whether record r may serve point p (normal n) across geometry (docs/leaks.md): a wall standing
- * between them on their surface (a floor chart running under a wall between two rooms). Only a
- * record whose tangent rays met geometry nearer than LMB_IC_CLEAR_SLACK x |p - p_i| can have one
- * in between (a straight wall crossing the segment at distance s is at most s from the record,
- * and the nearest of its 8 rays meets it within 1.0824 s), so only those pairs trace a ray.
+ * between them on their surface (a floor chart running under a wall between two rooms). A wall
+ * that crosses the segment from the record to p within its reach is met by one of the record's
+ * tangent rays (the nearest of 8 to its normal within 1.0824 x its distance); the record keeps
+ * the planes of the nearest two such faces, and only a point behind one of them traces a ray.
  */
 static int across_geometry(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3])
 {
-    if (!s->rt || !isfinite(r->clear))
+    if (!s->rt)
         return 0;
-    double d[3] = {p[0] - r->p[0], p[1] - r->p[1], p[2] - r->p[2]};
-    if (LMB_IC_CLEAR_SLACK * sqrt(lmb_dot3(d, d)) < r->clear)
-        return 0;
-    return !lmb_rt_in_sight(s->rt, r->p, r->n, p, n, r->lift);
+    int behind = 0;
+    for (int k = 0; k < 2 && !behind; k++) {
+        const float *pl = r->side[k];
+        behind = (pl[0] != 0 || pl[1] != 0 || pl[2] != 0) && pl[0] * p[0] + pl[1] * p[1] + pl[2] * p[2] < pl[3];
+    }
+    return behind && !lmb_rt_in_sight(s->rt, r->p, r->n, p, n, r->lift);
 }
 
 double lmb_ic_weight(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3])

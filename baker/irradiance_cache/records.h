@@ -40,8 +40,9 @@ typedef struct lmb_ic_record {
     float r_min, r_max;    /* the reach's clamps in world units (spacing x the texel's size) */
     float r;               /* reach: clamp(error x harmonic, r_min, r_max) */
     float var;             /* variance of lum(e) as an estimate (0: unknown): post/denoise.h's noise level */
-    float clear;           /* world: the nearest geometry along its surface (8 rays in its tangent plane,
-                              LMB_IC_CLEAR_REACH x r_max long; INFINITY: none), see lmb_ic_weight */
+    float side[2][4];      /* the planes of the nearest two faces (distinct orientations) its 8 tangent rays
+                              met within LMB_IC_CLEAR_REACH x r_max, turned to face it: (m, m . q); m = 0:
+                              none. A point behind one may lie across a wall (across_geometry) */
     float lift;            /* world: how far a sight test lifts it off its surface (raytrace/rt_sight.h) */
     uint32_t atlas, texel; /* where it was gathered: atlas and listed-texel index */
     uint32_t group;        /* placement order: the level (of all rounds) that placed it */
@@ -67,9 +68,6 @@ typedef struct lmb_ic_records {
  * a ray of 8 around the circle is longer than the way to a straight wall nearest to it, with a
  * margin. */
 #define LMB_IC_CLEAR_REACH 1.2
-/* A record whose geometry is nearer than this factor times a point's distance may lie across a
- * wall from the point: 1 / cos(22.5 degrees). */
-#define LMB_IC_CLEAR_SLACK 1.0824
 
 /* An empty set for error setting a (> 0). Free with lmb_ic_records_free. */
 void lmb_ic_records_init(lmb_ic_records *s, double error);

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "../raytrace/rt_sight.h"
+#include "../util/frame.h"
 #include "../util/lmb_math.h"
 #include "../util/rng.h"
 
@@ -92,6 +93,29 @@ static uint32_t keep_own_side(const lmb_direct *d, point_sum *ps, uint32_t used,
 }
 
 /*
+ * Whether geometry stands within LMB_BESIDE_TEXELS texels of point sp along its surface: 8 rays in
+ * its tangent plane, lifted as a sight test lifts (raytrace/rt_sight.h), 1.0824 x that long (the
+ * nearest of 8 rays to a straight wall meets it within 1 / cos(22.5 degrees) of its distance).
+ * Such a texel's neighbours in a bilinear lookup may lie across that geometry (cache/texel_sides.h).
+ */
+static int geometry_beside(const lmb_direct *d, const lmb_shading_point *sp, double texel_size, uint32_t *rays)
+{
+    double t1[3], t2[3], o[3], reach = 1.0824 * LMB_BESIDE_TEXELS * texel_size;
+    lmb_frame(sp->ng, t1, t2);
+    for (int k = 0; k < 3; k++)
+        o[k] = sp->p[k] + LMB_SIGHT_LIFT * texel_size * sp->ng[k];
+    for (int j = 0; j < 8; j++) {
+        double a = j * (LMB_PI / 4), w[3];
+        for (int k = 0; k < 3; k++)
+            w[k] = cos(a) * t1[k] + sin(a) * t2[k];
+        ++*rays;
+        if (lmb_rt_occluded(lmb_direct_rt(d), o, w, 0.0, reach))
+            return 1;
+    }
+    return 0;
+}
+
+/*
  * Direct light of listed texel i with `rounds` (>= 2) rounds of the sampled lights. Each usable
  * point evaluates its exact lights once and its sampled lights (area lights, sun discs, many
  * lights, the sky) in rounds of half samples.direct (and half sky.samples) along one scrambled
@@ -127,8 +151,10 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         near_back |= sight.sees_back;
         used++;
     }
+    uint32_t own_side = used;
     if (near && used > 1)
         used = keep_own_side(job->direct, ps, used, t->texel_size[i], &r);
+    int beside = used && (used < own_side || (near && geometry_beside(job->direct, &ps[0].sp, t->texel_size[i], &r)));
     t->gather_at[i] = used ? (uint8_t)ps[0].k : 0;
     for (uint32_t j = 0; j < used; j++) {
         point_sum *p = &ps[j];
@@ -176,7 +202,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         }
     t->valid[i] = used > 0;
     t->edge[i] = (uint8_t)((used > 0 && (used < t->points_in[i] || near_back) ? LMB_EDGE_COVERED : 0) |
-                           (near ? LMB_EDGE_NEAR : 0));
+                           (beside ? LMB_EDGE_NEAR : 0));
     for (int d = 0; d < 3; d++) {
         out[3 * i + d] = used ? (float)(sum[d] / used) : 0.0f;
         if (job->direction)

@@ -9,6 +9,8 @@ int lmb_rt_in_sight(const lmb_rt *rt, const double a[3], const double ng_a[3], c
     double c = ng_a[0] * ng_b[0] + ng_a[1] * ng_b[1] + ng_a[2] * ng_b[2];
     if (c < LMB_SIGHT_SAME_PLANE)
         return 1;
+    double gap[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    lift = fmax(lift, LMB_SIGHT_LIFT_PER_DISTANCE * sqrt(gap[0] * gap[0] + gap[1] * gap[1] + gap[2] * gap[2]));
     double o[3], d[3];
     for (int k = 0; k < 3; k++) {
         o[k] = a[k] + lift * ng_a[k];

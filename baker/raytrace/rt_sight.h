@@ -5,12 +5,13 @@
  * bilinear lookup reads: each pair lies on one surface (or two nearly parallel ones) within a
  * few texels, and a wall standing between them blocks the segment joining them.
  *
- * Both points are lifted off their surfaces by `lift` along their geometric normals before the
- * segment is traced, so the surfaces themselves do not block it, nor does a curved surface's chord
- * dip under it (the chord of two points 1.4 texels apart on a surface turning by 18 degrees sinks
- * 0.054 texels; callers lift by LMB_SIGHT_LIFT texels). Pairs whose geometric normals differ by
- * more than that (a chart folded over a box's edge, whose segment would cut through the box) are
- * in sight by definition: a wall's two sides are not one surface.
+ * Both points are lifted off their surfaces along their normals before the segment is traced,
+ * so the surfaces themselves do not block it, nor does a curved surface's chord dip under it: by
+ * the larger of `lift` (callers: LMB_SIGHT_LIFT texels) and LMB_SIGHT_LIFT_PER_DISTANCE x their
+ * distance (a chord of length d between normals up to 18 degrees apart sinks at most d x 0.31 / 8
+ * = 0.039 d under a convex surface). Pairs whose normals differ by more than that (a chart folded
+ * over a box's edge, whose segment would cut through the box) are in sight by definition: a
+ * wall's two sides are not one surface.
  */
 #ifndef LMBAKE_RT_SIGHT_H
 #define LMBAKE_RT_SIGHT_H
@@ -19,9 +20,10 @@
 
 #define LMB_SIGHT_LIFT 0.1        /* texels */
 #define LMB_SIGHT_SAME_PLANE 0.95 /* the cosine above which two points' surfaces are compared */
+#define LMB_SIGHT_LIFT_PER_DISTANCE 0.05
 
-/* 1 when nothing blocks the segment from a + lift ng_a to b + lift ng_b, or when ng_a . ng_b is
- * below LMB_SIGHT_SAME_PLANE (ng: unit geometric normals, front side). */
+/* 1 when nothing blocks the segment from a + l ng_a to b + l ng_b (l = max(lift, 0.05 |b - a|)),
+ * or when ng_a . ng_b is below LMB_SIGHT_SAME_PLANE (ng: unit normals, front side). */
 int lmb_rt_in_sight(const lmb_rt *rt, const double a[3], const double ng_a[3], const double b[3], const double ng_b[3],
                     double lift);
 
