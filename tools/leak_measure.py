@@ -9,7 +9,8 @@ usage: leak_measure.py OUTDIR SCENE        prints one JSON line
 
 Texel positions: each lightmapped triangle's TEXCOORD_1 is rasterised at texel centres (those
 within half a texel of the triangle, clamped onto it). "Away" texels are more than one texel from
-every face of the dark box but the one they lie on. Probe-lit points: a grid over the dark box
+every face of the dark box but the one they lie on (a texel clamped onto an edge lies on two: it
+is at a wall). Probe-lit points: a grid over the dark box
 kept 0.3 m inside it; each reads the brightest of the six ambient-cube faces.
 """
 import json
@@ -140,7 +141,7 @@ def away_from_faces(p, lo, hi, size):
     d = np.concatenate([p - lo, hi - p], axis=1)  # 6 distances
     on = d < 1e-4
     d = np.where(on, np.inf, d)
-    return d.min(axis=1) > size
+    return (on.sum(axis=1) <= 1) & (d.min(axis=1) > size)  # a texel on an edge (two faces) is at a wall
 
 
 def probes(doc, blobs):
@@ -226,7 +227,7 @@ def probe_points(lo, hi, margin):
     return np.stack([x.ravel() for x in g], axis=1)
 
 
-def measure(out, scene):
+def measure(out, scene, margin=PROBE_MARGIN, probes_too=True):
     name = [f for f in os.listdir(out) if f.endswith(".gltf")][0]
     doc = json.load(open(os.path.join(out, name)))
     blobs = [open(os.path.join(out, b["uri"]), "rb").read() for b in doc["buffers"]]
@@ -244,13 +245,13 @@ def measure(out, scene):
         axis, at, _ = wall
         foot = dark & (np.abs(pts[:, axis] - at) < size * 1.01) | dark & (pts[:, axis] - at < size)
         r["dark_wall_max"] = float(lum[foot].max()) if foot.any() else 0.0
-    pr = probes(doc, blobs)
+    pr = probes(doc, blobs) if probes_too else None
     if pr:
         pos, cube, tets = pr
         ind = inside(pos, dark_lo, dark_hi)
         r["dark_probes"] = int(ind.sum())
         r["dark_probe_max"] = float((cube[ind] @ LUM).max()) if ind.any() else 0.0
-        pts3 = probe_points(dark_lo, dark_hi, PROBE_MARGIN)
+        pts3 = probe_points(dark_lo, dark_hi, margin)
         if tets is not None and len(tets):
             r["tetra_max"] = float((tetra_lookup(pts3, pos, cube, tets) @ LUM).max())
         vols = []

@@ -270,12 +270,17 @@ int64_t lmb_ic_records_nearest(const lmb_ic_records *s, const double p[3], const
  * between them on their surface (a floor chart running under a wall between two rooms). A wall
  * that crosses the segment from the record to p within its reach is met by one of the record's
  * tangent rays (the nearest of 8 to its normal within 1.0824 x its distance); the record keeps
- * the planes of the nearest two such faces, and only a point behind one of them traces a ray.
+ * the planes of the nearest two such faces, and only a point behind one of them traces a ray. A
+ * point off the record's plane (a ceiling's texel under a roof's record 4 cm above it: Ward's
+ * test lets a record serve what lies in front of it) always does: a slab may lie between.
  */
 static int across_geometry(const lmb_ic_records *s, const lmb_ic_record *r, const double p[3], const double n[3])
 {
     if (!s->rt)
         return 0;
+    double d[3] = {p[0] - r->p[0], p[1] - r->p[1], p[2] - r->p[2]};
+    if (fabs(lmb_dot3(d, r->n)) > 2.0 * r->lift) /* off its plane: a slab may lie between (a ceiling under a roof) */
+        return !lmb_rt_in_sight(s->rt, r->p, r->n, p, n, r->lift);
     int behind = 0;
     for (int k = 0; k < 2 && !behind; k++) {
         const float *pl = r->side[k];

@@ -429,7 +429,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     if (!w)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory");
     lmb_status st = LMB_OK;
-    uint64_t total = 0;
+    uint64_t total = 0, beside = 0;
     lmb_rim_stats rim = {0, 0, 0};
     /* gather points and direct light, atlas by atlas */
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
@@ -455,6 +455,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         for (uint32_t i = 0; i < w[a].t.count; i++) {
             stats->texels++;
             stats->valid_texels += w[a].t.valid[i];
+            beside += w[a].t.valid[i] && (w[a].t.edge[i] & LMB_EDGE_NEAR);
         }
         total += w[a].t.count;
         if (st == LMB_OK && cfg->stages_out[0])
@@ -466,6 +467,10 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
         lmb_stages_out_done(cfg, "direct", log);
     stats->rim_limited = rim.limited;
     stats->rim_energy = rim.total > 0 ? rim.removed / rim.total : 0;
+    if (stats->texels > stats->valid_texels || beside)
+        lmb_info(log, "texels: %llu inside geometry (every gather point in a solid: filled from valid neighbours, never "
+                 "lit); %llu beside geometry (lit from their own side, read only from it: docs/leaks.md)",
+                 (unsigned long long)(stats->texels - stats->valid_texels), (unsigned long long)beside);
     if (rim.limited)
         lmb_info(log, "rims: %llu partly covered texels limited to their neighbours (%.3f%% of the direct light)",
                  (unsigned long long)rim.limited, 100.0 * stats->rim_energy);

@@ -15,6 +15,7 @@
 #define AUTO_PROBES 256       /* auto spacing: the level's lightmapped surface area / spacing^2 */
 #define AUTO_MAX_CELLS 4096   /* auto spacing: widened until the grid has at most this many cells (32,768 probes at most) */
 #define FAR_CELLS 3           /* a probe with no surface within this many cells is outside the level */
+#define PROBE_CLEARANCE 0.05  /* cells: a probe nearer a surface than this moves away from it (virtual offset) */
 
 /* Calls fn for every lightmapped triangle, in world space. */
 typedef void (*triangle_fn)(void *user, const double q[9]);
@@ -205,11 +206,12 @@ static void mark_surface_cells(const lmb_scene *s, const lmb_layout *l, const gr
 }
 
 /* 0 keep, 1 inside geometry (most rays that hit something hit a back face), 2 outside the level
- * (no surface within FAR_CELLS cells in any direction). */
-static int probe_fate(const lmb_rt *rt, const double p[3], double far)
+ * (no surface within FAR_CELLS cells in any direction). *nearest: the nearest hit (t 0: none),
+ * *nearest_back: the nearest back-face hit (t 0: none). */
+static int probe_fate(const lmb_rt *rt, const double p[3], double far, lmb_rt_hit *nearest, lmb_rt_hit *nearest_back)
 {
     uint32_t hits = 0, back = 0;
-    double nearest = HUGE_VAL;
+    nearest->t = nearest_back->t = 0;
     for (uint32_t j = 0; j < TEST_RAYS; j++) {
         double w[3];
         lmb_sphere_direction(j, TEST_RAYS, w);
@@ -218,11 +220,69 @@ static int probe_fate(const lmb_rt *rt, const double p[3], double far)
             continue;
         hits++;
         back += h.backface != 0;
-        nearest = fmin(nearest, h.t);
+        if (!(nearest->t > 0) || h.t < nearest->t)
+            *nearest = h;
+        if (h.backface && (!(nearest_back->t > 0) || h.t < nearest_back->t))
+            *nearest_back = h;
     }
     if (hits && 2 * back > hits)
         return 1;
-    return !hits || nearest > far ? 2 : 0;
+    return !hits || nearest->t > far ? 2 : 0;
+}
+
+/*
+ * Virtual offset (Unity's name): a probe inside geometry, or nearer a surface than `clearance`,
+ * moves to free space instead of being dropped or reading the light of a point on the surface:
+ * through the nearest back face it sees (out of a wall, to the side nearer it; also a probe that
+ * sees a back face within 2 x clearance: one on a wall's face, whose test rays start past that
+ * face, which a grid aligned with the level puts on every wall) or away from the nearest front
+ * face, to `clearance` in front of that face. The moved probe is tested again;
+ * still inside: 1 (dropped). Returns the fate at the final position; *moved: 1 when it moved.
+ */
+static int place_probe(const lmb_rt *rt, double p[3], double far, double clearance, int *moved)
+{
+    lmb_rt_hit near, back;
+    *moved = 0;
+    int f = probe_fate(rt, p, far, &near, &back);
+    /* inside; or a back face close by (a probe on a wall's outer face, whose rays into the wall
+     * start past that face and meet the wall's far side); or a front face close by */
+    const lmb_rt_hit *h = f == 1 ? (back.t > 0 ? &back : NULL)
+                          : f != 0 ? NULL
+                          : back.t > 0 && back.t < 2 * clearance ? &back
+                          : near.t > 0 && near.t < clearance ? &near : NULL;
+    if (!h)
+        return f;
+    double q[3];
+    for (int k = 0; k < 3; k++) /* the face's front side is where free space is */
+        q[k] = h->p[k] + clearance * h->ng[k];
+    int g = probe_fate(rt, q, far, &near, &back);
+    if (g == 1)
+        return f == 1 ? 1 : f;
+    memcpy(p, q, sizeof q);
+    *moved = 1;
+    return g;
+}
+
+/* lmb_probes_line_walls's test for a probe it would add. */
+static int inside_geometry(const lmb_rt *rt, const double p[3])
+{
+    lmb_rt_hit near, back;
+    return probe_fate(rt, p, HUGE_VAL, &near, &back) == 1;
+}
+
+uint32_t lmb_probe_voxel_of(const lmb_probe_set *set, const double q[3])
+{
+    if (!set->grid_count || set->grids[0].volume != 0 || set->grids[0].from_node)
+        return UINT32_MAX;
+    const lmb_probe_grid *g = &set->grids[0];
+    uint32_t v[3];
+    for (int k = 0; k < 3; k++) {
+        double x = floor((q[k] - g->lo[k]) / g->cell[k]);
+        if (!(x >= 0) || x >= g->res[k])
+            return UINT32_MAX;
+        v[k] = (uint32_t)x;
+    }
+    return g->first_voxel + (v[2] * g->res[1] + v[1]) * g->res[0] + v[0];
 }
 
 /* The grid: auto spacing from the surface area (a probe per AUTO_PROBES-th of it), widened to
@@ -467,17 +527,22 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
     }
     const lmb_probe_grid *g0 = &out->grids[0];
     double far = FAR_CELLS * fmax(g0->cell[0], fmax(g0->cell[1], g0->cell[2]));
+    double clearance = PROBE_CLEARANCE * fmin(g0->cell[0], fmin(g0->cell[1], g0->cell[2]));
     int threads = cfg->threads > 0 ? (int)cfg->threads : omp_get_max_threads();
 #pragma omp parallel num_threads(threads)
     {
         lmb_rt_thread_init();
 #pragma omp for schedule(dynamic, 64)
         for (size_t i = 0; i < c.count; i++) {
-            int f = probe_fate(rt, c.p + 3 * i, c.auto_grid[i] ? far : HUGE_VAL);
+            int moved;
+            int f = place_probe(rt, c.p + 3 * i, c.auto_grid[i] ? far : HUGE_VAL, clearance, &moved);
             fate[i] = (uint8_t)(f == 2 && !c.auto_grid[i] ? 0 : f); /* an artist's probe in the open stays */
+            fate[i] |= (uint8_t)(moved && fate[i] == 0 ? 4 : 0);
         }
     }
     for (size_t i = 0; i < c.count; i++) {
+        out->moved += fate[i] == 4;
+        fate[i] &= 3;
         out->dropped_inside += fate[i] == 1;
         out->dropped_outside += fate[i] == 2;
         if (fate[i] == 0) {
@@ -490,6 +555,11 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
     free(c.auto_grid);
     out->position = c.p;
     out->cell = c.voxel;
+    lmb_status walls = lmb_probes_line_walls(out, rt, clearance, LMB_PROBES_MAX, threads, inside_geometry, err);
+    if (walls != LMB_OK) {
+        lmb_probe_set_free(out);
+        return walls;
+    }
     out->sh = calloc((size_t)out->count * LMB_PROBE_SH + 1, sizeof *out->sh);
     out->cube = calloc((size_t)out->count * LMB_PROBE_CUBE + 1, sizeof *out->cube);
     if (!out->sh || !out->cube) {
@@ -502,9 +572,11 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
                  n[2], out->spacing, cfg->probe_spacing > 0 ? "probes.spacing" : "auto: from the lightmapped surface's area",
                  out->refined);
     }
-    lmb_info(log, "probes: %u (%u volume(s) from probes.volumes, %u from nodes' extras.lightmap_probes); %u inside "
-             "geometry and %u outside the level dropped", out->count, cfg->probe_volume_count, s->probe_volume_count,
-             out->dropped_inside, out->dropped_outside);
+    lmb_info(log, "probes: %u (%u volume(s) from probes.volumes, %u from nodes' extras.lightmap_probes); %u moved "
+             "out of geometry or off a surface (virtual offset), %u inside geometry and %u outside the level dropped; "
+             "%u added on both sides of walls the tetrahedra crossed",
+             out->count, cfg->probe_volume_count, s->probe_volume_count, out->moved, out->dropped_inside,
+             out->dropped_outside, out->wall_probes);
     return LMB_OK;
 }
 

@@ -55,6 +55,8 @@ typedef struct lmb_probe_set {
     float *cube;       /* LMB_PROBE_CUBE per probe, lux */
     double spacing;    /* the auto grid's cell size, world units (probes near surfaces: half of it) */
     uint32_t refined;  /* auto grid cells split because they hold surface */
+    uint32_t moved;  /* probes moved out of geometry or off a surface (virtual offset) */
+    uint32_t wall_probes; /* probes added on both sides of walls the tetrahedra crossed (wall_probes.c) */
     uint32_t dropped_inside, dropped_outside;
     uint32_t rays;     /* rays per probe (probes.rays) */
     uint32_t *cell;    /* per probe: its voxel among all grids' (lmb_probe_grid.first_voxel + x fastest) */
@@ -97,6 +99,16 @@ lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb
                             const lmb_log *log, lmb_error *err);
 
 void lmb_probe_set_free(lmb_probe_set *set);
+
+/* The auto grid's voxel holding world point q (UINT32_MAX: no auto grid, or q outside it): where a
+ * probe added after placement counts in the irradiance volume. */
+uint32_t lmb_probe_voxel_of(const lmb_probe_set *set, const double q[3]);
+
+/* Adds probes on both sides of every wall an edge of the probes' tetrahedra crosses, `offset` in
+ * front of it (wall_probes.c), at most up to `limit` probes in all; `inside` says whether a point
+ * is inside geometry. Before the probes are lit (set->sh and set->cube not yet allocated). */
+lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_rt *rt, double offset, uint32_t limit, int threads,
+                                 int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err);
 
 /* The Delaunay tetrahedra of the probe positions (tetrahedra.c, qhull): 4 probe indices each,
  * positive volume, flat ones dropped. Fewer than 4 probes, or all in a plane: none, and `why`
