@@ -158,7 +158,8 @@ def probes(doc, blobs):
 
 def tetra_lookup(points, pos, cube, tets):
     """Ambient cubes at points by the barycentric weights of the tetrahedron holding each (the
-    preview's and Unity's way); beyond the hull: 8 nearest probes by inverse distance squared."""
+    preview's and Unity's way); beyond the hull: the tetrahedron the point is least outside, its
+    weights clamped to >= 0 and renormalised (the preview's rule, Unity's extrapolation)."""
     out = np.zeros((len(points), 6, 3))
     a = pos[tets[:, 0]]
     m = np.stack([pos[tets[:, 1]] - a, pos[tets[:, 2]] - a, pos[tets[:, 3]] - a], axis=2)  # (T, 3, 3)
@@ -172,11 +173,11 @@ def tetra_lookup(points, pos, cube, tets):
         if len(hit):
             t = hit[0]
             out[i] = np.einsum("k,kfc->fc", w[t], cube[tets[t]])
-        else:
-            d2 = ((pos - p) ** 2).sum(axis=1)
-            near = np.argsort(d2)[:8]
-            wt = 1 / np.maximum(d2[near], 1e-12)
-            out[i] = np.einsum("k,kfc->fc", wt / wt.sum(), cube[near])
+        else:  # beyond the hull: the tetrahedron it is least outside, weights clamped (the preview's rule)
+            least = np.where(good, w.min(axis=1), -np.inf)
+            t = int(np.argmax(least))
+            c = np.maximum(w[t], 0)
+            out[i] = np.einsum("k,kfc->fc", c / c.sum(), cube[tets[t]])
     return out
 
 

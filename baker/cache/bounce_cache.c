@@ -190,7 +190,7 @@ static void front_light(const lmb_cache *c, const lmb_rt_geom *g, const lmb_rt_h
     const lmb_texel_sides *s = &c->sides[a];
     int beside = 0;
     for (int k = 0; k < 4 && s->near; k++)
-        beside |= s->near[texel[k]];
+        beside |= lmb_texel_sides_near(s, texel[k]);
     double sum = 0;
     if (beside)
         for (int k = 0; k < 4; k++) {

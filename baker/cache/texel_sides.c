@@ -72,7 +72,7 @@ lmb_status lmb_texel_sides_build(lmb_texel_sides *s, const lmb_texels *t, const 
     uint32_t n = 0;
     for (uint32_t i = 0; i < t->count; i++)
         n += t->valid[i] && (t->edge[i] & LMB_EDGE_NEAR);
-    s->near = calloc((size_t)w * h + 1, 1);
+    s->near = calloc(((size_t)w * h + 63) / 64 + 1, sizeof *s->near);
     s->anchors = malloc(((size_t)n + 1) * sizeof *s->anchors);
     uint32_t *list = malloc(((size_t)n + 1) * sizeof *list);
     if (!s->near || !s->anchors || !list) {
@@ -99,32 +99,42 @@ lmb_status lmb_texel_sides_build(lmb_texel_sides *s, const lmb_texels *t, const 
         sorted &= s->anchors[k].texel > s->anchors[k - 1].texel;
     if (!sorted)
         qsort(s->anchors, s->count, sizeof *s->anchors, by_texel);
+    /* only anchors with a plane are kept (a texel whose tangent rays met nothing now needs no test) */
+    uint32_t kept = 0;
     for (uint32_t k = 0; k < s->count; k++)
-        s->near[s->anchors[k].texel] = s->anchors[k].planes > 0;
+        if (s->anchors[k].planes > 0) {
+            s->anchors[kept++] = s->anchors[k];
+            s->near[s->anchors[k].texel >> 6] |= 1ull << (s->anchors[k].texel & 63);
+        }
+    s->count = kept;
+    size_t words = ((size_t)w * h + 63) / 64;
+    s->rank = malloc((words + 1) * sizeof *s->rank);
+    if (!s->rank) {
+        lmb_texel_sides_free(s);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "bounce cache: out of memory for %u texels beside walls", n);
+    }
+    uint32_t before = 0;
+    for (size_t k = 0; k < words; k++) {
+        s->rank[k] = before;
+        before += (uint32_t)__builtin_popcountll(s->near[k]);
+    }
     return LMB_OK;
 }
 
 void lmb_texel_sides_free(lmb_texel_sides *s)
 {
     free(s->near);
+    free(s->rank);
     free(s->anchors);
     memset(s, 0, sizeof *s);
 }
 
 int lmb_texel_sides_in_sight(const lmb_texel_sides *s, uint32_t texel, const double p[3])
 {
-    if (!s->near || !s->near[texel])
+    if (!lmb_texel_sides_near(s, texel))
         return 1;
-    uint32_t lo = 0, hi = s->count;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (s->anchors[mid].texel < texel)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    if (lo >= s->count || s->anchors[lo].texel != texel)
-        return 1;
+    uint64_t below = s->near[texel >> 6] & ((1ull << (texel & 63)) - 1);
+    uint32_t lo = s->rank[texel >> 6] + (uint32_t)__builtin_popcountll(below);
     const lmb_texel_anchor *a = &s->anchors[lo];
     for (uint32_t q = 0; q < a->planes; q++) {
         const lmb_side_plane *pl = &a->plane[q];

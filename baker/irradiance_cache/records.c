@@ -438,6 +438,8 @@ static void fit_visit(void *user, uint32_t k)
     double along = lmb_dot3(d, self->n), dist2 = lmb_dot3(d, d), reach = 2 * self->r;
     if (fabs(along) > 0.25 * sqrt(dist2) || dist2 >= reach * reach)
         return; /* off the record's plane: not the same surface */
+    if (across_geometry(c->s, self, r->p, r->n))
+        return; /* across a wall: another room's light says nothing of this one's slope */
     double u = lmb_dot3(d, c->t), v = lmb_dot3(d, c->b);
     double w = 1 - sqrt(dist2) / reach;
     c->a[0] += w * u * u;

@@ -93,13 +93,17 @@ static uint32_t keep_own_side(const lmb_direct *d, point_sum *ps, uint32_t used,
 }
 
 /*
- * Whether geometry stands within LMB_BESIDE_TEXELS texels of point sp along its surface: 8 rays in
- * its tangent plane, lifted as a sight test lifts (raytrace/rt_sight.h), 1.0824 x that long (the
- * nearest of 8 rays to a straight wall meets it within 1 / cos(22.5 degrees) of its distance).
- * Such a texel's neighbours in a bilinear lookup may lie across that geometry (cache/texel_sides.h).
+ * Whether a thin wall stands within LMB_BESIDE_TEXELS texels of point sp along its surface: 8 rays
+ * in its tangent plane, lifted as a sight test lifts (raytrace/rt_sight.h), 1.0824 x that long
+ * (the nearest of 8 rays to a straight wall meets it within 1 / cos(22.5 degrees) of its
+ * distance), and for a ray that meets a face, the same ray on from there: the wall is thin when it
+ * ends within LMB_THIN_TEXELS texels (the ray meets its far side). Only across such a wall can a
+ * bilinear lookup on the other side read this texel (cache/texel_sides.h); a crate or a step
+ * wider than that keeps every lookup on its own side.
  */
-static int geometry_beside(const lmb_direct *d, const lmb_shading_point *sp, double texel_size, uint32_t *rays)
+static int thin_wall_beside(const lmb_direct *d, const lmb_shading_point *sp, double texel_size, uint32_t *rays)
 {
+    const lmb_rt *rt = lmb_direct_rt(d);
     double t1[3], t2[3], o[3], reach = 1.0824 * LMB_BESIDE_TEXELS * texel_size;
     lmb_frame(sp->ng, t1, t2);
     for (int k = 0; k < 3; k++)
@@ -108,8 +112,12 @@ static int geometry_beside(const lmb_direct *d, const lmb_shading_point *sp, dou
         double a = j * (LMB_PI / 4), w[3];
         for (int k = 0; k < 3; k++)
             w[k] = cos(a) * t1[k] + sin(a) * t2[k];
+        lmb_rt_hit h, far;
         ++*rays;
-        if (lmb_rt_occluded(lmb_direct_rt(d), o, w, 0.0, reach))
+        if (!lmb_rt_intersect(rt, o, w, 0.0, reach, &h))
+            continue;
+        ++*rays;
+        if (lmb_rt_intersect(rt, h.p, w, rt->eps, LMB_THIN_TEXELS * texel_size, &far))
             return 1;
     }
     return 0;
@@ -154,7 +162,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
     uint32_t own_side = used;
     if (near && used > 1)
         used = keep_own_side(job->direct, ps, used, t->texel_size[i], &r);
-    int beside = used && (used < own_side || (near && geometry_beside(job->direct, &ps[0].sp, t->texel_size[i], &r)));
+    int beside = used && (used < own_side || (near && thin_wall_beside(job->direct, &ps[0].sp, t->texel_size[i], &r)));
     t->gather_at[i] = used ? (uint8_t)ps[0].k : 0;
     for (uint32_t j = 0; j < used; j++) {
         point_sum *p = &ps[j];

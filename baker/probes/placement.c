@@ -555,7 +555,9 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
     free(c.auto_grid);
     out->position = c.p;
     out->cell = c.voxel;
-    lmb_status walls = lmb_probes_line_walls(out, rt, clearance, LMB_PROBES_MAX, threads, inside_geometry, err);
+    /* walls lined at half the probes' spacing near surfaces (a quarter cell) */
+    double lining = 0.25 * fmin(g0->cell[0], fmin(g0->cell[1], g0->cell[2]));
+    lmb_status walls = lmb_probes_line_walls(out, rt, clearance, lining, LMB_PROBES_MAX, threads, inside_geometry, err);
     if (walls != LMB_OK) {
         lmb_probe_set_free(out);
         return walls;

@@ -105,10 +105,11 @@ void lmb_probe_set_free(lmb_probe_set *set);
 uint32_t lmb_probe_voxel_of(const lmb_probe_set *set, const double q[3]);
 
 /* Adds probes on both sides of every wall an edge of the probes' tetrahedra crosses, `offset` in
- * front of it (wall_probes.c), at most up to `limit` probes in all; `inside` says whether a point
- * is inside geometry. Before the probes are lit (set->sh and set->cube not yet allocated). */
-lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_rt *rt, double offset, uint32_t limit, int threads,
-                                 int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err);
+ * front of it, none within `spacing` of another probe (wall_probes.c), at most up to `limit`
+ * probes in all; `inside` says whether a point is inside geometry. Before the probes are lit
+ * (set->sh and set->cube not yet allocated). */
+lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_rt *rt, double offset, double spacing, uint32_t limit,
+                                 int threads, int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err);
 
 /* The Delaunay tetrahedra of the probe positions (tetrahedra.c, qhull): 4 probe indices each,
  * positive volume, flat ones dropped. Fewer than 4 probes, or all in a plane: none, and `why`

@@ -29,14 +29,16 @@ typedef struct lmb_point_ref {
 } lmb_point_ref;
 
 /* A texel's edge flags. COVERED: valid but some of its points are inside geometry, see a back face
- * or lie across geometry from its gather point (post/rim.c limits these). NEAR: geometry stands
- * within LMB_BESIDE_TEXELS texels of its gather point along its surface, or split its points (a
- * wall's foot, a contact): a lookup from a hit may read this texel across that geometry, so the
- * bounce cache checks the texel's gather point is in sight (cache/texel_sides.h). Only texels
- * some of whose hemisphere rays hit within LMB_NEAR_TEXELS texels are looked at that closely. */
+ * or lie across geometry from its gather point (post/rim.c limits these). NEAR: a wall thinner
+ * than LMB_THIN_TEXELS texels stands within LMB_BESIDE_TEXELS texels of its gather point along
+ * its surface, or geometry split its points (a thin wall's foot): a lookup from a hit may read
+ * this texel across that wall, so the bounce cache checks the hit's side (cache/texel_sides.h).
+ * Only texels some of whose hemisphere rays hit within LMB_NEAR_TEXELS texels are looked at that
+ * closely. */
 enum { LMB_EDGE_COVERED = 1, LMB_EDGE_NEAR = 2 };
 #define LMB_NEAR_TEXELS 3.0
 #define LMB_BESIDE_TEXELS 1.5
+#define LMB_THIN_TEXELS 2.0
 
 typedef struct lmb_texels {
     uint32_t width, height, samples;

@@ -7,8 +7,11 @@
 // Interpolation: as Unity and Godot do, over the probes' tetrahedra (the bake's Delaunay
 // tetrahedra): inside one, its four probes with the point's barycentric weights (a probe at the
 // centre itself has weight 1, so a test can read one probe's light exactly). Outside them all
-// (beyond the probes' hull) or with no tetrahedra in the file: the 8 nearest probes weighted by
-// 1 / d^2.
+// (beyond the probes' hull: below the lowest layer of probes, near a wall): the tetrahedron the
+// point is least outside (its smallest barycentric weight the largest), the weights clamped to
+// >= 0 and renormalised, as Unity extrapolates from the hull: the probes of the point's own room
+// (the nearest probes by distance may lie across a wall, docs/leaks.md). With no tetrahedra in
+// the file: the 8 nearest probes weighted by 1 / d^2.
 import * as THREE from 'three';
 
 const SH_Y = [0.282095, 0.488603, 0.488603, 0.488603, 1.092548, 1.092548, 0.315392, 1.092548, 0.546274];
@@ -27,11 +30,13 @@ export async function loadProbes(parser) {
   return { count: p.count, positions, sh, spacing: p.spacing || 0, tetrahedra };
 }
 
-// The tetrahedron holding x and x's barycentric weights in it, or null (outside them all).
+// The tetrahedron holding x and x's barycentric weights in it; beyond them all, the one x is
+// least outside with its weights clamped and renormalised (outside: true); null: no tetrahedra.
 export function findTetrahedron(probes, x) {
   const t = probes.tetrahedra, P = probes.positions;
   if (!t) return null;
   const eps = 1e-7;
+  let best = null, bestLeast = -Infinity;
   for (let k = 0; k < t.length; k += 4) {
     const a = 3 * t[k], v = [0, 1, 2].map((j) => [P[3 * t[k + j + 1]] - P[a], P[3 * t[k + j + 1] + 1] - P[a + 1], P[3 * t[k + j + 1] + 2] - P[a + 2]]);
     const q = [x[0] - P[a], x[1] - P[a + 1], x[2] - P[a + 2]];
@@ -40,19 +45,27 @@ export function findTetrahedron(probes, x) {
     if (!(d > 0)) continue;
     const b1 = det(q, v[1], v[2]) / d, b2 = det(v[0], q, v[2]) / d, b3 = det(v[0], v[1], q) / d, b0 = 1 - b1 - b2 - b3;
     if (b0 >= -eps && b1 >= -eps && b2 >= -eps && b3 >= -eps) return { probes: [t[k], t[k + 1], t[k + 2], t[k + 3]], weights: [b0, b1, b2, b3] };
+    const least = Math.min(b0, b1, b2, b3);
+    if (least > bestLeast) {
+      bestLeast = least;
+      best = { probes: [t[k], t[k + 1], t[k + 2], t[k + 3]], weights: [b0, b1, b2, b3] };
+    }
   }
-  return null;
+  if (!best) return null;
+  const clamped = best.weights.map((w) => Math.max(0, w)), sum = clamped.reduce((a, b) => a + b, 0);
+  return { probes: best.probes, weights: clamped.map((w) => w / sum), outside: true };
 }
 
-// The irradiance SH (27 floats) at point x: barycentric in its tetrahedron, else IDW over the 8
-// nearest probes. {sh, probes (those used), how: 'tetrahedron' or 'nearest'}.
+// The irradiance SH (27 floats) at point x: barycentric in its tetrahedron (or the nearest one,
+// beyond the hull), else (no tetrahedra) IDW over the 8 nearest probes. {sh, probes (those used),
+// how: 'tetrahedron', 'hull' or 'nearest'}.
 export function interpolateSH(probes, x) {
   const tet = findTetrahedron(probes, x);
   if (tet) {
     const out = new Float32Array(27);
     tet.probes.forEach((i, j) => { for (let k = 0; k < 27; k++) out[k] += tet.weights[j] * probes.sh[27 * i + k]; });
     const used = tet.probes.filter((_, j) => tet.weights[j] > 1e-6);
-    return { sh: out, probes: used, weights: tet.weights, how: 'tetrahedron' };
+    return { sh: out, probes: used, weights: tet.weights, how: tet.outside ? 'hull' : 'tetrahedron' };
   }
   const near = [];
   for (let i = 0; i < probes.count; i++) {
