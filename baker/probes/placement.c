@@ -239,15 +239,16 @@ static int probe_fate(const lmb_rt *rt, const double p[3], double far, lmb_rt_hi
  * face, to `clearance` in front of that face. The moved probe is tested again;
  * still inside: 1 (dropped). Returns the fate at the final position; *moved: 1 when it moved.
  */
-static int place_probe(const lmb_rt *rt, double p[3], double far, double clearance, int *moved)
+static int place_probe(const lmb_rt *rt, double p[3], double far, double clearance, int auto_grid, int *moved)
 {
     lmb_rt_hit near, back;
     *moved = 0;
     int f = probe_fate(rt, p, far, &near, &back);
     /* inside; or a back face close by (a probe on a wall's outer face, whose rays into the wall
-     * start past that face and meet the wall's far side); or a front face close by */
+     * start past that face and meet the wall's far side); or a front face close by. An artist's
+     * volume moves only out of geometry: its grid is where it was asked for */
     const lmb_rt_hit *h = f == 1 ? (back.t > 0 ? &back : NULL)
-                          : f != 0 ? NULL
+                          : f != 0 || !auto_grid ? NULL
                           : back.t > 0 && back.t < 2 * clearance ? &back
                           : near.t > 0 && near.t < clearance ? &near : NULL;
     if (!h)
@@ -278,9 +279,9 @@ uint32_t lmb_probe_voxel_of(const lmb_probe_set *set, const double q[3])
     uint32_t v[3];
     for (int k = 0; k < 3; k++) {
         double x = floor((q[k] - g->lo[k]) / g->cell[k]);
-        if (!(x >= 0) || x >= g->res[k])
+        if (!(x >= -1) || x > g->res[k]) /* more than a cell outside the grid */
             return UINT32_MAX;
-        v[k] = (uint32_t)x;
+        v[k] = x < 0 ? 0 : x >= g->res[k] ? g->res[k] - 1 : (uint32_t)x; /* just outside: the edge voxel */
     }
     return g->first_voxel + (v[2] * g->res[1] + v[1]) * g->res[0] + v[0];
 }
@@ -535,13 +536,17 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
 #pragma omp for schedule(dynamic, 64)
         for (size_t i = 0; i < c.count; i++) {
             int moved;
-            int f = place_probe(rt, c.p + 3 * i, c.auto_grid[i] ? far : HUGE_VAL, clearance, &moved);
+            int f = place_probe(rt, c.p + 3 * i, c.auto_grid[i] ? far : HUGE_VAL, clearance, c.auto_grid[i], &moved);
             fate[i] = (uint8_t)(f == 2 && !c.auto_grid[i] ? 0 : f); /* an artist's probe in the open stays */
             fate[i] |= (uint8_t)(moved && fate[i] == 0 ? 4 : 0);
         }
     }
     for (size_t i = 0; i < c.count; i++) {
         out->moved += fate[i] == 4;
+        if (fate[i] == 4 && c.auto_grid[i]) { /* a moved probe counts in the voxel it now lies in */
+            uint32_t v = lmb_probe_voxel_of(out, c.p + 3 * i);
+            c.voxel[i] = v != UINT32_MAX ? v : c.voxel[i];
+        }
         fate[i] &= 3;
         out->dropped_inside += fate[i] == 1;
         out->dropped_outside += fate[i] == 2;
@@ -557,7 +562,9 @@ lmb_status lmb_probes_place(const lmb_scene *s, const lmb_layout *l, const lmb_c
     out->cell = c.voxel;
     /* walls lined at half the probes' spacing near surfaces (a quarter cell) */
     double lining = 0.25 * fmin(g0->cell[0], fmin(g0->cell[1], g0->cell[2]));
-    lmb_status walls = lmb_probes_line_walls(out, rt, clearance, lining, LMB_PROBES_MAX, threads, inside_geometry, err);
+    lmb_status walls = cfg->probes_auto ? lmb_probes_line_walls(out, l, rt, clearance, lining, LMB_PROBES_MAX, threads,
+                                                                inside_geometry, err)
+                                        : LMB_OK; /* an artist's volumes alone: the probes asked for */
     if (walls != LMB_OK) {
         lmb_probe_set_free(out);
         return walls;

@@ -100,16 +100,19 @@ lmb_status lmb_probes_light(lmb_probe_set *set, const lmb_config *cfg, const lmb
 
 void lmb_probe_set_free(lmb_probe_set *set);
 
-/* The auto grid's voxel holding world point q (UINT32_MAX: no auto grid, or q outside it): where a
- * probe added after placement counts in the irradiance volume. */
+/* The auto grid's voxel holding world point q, or the edge voxel for q less than a cell outside
+ * the grid (UINT32_MAX: no auto grid, or q farther out): where a probe moved or added after
+ * placement counts in the irradiance volume. */
 uint32_t lmb_probe_voxel_of(const lmb_probe_set *set, const double q[3]);
 
-/* Adds probes on both sides of every wall an edge of the probes' tetrahedra crosses, `offset` in
- * front of it, none within `spacing` of another probe (wall_probes.c), at most up to `limit`
+/* Adds probes on both sides of every wall (lightmapped geometry: not a prop the probes light) an
+ * edge of the probes' tetrahedra crosses, `offset` in front of it, none within `spacing` of
+ * another probe (wall_probes.c), at most up to `limit`
  * probes in all; `inside` says whether a point is inside geometry. Before the probes are lit
  * (set->sh and set->cube not yet allocated). */
-lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_rt *rt, double offset, double spacing, uint32_t limit,
-                                 int threads, int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err);
+lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_layout *layout, const lmb_rt *rt,
+                                 double offset, double spacing, uint32_t limit, int threads,
+                                 int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err);
 
 /* The Delaunay tetrahedra of the probe positions (tetrahedra.c, qhull): 4 probe indices each,
  * positive volume, flat ones dropped. Fewer than 4 probes, or all in a plane: none, and `why`

@@ -35,8 +35,10 @@ static int by_edge(const void *x, const void *y)
     return p->b < q->b ? -1 : p->b > q->b;
 }
 
-/* The point `offset` in front of the face ray o -> target meets first (0: nothing in between). */
-static int in_front_of_wall(const lmb_rt *rt, const double o[3], const double target[3], double offset, double q[3])
+/* The point `offset` in front of the face ray o -> target meets first (0: nothing in between, or
+ * what it meets is not a wall: a prop the probes light, which moves or is small). */
+static int in_front_of_wall(const lmb_rt *rt, const lmb_layout *layout, const double o[3], const double target[3],
+                            double offset, double q[3])
 {
     double d[3] = {target[0] - o[0], target[1] - o[1], target[2] - o[2]};
     double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
@@ -45,7 +47,8 @@ static int in_front_of_wall(const lmb_rt *rt, const double o[3], const double ta
     for (int k = 0; k < 3; k++)
         d[k] /= len;
     lmb_rt_hit h;
-    if (!lmb_rt_intersect(rt, o, d, rt->eps, len, &h) || h.t < 2 * offset)
+    if (!lmb_rt_intersect(rt, o, d, rt->eps, len, &h) || h.t < 2 * offset ||
+        !layout->instances[rt->geoms[h.geom].instance].lightmapped)
         return 0;
     double side = h.backface ? -1.0 : 1.0; /* toward where the ray came from */
     for (int k = 0; k < 3; k++)
@@ -109,8 +112,9 @@ static int crowded(const probe_hash *h, const double *pos, const double q[3])
     return 0;
 }
 
-lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_rt *rt, double offset, double spacing, uint32_t limit,
-                                 int threads, int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err)
+lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_layout *layout, const lmb_rt *rt,
+                                 double offset, double spacing, uint32_t limit, int threads,
+                                 int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err)
 {
     for (int round = 0; round < LMB_WALL_PROBE_ROUNDS && set->count >= 4; round++) {
         lmb_probe_tetrahedra_out tets;
@@ -150,8 +154,8 @@ lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_rt *rt, double of
 #pragma omp for schedule(dynamic, 256)
             for (int64_t k = 0; k < (int64_t)m; k++) {
                 const double *a = pos + 3 * (size_t)e[k].a, *b = pos + 3 * (size_t)e[k].b;
-                got[2 * k] = (uint8_t)(in_front_of_wall(rt, a, b, offset, cand + 6 * k) && !inside(rt, cand + 6 * k));
-                got[2 * k + 1] = (uint8_t)(in_front_of_wall(rt, b, a, offset, cand + 6 * k + 3) &&
+                got[2 * k] = (uint8_t)(in_front_of_wall(rt, layout, a, b, offset, cand + 6 * k) && !inside(rt, cand + 6 * k));
+                got[2 * k + 1] = (uint8_t)(in_front_of_wall(rt, layout, b, a, offset, cand + 6 * k + 3) &&
                                            !inside(rt, cand + 6 * k + 3));
             }
         }

@@ -411,9 +411,10 @@ def adaptive(lmbake, work):
 
 
 TETRA_CONFIG = "atlas: {texels: 40000}\nbounces: 1\n"
+# above the blocks: no probe of the layer is inside geometry (one would move out of the layer)
 FLAT_CONFIG = TETRA_CONFIG + """probes:
   auto: false
-  volumes: [{min: [-500, 100, -500], max: [-100, 110, -100], resolution: [4, 1, 4]}]
+  volumes: [{min: [-500, 400, -500], max: [-100, 410, -100], resolution: [4, 1, 4]}]
 """
 
 

@@ -74,6 +74,8 @@ def main():
     probes = doc["asset"].get("extras", {}).get("lightmap", {}).get("probes")
     if probes:
         read.add(probes["positions"])
+        if "tetrahedra" in probes:
+            read.add(probes["tetrahedra"])
         views |= {probes["sh"], probes["ambientCube"]}
     problems = []
     if drawn != set(range(len(doc["meshes"]))):
