@@ -2,60 +2,25 @@
 #include "texel_sides.h"
 
 #include "raytrace/rt_sight.h"
-#include "util/frame.h"
-#include "util/lmb_math.h"
 
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* The planes of the nearest faces 8 tangent rays from texel i's gather point meet (lifted as a
- * sight test lifts, 1.0824 x LMB_BESIDE_TEXELS texels long, as texel_direct.c looked), each
- * turned to face the point; a second plane only where its face turns by more than 25 degrees
- * from the first (a corner), so a wall's face counts once. */
+/* The planes of the nearest faces beside texel i's gather point (lmb_rt_sides: lifted as a sight
+ * test lifts, 1.0824 x LMB_BESIDE_TEXELS texels long, as texel_direct.c looked). */
 static void texel_planes(const lmb_texels *t, uint32_t i, const lmb_rt *rt, lmb_texel_anchor *a)
 {
     lmb_gather_point g;
     lmb_texels_point(t, i, t->gather_at[i], &g);
-    double ng[3] = {g.ng[0], g.ng[1], g.ng[2]}, t1[3], t2[3], o[3];
-    double size = t->texel_size[i], reach = 1.0824 * LMB_BESIDE_TEXELS * size;
-    lmb_frame(ng, t1, t2);
-    for (int k = 0; k < 3; k++)
-        o[k] = g.p[k] + LMB_SIGHT_LIFT * size * ng[k];
-    lmb_rt_hit hit[8];
-    int got[8] = {0};
-    for (int j = 0; j < 8; j++) {
-        double ang = j * (LMB_PI / 4), w[3];
+    double ng[3] = {g.ng[0], g.ng[1], g.ng[2]}, size = t->texel_size[i];
+    lmb_rt_side side[LMB_SIDE_PLANES];
+    a->planes = lmb_rt_sides(rt, g.p, ng, LMB_SIGHT_LIFT * size, 1.0824 * LMB_BESIDE_TEXELS * size, side, LMB_SIDE_PLANES);
+    for (uint32_t q = 0; q < a->planes; q++) {
         for (int k = 0; k < 3; k++)
-            w[k] = cos(ang) * t1[k] + sin(ang) * t2[k];
-        got[j] = lmb_rt_intersect(rt, o, w, 0.0, reach, &hit[j]);
-    }
-    a->planes = 0;
-    for (int pick = 0; pick < LMB_SIDE_PLANES; pick++) {
-        int best = -1;
-        for (int j = 0; j < 8; j++) {
-            if (!got[j] || (best >= 0 && !(hit[j].t < hit[best].t)))
-                continue;
-            int same = 0; /* a face already taken, or one turned less than 25 degrees from it */
-            for (uint32_t q = 0; q < a->planes; q++) {
-                const float *m = a->plane[q].m;
-                same |= fabs(m[0] * hit[j].ng[0] + m[1] * hit[j].ng[1] + m[2] * hit[j].ng[2]) > 0.906;
-            }
-            if (!same)
-                best = j;
-        }
-        if (best < 0)
-            break;
-        lmb_side_plane *pl = &a->plane[a->planes++];
-        double side = 0;
-        for (int k = 0; k < 3; k++)
-            side += (o[k] - hit[best].p[k]) * hit[best].ng[k];
-        for (int k = 0; k < 3; k++) {
-            pl->q[k] = (float)hit[best].p[k];
-            pl->m[k] = side < 0 ? -hit[best].ng[k] : hit[best].ng[k];
-        }
-        got[best] = 0;
+            a->plane[q].m[k] = (float)side[q].m[k];
+        a->plane[q].d = (float)side[q].d;
     }
 }
 
@@ -138,8 +103,7 @@ int lmb_texel_sides_in_sight(const lmb_texel_sides *s, uint32_t texel, const dou
     const lmb_texel_anchor *a = &s->anchors[lo];
     for (uint32_t q = 0; q < a->planes; q++) {
         const lmb_side_plane *pl = &a->plane[q];
-        double d = (p[0] - pl->q[0]) * pl->m[0] + (p[1] - pl->q[1]) * pl->m[1] + (p[2] - pl->q[2]) * pl->m[2];
-        if (d < 0)
+        if (pl->m[0] * p[0] + pl->m[1] * p[1] + pl->m[2] * p[2] < pl->d)
             return 0;
     }
     return 1;

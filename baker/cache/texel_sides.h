@@ -18,10 +18,10 @@
 #include "raytrace/rt_scene.h"
 #include "texels/texels.h"
 
-/* A side of the geometry beside a texel: points x with (x - q) . m >= 0 are on the texel's side
- * of that face's plane. */
+/* A side of the geometry beside a texel: points x with m . x >= d are on the texel's side of that
+ * face's plane (raytrace/rt_sight.h, lmb_rt_sides). */
 typedef struct lmb_side_plane {
-    float q[3], m[3];
+    float m[3], d;
 } lmb_side_plane;
 
 #define LMB_SIDE_PLANES 2

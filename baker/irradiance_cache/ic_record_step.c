@@ -4,7 +4,6 @@
 
 #include "gather/guide.h"
 #include "raytrace/rt_sight.h"
-#include "util/frame.h"
 
 #include <omp.h>
 #include <stddef.h>
@@ -34,49 +33,21 @@ static int reserve_mix(pass_ctx *c, uint32_t n)
     return 1;
 }
 
-/* The faces beside the record along its surface (lmb_ic_record.side): 8 rays in the tangent plane
- * of its gather point's geometric normal, lifted as a sight test lifts it; the nearest face, and
- * the nearest turned more than 25 degrees from it (a corner's second wall). */
+/* The faces beside the record along its surface (lmb_ic_record.side, lmb_rt_sides): lifted as a
+ * sight test lifts it, LMB_IC_CLEAR_REACH x its largest reach long. */
 static void record_sides(const pass_ctx *c, texel_at x, lmb_ic_record *r)
 {
     const lmb_texels *t = c->t[x.atlas];
     lmb_gather_point g;
     lmb_texels_point(t, x.index, t->gather_at[x.index], &g);
-    double ng[3] = {g.ng[0], g.ng[1], g.ng[2]}, t1[3], t2[3], o[3];
-    lmb_frame(ng, t1, t2);
+    double ng[3] = {g.ng[0], g.ng[1], g.ng[2]};
     r->lift = (float)(LMB_SIGHT_LIFT * t->texel_size[x.index]);
-    for (int k = 0; k < 3; k++)
-        o[k] = r->p[k] + r->lift * ng[k];
-    double reach = LMB_IC_CLEAR_REACH * r->r_max;
-    lmb_rt_hit hit[8];
-    int got[8];
-    for (int j = 0; j < 8; j++) {
-        double a = j * (LMB_PI / 4), d[3];
+    lmb_rt_side side[2];
+    uint32_t n = lmb_rt_sides(c->job->rt, r->p, ng, r->lift, LMB_IC_CLEAR_REACH * r->r_max, side, 2);
+    for (uint32_t q = 0; q < n; q++) {
         for (int k = 0; k < 3; k++)
-            d[k] = cos(a) * t1[k] + sin(a) * t2[k];
-        got[j] = lmb_rt_intersect(c->job->rt, o, d, 0.0, reach, &hit[j]);
-    }
-    for (int pick = 0; pick < 2; pick++) {
-        int best = -1;
-        for (int j = 0; j < 8; j++) {
-            if (!got[j] || (best >= 0 && !(hit[j].t < hit[best].t)))
-                continue;
-            const float *m = r->side[0];
-            if (pick && fabs(m[0] * hit[j].ng[0] + m[1] * hit[j].ng[1] + m[2] * hit[j].ng[2]) > 0.906)
-                continue;
-            best = j;
-        }
-        if (best < 0)
-            break;
-        double side = 0, m[3];
-        for (int k = 0; k < 3; k++)
-            side += (o[k] - hit[best].p[k]) * hit[best].ng[k];
-        for (int k = 0; k < 3; k++)
-            m[k] = side < 0 ? -hit[best].ng[k] : hit[best].ng[k];
-        for (int k = 0; k < 3; k++)
-            r->side[pick][k] = (float)m[k];
-        r->side[pick][3] = (float)(m[0] * hit[best].p[0] + m[1] * hit[best].p[1] + m[2] * hit[best].p[2]);
-        got[best] = 0;
+            r->side[q][k] = (float)side[q].m[k];
+        r->side[q][3] = (float)side[q].d;
     }
 }
 

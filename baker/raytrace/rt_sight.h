@@ -27,4 +27,17 @@
 int lmb_rt_in_sight(const lmb_rt *rt, const double a[3], const double ng_a[3], const double b[3], const double ng_b[3],
                     double lift);
 
+/* A face beside a point along its surface, as a plane turned to face the point: x lies on the
+ * point's side when m . x >= d. */
+typedef struct lmb_rt_side {
+    double m[3], d;
+} lmb_rt_side;
+
+/* The faces beside surface point p (geometric normal ng): 8 rays in the tangent plane, lifted by
+ * `lift`, `reach` long; the nearest face met, then the nearest turned more than 25 degrees from
+ * those taken (a corner's second wall), up to `most`. Returns how many went into out. The rays
+ * cover the circle every 45 degrees: a straight wall at distance s is met within 1.0824 s. */
+uint32_t lmb_rt_sides(const lmb_rt *rt, const double p[3], const double ng[3], double lift, double reach,
+                      lmb_rt_side *out, uint32_t most);
+
 #endif
