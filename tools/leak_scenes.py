@@ -37,6 +37,12 @@ WALLS_CM = (1, 2, 5, 20)
 GREY = (0.7, 0.7, 0.7)
 
 
+def open_top(x0, y0, z0, x1, y1, z1, inward=False):
+    """A box's four sides, no top and no bottom: walls standing on a floor under a ceiling."""
+    return [tri for tri in box(x0, y0, z0, x1, y1, z1, inward=inward, bottom=False)
+            if not all(abs(p[1] - y1) < 1e-9 for p in tri)]
+
+
 def two_rooms(out, t_cm, scale=1.0):
     """Two sealed rooms split by a wall t_cm thick; returns (lit box, dark box, wall x range)."""
     s = Scene()
@@ -47,11 +53,9 @@ def two_rooms(out, t_cm, scale=1.0):
     s.mesh("floor", quad((x0, 0, -d / 2), (x0, 0, d / 2), (x1, 0, d / 2), (x1, 0, -d / 2)), grey)
     s.mesh("ceiling", quad((x0, h, -d / 2), (x1, h, -d / 2), (x1, h, d / 2), (x0, h, d / 2)), grey)
     # the outer walls, facing in: a box without top or bottom
-    s.mesh("outer_walls", [tri for tri in box(x0, 0, -d / 2, x1, h, d / 2, inward=True, bottom=False)
-                           if not all(abs(p[1] - h) < 1e-9 for p in tri)], grey)
+    s.mesh("outer_walls", open_top(x0, 0, -d / 2, x1, h, d / 2, inward=True), grey)
     # the dividing wall: a closed box's four sides, standing on the floor, touching the ceiling
-    s.mesh("wall", [tri for tri in box(-t / 2, 0, -d / 2, t / 2, h, d / 2, bottom=False)
-                    if not all(abs(p[1] - h) < 1e-9 for p in tri)], grey)
+    s.mesh("wall", open_top(-t / 2, 0, -d / 2, t / 2, h, d / 2), grey)
     s.light("lamp", "point", LAMP_CD, translation=(-w / 2 - t / 2, h / 2, 0.0))
     s.write(os.path.join(out, "two-rooms-%d.gltf" % t_cm))
 
@@ -71,7 +75,7 @@ def corridor(out):
             keep.append(tri)
     # leg A's +z face spans x 0..6 at z = 1: cut it to x 0..5
     keep = [tri for tri in keep if not all(abs(p[2] - 1) < 1e-9 for p in tri)]
-    keep += quad((0, 0, 1), (0, 2.5, 1), (5, 2.5, 1), (5, 0, 1))[::1]
+    keep += quad((0, 0, 1), (0, 2.5, 1), (5, 2.5, 1), (5, 0, 1))
     s.mesh("corridor", keep, grey)
     s.light("lamp", "point", 100.0, translation=(0.5, 2.0, 0.5))
     s.write(os.path.join(out, "corridor-L.gltf"))
@@ -90,10 +94,8 @@ def slab(out):
     s = Scene()
     grey = s.material("grey", GREY)
     s.mesh("ground", quad((-10, 0, -10), (-10, 0, 10), (10, 0, 10), (10, 0, -10)), grey)
-    s.mesh("room_walls", [tri for tri in box(-3, 0, -3, 3, 3, 3, bottom=False)
-                          if not all(abs(p[1] - 3) < 1e-9 for p in tri)], grey)
-    s.mesh("room_walls_in", [tri for tri in box(-2.9, 0, -2.9, 2.9, 2.98, 2.9, inward=True, bottom=False)
-                             if not all(abs(p[1] - 2.98) < 1e-9 for p in tri)], grey)
+    s.mesh("room_walls", open_top(-3, 0, -3, 3, 3, 3), grey)
+    s.mesh("room_walls_in", open_top(-2.9, 0, -2.9, 2.9, 2.98, 2.9, inward=True), grey)
     s.mesh("ceiling_slab", box(-3, 2.98, -3, 3, 3.0, 3), grey)       # 2 cm
     s.mesh("roof", box(-5, 3.02, -5, 5, 3.07, 5), grey)              # 5 cm, 2 cm above
     s.light("sun", "directional", 1000.0, rotation=[-0.3826834, 0, 0, 0.9238795])
@@ -104,8 +106,7 @@ def courtyard(out):
     s = Scene()
     grey = s.material("grey", GREY)
     s.mesh("ground", quad((-6, 0, -6), (-6, 0, 6), (6, 0, 6), (6, 0, -6)), grey)
-    s.mesh("yard_walls", [tri for tri in box(-6, 0, -6, 6, 4, 6, inward=True, bottom=False)
-                          if not all(abs(p[1] - 4) < 1e-9 for p in tri)], grey)
+    s.mesh("yard_walls", open_top(-6, 0, -6, 6, 4, 6, inward=True), grey)
     t = 0.05
     s.mesh("hut_out", box(-1.5, 0, -1.5, 1.5, 3, 1.5, bottom=False), grey)
     s.mesh("hut_in", box(-1.5 + t, 0, -1.5 + t, 1.5 - t, 3 - t, 1.5 - t, inward=True, bottom=False), grey)

@@ -109,9 +109,8 @@ static int thin_wall_beside(const lmb_direct *d, const lmb_shading_point *sp, do
     for (int k = 0; k < 3; k++)
         o[k] = sp->p[k] + LMB_SIGHT_LIFT * texel_size * sp->ng[k];
     for (int j = 0; j < 8; j++) {
-        double a = j * (LMB_PI / 4), w[3];
-        for (int k = 0; k < 3; k++)
-            w[k] = cos(a) * t1[k] + sin(a) * t2[k];
+        double w[3];
+        lmb_rt_tangent_direction(t1, t2, j, w);
         lmb_rt_hit h, far;
         ++*rays;
         if (!lmb_rt_intersect(rt, o, w, 0.0, reach, &h))

@@ -2,7 +2,6 @@
 #include "rt_sight.h"
 
 #include "util/frame.h"
-#include "util/lmb_math.h"
 
 #include <math.h>
 
@@ -38,9 +37,8 @@ uint32_t lmb_rt_sides(const lmb_rt *rt, const double p[3], const double ng[3], d
     lmb_rt_hit hit[8];
     int got[8];
     for (int j = 0; j < 8; j++) {
-        double a = j * (LMB_PI / 4), w[3];
-        for (int k = 0; k < 3; k++)
-            w[k] = cos(a) * t1[k] + sin(a) * t2[k];
+        double w[3];
+        lmb_rt_tangent_direction(t1, t2, j, w);
         got[j] = lmb_rt_intersect(rt, o, w, 0.0, reach, &hit[j]);
     }
     uint32_t n = 0;

@@ -18,6 +18,8 @@
 
 #include "rt_scene.h"
 
+#include <math.h>
+
 #define LMB_SIGHT_LIFT 0.1        /* texels */
 #define LMB_SIGHT_SAME_PLANE 0.95 /* the cosine above which two points' surfaces are compared */
 #define LMB_SIGHT_LIFT_PER_DISTANCE 0.05
@@ -26,6 +28,15 @@
  * or when ng_a . ng_b is below LMB_SIGHT_SAME_PLANE (ng: unit normals, front side). */
 int lmb_rt_in_sight(const lmb_rt *rt, const double a[3], const double ng_a[3], const double b[3], const double ng_b[3],
                     double lift);
+
+/* Direction j of 8 around the circle of tangents t1, t2 (every 45 degrees): the rays that look
+ * along a surface for the geometry beside a point (lmb_rt_sides, texel_direct.c). */
+static inline void lmb_rt_tangent_direction(const double t1[3], const double t2[3], int j, double w[3])
+{
+    double a = j * (3.14159265358979323846 / 4);
+    for (int k = 0; k < 3; k++)
+        w[k] = cos(a) * t1[k] + sin(a) * t2[k];
+}
 
 /* A face beside a point along its surface, as a plane turned to face the point: x lies on the
  * point's side when m . x >= d. */
