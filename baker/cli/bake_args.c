@@ -99,6 +99,10 @@ int bake_args_parse(int argc, char **argv, bake_args *a, const char *help)
         } else if ((r = cli_opt_value(argc, argv, &i, "--worker", NULL, &v)) != 0) {
             if (r < 0 || !parse_fraction(v, &a->worker, &a->workers))
                 return cli_usage_error("worker", "--worker needs W/J with 1 <= W <= J <= 100000, e.g. 1/2");
+        } else if ((r = cli_opt_value(argc, argv, &i, "--tail-threads", NULL, &v)) != 0) {
+            if (r < 0 || !cli_parse_uint(v, 1024, &a->tail_threads))
+                return cli_usage_error("worker", "--tail-threads needs a number 0..1024 (0: every core)");
+            a->tail_threads_given = 1;
         } else if ((r = cli_opt_value(argc, argv, &i, "--wait-timeout", NULL, &v)) != 0) {
             if (r < 0 || !cli_parse_uint(v, 100000000, &a->wait_timeout))
                 return cli_usage_error("worker", "--wait-timeout needs seconds 0..100000000 (0: wait for ever)");
@@ -133,8 +137,8 @@ int bake_args_check_stage(stage_kind stage, bake_args *a, char *plan_path, size_
     static const char *const names[] = {"bake", "plan", "step", "merge", "finish", "worker"};
     const char *name = names[stage];
     int farm_stage = stage == STAGE_STEP || stage == STAGE_MERGE || stage == STAGE_FINISH || stage == STAGE_WORKER;
-    if (stage != STAGE_WORKER && (a->worker || a->wait_timeout))
-        return cli_usage_error(name, "--worker and --wait-timeout are options of 'lmbake worker'");
+    if (stage != STAGE_WORKER && (a->worker || a->wait_timeout || a->tail_threads_given))
+        return cli_usage_error(name, "--worker, --wait-timeout and --tail-threads are options of 'lmbake worker'");
     if (stage == STAGE_WORKER && (a->step >= 0 || a->shard || !a->shards))
         return cli_usage_error(name, "a worker takes --shards N (and --worker W/J), not --step or --shard");
     if (stage == STAGE_WORKER && !a->worker)

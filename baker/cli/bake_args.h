@@ -22,6 +22,8 @@ typedef struct bake_args {
     long long step;               /* -1: not given */
     unsigned long long shard, shards; /* --shard K/N (K 1-based), --shards N */
     unsigned long long worker, workers, wait_timeout; /* --worker W/J (W 1-based), --wait-timeout S */
+    unsigned long long tail_threads; /* --tail-threads T: the output worker's threads after the last step */
+    int tail_threads_given;
     int outdir_given;
 } bake_args;
 

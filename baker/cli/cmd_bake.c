@@ -157,6 +157,9 @@ static const char worker_help[] =
     "  --worker W/J         this worker of J (default 1/1); J <= N\n"
     "  -o, --output DIR     worker 1 writes the bake there after the last step (the other\n"
     "                       workers ignore it: one command line serves them all)\n"
+    "  --tail-threads T     worker 1's threads after the last step, when the others have stopped\n"
+    "                       (post-processing and writing; default 0: every core of its machine;\n"
+    "                       --threads is a worker's share while all of them work)\n"
     "  --wait-timeout S     fail when another worker's part is S seconds late (default 0: wait;\n"
     "                       a worker says every minute which part it waits for)\n"
     "  --threads T, -q      as for 'lmbake bake'\n"
@@ -339,7 +342,7 @@ static int run(int argc, char **argv, stage_kind stage)
                        a.farm, (uint32_t)(a.step > 0 ? a.step : 0), (uint32_t)(a.shard ? a.shard - 1 : 0),
                        (uint32_t)(a.shards ? a.shards : 1), 0, 0,
                        (uint32_t)(a.worker ? a.worker - 1 : 0), (uint32_t)(a.workers ? a.workers : 1),
-                       (double)a.wait_timeout, a.layout_cache, 0};
+                       (double)a.wait_timeout, a.layout_cache, 0, (uint32_t)a.tail_threads};
     int writes_bake = stage != STAGE_STEP && (stage != STAGE_WORKER || (a.outdir_given && a.worker == 1));
     lmb_bake_stats bs;
     double ts = cli_now();

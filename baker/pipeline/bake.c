@@ -159,7 +159,7 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err)
 {
-    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, NULL, 0};
+    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, NULL, 0, 0};
     return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
 }
 
@@ -312,6 +312,12 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         goto done;
     }
     run->steps = lmb_steps_count(steps);
+    /* After the last step a worker writing the output runs alone: the cores the other workers
+     * used are free, and the output is the same bytes at any thread count. */
+    lmb_config tail_cfg = *cfg;
+    if (finishes)
+        tail_cfg.threads = run->tail_threads;
+    cfg = &tail_cfg;
     if (st == LMB_OK && !dark)
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
     /* The light is done: what only lighting read goes before the images, where OpenImageIO's

@@ -155,6 +155,16 @@ static uint64_t get_u64(const uint8_t *p)
 lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
                           const void *body, size_t body_length, lmb_error *err)
 {
+    lmb_part_piece whole = {body, body_length};
+    return lmb_part_write_pieces(path, id, place, &whole, 1, err);
+}
+
+lmb_status lmb_part_write_pieces(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
+                                 const lmb_part_piece *pieces, size_t n, lmb_error *err)
+{
+    size_t body_length = 0;
+    for (size_t i = 0; i < n; i++)
+        body_length += pieces[i].size;
     uint8_t h[HEADER_BYTES], *p = h;
     size_t config_length = id->config_text ? strlen(id->config_text) : 0;
     memcpy(p, magic, 8), p += 8;
@@ -175,7 +185,8 @@ lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const l
     sha256_init(&c);
     sha256_update(&c, sizeof h, h);
     sha256_update(&c, config_length, (const uint8_t *)id->config_text);
-    sha256_update(&c, body_length, body);
+    for (size_t i = 0; i < n; i++)
+        sha256_update(&c, pieces[i].size, pieces[i].data);
     sha256_digest(&c, 32, sum);
 
     char host[256], tmp[4600];
@@ -188,7 +199,8 @@ lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const l
         return lmb_error_set(err, LMB_ERR_INTERNAL, "cannot write '%s': %s", tmp, strerror(errno));
     int bad = fwrite(h, 1, sizeof h, f) != sizeof h;
     bad |= config_length && fwrite(id->config_text, 1, config_length, f) != config_length;
-    bad |= body_length && fwrite(body, 1, body_length, f) != body_length;
+    for (size_t i = 0; i < n; i++)
+        bad |= pieces[i].size && fwrite(pieces[i].data, 1, pieces[i].size, f) != pieces[i].size;
     bad |= fwrite(sum, 1, 32, f) != 32;
     bad |= fclose(f) != 0;
     if (bad || rename(tmp, path) != 0) {
@@ -313,12 +325,7 @@ lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, cons
     }
     *got = place;
     *body_length = (size_t)length;
-    *body = malloc((size_t)length + 1);
-    if (!*body) {
-        free(file);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "'%s': out of memory", path);
-    }
-    memcpy(*body, file + HEADER_BYTES + config_length, (size_t)length);
-    free(file);
+    memmove(file, file + HEADER_BYTES + config_length, (size_t)length);
+    *body = file;
     return LMB_OK;
 }

@@ -54,9 +54,21 @@ void lmb_part_identity_free(lmb_part_identity *id);
 lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
                           const void *body, size_t body_length, lmb_error *err);
 
+/* A piece of a body written as it lies in memory (a step's header and its results). */
+typedef struct lmb_part_piece {
+    const void *data;
+    size_t size;
+} lmb_part_piece;
+
+/* lmb_part_write of the body made of n pieces in turn, with no copy of them joined: a step's
+ * results are megabytes, and a copy is as many fresh pages to fault in. */
+lmb_status lmb_part_write_pieces(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
+                                 const lmb_part_piece *pieces, size_t n, lmb_error *err);
+
 /* Reads path, checks its checksum, then its identity against *expect and its place against
  * *want (kind, step, shard, shards; shards 0 in want: any), naming the first difference.
- * On success *body (owned, free()) and *body_length hold the body and *got its place. */
+ * On success *body (owned, free()) and *body_length hold the body and *got its place (the
+ * body is moved to the start of the buffer the file was read into: no second buffer). */
 lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
                          lmb_part_place *got, void **body, size_t *body_length, lmb_error *err);
 

@@ -176,17 +176,11 @@ static lmb_status run_shard(lmb_steps *s, const lmb_step_desc *d, uint32_t step,
     step_body b = {0, d->items, {0}, {0}, mine, chunks, out->data, out->size};
     memcpy(b.counters, counters, sizeof b.counters);
     snprintf(b.name, sizeof b.name, "%s", d->name);
-    size_t size = 0;
-    uint8_t *body = st == LMB_OK ? lmb_step_body_encode(&b, &size) : NULL;
-    free(chunks);
-    if (st != LMB_OK)
-        return st;
-    if (!body)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory for step %u's part", step);
     lmb_step_part_path(s->dir, step, shard, s->shards, path, sizeof path);
     lmb_part_place place = {LMB_PART_SHARD, step, shard, s->shards};
-    st = lmb_part_write(path, &s->id, &place, body, size, err);
-    free(body);
+    if (st == LMB_OK)
+        st = lmb_step_body_write(path, &s->id, &place, &b, err);
+    free(chunks);
     if (st == LMB_OK) /* the farm benchmark reads this line's time */
         lmb_info(s->log, "step %u (%s): shard %u of %u computed in %.4f s (%llu of %llu items in %llu chunks), wrote %s",
                  step, d->name, shard + 1, s->shards, took, (unsigned long long)items, (unsigned long long)d->items,

@@ -28,14 +28,15 @@ static void put(uint8_t **p, const void *v, size_t n)
     *p += n;
 }
 
-/* The body for b (bytes from b->bytes), malloc'd. */
-uint8_t *lmb_step_body_encode(const step_body *b, size_t *size)
+static size_t head_size(const step_body *b)
+{
+    return BODY_HEADER + strlen(b->name) + 24 * b->chunk_count;
+}
+
+/* Everything of b's body before its result bytes, into p (head_size(b) bytes). */
+static void put_head(const step_body *b, uint8_t *p)
 {
     uint32_t name_length = (uint32_t)strlen(b->name);
-    *size = BODY_HEADER + name_length + 24 * b->chunk_count + b->size;
-    uint8_t *body = malloc(*size + 1), *p = body;
-    if (!body)
-        return NULL;
     put(&p, &b->end, 4);
     put(&p, &name_length, 4);
     put(&p, &b->items, 8);
@@ -48,9 +49,33 @@ uint8_t *lmb_step_body_encode(const step_body *b, size_t *size)
         put(&p, &b->chunks[c].last, 8);
         put(&p, &b->chunks[c].size, 8);
     }
+}
+
+uint8_t *lmb_step_body_encode(const step_body *b, size_t *size)
+{
+    size_t head = head_size(b);
+    *size = head + b->size;
+    uint8_t *body = malloc(*size + 1);
+    if (!body)
+        return NULL;
+    put_head(b, body);
     if (b->size)
-        put(&p, b->bytes, b->size);
+        memcpy(body + head, b->bytes, b->size);
     return body;
+}
+
+lmb_status lmb_step_body_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
+                               const step_body *b, lmb_error *err)
+{
+    size_t size = head_size(b);
+    uint8_t *head = malloc(size + 1);
+    if (!head)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory for '%s'", path);
+    put_head(b, head);
+    lmb_part_piece pieces[2] = {{head, size}, {b->bytes, b->size}};
+    lmb_status st = lmb_part_write_pieces(path, id, place, pieces, 2, err);
+    free(head);
+    return st;
 }
 
 lmb_status lmb_step_body_decode(const char *path, const uint8_t *body, size_t size, step_body *b, lmb_error *err)
@@ -268,15 +293,10 @@ lmb_status lmb_step_merge_parts(const char *dir, const lmb_part_identity *id, ui
             m.size += all[c].size;
         }
         m.bytes = bytes;
-        size_t size;
-        uint8_t *body = lmb_step_body_encode(&m, &size);
-        if (!body)
-            st = lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory");
         lmb_step_state_path(dir, step, path, sizeof path);
         lmb_part_place place = {LMB_PART_STATE, step, 0, 1};
-        if (st == LMB_OK && write_state)
-            st = lmb_part_write(path, id, &place, body, size, err);
-        free(body);
+        if (write_state)
+            st = lmb_step_body_write(path, id, &place, &m, err);
         if (st == LMB_OK && out) { /* the merged bytes become out's (no copy) */
             free(out->data);
             out->data = bytes;

@@ -588,6 +588,9 @@ typedef struct lmb_farm_run {
     const char *layout_cache; /* LMB_FARM_LOCAL with no plan: a folder of layouts kept between bakes
                                  (lmbake bake --layout-cache, docs/watch.md); NULL: none */
     int layout_reused;        /* out: the layout was read back from layout_cache, not built */
+    uint32_t tail_threads;    /* LMB_FARM_WORKER, the worker that writes the output: threads for what
+                                 runs after the last step, when the other workers have stopped
+                                 (post-processing, images, glTF); 0: every core of its machine */
 } lmb_farm_run;
 
 /* lmb_bake_planned through the farm: plan_path is required unless mode is LMB_FARM_LOCAL.

@@ -1,6 +1,6 @@
 /*
  * The farm's step runner (baker/steps/runner.h) on a synthetic step of 1,000 items whose cost
- * grows with the index (item i costs i + 1): each of 4 shards computes 8 chunks spread over
+ * grows with the index (item i costs i + 1): each of 4 shards computes LMB_STEP_CHUNKS_PER_SHARD (32) chunks spread over
  * the step (chunk c to shard c mod 4), the shards' chunks tile [0, 1000) exactly once, and each
  * shard's cost is within 1.5% of a quarter of the total (chunks cut by cost, not by count); the merged
  * state reads back (finish mode) as the items in order with the counters summed; a shard run
@@ -14,6 +14,7 @@
 #define _GNU_SOURCE
 #include "check.h"
 #include "steps/runner.h"
+#include "steps/step_parts.h"
 
 #include <lmbake/lmbake.h>
 #include <stdio.h>
@@ -197,7 +198,7 @@ int main(int argc, char **argv)
         CHECK_INT(lmb_steps_run(s, &d, &out, counters, &err), LMB_STEP_STOPPED);
         printf("shard %d: %llu items in %llu chunks, cost %.0f of %.0f (quarter %.0f)\n", k + 1,
                (unsigned long long)f.items, (unsigned long long)f.calls, f.cost, total, total / SHARDS);
-        CHECK_INT(f.calls, 8);
+        CHECK_INT(f.calls, LMB_STEP_CHUNKS_PER_SHARD);
         CHECK(fabs(f.cost - total / SHARDS) <= 0.015 * total / SHARDS);
         lmb_buf_free(&out);
         lmb_steps_free(s);
