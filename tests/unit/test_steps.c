@@ -5,7 +5,8 @@
  * shard's cost is within 1.5% of a quarter of the total (chunks cut by cost, not by count); the merged
  * state reads back (finish mode) as the items in order with the counters summed; a shard run
  * twice writes the same bytes; a step under min_rays runs in every process and is no farm step;
- * a merge over a missing part or a part of another config is refused, naming it. Streamed
+ * a merge over a missing part or a part of another config is refused, naming it; a worker
+ * whose step 0 is another step than the farm folder's refuses, naming both. Streamed
  * (lmb_steps_run_streamed): a local step is computed 64 items at a time and taken in order,
  * the same bytes and counters as whole; in finish mode it is read and taken at once; the float
  * sink fills arrays of 4, 0 and 6 floats across chunk borders and refuses a float too many.
@@ -301,6 +302,17 @@ int main(int argc, char **argv)
         lmb_step_desc d2 = {"next", 5, NULL, 1e9, compute, &f};
         CHECK_INT(lmb_steps_run(s, &d2, &out, counters, &err), LMB_ERR_INPUT);
         CHECK(strstr(err.message, "has not been merged") != NULL);
+        lmb_buf_free(&out);
+        lmb_steps_free(s);
+        /* a farm folder whose step 0 is another step (an older lmbake's step list): a worker
+         * refuses, naming both steps, and computes and merges nothing */
+        lmb_steps_worker w = {SHARDS, 0, 2, 0};
+        CHECK_INT(lmb_steps_create_worker(farm, &id, &w, 100.0, NULL, &s, &err), LMB_OK);
+        lmb_step_desc d3 = {"texels served", ITEMS, NULL, 1e9, compute, &f};
+        CHECK_INT(lmb_steps_run(s, &d3, &out, counters, &err), LMB_ERR_INPUT);
+        printf("refused: %s\n", err.message);
+        CHECK(strstr(err.message, "'skewed'") && strstr(err.message, "'texels served'"));
+        CHECK_INT(f.calls, 0);
         lmb_buf_free(&out);
         lmb_steps_free(s);
     }
