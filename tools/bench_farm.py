@@ -16,6 +16,15 @@
    reported: start (load, plan, ray-tracing scene, before the first step), between steps
    (the code between steps, merges), and the tail after the last step.
 
+With LMB_BENCH_BEFORE=OTHER_LMBAKE (tools/bench_farm.sh's second argument) both measures run
+for that binary too, side by side: in each round of 1, the four runs alternate (bake and farm
+of this binary, then of the other); in 2, the two workers of each shard count run one after
+the other. Rows carry binary=after|before.
+
+Also reported, less noisy than the ratio to a bake run at another time on this shared machine:
+the critical path over the same worker run's one-machine time (plan + the worker's wall, every
+shard computed in turn on one thread: a one-machine bake through the farm).
+
 usage: bench_farm.py LMBAKE WORKDIR CSV PNG ROUNDS SHARDS_LIST SCENE [SCENE ...]
        (SHARDS_LIST e.g. "1,4,16"; critical paths are measured on the last scene)
 """
@@ -61,58 +70,73 @@ def timed_worker(args):
     return time.time() - t0, shards
 
 
-def side_by_side(lmbake, scene, work, rounds, rows):
+def side_by_side(binaries, scene, work, rounds, rows):
     name = os.path.splitext(os.path.basename(scene))[0]
     for rnd in range(1, rounds + 1):
-        ref, farm, out = (os.path.join(work, "%s-%s" % (name, s)) for s in ("bake", "farm", "out"))
-        for d in (ref, farm, out):
-            shutil.rmtree(d, ignore_errors=True)
-        bake = run([lmbake, "bake", scene, "-o", ref, "-q", "--threads", "2"])
-        wall = run([lmbake, "farm", "parallel", scene, "--farm", farm, "-o", out, "--shards", "2", "--workers", "2",
-                    "--threads", "1", "-q"])
-        same = identical(ref, out)
-        rows.append(dict(measure="this machine", scene=name, round=rnd, shards=2, bake_s=round(bake, 2),
-                         farm_s=round(wall, 2), ratio=round(wall / bake, 4), identical=same))
-        print("%s round %d: bake --threads 2 %.1f s, farm parallel 2 workers x 1 thread %.1f s: %.3fx, identical: %s"
-              % (name, rnd, bake, wall, wall / bake, same), flush=True)
-        if not same:
-            sys.exit("bench_farm: the farm's output differs from lmbake bake")
+        for tag, lmbake in binaries:
+            ref, farm, out = (os.path.join(work, "%s-%s-%s" % (name, tag, s)) for s in ("bake", "farm", "out"))
+            for d in (ref, farm, out):
+                shutil.rmtree(d, ignore_errors=True)
+            bake = run([lmbake, "bake", scene, "-o", ref, "-q", "--threads", "2"])
+            wall = run([lmbake, "farm", "parallel", scene, "--farm", farm, "-o", out, "--shards", "2", "--workers",
+                        "2", "--threads", "1", "-q"])
+            same = identical(ref, out)
+            rows.append(dict(measure="this machine", binary=tag, scene=name, round=rnd, shards=2, bake_s=round(bake, 2),
+                             farm_s=round(wall, 2), ratio=round(wall / bake, 4), identical=same))
+            print("%s %s round %d: bake --threads 2 %.1f s, farm parallel 2 workers x 1 thread %.1f s: %.3fx, "
+                  "identical: %s" % (tag, name, rnd, bake, wall, wall / bake, same), flush=True)
+            if not same:
+                sys.exit("bench_farm: the farm's output differs from lmbake bake")
 
 
-def critical_paths(lmbake, scene, work, shard_counts, rows):
+def critical_paths(binaries, scene, work, shard_counts, rows):
     name = os.path.splitext(os.path.basename(scene))[0]
-    ref = os.path.join(work, name + "-bake-1thread")
-    shutil.rmtree(ref, ignore_errors=True)
-    bake = run([lmbake, "bake", scene, "-o", ref, "-q", "--threads", "1"])
-    print("%s: bake --threads 1 %.1f s" % (name, bake), flush=True)
+    bakes = {}
+    for tag, lmbake in binaries:
+        ref = os.path.join(work, "%s-%s-bake-1thread" % (name, tag))
+        shutil.rmtree(ref, ignore_errors=True)
+        bakes[tag] = (ref, run([lmbake, "bake", scene, "-o", ref, "-q", "--threads", "1"]))
+        print("%s %s: bake --threads 1 %.1f s" % (tag, name, bakes[tag][1]), flush=True)
     for n in shard_counts:
-        farm, out = (os.path.join(work, "%s-%d-%s" % (name, n, s)) for s in ("farm", "out"))
-        shutil.rmtree(farm, ignore_errors=True)
-        shutil.rmtree(out, ignore_errors=True)
-        plan = run([lmbake, "plan", scene, "--farm", farm, "--threads", "1", "-q"])
-        wall, shards = timed_worker([lmbake, "worker", scene, "--farm", farm, "--shards", str(n), "--worker", "1/1",
-                                     "--threads", "1", "-o", out])
-        same = identical(ref, out)
-        if not same:
-            sys.exit("bench_farm: the worker's output at %d shards differs from lmbake bake" % n)
-        steps = sorted({s for _, s, _, _ in shards})
-        slowest = {s: max(t for _, st, _, t in shards if st == s) for s in steps}
-        total = sum(t for _, _, _, t in shards)
-        start = shards[0][0] - shards[0][3] if shards else wall
-        tail = wall - shards[-1][0] if shards else 0.0
-        between = wall - total - start - tail
-        critical = plan + (wall - total) + sum(slowest.values())
-        mean = total / n
-        rows.append(dict(measure="critical path", scene=name, round=1, shards=n, bake_s=round(bake, 2),
-                         farm_s=round(critical, 2), ratio=round(critical / bake, 4), identical=same,
-                         steps=len(steps), plan_s=round(plan, 2), start_s=round(start, 2),
-                         between_s=round(between, 2), tail_s=round(tail, 2),
-                         shard_work_s=round(total, 2), slowest_sum_s=round(sum(slowest.values()), 2),
-                         slowest_over_mean=round(sum(slowest.values()) / mean, 3) if mean else 1.0))
-        print("%s, %d shards: %d steps; critical path %.1f s = plan %.1f + start %.1f + between steps %.1f + tail %.1f "
-              "+ slowest shards %.1f (all shards' work %.1f s, slowest/mean %.2f): %.3fx the bake, identical: %s" %
-              (name, n, len(steps), critical, plan, start, between, tail, sum(slowest.values()), total,
-               rows[-1]["slowest_over_mean"], critical / bake, same), flush=True)
+        for tag, lmbake in binaries:
+            critical_path(lmbake, tag, scene, name, work, n, bakes[tag], rows)
+
+
+def critical_path(lmbake, tag, scene, name, work, n, bake_run, rows):
+    """One worker computes every shard of every step in turn at 1 thread (its tail too:
+    --tail-threads 1, a machine of one core, where the binary has the option)."""
+    ref, bake = bake_run
+    farm, out = (os.path.join(work, "%s-%s-%d-%s" % (name, tag, n, s)) for s in ("farm", "out"))
+    shutil.rmtree(farm, ignore_errors=True)
+    shutil.rmtree(out, ignore_errors=True)
+    plan = run([lmbake, "plan", scene, "--farm", farm, "--threads", "1", "-q"])
+    one_core = ["--tail-threads", "1"] if "--tail-threads" in subprocess.run(
+        [lmbake, "worker", "--help"], capture_output=True, text=True).stdout else []
+    wall, shards = timed_worker([lmbake, "worker", scene, "--farm", farm, "--shards", str(n), "--worker", "1/1",
+                                 "--threads", "1", "-o", out] + one_core)
+    same = identical(ref, out)
+    if not same:
+        sys.exit("bench_farm: the worker's output at %d shards differs from lmbake bake" % n)
+    steps = sorted({s for _, s, _, _ in shards})
+    slowest = {s: max(t for _, st, _, t in shards if st == s) for s in steps}
+    total = sum(t for _, _, _, t in shards)
+    start = shards[0][0] - shards[0][3] if shards else wall
+    tail = wall - shards[-1][0] if shards else 0.0
+    between = wall - total - start - tail
+    critical = plan + (wall - total) + sum(slowest.values())
+    mean = total / n
+    rows.append(dict(measure="critical path", binary=tag, scene=name, round=1, shards=n, bake_s=round(bake, 2),
+                     farm_s=round(critical, 2), ratio=round(critical / bake, 4), identical=same,
+                     one_machine_s=round(plan + wall, 2), ratio_same_run=round(critical / (plan + wall), 4),
+                     steps=len(steps), plan_s=round(plan, 2), start_s=round(start, 2),
+                     between_s=round(between, 2), tail_s=round(tail, 2),
+                     shard_work_s=round(total, 2), slowest_sum_s=round(sum(slowest.values()), 2),
+                     slowest_over_mean=round(sum(slowest.values()) / mean, 3) if mean else 1.0))
+    print("%s %s, %d shards: %d steps; critical path %.1f s = plan %.1f + start %.1f + between steps %.1f + tail "
+          "%.1f + slowest shards %.1f (all shards' work %.1f s, slowest/mean %.2f): %.3fx the bake, %.3fx this "
+          "run's one machine (%.1f s), identical: %s" %
+          (tag, name, n, len(steps), critical, plan, start, between, tail, sum(slowest.values()), total,
+           rows[-1]["slowest_over_mean"], critical / bake, critical / (plan + wall), plan + wall, same), flush=True)
 
 
 def main():
@@ -121,10 +145,14 @@ def main():
     rounds = int(rounds)
     shard_counts = [int(s) for s in shard_list.split(",") if s]
     os.makedirs(work, exist_ok=True)
+    binaries = [("after", lmbake)]
+    if os.environ.get("LMB_BENCH_BEFORE"):
+        binaries.append(("before", os.environ["LMB_BENCH_BEFORE"]))
     rows = []
     for scene in scenes:
-        side_by_side(lmbake, scene, work, rounds, rows)
-    critical_paths(lmbake, scenes[-1], work, shard_counts, rows)
+        side_by_side(binaries, scene, work, rounds, rows)
+    if shard_counts:
+        critical_paths(binaries, scenes[-1], work, shard_counts, rows)
     keys = []
     for r in rows:
         keys += [k for k in r if k not in keys]
@@ -135,14 +163,16 @@ def main():
     print("summary:")
     for scene in scenes:
         name = os.path.splitext(os.path.basename(scene))[0]
-        sel = [r for r in rows if r["measure"] == "this machine" and r["scene"] == name]
-        if not sel:
-            continue
-        print("  %s: farm parallel 2 x 1 thread / bake --threads 2: median %.3fx (%s)" %
-              (name, statistics.median(r["ratio"] for r in sel), ", ".join("%.3f" % r["ratio"] for r in sel)))
+        for tag, _ in binaries:
+            sel = [r for r in rows if r["measure"] == "this machine" and r["scene"] == name and r["binary"] == tag]
+            if not sel:
+                continue
+            print("  %s %s: farm parallel 2 x 1 thread / bake --threads 2: median %.3fx (%s)" %
+                  (tag, name, statistics.median(r["ratio"] for r in sel), ", ".join("%.3f" % r["ratio"] for r in sel)))
     for r in rows:
         if r["measure"] == "critical path":
-            print("  %s, %d shards: critical path / bake --threads 1: %.3fx" % (r["scene"], r["shards"], r["ratio"]))
+            print("  %s %s, %d shards: critical path / bake --threads 1: %.3fx; / this run's one machine: %.3fx" %
+                  (r["binary"], r["scene"], r["shards"], r["ratio"], r["ratio_same_run"]))
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -150,10 +180,14 @@ def main():
     except ImportError:
         print("bench_farm: no matplotlib: no plot")
         return
-    crit = [r for r in rows if r["measure"] == "critical path"]
     fig, ax = plt.subplots(figsize=(7, 4))
-    ns = [r["shards"] for r in crit]
-    ax.plot(ns, [r["ratio"] for r in crit], "o-", label="critical path / bake --threads 1")
+    crit = []
+    for tag, _ in binaries:
+        crit = [r for r in rows if r["measure"] == "critical path" and r["binary"] == tag]
+        ns = [r["shards"] for r in crit]
+        ax.plot(ns, [r["ratio_same_run"] for r in crit], "o-" if tag == "after" else "s:",
+                label="%s: critical path / one machine" % tag)
+    ns = sorted({r["shards"] for r in rows if r["measure"] == "critical path"})
     ax.plot(ns, [1.0 / n for n in ns], "k--", label="ideal 1/N")
     ax.set_xscale("log", base=2)
     ax.set_yscale("log", base=2)
