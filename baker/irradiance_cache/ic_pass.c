@@ -84,6 +84,36 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, uint32_t
     return LMB_OK;
 }
 
+/* The items of a per-texel step (texels served, interpolation): every atlas's listed texels in
+ * order; first[a] is atlas a's first item (atlas_count + 1 entries, malloc'd). */
+typedef struct texel_items {
+    const pass_ctx *c;
+    uint64_t *first;
+} texel_items;
+
+static lmb_status texel_items_make(const pass_ctx *c, texel_items *ti, lmb_error *err)
+{
+    ti->c = c;
+    ti->first = calloc((size_t)c->atlas_count + 2, sizeof *ti->first);
+    if (!ti->first)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
+    for (uint32_t a = 0; a < c->atlas_count; a++)
+        ti->first[a + 1] = ti->first[a] + c->t[a]->count;
+    return LMB_OK;
+}
+
+/* Atlas a's texels [*i0, *i1) among items [first, last); 0 when it holds none of them. */
+static int texel_items_span(const texel_items *ti, uint32_t a, uint64_t first, uint64_t last, uint32_t *i0,
+                            uint32_t *i1)
+{
+    uint64_t a0 = ti->first[a], a1 = ti->first[a + 1];
+    if (a1 <= first || a0 >= last)
+        return 0;
+    *i0 = (uint32_t)((first > a0 ? first : a0) - a0);
+    *i1 = (uint32_t)((last < a1 ? last : a1) - a0);
+    return 1;
+}
+
 /* records.serves: how many texels each record serves, from its shares of every valid texel's
  * interpolation (lmb_ic_add_shares), rounded up and kept within [1, ray_scale]. A record that
  * gathers ray_scale x a texel's rays for fewer texels than that costs more than gathering at
@@ -95,16 +125,11 @@ static lmb_status level_candidates(const pass_ctx *c, uint32_t spacing, uint32_t
  * texels in order; a call's bytes are the shares it added, u32 n then n x (u32 record, u64
  * share), records ascending. The shares are integers: their sum is the same however the
  * texels are split, at any thread count. */
-typedef struct served_step {
-    const pass_ctx *c;
-    uint64_t *first; /* per atlas (+1): its first item */
-} served_step;
-
 static lmb_status served_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
-    const served_step *ss = user;
-    const pass_ctx *c = ss->c;
+    const texel_items *ti = user;
+    const pass_ctx *c = ti->c;
     (void)counters;
     uint32_t m = c->records.count;
     uint64_t *share = calloc((size_t)m + 1, sizeof *share);
@@ -112,10 +137,9 @@ static lmb_status served_range(void *user, uint64_t first, uint64_t last, lmb_bu
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", m);
     for (uint32_t a = 0; a < c->atlas_count; a++) {
         const lmb_texels *t = c->t[a];
-        uint64_t a0 = ss->first[a], a1 = ss->first[a + 1];
-        if (a1 <= first || a0 >= last)
+        uint32_t i0, i1;
+        if (!texel_items_span(ti, a, first, last, &i0, &i1))
             continue;
-        uint32_t i0 = (uint32_t)((first > a0 ? first : a0) - a0), i1 = (uint32_t)((last < a1 ? last : a1) - a0);
 #pragma omp parallel for num_threads(c->threads) schedule(dynamic, 1024)
         for (uint32_t i = i0; i < i1; i++) {
             double p[3], n[3];
@@ -169,30 +193,30 @@ static lmb_status count_served(pass_ctx *c, lmb_error *err)
     uint32_t m = c->records.count, scale = c->opt->ray_scale;
     if (scale <= 1 || !m || c->records.serves)
         return LMB_OK;
-    served_step ss = {c, calloc((size_t)c->atlas_count + 2, sizeof(uint64_t))};
+    texel_items ti;
+    lmb_status st = texel_items_make(c, &ti, err);
+    if (st != LMB_OK)
+        return st;
     served_sum sum = {calloc(m, sizeof(uint64_t)), m};
     uint32_t *serves = malloc((size_t)m * sizeof *serves);
-    if (!ss.first || !sum.share || !serves) {
-        free(ss.first);
+    if (!sum.share || !serves) {
+        free(ti.first);
         free(sum.share);
         free(serves);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for %u records", m);
     }
-    for (uint32_t a = 0; a < c->atlas_count; a++)
-        ss.first[a + 1] = ss.first[a] + c->t[a]->count;
     char name[160];
     snprintf(name, sizeof name, "%s: texels served", c->stage);
     /* rays: an interpolation and a second walk per texel; counted as 16 rays per texel */
-    lmb_step_desc d = {name, ss.first[c->atlas_count], NULL, 16.0 * (double)ss.first[c->atlas_count], served_range,
-                       &ss};
+    lmb_step_desc d = {name, ti.first[c->atlas_count], NULL, 16.0 * (double)ti.first[c->atlas_count], served_range,
+                       &ti};
     uint64_t counters[LMB_STEP_COUNTERS];
-    lmb_status st =
-        lmb_steps_run_streamed(c->job->steps, &d, LMB_STEP_STREAM_ITEMS, take_served, &sum, counters, err);
+    st = lmb_steps_run_streamed(c->job->steps, &d, LMB_STEP_STREAM_ITEMS, take_served, &sum, counters, err);
     for (uint32_t k = 0; k < m && st == LMB_OK; k++) {
         uint64_t texels = (sum.share[k] + LMB_IC_SHARE_ONE - 1) / LMB_IC_SHARE_ONE;
         serves[k] = texels < 1 ? 1 : texels > scale ? scale : (uint32_t)texels;
     }
-    free(ss.first);
+    free(ti.first);
     free(sum.share);
     if (st != LMB_OK) {
         free(serves);
@@ -389,23 +413,17 @@ static lmb_status fit_gradients(pass_ctx *c, lmb_error *err)
 }
 
 /* Interpolation as a step (steps/runner.h): items are every atlas's listed texels in order. */
-typedef struct interp_step {
-    const pass_ctx *c;
-    uint64_t *first; /* per atlas (+1): its first item */
-} interp_step;
-
 static lmb_status interpolate_range(void *user, uint64_t first, uint64_t last, lmb_buf *out,
                                     uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
-    const interp_step *is = user;
-    const pass_ctx *c = is->c;
+    const texel_items *ti = user;
+    const pass_ctx *c = ti->c;
     (void)counters;
     for (uint32_t a = 0; a < c->atlas_count; a++) {
         const lmb_texels *t = c->t[a];
-        uint64_t a0 = is->first[a], a1 = is->first[a + 1];
-        if (a1 <= first || a0 >= last)
+        uint32_t i0, i1;
+        if (!texel_items_span(ti, a, first, last, &i0, &i1))
             continue;
-        uint32_t i0 = (uint32_t)((first > a0 ? first : a0) - a0), i1 = (uint32_t)((last < a1 ? last : a1) - a0);
         float *o = malloc(3 * sizeof *o * ((size_t)(i1 - i0) + 1));
         if (!o)
             return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for atlas %u", a);
@@ -435,11 +453,10 @@ static lmb_status interpolate_range(void *user, uint64_t first, uint64_t last, l
  * farm process that replays this pass. */
 static lmb_status interpolate_all(const pass_ctx *c, float *const *out, lmb_error *err)
 {
-    interp_step is = {c, calloc((size_t)c->atlas_count + 2, sizeof(uint64_t))};
-    if (!is.first)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory");
-    for (uint32_t a = 0; a < c->atlas_count; a++)
-        is.first[a + 1] = is.first[a] + c->t[a]->count;
+    texel_items is;
+    lmb_status st = texel_items_make(c, &is, err);
+    if (st != LMB_OK)
+        return st;
     char name[160];
     snprintf(name, sizeof name, "%s: interpolation", c->stage);
     /* rays: a lookup visits tens of records; counted as 8 rays per texel for farm.min_step_rays */
@@ -453,7 +470,7 @@ static lmb_status interpolate_all(const pass_ctx *c, float *const *out, lmb_erro
     for (uint32_t a = 0; a < c->atlas_count; a++)
         floats[a] = 3 * (uint64_t)c->t[a]->count;
     lmb_float_sink sink = {c->atlas_count, out, floats, 0, 0};
-    lmb_status st = lmb_steps_run_streamed(c->job->steps, &d, LMB_STEP_STREAM_ITEMS, lmb_take_floats, &sink, counters, err);
+    st = lmb_steps_run_streamed(c->job->steps, &d, LMB_STEP_STREAM_ITEMS, lmb_take_floats, &sink, counters, err);
     if (st == LMB_OK && !lmb_float_sink_full(&sink))
         st = lmb_error_set(err, LMB_ERR_INPUT, "%s: step holds too few texels", name);
     free(floats);
