@@ -381,14 +381,9 @@ lmb_status lmb_steps_write_end(lmb_steps *s, lmb_error *err)
     memset(&b, 0, sizeof b);
     b.end = 1;
     snprintf(b.name, sizeof b.name, "end");
-    size_t size;
-    uint8_t *body = lmb_step_body_encode(&b, &size);
-    if (!body)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "out of memory");
     lmb_step_part_path(s->dir, s->step, s->shard, s->shards, path, sizeof path);
     lmb_part_place place = {LMB_PART_SHARD, s->step, s->shard, s->shards};
-    lmb_status st = lmb_part_write(path, &s->id, &place, body, size, err);
-    free(body);
+    lmb_status st = lmb_step_body_write(path, &s->id, &place, &b, err);
     if (st == LMB_OK)
         lmb_info(s->log, "step %u: the bake has %u steps: nothing to do (wrote %s)", s->step, s->next, path);
     return st;

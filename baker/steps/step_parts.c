@@ -51,19 +51,6 @@ static void put_head(const step_body *b, uint8_t *p)
     }
 }
 
-uint8_t *lmb_step_body_encode(const step_body *b, size_t *size)
-{
-    size_t head = head_size(b);
-    *size = head + b->size;
-    uint8_t *body = malloc(*size + 1);
-    if (!body)
-        return NULL;
-    put_head(b, body);
-    if (b->size)
-        memcpy(body + head, b->bytes, b->size);
-    return body;
-}
-
 lmb_status lmb_step_body_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
                                const step_body *b, lmb_error *err)
 {

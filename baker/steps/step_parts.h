@@ -37,8 +37,6 @@ typedef struct step_body {
  * chunk costs a call and 24 bytes in the part. */
 #define LMB_STEP_CHUNKS_PER_SHARD 32
 
-/* The body for b (bytes from b->bytes), malloc'd. */
-uint8_t *lmb_step_body_encode(const step_body *b, size_t *size);
 /* Writes b as the body of a part or state file at path: its head (everything before the
  * results) and b->bytes as they lie, not joined into one copy first. */
 lmb_status lmb_step_body_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
