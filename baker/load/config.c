@@ -58,7 +58,7 @@ static const char *const emission_sides[] = {"front", "material", NULL};
 static const char *const sky_samplings[] = {"mis", "cosine", NULL};
 static const char *const output_formats[] = {"exr", "hdr", "png", "mask", "ktx2", "rgbm", NULL};
 static const char *const output_scales[] = {"irradiance", "radiance", NULL};
-static const char *const ktx2_formats[] = {"e5b9g9r9", "b10g11r11", "rgba16f", NULL};
+static const char *const ktx2_formats[] = {"e5b9g9r9", "b10g11r11", "rgba16f", "bc6h", "astc_hdr", NULL};
 static const char *const ktx2_supercompressions[] = {"none", "zstd", NULL};
 static const char *const light_mode_names[] = {"baked", "indirect", "realtime", NULL};
 _Static_assert(LMB_LIGHT_BAKED == 0 && LMB_LIGHT_INDIRECT == 1 && LMB_LIGHT_REALTIME == 2, "light_mode_names");
@@ -114,6 +114,7 @@ static const key_spec config_keys[] = {
     BOOL("output.directional", OFF(directional)),
     ENUM("output.ktx2_format", OFF(ktx2_format), ktx2_formats),
     ENUM("output.ktx2_supercompression", OFF(ktx2_zstd), ktx2_supercompressions),
+    BOOL("output.ktx2_mipmaps", OFF(ktx2_mipmaps)),
     ENUM("output.scale", OFF(output_scale), output_scales),
     FLOAT_AUTO("output.rgbm_range", OFF(rgbm_range), 0, 1e9, OPEN_LO),
     LIST("lightmap.include", lmb_cfg_set_globs, OFF(include), OFF(include_count)),

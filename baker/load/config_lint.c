@@ -59,6 +59,8 @@ lmb_status lmb_config_lint(const lmb_config *c, const lmb_log *log, lmb_error *e
             off(log, name, "output.ktx2_format", "output.formats has no ktx2");
         if (c->ktx2_zstd != d.ktx2_zstd)
             off(log, name, "output.ktx2_supercompression", "output.formats has no ktx2");
+        if (c->ktx2_mipmaps != d.ktx2_mipmaps)
+            off(log, name, "output.ktx2_mipmaps", "output.formats has no ktx2");
     }
     if (!(c->output_formats & LMB_OUTPUT_RGBM) && c->rgbm_range != d.rgbm_range)
         off(log, name, "output.rgbm_range", "output.formats has no rgbm");

@@ -138,7 +138,7 @@ static lmb_status pack_instances(const lmb_scene *s, const lmb_config *cfg, lmb_
             chart_id[q] = k;
         }
     }
-    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1, cfg->threads};
+    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1, cfg->threads, lmb_pack_block_for(cfg)};
     if (st == LMB_OK)
         st = lmb_pack_charts(charts, nc, &opt, &r, err);
     if (st == LMB_ERR_INPUT && r.failed_group < n) {

@@ -404,8 +404,8 @@ static uint32_t oversized_group(const lmb_pack_item *items, uint32_t count, uint
     return bad;
 }
 
-lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const lmb_pack_options *opt,
-                           lmb_pack_result *out, lmb_error *err)
+static lmb_status pack_texels(const lmb_pack_chart *charts, uint32_t count, const lmb_pack_options *opt,
+                              lmb_pack_result *out, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
     out->failed_group = out->failed_chart = NONE;
@@ -508,4 +508,58 @@ lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const l
         out->failed_chart = c;
     }
     return st;
+}
+
+/* Block-aligned packing (opt->block > 1): the charts scaled by 1 / block and packed in block
+ * units with a border of one block (at least padding + 1 texels for padding < block), then the
+ * placements' translations and the atlas sizes scaled back. A chart's footprint in block units
+ * covers every block its texels touch, so no block holds texels of two charts. */
+lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const lmb_pack_options *opt,
+                           lmb_pack_result *out, lmb_error *err)
+{
+    if (opt->block <= 1)
+        return pack_texels(charts, count, opt, out, err);
+    double k = 1.0 / opt->block;
+    size_t triangles = 0;
+    for (uint32_t i = 0; i < count; i++)
+        triangles += charts[i].triangle_count;
+    lmb_pack_chart *scaled = calloc((size_t)count + 1, sizeof *scaled);
+    double *uv = malloc((6 * triangles + 1) * sizeof *uv);
+    if (!scaled || !uv) {
+        free(scaled);
+        free(uv);
+        memset(out, 0, sizeof *out);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
+    }
+    for (uint32_t i = 0, at = 0; i < count; i++) {
+        scaled[i] = charts[i];
+        scaled[i].uv = uv + at;
+        for (uint32_t t = 0; t < 6 * charts[i].triangle_count; t++)
+            uv[at + t] = charts[i].uv[t] * k;
+        at += 6 * charts[i].triangle_count;
+    }
+    lmb_pack_options o = *opt;
+    o.block = 1;
+    o.max_size = opt->max_size / opt->block;
+    o.padding = (opt->padding + 1 + opt->block - 1) / opt->block - 1;
+    lmb_status st = pack_texels(scaled, count, &o, out, err);
+    free(scaled);
+    free(uv);
+    if (st != LMB_OK)
+        return st;
+    for (uint32_t a = 0; a < out->atlas_count; a++) {
+        out->width[a] *= opt->block;
+        out->height[a] *= opt->block;
+    }
+    for (uint32_t i = 0; i < count; i++) {
+        out->placements[i].m[2] *= opt->block;
+        out->placements[i].m[5] *= opt->block;
+    }
+    return LMB_OK;
+}
+
+uint32_t lmb_pack_block_for(const lmb_config *cfg)
+{
+    int blocks = cfg->ktx2_format == LMB_KTX2_BC6H || cfg->ktx2_format == LMB_KTX2_ASTC_HDR;
+    return (cfg->output_formats & LMB_OUTPUT_KTX2) && blocks ? 4 : 1;
 }

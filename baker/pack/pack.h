@@ -22,7 +22,14 @@ typedef struct lmb_pack_options {
     int grouped;       /* every group lands whole in one atlas; a group that cannot is an error */
     uint32_t threads;  /* charts' footprints are made on this many threads (0: all cores); the
                           packing itself, and so its result, does not depend on it */
+    uint32_t block;    /* > 1: charts on a grid of block x block texels, no block shared by two
+                          (block-compressed lightmaps: a block holds one chart's light, so the
+                          encoder does not quantize two charts' light together); 0 or 1: none */
 } lmb_pack_options;
+
+/* The block size a config's outputs want the atlas packed on: 4 when a lightmap is written in a
+ * 4 x 4 block format (output.ktx2_format bc6h or astc_hdr), else 1. */
+uint32_t lmb_pack_block_for(const lmb_config *cfg);
 
 /* Chart-local uv -> atlas texel coordinates: x = m[0] u + m[1] v + m[2], y = m[3] u + m[4] v + m[5]
  * (a rotation, possibly with a flip, and a translation: lengths are kept). */

@@ -109,7 +109,7 @@ static lmb_status pack_block(const lmb_scene *s, const lmb_config *cfg, lmb_layo
         charts[k].group = 0;
         at += len;
     }
-    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1, cfg->threads};
+    lmb_pack_options opt = {cfg->max_atlas_size, cfg->padding, 1, cfg->threads, lmb_pack_block_for(cfg)};
     if (st == LMB_OK)
         st = lmb_pack_charts(charts, c->chart_count, &opt, &r, err);
     if (st == LMB_OK) {

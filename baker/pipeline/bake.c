@@ -27,6 +27,7 @@
 #include "seams/seams.h"
 #include "texels/texels.h"
 #include "write/atlas_images.h"
+#include "write/ktx2.h"
 #include "write/lightmapped_gltf.h"
 #include "write/output_dir.h"
 #include "write/records_file.h"
@@ -36,9 +37,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
-/* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
- * neighbours, then seams stitched. */
 /* A bake of `texels` texels (0: not known yet) must fit the memory left: otherwise an error
  * naming the key, the estimate and what fits, before the work that would be killed. */
 static lmb_status texels_fit_memory(const lmb_config *cfg, uint64_t texels, lmb_error *err)
@@ -92,6 +90,8 @@ static lmb_status dark_atlases(const lmb_scene *s, const lmb_config *cfg, const 
     return LMB_OK;
 }
 
+/* The post stage on the final lightmaps (docs/artists.md): fireflies spread to their
+ * neighbours, then seams stitched. */
 static lmb_status post_process(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const lmb_rt *rt,
                                lmb_cache *cache, lmb_progress_fn progress, void *user, lmb_bake_stats *stats,
                                const lmb_log *log, lmb_error *err)
@@ -343,6 +343,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         if (st == LMB_OK && outputs[a].rgbm_clamped)
             lmb_warn(log, "atlas %u: %llu texels brighter than RGBM's range %g were clamped (output.rgbm_range; auto "
                      "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
+        if (st == LMB_OK && outputs[a].ktx2.clamped)
+            lmb_warn(log, "atlas %u: %llu texels brighter than %s's range (65504) were clamped in the .ktx2 (output.scale: "
+                     "radiance divides by pi)", a, (unsigned long long)outputs[a].ktx2.clamped,
+                     cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR");
     }
     if (progress && st == LMB_OK)
         progress(user, "images", l.atlas_count, l.atlas_count);

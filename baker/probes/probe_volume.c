@@ -107,7 +107,8 @@ lmb_status lmb_probe_volume_write_ktx2(const lmb_probe_volume *v, double scale, 
                         q[c] = (float)(cube[3 * face + c] * scale);
                 }
             }
-    lmb_status st = lmb_ktx2_write_3d(path, rx, 2 * ry, 3 * rz, rgb, LMB_KTX2_E5B9G9R9, 0, err);
+    lmb_ktx2_options o = {LMB_KTX2_E5B9G9R9, 0, 0, 1, NULL};
+    lmb_status st = lmb_ktx2_write_3d(path, rx, 2 * ry, 3 * rz, rgb, &o, err);
     free(rgb);
     return st;
 }

@@ -5,6 +5,7 @@
 #include "steps/part_file.h"
 #include "steps/plan_codec.h"
 #include "util/clock.h"
+#include "pack/pack.h"
 #include "write/output_dir.h"
 
 #include <nettle/sha2.h>
@@ -33,7 +34,8 @@ static int lighting_only_section(const char *line, size_t len)
 
 /* The config's text (lmb_config_write, threads aside) without its lighting-only sections; of
  * `samples`, samples.texel (the gather points per texel) stays: the texel count it makes is
- * checked against memory before the layout. */
+ * checked against memory before the layout. One output choice shapes the layout: a block
+ * format packs charts on its block grid (lmb_pack_block_for); a line says so. */
 static char *layout_config_text(const lmb_config *cfg)
 {
     lmb_config bare = *cfg;
@@ -64,6 +66,17 @@ static char *layout_config_text(const lmb_config *cfg)
     }
     out[o] = '\0';
     free(full);
+    if (lmb_pack_block_for(cfg) > 1) {
+        char line[64];
+        int k = snprintf(line, sizeof line, "# atlas blocks: %u\n", lmb_pack_block_for(cfg));
+        char *grown = realloc(out, o + (size_t)k + 1);
+        if (!grown) {
+            free(out);
+            return NULL;
+        }
+        memcpy(grown + o, line, (size_t)k + 1);
+        out = grown;
+    }
     return out;
 }
 

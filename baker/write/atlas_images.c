@@ -55,8 +55,8 @@ typedef struct image_job {
     uint32_t channels;
     const float *f32;
     const uint8_t *u8;
-    lmb_ktx2_format ktx2_format;
-    int zstd_level;
+    lmb_ktx2_options ktx2;
+    lmb_ktx2_report *ktx2_report; /* may be NULL */
 } image_job;
 
 /* Writes the files of jobs[0..n) at once, a file per thread (each encoder runs on one thread,
@@ -73,7 +73,7 @@ static lmb_status write_images(const image_job *jobs, int n, uint32_t w, uint32_
         errs[k] = (lmb_error){LMB_OK, ""};
         sts[k] = j->kind == IMAGE_F32  ? lmb_image_write_f32(j->path, w, h, j->channels, j->f32, &errs[k])
                  : j->kind == IMAGE_U8 ? lmb_image_write_u8(j->path, w, h, j->channels, j->u8, &errs[k])
-                                       : lmb_ktx2_write(j->path, w, h, j->f32, j->ktx2_format, j->zstd_level, &errs[k]);
+                                       : lmb_ktx2_write(j->path, w, h, j->f32, &j->ktx2, j->ktx2_report, &errs[k]);
     }
     for (int k = 0; k < n; k++)
         if (sts[k] != LMB_OK) {
@@ -106,7 +106,7 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
     size_t n = (size_t)w * h;
     int threads = image_threads(cfg);
     float *rgb = scaled_copy(cfg, irradiance, n);
-    uint8_t *png = malloc(3 * n + 1), *rgbm = NULL, *mask = NULL;
+    uint8_t *png = malloc(3 * n + 1), *rgbm = NULL, *mask = NULL, *care = NULL;
     if ((cfg->output_formats & LMB_OUTPUT_RGBM))
         rgbm = malloc(4 * n + 1);
     if ((cfg->output_formats & LMB_OUTPUT_MASK))
@@ -118,32 +118,36 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
     int count = 0;
     if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_EXR)) {
-        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, 0, 0};
+        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, {0}, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.exr", dir, stem, a);
     }
     /* the glTF references the .hdr and .png: written whatever the formats say */
     if (st == LMB_OK) {
-        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, 0, 0};
+        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, {0}, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
         tonemap(rgb, valid, w, h, threads, png);
-        jobs[count] = (image_job){IMAGE_U8, "", 3, NULL, png, 0, 0};
+        jobs[count] = (image_job){IMAGE_U8, "", 3, NULL, png, {0}, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.png", dir, stem, a);
     }
     if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_KTX2)) {
-        jobs[count] = (image_job){IMAGE_KTX2, "", 3, rgb, NULL, (lmb_ktx2_format)cfg->ktx2_format,
-                                  cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0};
+        care = lmb_ktx2_lookup_texels(valid, w, h);
+        if (!care)
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
+        lmb_ktx2_options o = {(lmb_ktx2_format)cfg->ktx2_format, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0,
+                              cfg->ktx2_mipmaps, 1, care};
+        jobs[count] = (image_job){IMAGE_KTX2, "", 3, rgb, NULL, o, &info->ktx2};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.ktx2", dir, stem, a);
     }
     if (st == LMB_OK && rgbm) {
         info->rgbm_range = lmb_rgbm_range(cfg->rgbm_range, rgb, valid, n);
         info->rgbm_clamped = lmb_rgbm_encode(rgb, valid, n, info->rgbm_range, rgbm);
-        jobs[count] = (image_job){IMAGE_U8, "", 4, NULL, rgbm, 0, 0};
+        jobs[count] = (image_job){IMAGE_U8, "", 4, NULL, rgbm, {0}, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-rgbm.png", dir, stem, a);
     }
     if (st == LMB_OK && mask) {
         for (size_t i = 0; i < n; i++)
             mask[i] = valid[i] == LMB_TEXEL_VALID ? 255 : valid[i] == LMB_TEXEL_INSIDE ? 128 : 0;
-        jobs[count] = (image_job){IMAGE_U8, "", 1, NULL, mask, 0, 0};
+        jobs[count] = (image_job){IMAGE_U8, "", 1, NULL, mask, {0}, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-mask.png", dir, stem, a);
     }
     if (st == LMB_OK)
@@ -153,6 +157,7 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
     free(png);
     free(rgbm);
     free(mask);
+    free(care);
     return st;
 }
 
@@ -162,7 +167,7 @@ lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const cha
     float *rgb = scaled_copy(cfg, irradiance, (size_t)w * h);
     if (!rgb)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
-    image_job job = {IMAGE_F32, "", 3, rgb, NULL, 0, 0};
+    image_job job = {IMAGE_F32, "", 3, rgb, NULL, {0}, NULL};
     snprintf(job.path, sizeof job.path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
     lmb_status st = write_images(&job, 1, w, h, image_threads(cfg), err);
     free(rgb);
@@ -184,12 +189,13 @@ lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, co
         png[i] = (uint8_t)(v <= 0 ? 0 : v >= 1 ? 255 : lround(v * 255.0));
     }
     int count = 0;
-    jobs[count] = (image_job){IMAGE_F32, "", 3, d, NULL, 0, 0};
+    jobs[count] = (image_job){IMAGE_F32, "", 3, d, NULL, {0}, NULL};
     snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-dir.exr", dir, stem, a);
-    jobs[count] = (image_job){IMAGE_U8, "", 3, NULL, png, 0, 0};
+    jobs[count] = (image_job){IMAGE_U8, "", 3, NULL, png, {0}, NULL};
     snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-dir.png", dir, stem, a);
     if (cfg->output_formats & LMB_OUTPUT_KTX2) { /* signed: half floats */
-        jobs[count] = (image_job){IMAGE_KTX2, "", 3, d, NULL, LMB_KTX2_RGBA16F, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0};
+        lmb_ktx2_options o = {LMB_KTX2_RGBA16F, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0, cfg->ktx2_mipmaps, 1, NULL};
+        jobs[count] = (image_job){IMAGE_KTX2, "", 3, d, NULL, o, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u-dir.ktx2", dir, stem, a);
     }
     lmb_status st = write_images(jobs, count, w, h, image_threads(cfg), err);

@@ -12,10 +12,13 @@
 
 #include <lmbake/lmbake.h>
 
+#include "ktx2.h"
+
 /* What writing an atlas decided, for the glTF and the log. */
 typedef struct lmb_atlas_output {
     double rgbm_range;     /* rgbm: the range written */
     uint64_t rgbm_clamped; /* rgbm: valid texels above it, clamped */
+    lmb_ktx2_report ktx2;  /* ktx2: texels above the block format's range, clamped */
 } lmb_atlas_output;
 
 /* irradiance: 3 floats per atlas texel (E, lux); valid: LMB_TEXEL_* per texel. Files go into dir. */

@@ -12,6 +12,10 @@
  */
 #include "ktx2.h"
 
+#include "astc_adapter.h"
+#include "bc6h.h"
+#include "post/dilate.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,7 +24,19 @@
 
 uint32_t lmb_ktx2_vkformat(lmb_ktx2_format f)
 {
-    return f == LMB_KTX2_E5B9G9R9 ? 123u : f == LMB_KTX2_B10G11R11 ? 122u : 97u;
+    switch (f) {
+    case LMB_KTX2_E5B9G9R9: return 123u;
+    case LMB_KTX2_B10G11R11: return 122u;
+    case LMB_KTX2_RGBA16F: return 97u;
+    case LMB_KTX2_BC6H: return 143u;
+    case LMB_KTX2_ASTC_HDR: return 1000066000u;
+    }
+    return 0;
+}
+
+int lmb_ktx2_is_block(lmb_ktx2_format f)
+{
+    return f == LMB_KTX2_BC6H || f == LMB_KTX2_ASTC_HDR;
 }
 
 static float clamp_nonneg(float v, float max)
@@ -176,9 +192,23 @@ static void sample(bytes *b, uint32_t offset, uint32_t bits, uint32_t channel, u
 }
 
 /* The Basic DFD of format f: colour model RGBSDA, BT.709 primaries, linear transfer, straight
- * alpha, 1x1x1x1 blocks, bytesPlane0 = the texel's size. */
+ * alpha, 1x1x1x1 blocks, bytesPlane0 = the texel's size; for the block formats, model BC6H (133)
+ * or ASTC (162), 4x4 blocks of 16 bytes and one 128-bit sample (as KTX-Software's dfdutils
+ * writes them: BC6H unsigned float in [0, 1], ASTC HDR signed float in [-1, 1]). */
 static void dfd(bytes *b, lmb_ktx2_format f)
 {
+    if (lmb_ktx2_is_block(f)) {
+        int bc6h = f == LMB_KTX2_BC6H;
+        put32(b, 4 + 24 + 16);
+        put32(b, 0);
+        put32(b, 2 | (24 + 16) << 16);
+        put32(b, (bc6h ? 133u : 162u) | 1 << 8 | 1 << 16);
+        put32(b, 3 | 3 << 8); /* 4x4x1x1 */
+        put32(b, 16);
+        put32(b, 0);
+        sample(b, 0, 128, bc6h ? 0x80 : 0xC0, bc6h ? 0 : float_bits(-1.0f), float_bits(1.0f));
+        return;
+    }
     uint32_t samples = f == LMB_KTX2_E5B9G9R9 ? 6 : f == LMB_KTX2_B10G11R11 ? 3 : 4;
     uint32_t block = 24 + 16 * samples;
     put32(b, 4 + block);      /* dfdTotalSize */
@@ -214,22 +244,51 @@ static void key_value(bytes *b, const char *key, const char *value)
     pad_to(b, 4);
 }
 
-lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f, int zstd_level,
-                           uint8_t **out, size_t *size, lmb_error *err)
+uint8_t *lmb_ktx2_lookup_texels(const uint8_t *state, uint32_t w, uint32_t h)
 {
-    return lmb_ktx2_encode_3d(w, h, 0, rgb, f, zstd_level, out, size, err);
+    uint8_t *care = calloc((size_t)w * h + 1, 1);
+    for (uint32_t y = 0; care && y < h; y++)
+        for (uint32_t x = 0; x < w; x++) {
+            if (state[(size_t)y * w + x] != LMB_TEXEL_VALID)
+                continue;
+            for (uint32_t yy = y ? y - 1 : 0; yy <= y + 1 && yy < h; yy++)
+                for (uint32_t xx = x ? x - 1 : 0; xx <= x + 1 && xx < w; xx++)
+                    care[(size_t)yy * w + xx] = 1;
+        }
+    return care;
 }
 
-lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *rgb, lmb_ktx2_format f, int zstd_level,
-                              uint8_t **out, size_t *size, lmb_error *err)
+/* The bytes of one level: packed texels or blocks. Returns the size, 0 when out of memory. */
+static size_t encode_level(uint32_t w, uint32_t h, uint32_t d, const float *rgb, const lmb_ktx2_options *o,
+                           const uint8_t *care, uint8_t **out, lmb_ktx2_report *report, lmb_error *err,
+                           lmb_status *st)
 {
-    *out = NULL;
-    *size = 0;
-    size_t texel = f == LMB_KTX2_RGBA16F ? 8 : 4, raw_size = (size_t)w * h * (d ? d : 1) * texel;
-    uint8_t *raw = malloc(raw_size + 1);
-    if (!raw)
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for a %ux%u level", w, h);
-    for (size_t i = 0; i < raw_size / texel; i++) {
+    lmb_ktx2_format f = o->format;
+    *st = LMB_OK;
+    if (lmb_ktx2_is_block(f)) {
+        size_t size = f == LMB_KTX2_BC6H ? lmb_bc6h_size(w, h) : lmb_astc_size(w, h);
+        *out = malloc(size + 1);
+        if (!*out) {
+            *st = lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for a %ux%u level", w, h);
+            return 0;
+        }
+        uint64_t clamped = 0;
+        if (f == LMB_KTX2_BC6H)
+            clamped = lmb_bc6h_encode(w, h, rgb, care, o->threads, *out);
+        else
+            *st = lmb_astc_hdr_encode(w, h, rgb, o->threads, *out, &clamped, err);
+        if (report)
+            report->clamped += clamped;
+        return size;
+    }
+    size_t texel = f == LMB_KTX2_RGBA16F ? 8 : 4, size = (size_t)w * h * (d ? d : 1) * texel;
+    uint8_t *raw = malloc(size + 1);
+    *out = raw;
+    if (!raw) {
+        *st = lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for a %ux%u level", w, h);
+        return 0;
+    }
+    for (size_t i = 0; i < size / texel; i++) {
         const float *p = rgb + 3 * i;
         uint8_t *q = raw + texel * i;
         if (f == LMB_KTX2_RGBA16F) {
@@ -245,63 +304,164 @@ lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *r
                 q[k] = (uint8_t)(v >> (8 * k));
         }
     }
-    uint8_t *level = raw;
-    size_t level_size = raw_size;
-    if (zstd_level > 0) {
-        size_t bound = ZSTD_compressBound(raw_size);
-        level = malloc(bound + 1);
-        if (!level) {
-            free(raw);
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for zstd");
+    return size;
+}
+
+/* The next mip level: each texel the mean of the (up to) 2 x 2 texels above it. */
+static float *half_size(const float *rgb, uint32_t w, uint32_t h, uint32_t *nw, uint32_t *nh)
+{
+    *nw = w > 1 ? w / 2 : 1;
+    *nh = h > 1 ? h / 2 : 1;
+    float *out = malloc((size_t)*nw * *nh * 3 * sizeof *out + 1);
+    for (uint32_t y = 0; out && y < *nh; y++)
+        for (uint32_t x = 0; x < *nw; x++)
+            for (int c = 0; c < 3; c++) {
+                uint32_t x0 = 2 * x < w ? 2 * x : w - 1, x1 = 2 * x + 1 < w ? 2 * x + 1 : w - 1;
+                uint32_t y0 = 2 * y < h ? 2 * y : h - 1, y1 = 2 * y + 1 < h ? 2 * y + 1 : h - 1;
+                double sum = (double)rgb[3 * ((size_t)y0 * w + x0) + c] + rgb[3 * ((size_t)y0 * w + x1) + c] +
+                             rgb[3 * ((size_t)y1 * w + x0) + c] + rgb[3 * ((size_t)y1 * w + x1) + c];
+                out[3 * ((size_t)y * *nw + x) + c] = (float)(sum / 4);
+            }
+    return out;
+}
+
+#define LMB_KTX2_MAX_LEVELS 32
+
+/* One level's bytes as the file holds them (supercompressed or not) and its raw size. */
+typedef struct level_bytes {
+    uint8_t *data;
+    size_t size, raw_size;
+} level_bytes;
+
+static void free_levels(level_bytes *lv, uint32_t n)
+{
+    for (uint32_t k = 0; k < n; k++)
+        free(lv[k].data);
+}
+
+/* Encodes (and supercompresses) every level into lv; *count levels. */
+static lmb_status encode_levels(uint32_t w, uint32_t h, uint32_t d, const float *rgb, const lmb_ktx2_options *o,
+                                level_bytes *lv, uint32_t *count, lmb_ktx2_report *report, lmb_error *err)
+{
+    uint32_t n = 1;
+    if (o->mipmaps && !d)
+        for (uint32_t m = w > h ? w : h; m > 1; m /= 2)
+            n++;
+    *count = 0;
+    const float *level = rgb;
+    float *owned = NULL;
+    uint32_t lw = w, lh = h;
+    lmb_status st = LMB_OK;
+    for (uint32_t k = 0; k < n && st == LMB_OK; k++) {
+        if (k > 0) {
+            uint32_t nw, nh;
+            float *next = half_size(level, lw, lh, &nw, &nh);
+            free(owned);
+            owned = next;
+            level = next;
+            lw = nw;
+            lh = nh;
+            if (!next) {
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for mip level %u", k);
+                break;
+            }
         }
-        level_size = ZSTD_compress(level, bound, raw, raw_size, zstd_level);
-        if (ZSTD_isError(level_size)) {
-            lmb_status st = lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: zstd: %s", ZSTD_getErrorName(level_size));
-            free(level);
+        uint8_t *raw = NULL;
+        size_t raw_size = encode_level(lw, lh, d, level, o, k == 0 ? o->care : NULL, &raw, report, err, &st);
+        if (st != LMB_OK) {
             free(raw);
-            return st;
+            break;
         }
+        lv[k] = (level_bytes){raw, raw_size, raw_size};
+        (*count)++;
+        if (o->zstd_level > 0) {
+            size_t bound = ZSTD_compressBound(raw_size);
+            uint8_t *z = malloc(bound + 1);
+            if (!z) {
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory for zstd");
+                break;
+            }
+            size_t zs = ZSTD_compress(z, bound, raw, raw_size, o->zstd_level);
+            if (ZSTD_isError(zs)) {
+                free(z);
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: zstd: %s", ZSTD_getErrorName(zs));
+                break;
+            }
+            free(raw);
+            lv[k].data = z;
+            lv[k].size = zs;
+        }
+    }
+    free(owned);
+    return st;
+}
+
+lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, const lmb_ktx2_options *o, uint8_t **out,
+                           size_t *size, lmb_ktx2_report *report, lmb_error *err)
+{
+    return lmb_ktx2_encode_3d(w, h, 0, rgb, o, out, size, report, err);
+}
+
+lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *rgb, const lmb_ktx2_options *o,
+                              uint8_t **out, size_t *size, lmb_ktx2_report *report, lmb_error *err)
+{
+    *out = NULL;
+    *size = 0;
+    lmb_ktx2_format f = o->format;
+    if (d && lmb_ktx2_is_block(f))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: 3D textures are written in packed formats only");
+    level_bytes lv[LMB_KTX2_MAX_LEVELS] = {{0}};
+    uint32_t levels = 0;
+    lmb_status st = encode_levels(w, h, d, rgb, o, lv, &levels, report, err);
+    if (st != LMB_OK) {
+        free_levels(lv, levels);
+        return st;
     }
     static const uint8_t id[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
     bytes b = {0};
     put(&b, id, sizeof id);
     put32(&b, lmb_ktx2_vkformat(f));
-    put32(&b, f == LMB_KTX2_RGBA16F ? 2 : 4); /* typeSize */
+    put32(&b, lmb_ktx2_is_block(f) ? 1 : f == LMB_KTX2_RGBA16F ? 2 : 4); /* typeSize */
     put32(&b, w);
     put32(&b, h);
     put32(&b, d); /* pixelDepth: 0 for 2D */
     put32(&b, 0); /* layerCount */
     put32(&b, 1); /* faceCount */
-    put32(&b, 1); /* levelCount */
-    put32(&b, zstd_level > 0 ? 2 : 0);
+    put32(&b, levels);
+    put32(&b, o->zstd_level > 0 ? 2 : 0);
     size_t index = b.n;
     for (int k = 0; k < 4; k++)
         put32(&b, 0); /* dfd and kvd offsets and lengths, set below */
     put64(&b, 0);     /* sgdByteOffset */
     put64(&b, 0);     /* sgdByteLength */
     size_t level_index = b.n;
-    put64(&b, 0);
-    put64(&b, 0);
-    put64(&b, 0);
+    for (uint32_t k = 0; k < levels; k++) {
+        put64(&b, 0);
+        put64(&b, 0);
+        put64(&b, 0);
+    }
     size_t dfd_at = b.n;
     dfd(&b, f);
     size_t kvd_at = b.n;
     key_value(&b, "KTXorientation", d ? "rdi" : "rd");
     key_value(&b, "KTXwriter", "lmbake " LMB_VERSION_STRING);
     size_t kvd_end = b.n;
-    pad_to(&b, zstd_level > 0 ? 1 : 8);
-    size_t level_at = b.n;
-    put(&b, level, level_size);
+    /* levels smallest first (spec section 3.9), each at a multiple of lcm(texel block size, 4)
+     * uncompressed (16 for blocks, 8 covers the packed formats' 4 and 8), anywhere supercompressed */
+    size_t align = o->zstd_level > 0 ? 1 : lmb_ktx2_is_block(f) ? 16 : 8;
+    for (uint32_t k = levels; k-- > 0;) {
+        pad_to(&b, align);
+        size_t at = b.n;
+        put(&b, lv[k].data, lv[k].size);
+        set64(&b, level_index + 24 * k, at);
+        set64(&b, level_index + 24 * k + 8, lv[k].size);
+        set64(&b, level_index + 24 * k + 16, lv[k].raw_size);
+    }
     set32(&b, index, (uint32_t)dfd_at);
     set32(&b, index + 4, (uint32_t)(kvd_at - dfd_at));
     set32(&b, index + 8, (uint32_t)kvd_at);
     set32(&b, index + 12, (uint32_t)(kvd_end - kvd_at));
-    set64(&b, level_index, level_at);
-    set64(&b, level_index + 8, level_size);
-    set64(&b, level_index + 16, raw_size);
-    if (level != raw)
-        free(level);
-    free(raw);
+    free_levels(lv, levels);
     if (b.failed) {
         free(b.p);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "ktx2: out of memory");
@@ -311,24 +471,35 @@ lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *r
     return LMB_OK;
 }
 
-lmb_status lmb_ktx2_write(const char *path, uint32_t w, uint32_t h, const float *rgb, lmb_ktx2_format f,
-                          int zstd_level, lmb_error *err)
+/* data (freed here) written to path whole. */
+static lmb_status write_whole(const char *path, uint8_t *data, size_t size, lmb_error *err)
 {
-    return lmb_ktx2_write_3d(path, w, h, 0, rgb, f, zstd_level, err);
-}
-
-lmb_status lmb_ktx2_write_3d(const char *path, uint32_t w, uint32_t h, uint32_t d, const float *rgb,
-                             lmb_ktx2_format f, int zstd_level, lmb_error *err)
-{
-    uint8_t *data;
-    size_t size;
-    lmb_status st = lmb_ktx2_encode_3d(w, h, d, rgb, f, zstd_level, &data, &size, err);
-    if (st != LMB_OK)
-        return st;
     FILE *fp = fopen(path, "wb");
     int ok = fp && fwrite(data, 1, size, fp) == size;
     if (fp && fclose(fp) != 0)
         ok = 0;
     free(data);
     return ok ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write the KTX2 file", path);
+}
+
+lmb_status lmb_ktx2_write(const char *path, uint32_t w, uint32_t h, const float *rgb, const lmb_ktx2_options *o,
+                          lmb_ktx2_report *report, lmb_error *err)
+{
+    uint8_t *data;
+    size_t size;
+    lmb_status st = lmb_ktx2_encode(w, h, rgb, o, &data, &size, report, err);
+    if (st != LMB_OK)
+        return st;
+    return write_whole(path, data, size, err);
+}
+
+lmb_status lmb_ktx2_write_3d(const char *path, uint32_t w, uint32_t h, uint32_t d, const float *rgb,
+                             const lmb_ktx2_options *o, lmb_error *err)
+{
+    uint8_t *data;
+    size_t size;
+    lmb_status st = lmb_ktx2_encode_3d(w, h, d, rgb, o, &data, &size, NULL, err);
+    if (st != LMB_OK)
+        return st;
+    return write_whole(path, data, size, err);
 }

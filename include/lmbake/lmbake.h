@@ -276,6 +276,15 @@ typedef enum lmb_output_scale {
     LMB_SCALE_RADIANCE = 1    /* E / pi: the exitant radiance of a white diffuse surface, nits */
 } lmb_output_scale;
 
+/* output.ktx2_format: the KTX2 lightmap's texel format (write/ktx2.h writes them). */
+typedef enum lmb_ktx2_format {
+    LMB_KTX2_E5B9G9R9 = 0,  /* vkFormat 123 E5B9G9R9_UFLOAT_PACK32: shared exponent, 2^-9 relative */
+    LMB_KTX2_B10G11R11 = 1, /* vkFormat 122 B10G11R11_UFLOAT_PACK32: what bevy's Cornell box ships */
+    LMB_KTX2_RGBA16F = 2,   /* vkFormat 97 R16G16B16A16_SFLOAT: half floats, alpha 1 */
+    LMB_KTX2_BC6H = 3,      /* vkFormat 143 BC6H_UFLOAT_BLOCK: 4 x 4 blocks of 16 bytes (write/bc6h.h) */
+    LMB_KTX2_ASTC_HDR = 4   /* vkFormat 1000066000 ASTC_4x4_SFLOAT_BLOCK (write/astc_adapter.h) */
+} lmb_ktx2_format;
+
 /* A u32 key set to "auto" (bounces). */
 #define LMB_AUTO UINT32_MAX
 
@@ -371,8 +380,9 @@ typedef struct lmb_config {
     lmb_emission_sides reflect_sides;  /* materials.reflect_sides: which sides reflect light to the bake's rays */
     uint32_t directional_rays;     /* samples.directional: cosine rays per texel for the indirect light's direction */
     int directional;               /* output.directional: directional lightmaps (lmb_direction.h) */
-    int ktx2_format;               /* output.ktx2_format: lmb_ktx2_format (write/ktx2.h) */
+    int ktx2_format;               /* output.ktx2_format: lmb_ktx2_format */
     int ktx2_zstd;                 /* output.ktx2_supercompression: 1 zstd, 0 none */
+    int ktx2_mipmaps;              /* output.ktx2_mipmaps: 1 a full mip chain in the lightmap's .ktx2 */
     lmb_output_scale output_scale; /* output.scale: E or E / pi in every lightmap file */
     double rgbm_range;             /* output.rgbm_range: the largest value RGBM holds; 0 = auto (each atlas's
                                       largest valid texel, rounded up to a power of two) */

@@ -40,7 +40,7 @@ static int try_pack(const lmb_charts *c, double d, uint32_t size, uint32_t paddi
         p->charts[k].triangle_count = c->first[k + 1] - c->first[k];
         p->charts[k].uv = p->uv + 6 * c->first[k];
     }
-    lmb_pack_options o = {size, padding, 0, 0};
+    lmb_pack_options o = {size, padding, 0, 0, 1};
     lmb_error err;
     if (lmb_pack_charts(p->charts, c->chart_count, &o, &p->r, &err) != LMB_OK)
         return 0;

@@ -234,8 +234,8 @@ static void test_value_errors(void)
                  "key 'atlas.keep_uv1': expected true or false, got 'maybe'");
     expect_error("output:\n  formats:\n    - exr\n    - tiff\n", "level.yaml:4: ",
                  "key 'output.formats': expected one of exr, hdr, png, mask, ktx2, rgbm, got 'tiff'");
-    expect_error("output:\n  ktx2_format: bc6h\n", "level.yaml:2: ",
-                 "key 'output.ktx2_format': expected one of e5b9g9r9, b10g11r11, rgba16f, got 'bc6h'");
+    expect_error("output:\n  ktx2_format: bc7\n", "level.yaml:2: ",
+                 "key 'output.ktx2_format': expected one of e5b9g9r9, b10g11r11, rgba16f, bc6h, astc_hdr, got 'bc7'");
     expect_error("output:\n  ktx2_supercompression: lz4\n", "level.yaml:2: ",
                  "key 'output.ktx2_supercompression': expected one of none, zstd, got 'lz4'");
     expect_error("output:\n  scale: lux\n", "level.yaml:2: ",

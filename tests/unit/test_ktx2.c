@@ -80,7 +80,8 @@ static void test_container(void)
     uint8_t *data;
     size_t size;
     lmb_error err = {LMB_OK, ""};
-    CHECK_INT(lmb_ktx2_encode(1, 1, rgb, LMB_KTX2_RGBA16F, 0, &data, &size, &err), LMB_OK);
+    lmb_ktx2_options o = {LMB_KTX2_RGBA16F, 0, 0, 1, NULL};
+    CHECK_INT(lmb_ktx2_encode(1, 1, rgb, &o, &data, &size, NULL, &err), LMB_OK);
     static const uint8_t id[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
     CHECK(size > 80 && memcmp(data, id, 12) == 0);
     uint32_t vk, levels;

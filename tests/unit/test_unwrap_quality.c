@@ -36,7 +36,7 @@ static void check(const char *name, const gen_mesh *g, double density, double mi
         charts[k].triangle_count = c.first[k + 1] - c.first[k];
         charts[k].uv = uv + 6 * c.first[k];
     }
-    lmb_pack_options po = {1024, 2, 0, 0};
+    lmb_pack_options po = {1024, 2, 0, 0, 1};
     lmb_pack_result r;
     CHECK_INT(lmb_pack_charts(charts, c.chart_count, &po, &r, &err), LMB_OK);
     CHECK_INT(r.atlas_count, 1);

@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""Block-compressed KTX2 lightmaps (output.ktx2_format bc6h and astc_hdr) read back by decoders
+lmbake did not write (tools/ktx2_blocks.py: OpenImageIO's DDS reader for BC6H, Arm's astcenc for
+ASTC) against the EXR of the same bake.
+
+usage: check_ktx2_blocks.py LMBAKE WORKDIR
+
+  cornell  the demo Cornell box at 64 texels per unit (one bounce, few rays: noise makes blocks
+           harder, not easier), each format with a mip chain (BC6H supercompressed, ASTC not):
+           header (vkFormat 143 / 1000066000, typeSize 1, levelCount floor(log2(max side)) + 1,
+           each level's unpacked size ceil(w/4) x ceil(h/4) x 16), DFD (model BC6H 133 / ASTC
+           162, 4x4 blocks of 16 bytes, one 128-bit sample: BC6H unsigned float [0, 1], ASTC
+           signed float [-1, 1]); texels: mean relative error per chart texel at most 2%, and at
+           most 0.5% on 9 x 9 averages
+  seams    the sphere, cube and tiles of the seams scene (tests/bake/check_artists.py), each
+           format: the largest luminance jump across seams, measured on the decoded lightmap
+           as check_artists measures it on the EXR, under 1%
+"""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import OpenImageIO as oiio
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+sys.path.insert(0, os.path.join(ROOT, "tests", "bake"))
+import ktx2_blocks as kb  # noqa: E402
+import check_analytic as ca  # noqa: E402
+import check_artists  # noqa: E402
+
+FORMATS = {"bc6h": (kb.BC6H, 133, 0x80, 0, 0x3F800000, "zstd"),
+           "astc_hdr": (kb.ASTC, 162, 0xC0, 0xBF800000, 0x3F800000, "none")}
+
+
+def bake(lmbake, work, scene, name, config):
+    cfg = os.path.join(work, name + ".yaml")
+    with open(cfg, "w") as f:
+        f.write(config)
+    out = os.path.join(work, "out-" + name)
+    subprocess.run([lmbake, "bake", os.path.join(work, "scenes", scene + ".gltf"), "-c", cfg, "-o", out, "-q"],
+                   check=True)
+    return out
+
+
+def cornell(lmbake, work, fmt):
+    vk, model, channel, lower, upper, sc = FORMATS[fmt]
+    out = bake(lmbake, work, "cornell-point", "cornell-" + fmt,
+               "texel_density: 64\nbounces: 1\nsamples: {gather: 32, adaptive: false}\n"
+               "output: {formats: [exr, ktx2, mask], directional: false, ktx2_format: %s, "
+               "ktx2_supercompression: %s, ktx2_mipmaps: true}\n" % (fmt, sc))
+    stem = os.path.join(out, "cornell-point-lightmap-0")
+    ref = np.asarray(oiio.ImageBuf(stem + ".exr").get_pixels(oiio.FLOAT), dtype=np.float64)[..., :3]
+    mask = np.asarray(oiio.ImageBuf(stem + "-mask.png").get_pixels(oiio.FLOAT))[..., 0] > 0.99
+    info, got = kb.decode(stem + ".ktx2", work)
+    h, w = ref.shape[:2]
+    problems = []
+    levels = max(w, h).bit_length()
+    want = {"vkFormat": vk, "typeSize": 1, "pixelWidth": w, "pixelHeight": h, "pixelDepth": 0, "layerCount": 0,
+            "faceCount": 1, "levelCount": levels, "supercompressionScheme": 2 if sc == "zstd" else 0}
+    problems += ["%s %s, want %s" % (f, info[f], v) for f, v in want.items() if info[f] != v]
+    for k, lv in enumerate(info["levels"]):
+        lw, lh = max(1, w >> k), max(1, h >> k)
+        size = ((lw + 3) // 4) * ((lh + 3) // 4) * 16
+        if lv["unpacked"] != size or lv["uncompressed"] != size:
+            problems.append("level %d (%dx%d): %d bytes, want %d" % (k, lw, lh, lv["unpacked"], size))
+    d = info["dfd"]
+    want_dfd = {"versionNumber": 2, "colorModel": model, "colorPrimaries": 1, "transferFunction": 1,
+                "texelBlockDimension": [3, 3, 0, 0], "bytesPlane": [16, 0, 0, 0, 0, 0, 0, 0]}
+    problems += ["dfd %s %s, want %s" % (f, d[f], v) for f, v in want_dfd.items() if d[f] != v]
+    got_samples = [(s["bitOffset"], s["bitLength"] + 1, s["channelType"], s["sampleLower"] & 0xFFFFFFFF,
+                    s["sampleUpper"] & 0xFFFFFFFF) for s in d["samples"]]
+    if got_samples != [(0, 128, channel, lower, upper)]:
+        problems.append("dfd samples %s" % got_samples)
+    mean, p99, mean9, p99_9, n, n9 = kb.errors(ref, got, mask)
+    if not (mean <= 0.02 and mean9 <= 0.005 and n > 10000 and n9 > 1000):
+        problems.append("errors beyond the bounds")
+    print("cornell %-8s %dx%d, %d levels: relative error per texel mean %.3f%% (p99 %.2f%%, %d texels; bound 2%%), "
+          "9x9 averages mean %.4f%% (p99 %.3f%%, %d windows; bound 0.5%%): %s"
+          % (fmt, w, h, levels, 100 * mean, 100 * p99, n, 100 * mean9, 100 * p99_9, n9,
+             "ok" if not problems else "FAIL: " + "; ".join(problems)))
+    return not problems
+
+
+def seams(lmbake, work, fmt):
+    out = bake(lmbake, work, "seams", "seams-" + fmt,
+               "texel_density: 40\nlightmap:\n  exclude: [room]\noutput: {formats: [exr, ktx2], ktx2_format: %s}\n"
+               % fmt)
+    charts, images = ca.load_output(out)
+    exr_jumps = check_artists.seam_jumps(charts, images)
+    doc = json.load(open(os.path.join(out, [f for f in os.listdir(out) if f.endswith(".gltf")][0])))
+    decoded = {}
+    for ti in images:  # texture ti's image is <stem>-lightmap-N.png; its .ktx2 lies beside it
+        png = doc["images"][doc["textures"][ti]["source"]]["uri"]
+        _, decoded[ti] = kb.decode(os.path.join(out, png[:-4] + ".ktx2"), work)
+    jumps = check_artists.seam_jumps(charts, decoded)
+    ok = True
+    for node in ("sphere", "cube", "tiles"):
+        n, jump = jumps.get(node, (0, 1.0))
+        good = n >= 1 and jump < 0.01
+        ok &= good
+        print("seams %-8s %s: %d seam edges, largest luminance jump %.4f%% decoded (%.4f%% in the EXR; bound 1%%): %s"
+              % (fmt, node, n, 100 * jump, 100 * exr_jumps.get(node, (0, 0.0))[1], "ok" if good else "FAIL"))
+    return ok
+
+
+def main():
+    lmbake, work = sys.argv[1], sys.argv[2]
+    os.makedirs(work, exist_ok=True)
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
+                   check=True, stdout=subprocess.DEVNULL)
+    ok = True
+    for fmt in FORMATS:
+        ok &= cornell(lmbake, work, fmt)
+        ok &= seams(lmbake, work, fmt)
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()
