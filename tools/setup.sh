@@ -19,6 +19,7 @@ packages=(
   libcjson-dev                      # glTF JSON preflight (version, required extensions, compression)
   nettle-dev                        # SHA-256 of the staged bake's plan and part files
   libzstd-dev                       # Zstandard supercompression of KTX2 lightmaps
+  libastcenc-dev astcenc            # ASTC HDR lightmaps (Arm's encoder) and the tests' independent ASTC decoder
   libembree-dev libtbb-dev          # ray tracing (Embree's CMake config needs TBB)
   libopenimageio-dev openimageio-tools  # reading textures and sky images, other formats (OIIO's CMake config wants the tools)
   libopenexr-dev libimath-dev       # .exr lightmaps through OpenEXRCore (C), half floats (Imath's C half.h)

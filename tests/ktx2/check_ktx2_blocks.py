@@ -14,7 +14,10 @@ usage: check_ktx2_blocks.py LMBAKE WORKDIR
            most 0.5% on 9 x 9 averages
   seams    the sphere, cube and tiles of the seams scene (tests/bake/check_artists.py), each
            format: the largest luminance jump across seams, measured on the decoded lightmap
-           as check_artists measures it on the EXR, under 1%
+           as check_artists measures it on the EXR, under 1% (SEAM_BOUND); BC6H on the sphere
+           under 2.5%: the sun's terminator crosses it at 40 texels per metre, a 4 x 4 block
+           spans up to 1.6x in light, and one region's 16 steps then land 1.2% apart from the
+           EXR on each side (docs/output.md#block-compressed-lightmaps-bc6h-and-astc)
 """
 import json
 import os
@@ -32,6 +35,7 @@ import ktx2_blocks as kb  # noqa: E402
 import check_analytic as ca  # noqa: E402
 import check_artists  # noqa: E402
 
+SEAM_BOUND = {("bc6h", "sphere"): 0.025}
 FORMATS = {"bc6h": (kb.BC6H, 133, 0x80, 0, 0x3F800000, "zstd"),
            "astc_hdr": (kb.ASTC, 162, 0xC0, 0xBF800000, 0x3F800000, "none")}
 
@@ -100,10 +104,11 @@ def seams(lmbake, work, fmt):
     ok = True
     for node in ("sphere", "cube", "tiles"):
         n, jump = jumps.get(node, (0, 1.0))
-        good = n >= 1 and jump < 0.01
+        bound = SEAM_BOUND.get((fmt, node), 0.01)
+        good = n >= 1 and jump < bound
         ok &= good
-        print("seams %-8s %s: %d seam edges, largest luminance jump %.4f%% decoded (%.4f%% in the EXR; bound 1%%): %s"
-              % (fmt, node, n, 100 * jump, 100 * exr_jumps.get(node, (0, 0.0))[1], "ok" if good else "FAIL"))
+        print("seams %-8s %s: %d seam edges, largest luminance jump %.4f%% decoded (%.4f%% in the EXR; bound %g%%): %s"
+              % (fmt, node, n, 100 * jump, 100 * exr_jumps.get(node, (0, 0.0))[1], 100 * bound, "ok" if good else "FAIL"))
     return ok
 
 
