@@ -4,7 +4,8 @@ against the EXR of the same bake (the compression tests and tools/bench_compress
 
   read(path)            level 0's blocks and the header, through tests/ktx2/read_ktx2.mjs (npm
                         ktx-parse and three.js's Zstandard decoder)
-  decode(path, work)    level 0 as float RGB, (h, w, 3): BC6H through OpenImageIO's DDS reader
+  decode(path, work)    level 0 as float RGB, (h, w, 3): the packed formats as the reader decodes
+                        them (from the Vulkan formats' definitions), BC6H through OpenImageIO's DDS reader
                         (the blocks wrapped in a DDS file with a DX10 header, DXGI_FORMAT_BC6H_UF16),
                         ASTC through Arm's astcenc command-line decompressor (`astcenc -dh`, the
                         blocks wrapped in a .astc file)
@@ -75,7 +76,8 @@ def decode(path, work=None):
         return info, decode_bc6h(blocks, w, h, work)
     if info["vkFormat"] == ASTC:
         return info, decode_astc(blocks, w, h, work)
-    raise RuntimeError("%s: vkFormat %d is not a block format" % (path, info["vkFormat"]))
+    # a packed format: the reader decoded the texels itself (float32 RGB)
+    return info, np.frombuffer(blocks, dtype=np.float32).reshape(h, w, 3).astype(np.float64)
 
 
 def box9(img):

@@ -343,6 +343,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         if (st == LMB_OK && outputs[a].rgbm_clamped)
             lmb_warn(log, "atlas %u: %llu texels brighter than RGBM's range %g were clamped (output.rgbm_range; auto "
                      "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
+        if (st == LMB_OK && outputs[a].ktx2.encode_seconds > 0)
+            lmb_info(log, "atlas %u: %s blocks of %ux%u texels encoded in %.2fs", a,
+                     cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR", l.width[a], l.height[a],
+                     outputs[a].ktx2.encode_seconds);
         if (st == LMB_OK && outputs[a].ktx2.clamped)
             lmb_warn(log, "atlas %u: %llu texels brighter than %s's range (65504) were clamped in the .ktx2 (output.scale: "
                      "radiance divides by pi)", a, (unsigned long long)outputs[a].ktx2.clamped,

@@ -130,13 +130,19 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.png", dir, stem, a);
     }
     if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_KTX2)) {
+        lmb_ktx2_format f = (lmb_ktx2_format)cfg->ktx2_format;
         care = lmb_ktx2_lookup_texels(valid, w, h);
         if (!care)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
-        lmb_ktx2_options o = {(lmb_ktx2_format)cfg->ktx2_format, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0,
-                              cfg->ktx2_mipmaps, 1, care};
+        /* a block encoder is the one long job: it runs first, alone, on every thread */
+        lmb_ktx2_options o = {f, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0, cfg->ktx2_mipmaps,
+                              lmb_ktx2_is_block(f) ? threads : 1, care};
         jobs[count] = (image_job){IMAGE_KTX2, "", 3, rgb, NULL, o, &info->ktx2};
-        snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.ktx2", dir, stem, a);
+        snprintf(jobs[count].path, sizeof jobs->path, "%s/%s-lightmap-%u.ktx2", dir, stem, a);
+        if (st == LMB_OK && lmb_ktx2_is_block(f))
+            st = write_images(&jobs[count], 1, w, h, 1, err);
+        else
+            count++;
     }
     if (st == LMB_OK && rgbm) {
         info->rgbm_range = lmb_rgbm_range(cfg->rgbm_range, rgb, valid, n);

@@ -15,6 +15,7 @@
 #include "astc_adapter.h"
 #include "bc6h.h"
 #include "post/dilate.h"
+#include "util/clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -273,12 +274,15 @@ static size_t encode_level(uint32_t w, uint32_t h, uint32_t d, const float *rgb,
             return 0;
         }
         uint64_t clamped = 0;
+        double t0 = lmb_seconds();
         if (f == LMB_KTX2_BC6H)
             clamped = lmb_bc6h_encode(w, h, rgb, care, o->threads, *out);
         else
             *st = lmb_astc_hdr_encode(w, h, rgb, o->threads, *out, &clamped, err);
-        if (report)
+        if (report) {
             report->clamped += clamped;
+            report->encode_seconds += lmb_seconds() - t0;
+        }
         return size;
     }
     size_t texel = f == LMB_KTX2_RGBA16F ? 8 : 4, size = (size_t)w * h * (d ? d : 1) * texel;

@@ -32,6 +32,7 @@ typedef struct lmb_ktx2_options {
  * packed ones clamp silently to their own largest value, far above any lightmap's). */
 typedef struct lmb_ktx2_report {
     uint64_t clamped;
+    double encode_seconds; /* the block encoder's time over every level */
 } lmb_ktx2_report;
 
 /* The Zstandard level lightmaps are written with: zstd's default is 3; 12 gains a few % on

@@ -1,6 +1,7 @@
 // The preview's HTTP server (node's http module only): binds 127.0.0.1, serves the page,
-// three.js from the project's node_modules and the bake's folder, read-only, GET/HEAD only,
-// no directory listing, nothing outside those three roots. Shared by serve.mjs and render.mjs.
+// three.js from the project's node_modules, lmbake's loaders (loaders/) and the bake's folder,
+// read-only, GET/HEAD only, no directory listing, nothing outside those roots. Shared by
+// serve.mjs and render.mjs.
 import fs from 'node:fs';
 import http from 'node:http';
 import path from 'node:path';
@@ -66,6 +67,7 @@ export function startServer(gltfFile, { port = 0, log = () => {} } = {}) {
   }
   const roots = [
     ['/page/', path.join(projectRoot, 'tools', 'preview', 'page')],
+    ['/loaders/', path.join(projectRoot, 'loaders')],
     ['/three/build/', path.join(three, 'build')],
     ['/three/examples/jsm/', path.join(three, 'examples', 'jsm')],
     ['/bake/', bakeDir],

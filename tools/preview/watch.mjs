@@ -339,7 +339,7 @@ function listen(watched) {
 // HTTP: the watch page, the preview page in its frame, each bake's files, /status.
 const three = path.join(projectRoot, 'node_modules', 'three');
 const pageRoot = path.join(projectRoot, 'tools', 'preview', 'page');
-const staticRoots = [['/page/', pageRoot], ['/three/build/', path.join(three, 'build')], ['/three/examples/jsm/', path.join(three, 'examples', 'jsm')]];
+const staticRoots = [['/page/', pageRoot], ['/loaders/', path.join(projectRoot, 'loaders')], ['/three/build/', path.join(three, 'build')], ['/three/examples/jsm/', path.join(three, 'examples', 'jsm')]];
 const server = http.createServer((req, res) => {
   const send = (code, type, body) => {
     res.writeHead(code, { 'Content-Type': type, 'Cache-Control': 'no-store', 'X-Content-Type-Options': 'nosniff' });

@@ -8,7 +8,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { lightmapPlugin, lightmapScaleOffset, applyDirectionalLightmaps, applyLightmapRectangles, patchInstanceRectangles, gltfNodeIndex, LIGHTMAP_SOURCES } from './lightmap-plugin.js';
+import { lightmapPlugin, lightmapScaleOffset, applyDirectionalLightmaps, applyLightmapRectangles, patchInstanceRectangles, gltfNodeIndex, LIGHTMAP_SOURCES } from '/loaders/three/lmbake-three.js';
 import { lightmapMaterial, invalidMaterial, checkerMaterial, checkerGeometry } from './materials.js';
 import { AtlasView } from './atlas-view.js';
 import { Fly } from './fly.js';

@@ -13,7 +13,7 @@
 // uv1 x scale_k + offset_k first (lightmap-plugin.js INSTANCE_RECT_ATTRIBUTES), and every
 // copy is placed by its instance matrix.
 import * as THREE from 'three';
-import { INSTANCE_RECT_ATTRIBUTES } from './lightmap-plugin.js';
+import { INSTANCE_RECT_ATTRIBUTES } from '/loaders/three/lmbake-three.js';
 
 export const INVALID_COLOR = new THREE.Color(1, 0, 1);       // magenta, linear = sRGB
 export const BORDER_COLOR = new THREE.Color(1, 0.1, 0.0);    // linear; sRGB (255, 89, 0)

@@ -5,7 +5,7 @@
 // little-endian float32, x y z (world) and the reach (world units).
 import * as THREE from 'three';
 import { RECORD_RAMP } from './record-ramp.js';
-import { cloneWithPatches } from './lightmap-plugin.js';
+import { cloneWithPatches } from '/loaders/three/lmbake-three.js';
 
 export { RECORD_RAMP };
 

@@ -1,15 +1,24 @@
-// GLTFLoader plugin for lmbake's lightmaps: MOZ_lightmap on materials ({index, texCoord,
-// intensity} -> material.lightMap / lightMapIntensity, its KHR_texture_transform -> the
-// texture's offset / repeat) and, on the lightmap texture, either the KTX2 file its
-// extras.lightmap.files.ktx2 names (loaded by three's KTX2Loader, raw formats with its Zstandard
-// decoder, no Basis transcoder) or MOZ_texture_rgbe (a Radiance .hdr read with three's
-// HDRLoader), both holding linear irradiance E in lux (or E/pi with extras.lightmap.scale
-// "radiance" and MOZ_lightmap.intensity pi). Every lightmap becomes an "atlas" record in
-// `atlases`, with its float data kept for the CPU (hover values, invalid-texel mask).
+// lmbake-three: lmbake's lightmaps and light probes in three.js, as a GLTFLoader plugin
+// (README.md beside this file; docs/output.md says what the files hold). The lmbake preview is
+// built on it.
+//   const loader = new GLTFLoader().register(lmbakeLightmaps({ renderer }));
+//   const gltf = await loader.loadAsync('level.gltf');   // every lightmapped material lit
+//   scene.add(gltf.scene);
+// What it reads: MOZ_lightmap on materials ({index, texCoord, intensity} -> material.lightMap /
+// lightMapIntensity, its KHR_texture_transform -> the texture's offset / repeat); on the lightmap
+// texture, the KTX2 file its extras.lightmap.files.ktx2 names when the GPU can sample its format
+// (E5B9G9R9, B10G11R11 and RGBA16F through three's KTX2Loader, Zstandard decoded; BC6H with
+// EXT_texture_compression_bptc; ASTC 4x4 HDR with WEBGL_compressed_texture_astc's hdr profile),
+// else MOZ_texture_rgbe (the Radiance .hdr, three's HDRLoader); both hold linear irradiance E in
+// lux (or E/pi with extras.lightmap.scale "radiance" and MOZ_lightmap.intensity pi). After
+// loading, per-copy rectangles of EXT_mesh_gpu_instancing (_LIGHTMAP_SCALE / _LIGHTMAP_OFFSET)
+// and per-node rectangles (extras.lightmap.scaleOffset) are put on the objects. Probes
+// (asset.extras.lightmap.probes): lmbake-probes.js.
 import * as THREE from 'three';
 import { HDRLoader } from 'three/addons/loaders/HDRLoader.js';
 import { KTX2Loader } from 'three/addons/loaders/KTX2Loader.js';
 import { read as readKtx2Header, KHR_SUPERCOMPRESSION_NONE, KHR_SUPERCOMPRESSION_ZSTD } from 'three/addons/libs/ktx-parse.module.js';
+import { ZSTDDecoder } from 'three/addons/libs/zstddec.module.js';
 
 export const LIGHTMAP_SOURCES = ['ktx2', 'hdr'];
 // The KTX2 lightmap formats (docs/output.md#ktx2): the vkFormat, the three.js type and format
@@ -20,18 +29,52 @@ const KTX2_FORMATS = {
   122: { name: 'B10G11R11_UFLOAT_PACK32', type: THREE.UnsignedInt101111Type, format: THREE.RGBFormat, gl: 'R11F_G11F_B10F' },
   97: { name: 'R16G16B16A16_SFLOAT', type: THREE.HalfFloatType, format: THREE.RGBAFormat, gl: 'RGBA16F' },
 };
+// The block formats (1 byte per texel on the GPU): three's own format constants; BC6H is built
+// here (KTX2Loader reads it only through Basis), ASTC HDR through KTX2Loader's raw path.
+const KTX2_BLOCK_FORMATS = {
+  143: { name: 'BC6H_UFLOAT_BLOCK', format: THREE.RGB_BPTC_UNSIGNED_Format, gl: 'COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT' },
+  1000066000: { name: 'ASTC_4x4_SFLOAT_BLOCK', format: THREE.RGBA_ASTC_4x4_Format, gl: 'COMPRESSED_RGBA_ASTC_4x4_KHR (hdr profile)' },
+};
+
+// Whether the renderer's GPU samples a KTX2 block format (vkFormat) natively.
+export function gpuSamples(renderer, vkFormat) {
+  if (vkFormat === 143) return renderer.extensions.has('EXT_texture_compression_bptc');
+  if (vkFormat === 1000066000) {
+    const astc = renderer.getContext().getExtension('WEBGL_compressed_texture_astc');
+    return !!astc && astc.getSupportedProfiles().includes('hdr');
+  }
+  return vkFormat in KTX2_FORMATS;
+}
+
+// The GLTFLoader plugin an engine project registers: every lightmapped material gets its
+// lightMap, and after loading, the lightmap rectangles are put on the objects
+// (applyLightmapRectangles; its result in gltf.userData.lmbakeRectangles).
+//   renderer: the page's WebGLRenderer (KTX2Loader.detectSupport(), the block formats' support);
+//   source: 'ktx2' (the default: the KTX2 file when the GPU samples its format, else the .hdr)
+//           or 'hdr';
+//   atlases: an array filled with one record per lightmap (format, size, CPU texels when read).
+export function lmbakeLightmaps({ renderer, source = 'ktx2', atlases = [] } = {}) {
+  if (!renderer) throw new Error('lmbakeLightmaps: pass { renderer } (the WebGLRenderer the lightmaps are for)');
+  const make = lightmapPlugin(atlases, { source, renderer, keepData: false });
+  return (parser) => {
+    const plugin = make(parser);
+    plugin.afterRoot = (gltf) => { gltf.userData.lmbakeRectangles = applyLightmapRectangles(gltf); };
+    return plugin;
+  };
+}
 
 // Returns a function to pass to GLTFLoader.register(); `atlases` is filled while loading.
 // source: 'ktx2' (the default: the KTX2 file when the glTF names one, else the .hdr) or 'hdr'.
 // renderer: the page's WebGLRenderer, for KTX2Loader.detectSupport() (parse() refuses to run
 // without it); without one a KTX2 cannot be loaded and the .hdr is used.
-export function lightmapPlugin(atlases, { source = 'ktx2', renderer = null } = {}) {
+export function lightmapPlugin(atlases, { source = 'ktx2', renderer = null, keepData = true } = {}) {
   if (!LIGHTMAP_SOURCES.includes(source)) throw new Error(`unknown lightmap source '${source}' (one of ${LIGHTMAP_SOURCES.join(', ')})`);
   // One KTX2Loader for every lightmap of the page. Its Basis transcoder (a worker fetching
-  // libs/basis/) starts only for vkFormat 0 (and ASTC HDR), which readKtx2 never passes it:
-  // raw formats go through createRawTexture, so no transcoder path is set.
+  // libs/basis/) starts only for vkFormat 0 (and Basis's own ASTC HDR, DFD colour model 0xA7),
+  // which readKtx2 never passes it: raw formats go through createRawTexture, so no transcoder
+  // path is set.
   const ktx2Loader = source === 'ktx2' && renderer ? new KTX2Loader().detectSupport(renderer) : null;
-  return (parser) => new LightmapPlugin(parser, atlases, source, ktx2Loader);
+  return (parser) => new LightmapPlugin(parser, atlases, source, ktx2Loader, renderer, keepData);
 }
 
 // The lightmap rectangle of a lightmap texture as [scaleU, scaleV, offsetU, offsetV]: the atlas
@@ -71,7 +114,7 @@ export function cloneWithPatches(material) {
 export function patchInstanceRectangles(material) {
   const [scale, offset] = INSTANCE_RECT_ATTRIBUTES;
   return addShaderPatch(material, 'lmbake-instance-rect', (shader) => {
-    if (!shader.vertexShader.includes('#include <uv_vertex>')) throw new Error(`lmbake preview: ${material.type} has no uv_vertex to patch for per-instance lightmap rectangles`);
+    if (!shader.vertexShader.includes('#include <uv_vertex>')) throw new Error(`lmbake: ${material.type} has no uv_vertex to patch for per-instance lightmap rectangles`);
     shader.vertexShader = `#ifdef USE_INSTANCING\nattribute vec2 ${scale};\nattribute vec2 ${offset};\n#endif\n` + shader.vertexShader.replace('#include <uv_vertex>', `#include <uv_vertex>
 #if defined( USE_LIGHTMAP ) && defined( USE_INSTANCING )
   vLightMapUv = ( lightMapTransform * vec3( LIGHTMAP_UV * ${scale} + ${offset}, 1 ) ).xy;
@@ -144,7 +187,9 @@ export function applyLightmapRectangles(gltf) {
 }
 
 class LightmapPlugin {
-  constructor(parser, atlases, source, ktx2Loader) {
+  constructor(parser, atlases, source, ktx2Loader, renderer, keepData) {
+    this.renderer = renderer;
+    this.keepData = keepData; // the texels as floats on the CPU too (the .hdr's for a block format)
     this.parser = parser;
     this.atlases = atlases;
     this.source = source;
@@ -214,10 +259,12 @@ class LightmapPlugin {
       } catch (e) {
         if (!rgbe) throw e;
         why = `${files.ktx2}: ${e.message}; `;
-        console.warn(`lmbake preview: atlas ${index}: ${why}falling back to the .hdr`);
+        console.warn(`lmbake: atlas ${index}: ${why}falling back to the .hdr`);
       }
     } else if (this.source === 'ktx2') why = 'the glTF names no KTX2 file; ';
     if (!decoded && rgbe) decoded = await this.readHdr(rgbe.source);
+    // A block format's texels are not decoded on the CPU: the .hdr gives them when they are kept
+    if (decoded && !decoded.data && this.keepData && rgbe) decoded.data = (await this.readHdr(rgbe.source)).data;
     if (!decoded) {
       // Only the tonemapped PNG: shown, but it is not irradiance; values are meaningless.
       console.warn(`MOZ_lightmap: texture ${textureIndex} has no MOZ_texture_rgbe .hdr; showing its PNG (not linear irradiance)`);
@@ -245,7 +292,7 @@ class LightmapPlugin {
     // Invalid texels: lmbake writes texels inside geometry as exactly 0 (RGBE exponent 0).
     const mask = new Uint8Array(width * height);
     let zero = 0;
-    for (let i = 0; i < width * height; i++) {
+    for (let i = 0; data && i < width * height; i++) {
       if (data[4 * i] === 0 && data[4 * i + 1] === 0 && data[4 * i + 2] === 0) { mask[i] = 255; zero++; }
     }
     const maskTex = new THREE.DataTexture(mask, width, height, THREE.RedFormat, THREE.UnsignedByteType);
@@ -257,7 +304,7 @@ class LightmapPlugin {
     const atlas = {
       index, textureIndex, uri, source: decoded.source, format: decoded.format, hdr: hdrUri, files,
       loader: decoded.loader, // the three.js loader that read the file: KTX2Loader or HDRLoader
-      gpu: decoded.texture ? `${decoded.gpu} (the KTX2Loader texture)` : 'RGBA16F (half floats from the decoded texels)',
+      gpu: decoded.texture ? `${decoded.gpu} (the ${decoded.loader} texture)` : 'RGBA16F (half floats from the decoded texels)',
       fallback: why ? why.replace(/; $/, '') : null, // why the KTX2 file was not used, when asked for
       // radiance: the files hold E/pi (MOZ_lightmap.intensity is pi); toLux makes a texel E
       scale: extras.scale || 'irradiance', toLux: extras.scale === 'radiance' ? Math.PI : 1,
@@ -265,7 +312,7 @@ class LightmapPlugin {
     };
     this.atlases[atlas.index] = atlas;
     tex.userData.atlas = atlas.index;
-    console.log(`lmbake preview: atlas ${index} from ${uri} (${decoded.format}, on the GPU ${atlas.gpu}${atlas.fallback ? '; not KTX2: ' + atlas.fallback : ''})`);
+    console.log(`lmbake: atlas ${index} from ${uri} (${decoded.format}, on the GPU ${atlas.gpu}${atlas.fallback ? '; not KTX2: ' + atlas.fallback : ''})`);
     return tex;
   }
 
@@ -295,8 +342,9 @@ class LightmapPlugin {
     if (!this.ktx2Loader) throw new Error('no renderer for KTX2Loader.detectSupport()');
     const buffer = await this.fetchFile(uri);
     const c = readKtx2Header(new Uint8Array(buffer));
+    if (c.vkFormat in KTX2_BLOCK_FORMATS) return this.readKtx2Blocks(uri, buffer, c);
     const f = KTX2_FORMATS[c.vkFormat];
-    if (!f) throw new Error(`vkFormat ${c.vkFormat} is not a lightmap format (123, 122 or 97)`);
+    if (!f) throw new Error(`vkFormat ${c.vkFormat} is not a lightmap format (123, 122, 97, 143 or 1000066000)`);
     if (c.pixelDepth > 0 || c.layerCount > 1 || c.faceCount !== 1) throw new Error('not a single 2D image');
     if (c.supercompressionScheme !== KHR_SUPERCOMPRESSION_NONE && c.supercompressionScheme !== KHR_SUPERCOMPRESSION_ZSTD) throw new Error(`supercompression scheme ${c.supercompressionScheme} (only none and zstd)`);
     const tex = await new Promise((resolve, reject) => this.ktx2Loader.parse(buffer, resolve, (e) => reject(e instanceof Error ? e : new Error(String(e)))));
@@ -316,6 +364,29 @@ class LightmapPlugin {
     decodeTexels(c.vkFormat, src, n, data);
     const zstd = c.supercompressionScheme === KHR_SUPERCOMPRESSION_ZSTD ? ' zstd' : '';
     return { width, height, data, uri, texture: tex, gpu: f.gl, source: 'ktx2', format: `${f.name}${zstd} (KTX2Loader)`, loader: 'KTX2Loader' };
+  }
+
+  // A block-format KTX2 (BC6H, ASTC 4x4 HDR) as the GPU samples it: level 0's blocks in a
+  // CompressedTexture (mip levels are not used: lightmaps are sampled bilinearly, as above);
+  // no CPU texels (data null). Throws when the GPU cannot sample the format (the caller falls
+  // back to the .hdr).
+  async readKtx2Blocks(uri, buffer, c) {
+    const f = KTX2_BLOCK_FORMATS[c.vkFormat];
+    if (!gpuSamples(this.renderer, c.vkFormat)) throw new Error(`this GPU cannot sample ${f.name} (${f.gl})`);
+    if (c.pixelDepth > 0 || c.layerCount > 1 || c.faceCount !== 1) throw new Error('not a single 2D image');
+    const orient = typeof c.keyValue.KTXorientation === 'string' ? c.keyValue.KTXorientation : 'rd';
+    if (orient[1] !== 'd') throw new Error(`KTXorientation ${orient}: block rows cannot be flipped`);
+    const width = c.pixelWidth, height = c.pixelHeight, level = c.levels[0];
+    let blocks = level.levelData;
+    if (c.supercompressionScheme === KHR_SUPERCOMPRESSION_ZSTD) {
+      if (!this.zstd) { this.zstd = new ZSTDDecoder(); await this.zstd.init(); }
+      blocks = this.zstd.decode(blocks, level.uncompressedByteLength);
+    } else if (c.supercompressionScheme !== KHR_SUPERCOMPRESSION_NONE) throw new Error(`supercompression scheme ${c.supercompressionScheme} (only none and zstd)`);
+    const expect = Math.ceil(width / 4) * Math.ceil(height / 4) * 16;
+    if (blocks.byteLength !== expect) throw new Error(`level 0 holds ${blocks.byteLength} bytes, ${width}x${height} in 4x4 blocks needs ${expect}`);
+    const tex = new THREE.CompressedTexture([{ data: new Uint8Array(blocks), width, height }], width, height, f.format, THREE.HalfFloatType);
+    const zstd = c.supercompressionScheme === KHR_SUPERCOMPRESSION_ZSTD ? ' zstd' : '';
+    return { width, height, data: null, uri, texture: tex, gpu: f.gl, source: 'ktx2', format: `${f.name}${zstd} (lmbake-three)`, loader: 'lmbake-three' };
   }
 
   async fetchFile(uri) {

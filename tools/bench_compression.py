@@ -1,0 +1,146 @@
+#!/usr/bin/env python3
+"""KTX2 lightmap formats against each other (docs/output.md#block-compressed-lightmaps-bc6h-and-astc):
+bevy's Cornell box, the generated level-single-10 (58k triangles, 10 x 10 rooms, 11 lights) and a
+sunlit outdoor level (level-gpu-100: 100 copies of a 4,000-triangle prop on a ground, a sun), each
+baked at the defaults once per KTX2 format. Per format and scene:
+  bytes per texel on the GPU (the level's size / texels) and on disk (the .ktx2 file, Zstandard);
+  encode seconds (the bake's log: the block encoder's time; the packed formats' is negligible)
+  and the bake's own seconds, and their ratio;
+  mean and p99 relative error per chart texel and on 9 x 9 averages against the same bake's EXR
+  (tools/ktx2_blocks.py; the block formats decoded by OpenImageIO's and astcenc's decoders, the
+  packed ones by tests/ktx2/read_ktx2.mjs);
+  the largest luminance jump across seams on the decoded lightmap and on the EXR (measured as
+  tests/bake/check_artists.py measures it).
+Writes OUTDIR/compression.csv, compression.md and compression.png (error against bytes).
+
+usage: bench_compression.py LMBAKE OUTDIR
+"""
+import csv
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+import OpenImageIO as oiio
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.join(ROOT, "tests", "bake"))
+import ktx2_blocks as kb  # noqa: E402
+import check_analytic as ca  # noqa: E402
+import check_artists  # noqa: E402
+
+# (name, output.ktx2_format, GPU bytes per texel of the level)
+FORMATS = [("E5B9G9R9", "e5b9g9r9", 4), ("B10G11R11", "b10g11r11", 4), ("RGBA16F", "rgba16f", 8),
+           ("BC6H", "bc6h", 1), ("ASTC 4x4 HDR", "astc_hdr", 1)]
+
+
+def bake(lmbake, work, scene, name, fmt):
+    out = os.path.join(work, name)
+    shutil.rmtree(out, ignore_errors=True)
+    cfg = os.path.join(work, name + ".yaml")
+    with open(cfg, "w") as f:
+        f.write("output: {formats: [exr, ktx2, mask], ktx2_format: %s, ktx2_supercompression: zstd}\n" % fmt)
+    t0 = time.time()
+    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out], capture_output=True, text=True)
+    seconds = time.time() - t0
+    if p.returncode != 0:
+        sys.exit("%s: bake failed: %s" % (name, p.stderr[-2000:]))
+    encode = sum(float(m) for m in re.findall(r"blocks of \d+x\d+ texels encoded in ([0-9.]+)s", p.stderr + p.stdout))
+    return out, seconds, encode
+
+
+def measure(out, work):
+    """Per atlas decoded, errors pooled over atlases, seam jumps."""
+    doc = json.load(open(os.path.join(out, [f for f in os.listdir(out) if f.endswith(".gltf")][0])))
+    charts, exrs = ca.load_output(out)
+    decoded, refs, masks, gpu, disk, texels = {}, [], [], 0, 0, 0
+    for ti in exrs:
+        stem = os.path.join(out, doc["images"][doc["textures"][ti]["source"]]["uri"][:-4])
+        info, got = kb.decode(stem + ".ktx2", work)
+        decoded[ti] = got
+        ref = np.asarray(exrs[ti], dtype=np.float64)[..., :3]
+        mask = np.asarray(oiio.ImageBuf(stem + "-mask.png").get_pixels(oiio.FLOAT))[..., 0] > 0.99
+        refs.append((ref, got, mask))
+        gpu += sum(lv["uncompressed"] for lv in info["levels"])
+        disk += os.path.getsize(stem + ".ktx2")
+        texels += ref.shape[0] * ref.shape[1]
+    per = [kb.errors(r, g, m) for r, g, m in refs]
+    n = sum(p[4] for p in per)
+    n9 = sum(p[5] for p in per)
+    mean = sum(p[0] * p[4] for p in per) / n
+    mean9 = sum(p[2] * p[5] for p in per) / max(n9, 1)
+    p99 = max(p[1] for p in per)
+    p99_9 = max(p[3] for p in per)
+    seams = check_artists.seam_jumps(charts, decoded)
+    seams_exr = check_artists.seam_jumps(charts, exrs)
+    jump = max((v[1] for v in seams.values()), default=0.0)
+    jump_exr = max((v[1] for v in seams_exr.values()), default=0.0)
+    return dict(gpu_bpt=gpu / texels, disk_bpt=disk / texels, mean=mean, p99=p99, mean9=mean9, p99_9=p99_9,
+                jump=jump, jump_exr=jump_exr, texels=texels, atlases=len(exrs))
+
+
+def main():
+    lmbake, outdir = sys.argv[1:3]
+    work = os.path.join(outdir, "compression-work")
+    os.makedirs(work, exist_ok=True)
+    subprocess.run([sys.executable, os.path.join(HERE, "make_levels.py"), work, "single:10", "gpu:100"], check=True,
+                   stdout=subprocess.DEVNULL)
+    scenes = [("bevy Cornell box", os.path.join(ROOT, "assets", "scenes", "cornell-box-bevy", "CornellBox.glb")),
+              ("level-single-10", os.path.join(work, "level-single-10.glb")),
+              ("sunlit outdoor (level-gpu-100)", os.path.join(work, "level-gpu-100.glb"))]
+    rows = []
+    for label, scene in scenes:
+        key = os.path.basename(scene).split(".")[0]
+        for name, fmt, _ in FORMATS:
+            out, seconds, encode = bake(lmbake, work, scene, "%s-%s" % (key, fmt), fmt)
+            m = measure(out, work)
+            row = dict(scene=label, format=name, bake_s=seconds, encode_s=encode, encode_share=encode / seconds, **m)
+            rows.append(row)
+            print("%-32s %-13s %5.2f B/texel GPU %5.2f disk; encode %.2fs of %.1fs (%.1f%%); error mean %.3f%% p99 "
+                  "%.2f%%, 9x9 mean %.4f%% p99 %.3f%%; seam jump %.3f%% (EXR %.3f%%)"
+                  % (label, name, m["gpu_bpt"], m["disk_bpt"], encode, seconds, 100 * encode / seconds,
+                     100 * m["mean"], 100 * m["p99"], 100 * m["mean9"], 100 * m["p99_9"], 100 * m["jump"],
+                     100 * m["jump_exr"]), flush=True)
+    keys = list(rows[0].keys())
+    with open(os.path.join(outdir, "compression.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
+    with open(os.path.join(outdir, "compression.md"), "w") as f:
+        f.write("| scene | format | GPU B/texel | disk B/texel | encode s | bake s | encode / bake | mean error | "
+                "p99 | 9x9 mean | 9x9 p99 | seam jump (EXR) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            f.write("| %s | %s | %.2f | %.2f | %.2f | %.1f | %.1f%% | %.3f%% | %.2f%% | %.4f%% | %.3f%% | %.3f%% (%.3f%%) |\n"
+                    % (r["scene"], r["format"], r["gpu_bpt"], r["disk_bpt"], r["encode_s"], r["bake_s"],
+                       100 * r["encode_share"], 100 * r["mean"], 100 * r["p99"], 100 * r["mean9"], 100 * r["p99_9"],
+                       100 * r["jump"], 100 * r["jump_exr"]))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for label, _ in scenes:
+        rs = [r for r in rows if r["scene"] == label]
+        ax.plot([r["gpu_bpt"] for r in rs], [100 * r["mean"] for r in rs], "o", label=label)
+        for r in rs:
+            ax.annotate(r["format"], (r["gpu_bpt"], 100 * r["mean"]), fontsize=7, xytext=(4, 2),
+                        textcoords="offset points")
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xlabel("bytes per texel on the GPU (level 0)")
+    ax.set_ylabel("mean relative error per texel against the EXR (%)")
+    ax.axhline(2.0, color="grey", lw=0.8, ls="--")
+    ax.legend(fontsize=8)
+    ax.set_title("KTX2 lightmap formats: error against size")
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, "compression.png"), dpi=120)
+    print(open(os.path.join(outdir, "compression.md")).read())
+
+
+if __name__ == "__main__":
+    main()
