@@ -68,6 +68,8 @@ export function startServer(gltfFile, { port = 0, log = () => {} } = {}) {
   const roots = [
     ['/page/', path.join(projectRoot, 'tools', 'preview', 'page')],
     ['/loaders/', path.join(projectRoot, 'loaders')],
+    ['/babylon/core/', path.join(projectRoot, 'node_modules', '@babylonjs', 'core')],
+    ['/babylon/loaders/', path.join(projectRoot, 'node_modules', '@babylonjs', 'loaders')],
     ['/three/build/', path.join(three, 'build')],
     ['/three/examples/jsm/', path.join(three, 'examples', 'jsm')],
     ['/bake/', bakeDir],

@@ -1,0 +1,168 @@
+// lmbake-babylon: lmbake's lightmaps and light probes in Babylon.js, as a glTF loader extension
+// (README.md beside this file; docs/output.md says what the files hold).
+//   registerLmbakeLightmaps();                                  // once, before loading
+//   const result = await SceneLoader.ImportMeshAsync('', '', 'level.gltf', scene);
+// What it reads: MOZ_lightmap on materials ({index, texCoord, intensity}, KHR_texture_transform on
+// it: the lightmap's rectangle) -> material.lightmapTexture (coordinatesIndex 1: TEXCOORD_1,
+// uOffset / vOffset / uScale / vScale as Babylon's KHR_texture_transform sets them), with
+// useLightmapAsShadowmap off. The texels: the KTX2 the lightmap texture's extras.lightmap.files.ktx2
+// names when it is BC6H without supercompression and the GPU samples BC6H
+// (EXT_texture_compression_bptc), else the Radiance .hdr of MOZ_texture_rgbe (read with Babylon's
+// own RGBE reader, uploaded as half floats). Both hold irradiance E in lux (or E / pi with
+// extras.lightmap.scale "radiance" and MOZ_lightmap.intensity pi).
+// Babylon adds a lightmap to a PBR material's final colour as it is (radiance), where a
+// diffuse surface under irradiance E shows albedo / pi x E: the texture's level is intensity / pi
+// and a material plugin multiplies the lightmap by the surface's diffuse albedo.
+// Not read: the per-copy rectangles of EXT_mesh_gpu_instancing (Babylon's extension makes thin
+// instances without custom attributes): bake such levels with atlas.share_meshes false.
+import { Texture } from '@babylonjs/core/Materials/Textures/texture.js';
+import { RawTexture } from '@babylonjs/core/Materials/Textures/rawTexture.js';
+import { MaterialPluginBase } from '@babylonjs/core/Materials/materialPluginBase.js';
+import { RGBE_ReadHeader, RGBE_ReadPixels } from '@babylonjs/core/Misc/HighDynamicRange/hdr.js';
+import { GLTFLoader } from '@babylonjs/loaders/glTF/2.0/glTFLoader.js';
+import { registerGLTFExtension, unregisterGLTFExtension } from '@babylonjs/loaders/glTF/2.0/glTFLoaderExtensionRegistry.js';
+
+const NAME = 'MOZ_lightmap';
+const TEXTUREFORMAT_RGBA = 5, TEXTURETYPE_HALF_FLOAT = 2, BILINEAR = 2;
+const COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT = 0x8e8f;
+
+// Multiplies a PBR material's lightmap by its diffuse albedo (surfaceAlbedo: base colour x
+// (1 - metallic)), so the lightmap lights the surface as the bake's irradiance does.
+class LightmapTimesAlbedo extends MaterialPluginBase {
+  constructor(material) {
+    super(material, 'LmbakeLightmapTimesAlbedo', 200, { LMBAKE_LIGHTMAP: false });
+    this._enable(true);
+  }
+
+  prepareDefines(defines) { defines.LMBAKE_LIGHTMAP = true; }
+
+  getClassName() { return 'LmbakeLightmapTimesAlbedo'; }
+
+  getCustomCode(shaderType) {
+    if (shaderType !== 'fragment') return null;
+    return { CUSTOM_FRAGMENT_BEFORE_FINALCOLORCOMPOSITION: '#if defined(LIGHTMAP) && defined(LMBAKE_LIGHTMAP)\nlightmapColor.rgb *= surfaceAlbedo;\n#endif\n' };
+  }
+}
+
+// float -> IEEE half bits (round to nearest), for the .hdr's upload
+function toHalf(f) {
+  const b = new DataView(new ArrayBuffer(4));
+  b.setFloat32(0, f);
+  const x = b.getUint32(0), sign = (x >>> 16) & 0x8000, e = ((x >>> 23) & 0xff) - 112, m = x & 0x7fffff;
+  if (e <= 0) return e < -10 ? sign : sign | ((m | 0x800000) >> (1 - e + 13));
+  if (e >= 31) return sign | 0x7bff;
+  const h = sign | (e << 10) | (m >> 13);
+  return (m & 0x1fff) > 0x1000 || ((m & 0x1fff) === 0x1000 && (h & 1)) ? h + 1 : h;
+}
+
+// The 2D level 0 of a KTX2 file: {vkFormat, width, height, supercompression, data} (header and
+// level index: KTX 2.0 specification, section 3).
+export function readKtx2Level0(buffer) {
+  const v = new DataView(buffer), id = new Uint8Array(buffer, 0, 12);
+  const magic = [0xab, 0x4b, 0x54, 0x58, 0x20, 0x32, 0x30, 0xbb, 0x0d, 0x0a, 0x1a, 0x0a];
+  if (!magic.every((b, i) => id[i] === b)) throw new Error('not a KTX2 file');
+  const vkFormat = v.getUint32(12, true), width = v.getUint32(20, true), height = v.getUint32(24, true);
+  const supercompression = v.getUint32(44, true);
+  const offset = Number(v.getBigUint64(80, true)), length = Number(v.getBigUint64(88, true));
+  return { vkFormat, width, height, supercompression, data: new Uint8Array(buffer, offset, length) };
+}
+
+class MozLightmap {
+  constructor(loader, options) {
+    this.name = NAME;
+    this.order = 200;
+    this._loader = loader;
+    this._options = options;
+    this.enabled = loader.isExtensionUsed(NAME);
+    this._textures = new Map(); // texture index -> Promise<{texture, source}>
+  }
+
+  dispose() { this._loader = null; }
+
+  loadMaterialPropertiesAsync(context, material, babylonMaterial) {
+    return GLTFLoader.LoadExtensionAsync(context, material, this.name, async (extContext, ext) => {
+      await this._loader.loadMaterialPropertiesAsync(context, material, babylonMaterial);
+      const base = await this._lightmap(extContext, ext.index);
+      if (!base) return;
+      // a texture of its own (its rectangle) on the shared GPU texture
+      const internal = base.getInternalTexture();
+      internal.incrementReferences();
+      const tex = new Texture(null, this._loader.babylonScene, { noMipmap: true, invertY: false, samplingMode: BILINEAR, internalTexture: internal });
+      tex.name = base.name;
+      tex.wrapU = tex.wrapV = Texture.CLAMP_ADDRESSMODE;
+      const tt = ext.extensions && ext.extensions.KHR_texture_transform;
+      tex.coordinatesIndex = (tt && tt.texCoord) ?? ext.texCoord ?? 1;
+      tex.uRotationCenter = 0;
+      tex.vRotationCenter = 0;
+      if (tt && tt.offset) { tex.uOffset = tt.offset[0]; tex.vOffset = tt.offset[1]; }
+      if (tt && tt.scale) { tex.uScale = tt.scale[0]; tex.vScale = tt.scale[1]; }
+      tex.level = (ext.intensity ?? 1) / Math.PI;
+      babylonMaterial.lightmapTexture = tex;
+      babylonMaterial.useLightmapAsShadowmap = false;
+      if (!babylonMaterial.pluginManager || !babylonMaterial.pluginManager.getPlugin('LmbakeLightmapTimesAlbedo')) new LightmapTimesAlbedo(babylonMaterial);
+    });
+  }
+
+  _lightmap(context, index) {
+    if (!this._textures.has(index)) this._textures.set(index, this._loadLightmap(context, index));
+    return this._textures.get(index);
+  }
+
+  // A file beside the glTF, through the loader (its root URL, its request hooks)
+  async _fetch(context, property, uri) {
+    const view = await this._loader.loadUriAsync(context, property, uri);
+    return view.buffer.slice(view.byteOffset, view.byteOffset + view.byteLength);
+  }
+
+  async _loadLightmap(context, index) {
+    const json = this._loader.gltf, scene = this._loader.babylonScene;
+    const def = json.textures && json.textures[index];
+    if (!def) throw new Error(`${context}: texture ${index} does not exist`);
+    const extras = (def.extras && def.extras.lightmap) || {}, files = extras.files || {};
+    const rgbe = def.extensions && def.extensions.MOZ_texture_rgbe;
+    const engine = scene.getEngine();
+    let texture = null, why = '';
+    if (files.ktx2 && this._options.source !== 'hdr') {
+      const k = readKtx2Level0(await this._fetch(context, def, files.ktx2));
+      if (k.vkFormat !== 143) why = `vkFormat ${k.vkFormat} (this loader reads BC6H, 143)`;
+      else if (k.supercompression !== 0) why = 'supercompressed (write it with output.ktx2_supercompression: none)';
+      else if (!engine.getCaps().bptc) why = 'this GPU cannot sample BC6H';
+      else {
+        // Babylon's raw textures take compressed formats from S3TC only: the texture is made
+        // empty, then its level 0 given the blocks (the engine's own compressed upload)
+        const internal = engine.createRawTexture(null, k.width, k.height, TEXTUREFORMAT_RGBA, false, false, BILINEAR, null, 0);
+        engine._bindTextureDirectly(engine._gl.TEXTURE_2D, internal, true);
+        engine._uploadCompressedDataToTextureDirectly(internal, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, k.width, k.height, k.data, 0, 0);
+        engine._bindTextureDirectly(engine._gl.TEXTURE_2D, null);
+        internal.isReady = true;
+        texture = new Texture(null, scene, { noMipmap: true, invertY: false, samplingMode: BILINEAR, internalTexture: internal });
+        texture.name = files.ktx2;
+        console.log(`lmbake-babylon: atlas from ${files.ktx2} (BC6H_UFLOAT_BLOCK)`);
+      }
+      if (why) console.log(`lmbake-babylon: ${files.ktx2}: ${why}; the .hdr instead`);
+    }
+    if (!texture && rgbe) {
+      const img = json.images[rgbe.source];
+      const bytes = new Uint8Array(await this._fetch(context, img, img.uri));
+      const info = RGBE_ReadHeader(bytes), rgb = RGBE_ReadPixels(bytes, info), n = info.width * info.height;
+      const half = new Uint16Array(4 * n);
+      for (let i = 0; i < n; i++) {
+        for (let c = 0; c < 3; c++) half[4 * i + c] = toHalf(rgb[3 * i + c]);
+        half[4 * i + 3] = 0x3c00;
+      }
+      texture = new RawTexture(half, info.width, info.height, TEXTUREFORMAT_RGBA, scene, false, false, BILINEAR, TEXTURETYPE_HALF_FLOAT);
+      texture.name = img.uri;
+      console.log(`lmbake-babylon: atlas from ${img.uri} (RGBE as half floats)`);
+    }
+    if (!texture) throw new Error(`${context}: lightmap texture ${index} has neither a BC6H KTX2 this GPU reads nor a .hdr`);
+    texture.wrapU = texture.wrapV = Texture.CLAMP_ADDRESSMODE;
+    return texture;
+  }
+}
+
+// Registers the extension with Babylon's glTF loader (once; again replaces it). source: 'ktx2'
+// (the default: a BC6H KTX2 when the GPU samples it, else the .hdr) or 'hdr'.
+export function registerLmbakeLightmaps({ source = 'ktx2' } = {}) {
+  unregisterGLTFExtension(NAME);
+  registerGLTFExtension(NAME, true, (loader) => new MozLightmap(loader, { source }));
+}
