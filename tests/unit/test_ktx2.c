@@ -1,11 +1,15 @@
 /*
  * KTX2 texel encoders (baker/write/ktx2.c) at the edges of their formats: zero, NaN and
  * negatives to 0, values past the range to its largest, round-to-nearest-even ties, half
- * subnormals, and the shared exponent chosen so the largest channel keeps 9 bits; and the
- * container's fixed bytes (identifier, level index) for a 1 x 1 image.
+ * subnormals, and the shared exponent chosen so the largest channel keeps 9 bits; the
+ * container's fixed bytes (identifier, level index) for a 1 x 1 image; BC6H's layouts (every
+ * mode's fields fill its block exactly, every endpoint bit once) and a mip chain's levels
+ * (smallest first, each at a multiple of 16, its size ceil(w/4) x ceil(h/4) x 16).
  */
 #include "check.h"
 
+#include "write/bc6h.h"
+#include "write/bc6h_modes.h"
 #include "write/ktx2.h"
 
 #include <math.h>
@@ -102,8 +106,80 @@ static void test_container(void)
     free(data);
 }
 
+/* Each mode's mode field, endpoint runs, partition and indices fill 128 bits, and each endpoint
+ * bit of its precision (w's bits; x, y, z: their difference's bits or w's) appears once. */
+static void test_bc6h_layouts(void)
+{
+    for (int m = 0; m < LMB_BC6H_MODES; m++) {
+        const lmb_bc6h_mode *md = &lmb_bc6h_modes[m];
+        int seen[13][16] = {{0}}, bits = md->mode_bits;
+        for (int r = 0; r < md->runs; r++) {
+            const lmb_bc6h_run *run = &md->run[r];
+            int n = run->count > 0 ? run->count : -run->count, step = run->count > 0 ? 1 : -1;
+            for (int k = 0; k < n; k++)
+                seen[run->field][run->first + step * k]++;
+            bits += n;
+        }
+        int indices = md->regions == 1 ? 16 * 4 - 1 : 16 * 3 - 2;
+        CHECK_INT(bits + indices, 128);
+        for (int e = 0; e < 2 * md->regions; e++)
+            for (int c = 0; c < 3; c++) {
+                int want = e > 0 && md->delta[c] ? md->delta[c] : md->bits;
+                for (int b = 0; b < 16; b++)
+                    CHECK_INT(seen[3 * e + c][b], b < want ? 1 : 0);
+            }
+        for (int b = 0; b < 16; b++)
+            CHECK_INT(seen[LMB_BC6H_PARTITION][b], md->regions == 2 && b < 5 ? 1 : 0);
+    }
+    /* every partition's second anchor lies in region 1 */
+    for (int p = 0; p < 32; p++)
+        CHECK_INT((lmb_bc6h_partitions[p] >> lmb_bc6h_anchor2[p]) & 1, 1);
+}
+
+/* A 13 x 6 BC6H image with a mip chain: 4 levels (13x6, 6x3, 3x1, 1x1), stored smallest first. */
+static void test_block_levels(void)
+{
+    float rgb[13 * 6 * 3];
+    for (int i = 0; i < 13 * 6 * 3; i++)
+        rgb[i] = 0.5f + (float)(i % 7);
+    lmb_ktx2_options o = {LMB_KTX2_BC6H, 0, 1, 1, NULL};
+    uint8_t *data;
+    size_t size;
+    lmb_error err = {LMB_OK, ""};
+    lmb_ktx2_report rep = {0, 0};
+    CHECK_INT(lmb_ktx2_encode(13, 6, rgb, &o, &data, &size, &rep, &err), LMB_OK);
+    uint32_t vk, type_size, levels;
+    memcpy(&vk, data + 12, 4);
+    memcpy(&type_size, data + 16, 4);
+    memcpy(&levels, data + 40, 4);
+    CHECK_INT(vk, 143);
+    CHECK_INT(type_size, 1);
+    CHECK_INT(levels, 4);
+    static const uint32_t w[4] = {13, 6, 3, 1}, h[4] = {6, 3, 1, 1};
+    uint64_t prev = UINT64_MAX;
+    for (uint32_t k = 0; k < 4; k++) {
+        uint64_t at, len, raw;
+        memcpy(&at, data + 80 + 24 * k, 8);
+        memcpy(&len, data + 88 + 24 * k, 8);
+        memcpy(&raw, data + 96 + 24 * k, 8);
+        CHECK(len == (uint64_t)((w[k] + 3) / 4) * ((h[k] + 3) / 4) * 16 && raw == len);
+        CHECK(at % 16 == 0 && at + len <= size && at < prev); /* smaller levels lie earlier */
+        prev = at;
+    }
+    CHECK_INT((int)rep.clamped, 0);
+    free(data);
+    /* a texel past BC6H's range is clamped and counted */
+    rgb[0] = 1e6f;
+    o.mipmaps = 0;
+    CHECK_INT(lmb_ktx2_encode(13, 6, rgb, &o, &data, &size, &rep, &err), LMB_OK);
+    CHECK_INT((int)rep.clamped, 1);
+    free(data);
+}
+
 int main(void)
 {
+    test_bc6h_layouts();
+    test_block_levels();
     test_half();
     test_e5b9g9r9();
     test_b10g11r11();
