@@ -12,6 +12,8 @@ usage: check_ktx2_blocks.py LMBAKE WORKDIR
            162, 4x4 blocks of 16 bytes, one 128-bit sample: BC6H unsigned float [0, 1], ASTC
            signed float [-1, 1]); texels: mean relative error per chart texel at most 2%, and at
            most 0.5% on 9 x 9 averages
+  range    the Cornell box with its light 10^6 times brighter: BC6H's texels past 65504 are
+           clamped, counted and warned about ("... were clamped in the .ktx2"), exit 0
   seams    the sphere, cube and tiles of the seams scene (tests/bake/check_artists.py), each
            format: the largest luminance jump across seams, measured on the decoded lightmap
            as check_artists measures it on the EXR, under 1% (SEAM_BOUND); BC6H on the sphere
@@ -21,6 +23,7 @@ usage: check_ktx2_blocks.py LMBAKE WORKDIR
 """
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -53,7 +56,7 @@ def bake(lmbake, work, scene, name, config):
 def cornell(lmbake, work, fmt):
     vk, model, channel, lower, upper, sc = FORMATS[fmt]
     out = bake(lmbake, work, "cornell-point", "cornell-" + fmt,
-               "texel_density: 64\nbounces: 1\nsamples: {gather: 32, adaptive: false}\n"
+               "texel_density: 64\nbounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\n"
                "output: {formats: [exr, ktx2, mask], directional: false, ktx2_format: %s, "
                "ktx2_supercompression: %s, ktx2_mipmaps: true}\n" % (fmt, sc))
     stem = os.path.join(out, "cornell-point-lightmap-0")
@@ -91,7 +94,8 @@ def cornell(lmbake, work, fmt):
 
 def seams(lmbake, work, fmt):
     out = bake(lmbake, work, "seams", "seams-" + fmt,
-               "texel_density: 40\nlightmap:\n  exclude: [room]\noutput: {formats: [exr, ktx2], ktx2_format: %s}\n"
+               "texel_density: 40\nlightmap:\n  exclude: [room]\nprobes: {auto: false}\n"
+               "output: {formats: [exr, ktx2], ktx2_format: %s}\n"
                % fmt)
     charts, images = ca.load_output(out)
     exr_jumps = check_artists.seam_jumps(charts, images)
@@ -112,12 +116,26 @@ def seams(lmbake, work, fmt):
     return ok
 
 
+def over_range(lmbake, work):
+    cfg = os.path.join(work, "range.yaml")
+    with open(cfg, "w") as f:
+        f.write("texel_density: 32\nbounces: 1\nsamples: {gather: 16, adaptive: false}\nprobes: {auto: false}\n"
+                "lights: {intensity_scale: 1000000}\noutput: {formats: [exr, ktx2], ktx2_format: bc6h}\n")
+    p = subprocess.run([lmbake, "bake", os.path.join(work, "scenes", "cornell-point.gltf"), "-c", cfg, "-o",
+                        os.path.join(work, "out-range"), "-q"], capture_output=True, text=True)
+    m = re.search(r"atlas 0: (\d+) texels brighter than BC6H's range \(65504\) were clamped in the \.ktx2", p.stderr)
+    good = p.returncode == 0 and m is not None and int(m.group(1)) > 0
+    print("range    bc6h: exit %d, %s: %s" % (p.returncode, ("%s texels clamped and warned about" % m.group(1)) if m
+                                              else "no warning", "ok" if good else "FAIL: " + p.stderr[-500:]))
+    return good
+
+
 def main():
     lmbake, work = sys.argv[1], sys.argv[2]
     os.makedirs(work, exist_ok=True)
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
                    check=True, stdout=subprocess.DEVNULL)
-    ok = True
+    ok = over_range(lmbake, work)
     for fmt in FORMATS:
         ok &= cornell(lmbake, work, fmt)
         ok &= seams(lmbake, work, fmt)

@@ -108,7 +108,8 @@ def main():
         cfg = os.path.join(work, fmt + ".yaml")
         with open(cfg, "w") as f:
             # the loaders are checked, not the light: one bounce, few rays
-            f.write("bounces: 1\nsamples: {gather: 32, adaptive: false}\noutput: {formats: [exr, ktx2], directional: "
+            f.write("bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\n"
+                    "output: {formats: [exr, ktx2], directional: "
                     "false, ktx2_format: %s, ktx2_supercompression: %s}\n" % (fmt, sc))
         subprocess.run([lmbake, "bake", SCENE, "-c", cfg, "-o", out, "-q"], check=True)
         for loader in loaders:

@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// Lightmap rectangles the preview puts on objects itself (tools/preview/page/lightmap-plugin.js
+// Lightmap rectangles the preview puts on objects itself (loaders/three/lmbake-three.js
 // applyLightmapRectangles), in headless Chromium:
 //   usage: node tests/preview/preview_instancing.mjs INSTANCED_GLTF SEAMS_GLTF SHOTS_DIR
 // INSTANCED_GLTF: a bake of tools/make_scenes.py's instanced-boxes.gltf (576 copies of one box

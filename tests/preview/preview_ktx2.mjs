@@ -1,5 +1,5 @@
 #!/usr/bin/env node
-// KTX2 lightmaps and lightmap rectangles in the preview (tools/preview/page/lightmap-plugin.js):
+// KTX2 lightmaps and lightmap rectangles in the preview (loaders/three/lmbake-three.js):
 //   usage: node tests/preview/preview_ktx2.mjs BAKE_GLTF KEEP_UV1_GLTF SHOTS_DIR
 // BAKE_GLTF: a bake with output.formats [..., hdr, ktx2], whose lightmap textures name both
 // files in extras.lightmap.files. The lit and lightmap views are shot with ?lightmap=hdr and

@@ -119,7 +119,7 @@ root.traverse((o) => {
   const lit = o.material, lm = lit.lightMap;
   // scaleOffset: the mesh's rectangle in its atlas (uv1 x scale + offset), from the lightMap's offset / repeat
   const e = { mesh: o, lit, geometry: o.geometry, atlas: lm && lm.userData.atlas !== undefined ? lm.userData.atlas : -1, scaleOffset: lightmapScaleOffset(lm), node: gltfNode(o) };
-  // an InstancedMesh with per-instance rectangles: {count, scale, offset} (lightmap-plugin.js)
+  // an InstancedMesh with per-instance rectangles: {count, scale, offset} (lmbake-three.js)
   e.instances = (lm && o.isInstancedMesh && o.userData.lightmapInstances) || null;
   const inst = e.instances ? 'inst' : '';
   if (lm) e.lightmap = cached(`lm:${lm.uuid}:${lit.lightMapIntensity}:${lit.side}:${inst}`, () => {

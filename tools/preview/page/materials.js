@@ -8,9 +8,9 @@
 //             block), texel grid lines when zoomed in, chart borders in red-orange.
 // The invalid and checker views read the atlas at uv1 x scale + offset, the mesh's lightmap
 // rectangle (MOZ_lightmap's KHR_texture_transform or the node's extras.lightmap.scaleOffset;
-// lightmap-plugin.js lightmapScaleOffset), as three's lightMap does for the lightmap and lit
+// lmbake-three.js lightmapScaleOffset), as three's lightMap does for the lightmap and lit
 // views. On an InstancedMesh with per-instance rectangles ({instanced: true}) each copy reads
-// uv1 x scale_k + offset_k first (lightmap-plugin.js INSTANCE_RECT_ATTRIBUTES), and every
+// uv1 x scale_k + offset_k first (lmbake-three.js INSTANCE_RECT_ATTRIBUTES), and every
 // copy is placed by its instance matrix.
 import * as THREE from 'three';
 import { INSTANCE_RECT_ATTRIBUTES } from '/loaders/three/lmbake-three.js';
