@@ -152,8 +152,8 @@ def main():
             row = dict(scene=label, format=name, bake_s=seconds, encode_s=encode, encode_share=encode / seconds, **m)
             rows.append(row)
             print("%-32s %-13s %5.2f B/texel GPU %5.2f disk; encode %.2fs of %.1fs (%.1f%%); error mean %.3f%% p99 "
-                  "%.2f%%, 9x9 mean %.4f%% p99 %.3f%%; seam jump %.3f%% (EXR %.3f%%)"
-                  % (label, name, m["gpu_bpt"], m["disk_bpt"], encode, seconds, 100 * encode / seconds,
+                  "%.2f%%, 9x9 mean %.4f%% p99 %.3f%%; seam jump %.3f%% (EXR %.3f%%), added at most %.3f%% over %d "
+                  "samples" % (label, name, m["gpu_bpt"], m["disk_bpt"], encode, seconds, 100 * encode / seconds,
                      100 * m["mean"], 100 * m["p99"], 100 * m["mean9"], 100 * m["p99_9"], 100 * m["jump"],
                      100 * m["jump_exr"], 100 * m["jump_added"], m["seam_samples"]), flush=True)
     keys = list(rows[0].keys())
