@@ -1,14 +1,18 @@
 /*
  * KTX 2.0 writer (see ktx2.h). Layout, all little-endian:
- *   identifier (12) | header: vkFormat, typeSize, pixelWidth, pixelHeight, pixelDepth 0,
- *   layerCount 0, faceCount 1, levelCount 1, supercompressionScheme (0 or 2 = Zstandard)
- *   | index: dfdByteOffset, dfdByteLength, kvdByteOffset, kvdByteLength, sgdByteOffset 0,
- *   sgdByteLength 0 | level index: byteOffset, byteLength, uncompressedByteLength (u64 each)
- *   | DFD: dfdTotalSize, one Basic block | key/value data, each entry padded to 4 bytes
- *   | level 0 (aligned to 8 bytes uncompressed, 1 supercompressed: spec section 3.9).
+ *   identifier (12) | header: vkFormat, typeSize (1 for block formats), pixelWidth,
+ *   pixelHeight, pixelDepth (0: 2D), layerCount 0, faceCount 1, levelCount (1, or the mip
+ *   chain's), supercompressionScheme (0 or 2 = Zstandard) | index: dfdByteOffset,
+ *   dfdByteLength, kvdByteOffset, kvdByteLength, sgdByteOffset 0, sgdByteLength 0 | level
+ *   index, level 0 first: byteOffset, byteLength, uncompressedByteLength (u64 each) | DFD:
+ *   dfdTotalSize, one Basic block | key/value data, each entry padded to 4 bytes | the levels,
+ *   smallest first, each aligned to lcm(texel block size, 4) uncompressed (8 covers the packed
+ *   formats, 16 the blocks), 1 supercompressed (spec section 3.9); each level supercompressed
+ *   on its own.
  * Texel encodings: E5B9G9R9 as the Vulkan specification's shared-exponent conversion
  * ("Fundamentals: Shared exponent", N = 9, B = 15, Emax = 31); B10G11R11 as unsigned 11- and
- * 10-bit floats rounded to nearest even from half floats; half floats rounded to nearest even.
+ * 10-bit floats rounded to nearest even from half floats; half floats rounded to nearest even;
+ * BC6H by bc6h.c, ASTC by astcenc (astc_adapter.h). Mip levels are 2 x 2 box averages.
  */
 #include "ktx2.h"
 
