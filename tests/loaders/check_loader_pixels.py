@@ -36,6 +36,8 @@ FORMATS = {"e5b9g9r9": "zstd", "bc6h": "none", "astc_hdr": "zstd"}
 # cannot sample the format
 EXPECT = {("three", "e5b9g9r9"): "ktx2", ("three", "bc6h"): "ktx2", ("three", "astc_hdr"): None,
           ("babylon", "e5b9g9r9"): "hdr", ("babylon", "bc6h"): "ktx2", ("babylon", "astc_hdr"): "hdr"}
+# Babylon reads both E5B9G9R9 and ASTC through the .hdr: the ASTC bake's page covers that path
+SKIP = {("babylon", "e5b9g9r9")}
 
 
 def bilinear(img, u, v):
@@ -113,6 +115,8 @@ def main():
                     "false, ktx2_format: %s, ktx2_supercompression: %s}\n" % (fmt, sc))
         subprocess.run([lmbake, "bake", SCENE, "-c", cfg, "-o", out, "-q"], check=True)
         for loader in loaders:
+            if (loader, fmt) in SKIP:
+                continue
             ok &= check(work, out, loader, fmt)
     sys.exit(0 if ok else 1)
 
