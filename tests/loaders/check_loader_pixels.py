@@ -7,7 +7,8 @@ of the file the loader used at those coordinates, decoded by a decoder lmbake di
 
 usage: check_loader_pixels.py LMBAKE WORKDIR LOADER[,LOADER...]
 
-bevy's Cornell box (one bounce, few rays: the loaders are checked, not the light), once per KTX2
+bevy's Cornell box (one bounce, few rays, 60,000 texels: the loaders are checked, not the light;
+a texel still covers about one pixel of the 320 x 240 probe), once per KTX2
 format: E5B9G9R9 with Zstandard, BC6H without, ASTC HDR with; each loader's page on each bake.
 Which file a loader must read: the KTX2 when it reads that format and the GPU samples it, else
 the .hdr, and the page must say why (EXPECT below; Chromium's SwiftShader has BC6H and no ASTC
@@ -110,7 +111,7 @@ def main():
         cfg = os.path.join(work, fmt + ".yaml")
         with open(cfg, "w") as f:
             # the loaders are checked, not the light: one bounce, few rays
-            f.write("bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\n"
+            f.write("bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\natlas: {texels: 60000}\n"
                     "output: {formats: [exr, ktx2], directional: "
                     "false, ktx2_format: %s, ktx2_supercompression: %s}\n" % (fmt, sc))
         subprocess.run([lmbake, "bake", SCENE, "-c", cfg, "-o", out, "-q"], check=True)
