@@ -5,6 +5,9 @@
  * axes), kept as bit masks in four quarter turns: dilated by 1 texel (what bilinear
  * filtering reads: what the atlas records) and by padding + 1 (what must not meet another
  * chart's record), so between what two charts can read lie at least `padding` texels.
+ * For block-compressed atlases both masks are then taken to blocks (a block is set when any of
+ * its texels is), at the sub-block offset that sets the fewest: charts placed on blocks whose
+ * records never share a block keep the texel padding and never meet in a block.
  */
 #include "pack_internal.h"
 
@@ -213,10 +216,77 @@ static int turn_mask(const lmb_mask *a, lmb_mask *b)
     return 1;
 }
 
+/* Blocks of b x b texels that texel mask t, shifted by (sx, sy) texels, touches: counted
+ * (out NULL) or set in out. */
+static uint64_t blocks_of(const lmb_mask *t, uint32_t b, uint32_t sx, uint32_t sy, lmb_mask *out)
+{
+    uint32_t bw = (t->w + sx + b - 1) / b, bh = (t->h + sy + b - 1) / b;
+    uint8_t *seen = calloc((size_t)bw * bh + 1, 1);
+    uint64_t n = 0;
+    if (!seen)
+        return UINT64_MAX;
+    for (uint32_t y = 0; y < t->h; y++)
+        for (uint32_t x = t->first[y]; x < t->w && x <= t->last[y]; x++)
+            if (lmb_mask_bit(t, x, y)) {
+                size_t k = (size_t)((y + sy) / b) * bw + (x + sx) / b;
+                n += !seen[k];
+                seen[k] = 1;
+            }
+    if (out) {
+        for (uint32_t y = 0; y < bh; y++)
+            for (uint32_t x = 0; x < bw; x++)
+                if (seen[(size_t)y * bw + x])
+                    mask_set(out, x, y);
+        mask_rows(out);
+    }
+    free(seen);
+    return n;
+}
+
+/* The texel masks of item it taken to b x b blocks at the sub-block shift that touches the
+ * fewest blocks (ties: the fewest recorded blocks, then the smallest shift); it->off moves by
+ * that shift. 0 when out of memory. */
+static int to_blocks(lmb_pack_item *it, uint32_t b)
+{
+    uint32_t best_x = 0, best_y = 0;
+    uint64_t best_shape = UINT64_MAX, best_occ = UINT64_MAX;
+    for (uint32_t sy = 0; sy < b; sy++)
+        for (uint32_t sx = 0; sx < b; sx++) {
+            uint64_t ns = blocks_of(&it->shape[0], b, sx, sy, NULL);
+            if (ns > best_shape)
+                continue;
+            uint64_t no = blocks_of(&it->occ[0], b, sx, sy, NULL);
+            if (ns == UINT64_MAX || no == UINT64_MAX)
+                return 0;
+            if (ns < best_shape || no < best_occ) {
+                best_shape = ns;
+                best_occ = no;
+                best_x = sx;
+                best_y = sy;
+            }
+        }
+    const lmb_mask *t = &it->shape[0];
+    lmb_mask shape, occ;
+    memset(&shape, 0, sizeof shape);
+    memset(&occ, 0, sizeof occ);
+    uint32_t bw = (t->w + best_x + b - 1) / b, bh = (t->h + best_y + b - 1) / b;
+    int ok = mask_alloc(&shape, bw, bh) && mask_alloc(&occ, bw, bh) &&
+             blocks_of(&it->shape[0], b, best_x, best_y, &shape) != UINT64_MAX &&
+             blocks_of(&it->occ[0], b, best_x, best_y, &occ) != UINT64_MAX;
+    lmb_mask_free(&it->shape[0]);
+    lmb_mask_free(&it->occ[0]);
+    it->shape[0] = shape;
+    it->occ[0] = occ;
+    it->off[0] += best_x;
+    it->off[1] += best_y;
+    it->block = b;
+    return ok;
+}
+
 /* Returns 1 when ready, 0 when out of memory, 2 when the chart's box (*bw x *bh) exceeds
  * max_size: checked before any lmb_mask is allocated. */
-int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, uint32_t max_size, lmb_pack_item *it,
-                   double *bw, double *bh)
+int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, uint32_t block, uint32_t max_size,
+                     lmb_pack_item *it, double *bw, double *bh)
 {
     uint32_t n = 3 * c->triangle_count;
     pt *p = malloc(((size_t)n + 1) * sizeof *p), *h = malloc(((size_t)n + 2) * sizeof *h);
@@ -225,6 +295,8 @@ int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, u
     memset(it, 0, sizeof *it);
     it->chart = index;
     it->group = c->group;
+    it->off[0] = it->off[1] = border;
+    it->block = 1;
     if (ok) {
         for (uint32_t i = 0; i < n; i++) {
             p[i].x = c->uv[2 * i];
@@ -233,7 +305,9 @@ int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, u
         min_box(h, n ? hull(p, n, h) : 0, it->m, it->lo, hi);
         *bw = floor(hi[0] - it->lo[0]) + 1 + 2.0 * border;
         *bh = floor(hi[1] - it->lo[1]) + 1 + 2.0 * border;
-        if (!(*bw <= max_size && *bh <= max_size)) {
+        /* with blocks, a sub-block shift may add up to block - 1 texels to either side */
+        double limit = block > 1 ? (double)(max_size / block * block) - (block - 1) : (double)max_size;
+        if (!(*bw <= limit && *bh <= limit)) {
             free(p);
             free(h);
             return 2;
@@ -246,11 +320,13 @@ int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, u
         }
         uint8_t *touch = touched(p, c->triangle_count, w, hh);
         ok = touch && build_mask(touch, w, hh, border, &it->shape[0]) && build_mask(touch, w, hh, 1, &it->occ[0]);
+        if (ok && block > 1)
+            ok = to_blocks(it, block);
         for (int k = 1; ok && k < 4; k++)
             ok = turn_mask(&it->shape[k - 1], &it->shape[k]) && turn_mask(&it->occ[k - 1], &it->occ[k]);
         free(touch);
-        for (uint32_t y = 0; ok && y < hh; y++)
-            for (uint32_t x = 0; x < w; x++)
+        for (uint32_t y = 0; ok && y < it->shape[0].h; y++)
+            for (uint32_t x = 0; x < it->shape[0].w; x++)
                 it->area += (uint64_t)lmb_mask_bit(&it->shape[0], x, y), it->occ_area += (uint64_t)lmb_mask_bit(&it->occ[0], x, y);
         if (ok) { /* FNV-1a over the size and the bit rows */
             const lmb_mask *m = &it->shape[0];

@@ -174,15 +174,15 @@ static int try_place(lmb_atlas *a, uint32_t ai, const lmb_pack_item *it, hints *
     return try_orientations(a, ai, it, h, turn, x, y);
 }
 
-static void placement(const lmb_pack_item *it, int turn, uint32_t x, uint32_t y, uint32_t border, uint32_t a,
-                      lmb_pack_placement *p)
+static void placement(const lmb_pack_item *it, int turn, uint32_t x, uint32_t y, uint32_t a, lmb_pack_placement *p)
 {
-    /* box frame: bx = m0 u + m1 v - lo0 + border, by = m2 u + m3 v - lo1 + border; each quarter
-     * turn maps (bx, by) -> (H - by, bx), H the height before it, as the footprint's quarter
-     * turns map texels (cx, cy) -> (H - 1 - cy, cx), so texel squares land on texel squares */
-    double r0[3] = {it->m[0], it->m[1], border - it->lo[0]}, r1[3] = {it->m[2], it->m[3], border - it->lo[1]};
+    /* box frame: bx = m0 u + m1 v - lo0 + off0, by = m2 u + m3 v - lo1 + off1; each quarter
+     * turn maps (bx, by) -> (H - by, bx), H the height before it in texels, as the footprint's
+     * quarter turns map cells (cx, cy) -> (H - 1 - cy, cx), so texel squares land on texel
+     * squares (and blocks on blocks: the frame is whole blocks); (x, y) is in cells */
+    double r0[3] = {it->m[0], it->m[1], it->off[0] - it->lo[0]}, r1[3] = {it->m[2], it->m[3], it->off[1] - it->lo[1]};
     for (int t = 0; t < turn; t++) {
-        double h = it->shape[t].h, n0[3] = {-r1[0], -r1[1], h - r1[2]};
+        double h = (double)it->shape[t].h * it->block, n0[3] = {-r1[0], -r1[1], h - r1[2]};
         memcpy(r1, r0, sizeof r0);
         memcpy(r0, n0, sizeof n0);
     }
@@ -191,14 +191,15 @@ static void placement(const lmb_pack_item *it, int turn, uint32_t x, uint32_t y,
         p->m[k] = r0[k];
         p->m[3 + k] = r1[k];
     }
-    p->m[2] += x;
-    p->m[5] += y;
+    p->m[2] += (double)x * it->block;
+    p->m[5] += (double)y * it->block;
 }
 
 /* The state of one placement run over the sorted items. */
 typedef struct placer {
     const lmb_pack_item *items;
-    uint32_t count, size, width, border;
+    uint32_t count, size, width; /* in cells (texels, or blocks) */
+    uint32_t block;               /* texels per cell side */
     int grouped;
     lmb_atlas *atlases;
     uint32_t atlas_count;
@@ -269,7 +270,8 @@ static lmb_status move_group(placer *p, uint32_t g, lmb_error *err)
     lmb_atlas_widen(&p->atlases[p->atlas_count - 1]);
     if (place_group_in(p, g, p->atlas_count - 1))
         return LMB_OK;
-    return lmb_error_set(err, LMB_ERR_INPUT, "group %u does not fit in one %ux%u atlas", g, p->size, p->size);
+    return lmb_error_set(err, LMB_ERR_INPUT, "group %u does not fit in one %ux%u atlas", g, p->size * p->block,
+                         p->size * p->block);
 }
 
 static lmb_status place_one(placer *p, uint32_t i, lmb_error *err)
@@ -325,9 +327,9 @@ static lmb_status place_all(const lmb_pack_item *items, uint32_t count, uint32_t
     memset(&p, 0, sizeof p);
     p.items = items;
     p.count = count;
-    p.size = opt->max_size;
+    p.block = opt->block > 1 ? opt->block : 1;
+    p.size = opt->max_size / p.block;
     p.width = width;
-    p.border = opt->padding + 1;
     p.grouped = opt->grouped;
     p.where = malloc(((size_t)count + 1) * sizeof *p.where);
     p.px = malloc(((size_t)count + 1) * sizeof *p.px);
@@ -356,12 +358,12 @@ static lmb_status place_all(const lmb_pack_item *items, uint32_t count, uint32_t
             uint32_t a = p.where[i];
             out->width[a] = p.px[i] + m->w > out->width[a] ? p.px[i] + m->w : out->width[a];
             out->height[a] = p.py[i] + m->h > out->height[a] ? p.py[i] + m->h : out->height[a];
-            placement(&items[i], p.turn[i], p.px[i], p.py[i], p.border, a, &out->placements[items[i].chart]);
+            placement(&items[i], p.turn[i], p.px[i], p.py[i], a, &out->placements[items[i].chart]);
         }
         for (uint32_t a = 0; st == LMB_OK && a < na; a++) {
-            uint32_t w = (out->width[a] + 3) / 4 * 4, h = (out->height[a] + 3) / 4 * 4;
-            out->width[a] = w > p.size ? p.size : w;
-            out->height[a] = h > p.size ? p.size : h;
+            uint32_t w = (out->width[a] * p.block + 3) / 4 * 4, h = (out->height[a] * p.block + 3) / 4 * 4;
+            out->width[a] = w > opt->max_size ? opt->max_size : w;
+            out->height[a] = h > opt->max_size ? opt->max_size : h;
         }
     }
     for (uint32_t a = 0; a < p.atlas_count; a++)
@@ -409,7 +411,8 @@ static lmb_status pack_texels(const lmb_pack_chart *charts, uint32_t count, cons
 {
     memset(out, 0, sizeof *out);
     out->failed_group = out->failed_chart = NONE;
-    uint32_t size = opt->max_size, border = opt->padding + 1, prepared = 0, groups = 0;
+    uint32_t block = opt->block > 1 ? opt->block : 1, size = opt->max_size, border = opt->padding + 1;
+    uint32_t cells = size / block, prepared = 0, groups = 0; /* cells: the atlas side in mask cells */
     lmb_pack_item *items = calloc((size_t)count + 1, sizeof *items);
     out->placements = calloc((size_t)count + 1, sizeof *out->placements);
     lmb_status st = (items && out->placements) ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
@@ -425,7 +428,7 @@ static lmb_status pack_texels(const lmb_pack_chart *charts, uint32_t count, cons
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
     for (uint32_t i = 0; i < to_prepare; i++) {
         box[2 * i] = box[2 * i + 1] = 0;
-        ready[i] = lmb_pack_prepare(&charts[i], i, border, size, &items[i], &box[2 * i], &box[2 * i + 1]);
+        ready[i] = lmb_pack_prepare(&charts[i], i, border, block, size, &items[i], &box[2 * i], &box[2 * i + 1]);
     }
     if (st == LMB_OK) /* all are prepared: all are freed at the end */
         prepared = count;
@@ -450,7 +453,7 @@ static lmb_status pack_texels(const lmb_pack_chart *charts, uint32_t count, cons
     }
     free(ready);
     free(box);
-    uint32_t bad = st == LMB_OK && opt->grouped ? oversized_group(items, count, groups, size) : NONE;
+    uint32_t bad = st == LMB_OK && opt->grouped ? oversized_group(items, count, groups, cells) : NONE;
     if (bad != NONE) {
         out->failed_group = bad;
         st = lmb_error_set(err, LMB_ERR_INPUT, "group %u does not fit in one %ux%u atlas (its footprints alone "
@@ -471,7 +474,7 @@ static lmb_status pack_texels(const lmb_pack_chart *charts, uint32_t count, cons
             qsort(items, count, sizeof *items, orders[k / tries]);
         uint32_t width = (uint32_t)ceil(sqrt((double)total * 1.05) * slack[k % tries]);
         width = width < widest ? widest : width;
-        width = width > size ? size : width;
+        width = width > cells ? cells : width;
         lmb_pack_result r;
         memset(&r, 0, sizeof r);
         r.placements = calloc((size_t)count + 1, sizeof *r.placements);
@@ -510,52 +513,12 @@ static lmb_status pack_texels(const lmb_pack_chart *charts, uint32_t count, cons
     return st;
 }
 
-/* Block-aligned packing (opt->block > 1): the charts scaled by 1 / block and packed in block
- * units with a border of one block (at least padding + 1 texels for padding < block), then the
- * placements' translations and the atlas sizes scaled back. A chart's footprint in block units
- * covers every block its texels touch, so no block holds texels of two charts. */
+/* With opt->block > 1 the masks' cells are blocks (footprint.c): charts land on the block grid
+ * and no block holds texels of two charts' records, which stay `padding` texels apart. */
 lmb_status lmb_pack_charts(const lmb_pack_chart *charts, uint32_t count, const lmb_pack_options *opt,
                            lmb_pack_result *out, lmb_error *err)
 {
-    if (opt->block <= 1)
-        return pack_texels(charts, count, opt, out, err);
-    double k = 1.0 / opt->block;
-    size_t triangles = 0;
-    for (uint32_t i = 0; i < count; i++)
-        triangles += charts[i].triangle_count;
-    lmb_pack_chart *scaled = calloc((size_t)count + 1, sizeof *scaled);
-    double *uv = malloc((6 * triangles + 1) * sizeof *uv);
-    if (!scaled || !uv) {
-        free(scaled);
-        free(uv);
-        memset(out, 0, sizeof *out);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "pack: out of memory");
-    }
-    for (uint32_t i = 0, at = 0; i < count; i++) {
-        scaled[i] = charts[i];
-        scaled[i].uv = uv + at;
-        for (uint32_t t = 0; t < 6 * charts[i].triangle_count; t++)
-            uv[at + t] = charts[i].uv[t] * k;
-        at += 6 * charts[i].triangle_count;
-    }
-    lmb_pack_options o = *opt;
-    o.block = 1;
-    o.max_size = opt->max_size / opt->block;
-    o.padding = (opt->padding + 1 + opt->block - 1) / opt->block - 1;
-    lmb_status st = pack_texels(scaled, count, &o, out, err);
-    free(scaled);
-    free(uv);
-    if (st != LMB_OK)
-        return st;
-    for (uint32_t a = 0; a < out->atlas_count; a++) {
-        out->width[a] *= opt->block;
-        out->height[a] *= opt->block;
-    }
-    for (uint32_t i = 0; i < count; i++) {
-        out->placements[i].m[2] *= opt->block;
-        out->placements[i].m[5] *= opt->block;
-    }
-    return LMB_OK;
+    return pack_texels(charts, count, opt, out, err);
 }
 
 uint32_t lmb_pack_block_for(const lmb_config *cfg)

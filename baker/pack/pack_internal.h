@@ -22,18 +22,21 @@ typedef struct lmb_pack_item {
     uint32_t chart;
     uint32_t group;
     double m[4];  /* rotation chart uv -> box frame */
-    double lo[2]; /* rotated bounds: lo placed at (border, border) */
+    double lo[2]; /* rotated bounds: lo placed at off (texels) in the masks' frame */
+    uint32_t off[2];  /* border, plus the sub-block shift with blocks */
+    uint32_t block;   /* mask cells are block x block texels (1: texels) */
     lmb_mask shape[4]; /* footprint dilated by padding + 1, tested against the atlas; k: turned k x 90 degrees */
     lmb_mask occ[4];   /* footprint dilated by 1 (the bilinear reach), what the atlas records */
-    uint64_t area;     /* set texels of shape[0] */
+    uint64_t area;     /* set cells of shape[0] */
     uint64_t shape_hash; /* of shape[0]'s size and bits: identical masks share it */
     uint64_t occ_area; /* set texels of occ[0]: footprints never share one, so their sum bounds an atlas */
 } lmb_pack_item;
 
 /* Returns 1 when ready, 0 when out of memory, 2 when the chart's box (*bw x *bh, padding
- * included) exceeds max_size: checked before any mask is allocated. */
-int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, uint32_t max_size, lmb_pack_item *it,
-                     double *bw, double *bh);
+ * included) exceeds max_size: checked before any mask is allocated. block > 1: the masks'
+ * cells are blocks of block x block texels (every block a texel of the mask touches). */
+int lmb_pack_prepare(const lmb_pack_chart *c, uint32_t index, uint32_t border, uint32_t block, uint32_t max_size,
+                     lmb_pack_item *it, double *bw, double *bh);
 
 void lmb_mask_free(lmb_mask *m);
 

@@ -225,7 +225,7 @@ static int refit(const block_in *b, const fit *f, int r, double x0[3], double x1
 }
 
 /* The line through region r's texels (weighted): endpoints at the extreme projections on the
- * principal axis into x0, x1; returns the weighted squared distance of the texels to the line. */
+ * principal axis of the texels that count into x0, x1; returns the weighted squared distance of the texels to the line. */
 static double region_line(const block_in *b, int regions, int p, int r, double x0[3], double x1[3])
 {
     double mean[3] = {0}, cov[6] = {0}, total = 0;
@@ -260,9 +260,14 @@ static double region_line(const block_in *b, int regions, int p, int r, double x
         for (int c = 0; c < 3; c++)
             axis[c] = v[c] / len;
     }
-    double lo = 1e30, hi = -1e30;
+    /* the extremes over the texels that count (a texel no lookup reads, weighted 1e-3, may hold
+     * a neighbour chart's dilated light: spanning it would coarsen the steps of those that do) */
+    double lo = 1e30, hi = -1e30, wmax = 0;
+    for (int i = 0; i < 16; i++)
+        if (region_of(regions, p, i) == r && b->wt[i] > wmax)
+            wmax = b->wt[i];
     for (int i = 0; i < 16; i++) {
-        if (region_of(regions, p, i) != r || !(b->wt[i] > 0))
+        if (region_of(regions, p, i) != r || !(b->wt[i] > 0) || b->wt[i] < 0.01 * wmax)
             continue;
         double t = 0;
         for (int c = 0; c < 3; c++)

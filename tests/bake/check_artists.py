@@ -103,9 +103,10 @@ def bilinear(img, u, v):
     return out
 
 
-def seam_jumps(charts, images, points=8):
-    """{node: (seam edges, largest relative luminance jump)} over edges two triangles share in
-    world space with different lightmap UVs (found here from the output glTF, not by the baker)."""
+def seam_edge_jumps(charts, images, points=8):
+    """{node: [largest relative luminance jump along each seam edge]} over edges two triangles
+    share in world space with different lightmap UVs (found here from the output glTF, not by
+    the baker)."""
     edges = {}
     for node, tex, tris in charts:
         node = "tiles" if node.startswith("tile") else node  # two instances of one mesh: one surface
@@ -129,9 +130,13 @@ def seam_jumps(charts, images, points=8):
             la = lum(bilinear(images[ta], a0[0] + t * (a1[0] - a0[0]), a0[1] + t * (a1[1] - a0[1])))
             lb = lum(bilinear(images[tb], b0[0] + t * (b1[0] - b0[0]), b0[1] + t * (b1[1] - b0[1])))
             worst = max(worst, abs(la - lb) / (0.5 * (la + lb)))
-        n, w = result.get(node, (0, 0.0))
-        result[node] = (n + 1, max(w, worst))
+        result.setdefault(node, []).append(worst)
     return result
+
+
+def seam_jumps(charts, images, points=8):
+    """{node: (seam edges, largest relative luminance jump)} (seam_edge_jumps)."""
+    return {node: (len(j), max(j)) for node, j in seam_edge_jumps(charts, images, points).items()}
 
 
 def lum(c):
