@@ -11,6 +11,7 @@ baked at the defaults once per KTX2 format. Per format and scene:
   packed ones by tests/ktx2/read_ktx2.mjs);
   the luminance jump across seams at each sample, as tests/bake/check_artists.py measures it, over
   edges between triangles that turn by less than 20 degrees (seams across one smooth surface),
+  at samples whose two sides read a chart's texels (not faces nothing sees, which have none),
   on the decoded lightmap and on the EXR: the largest growth over the EXR's is what the
   compression adds (the largest jump itself can be the light's own: a shadow edge on a seam).
 LMB_BENCH_REUSE=1 measures an earlier run's bakes again (their times kept in bench-times.json).
@@ -64,11 +65,21 @@ def bake(lmbake, work, scene, name, fmt):
     return out, seconds, encode
 
 
-def smooth_seam_jumps(charts, images, max_degrees=20.0, points=8):
+def reads_chart(mask, u, v):
+    """Whether a bilinear lookup at (u, v) reads a texel a chart covers (mask: valid or inside
+    geometry). A face nothing can see (skipped: atlas.skip_hidden) has no texels of its own: its
+    lookups read padding, which no one sees."""
+    h, w = mask.shape
+    x, y = int(np.floor(u * w - 0.5)), int(np.floor(v * h - 0.5))
+    return bool(mask[np.clip([y, y, y + 1, y + 1], 0, h - 1), np.clip([x, x + 1, x, x + 1], 0, w - 1)].any())
+
+
+def smooth_seam_jumps(charts, images, masks=None, max_degrees=20.0, points=8):
     """The relative luminance jump at every sample across seams, as tests/bake/check_artists.py measures
     it (bilinear lookups at 8 points along every edge two triangles share with different lightmap
     UVs), over the edges whose two triangles turn by less than max_degrees: seams across one
-    smooth surface, not the corners where a wall meets the floor (a real edge of the light)."""
+    smooth surface, not the corners where a wall meets the floor (a real edge of the light). With
+    masks (per texture, chart texels), samples where a side reads no chart texel are left out."""
     def normal(t):
         a, b, c = (np.array(p) for p in t)
         n = np.cross(b - a, c - a)
@@ -95,8 +106,12 @@ def smooth_seam_jumps(charts, images, max_degrees=20.0, points=8):
             continue  # one chart
         for k in range(points):
             t = (k + 0.5) / points
-            la = check_artists.lum(check_artists.bilinear(images[ta], a0[0] + t * (a1[0] - a0[0]), a0[1] + t * (a1[1] - a0[1])))
-            lb = check_artists.lum(check_artists.bilinear(images[tb], b0[0] + t * (b1[0] - b0[0]), b0[1] + t * (b1[1] - b0[1])))
+            ua, va = a0[0] + t * (a1[0] - a0[0]), a0[1] + t * (a1[1] - a0[1])
+            ub, vb = b0[0] + t * (b1[0] - b0[0]), b0[1] + t * (b1[1] - b0[1])
+            if masks is not None and not (reads_chart(masks[ta], ua, va) and reads_chart(masks[tb], ub, vb)):
+                continue
+            la = check_artists.lum(check_artists.bilinear(images[ta], ua, va))
+            lb = check_artists.lum(check_artists.bilinear(images[tb], ub, vb))
             jumps.append(abs(la - lb) / (0.5 * (la + lb)) if la + lb > 0 else 0.0)
     return np.array(jumps)
 
@@ -105,13 +120,15 @@ def measure(out, work):
     """Per atlas decoded, errors pooled over atlases, seam jumps."""
     doc = json.load(open(os.path.join(out, [f for f in os.listdir(out) if f.endswith(".gltf")][0])))
     charts, exrs = ca.load_output(out)
-    decoded, refs, masks, gpu, disk, texels = {}, [], [], 0, 0, 0
+    decoded, charted, refs, gpu, disk, texels = {}, {}, [], 0, 0, 0
     for ti in exrs:
         stem = os.path.join(out, doc["images"][doc["textures"][ti]["source"]]["uri"][:-4])
         info, got = kb.decode(stem + ".ktx2", work)
         decoded[ti] = got
         ref = np.asarray(exrs[ti], dtype=np.float64)[..., :3]
-        mask = np.asarray(oiio.ImageBuf(stem + "-mask.png").get_pixels(oiio.FLOAT))[..., 0] > 0.99
+        states = np.asarray(oiio.ImageBuf(stem + "-mask.png").get_pixels(oiio.FLOAT))[..., 0]
+        mask = states > 0.99
+        charted[ti] = states > 0.25  # valid or inside geometry
         refs.append((ref, got, mask))
         gpu += sum(lv["uncompressed"] for lv in info["levels"])
         disk += os.path.getsize(stem + ".ktx2")
@@ -123,8 +140,8 @@ def measure(out, work):
     mean9 = sum(p[2] * p[5] for p in per) / max(n9, 1)
     p99 = max(p[1] for p in per)
     p99_9 = max(p[3] for p in per)
-    jumps = smooth_seam_jumps(charts, decoded)
-    jumps_exr = smooth_seam_jumps(charts, exrs)
+    jumps = smooth_seam_jumps(charts, decoded, charted)
+    jumps_exr = smooth_seam_jumps(charts, exrs, charted)
     jump = float(jumps.max()) if jumps.size else 0.0
     jump_exr = float(jumps_exr.max()) if jumps_exr.size else 0.0
     # what the compression adds: the largest growth of a sample's jump over the EXR's

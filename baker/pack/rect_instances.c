@@ -289,7 +289,7 @@ lmb_status lmb_layout_rect_instances(const lmb_scene *s, const lmb_config *cfg, 
             }
         }
         lmb_rect_result_free(&r);
-        st = lmb_place_rects(items, n, cfg->padding, cfg->max_atlas_size, &r, err);
+        st = lmb_place_rects(items, n, cfg->padding, lmb_pack_block_for(cfg), cfg->max_atlas_size, &r, err);
         if (st != LMB_ERR_INPUT || !l->density.automatic || attempt >= 24 || r.failed_group >= ng)
             break;
         group *g = &groups[r.failed_group];

@@ -19,33 +19,40 @@ typedef struct shelf_state {
     uint32_t cx, cy, shelf, used_w; /* cursor, current shelf's height, widest row so far */
 } shelf_state;
 
+/* x rounded up to a multiple of block */
+static uint32_t on_grid(uint32_t x, uint32_t block)
+{
+    return (x + block - 1) / block * block;
+}
+
 /* Places items order[from..to) (one group) from state s in an atlas W wide and max_size high;
  * 0 if one does not fit (s is then unspecified). */
 static int place_group(const lmb_rect_item *items, const uint32_t *order, uint32_t from, uint32_t to, uint32_t W,
-                       uint32_t max_size, uint32_t padding, shelf_state *s, uint32_t *x, uint32_t *y)
+                       uint32_t max_size, uint32_t padding, uint32_t block, shelf_state *s, uint32_t *x, uint32_t *y)
 {
     for (uint32_t j = from; j < to; j++) {
         const lmb_rect_item *it = &items[order[j]];
         if (it->w > W || it->h > max_size)
             return 0;
         if (s->cx > 0 && s->cx + it->w > W) { /* next shelf */
-            s->cy += s->shelf + padding;
+            s->cy = on_grid(s->cy + s->shelf + padding, block);
             s->cx = s->shelf = 0;
         }
         if (s->cy + it->h > max_size)
             return 0;
         x[order[j]] = s->cx;
         y[order[j]] = s->cy;
-        s->cx += it->w + padding;
+        s->used_w = s->cx + it->w > s->used_w ? s->cx + it->w : s->used_w;
+        s->cx = on_grid(s->cx + it->w + padding, block);
         s->shelf = it->h > s->shelf ? it->h : s->shelf;
-        s->used_w = s->cx - padding > s->used_w ? s->cx - padding : s->used_w;
     }
     return 1;
 }
 
-lmb_status lmb_place_rects(const lmb_rect_item *items, uint32_t n, uint32_t padding, uint32_t max_size,
-                           lmb_rect_result *out, lmb_error *err)
+lmb_status lmb_place_rects(const lmb_rect_item *items, uint32_t n, uint32_t padding, uint32_t block,
+                           uint32_t max_size, lmb_rect_result *out, lmb_error *err)
 {
+    block = block > 1 ? block : 1;
     memset(out, 0, sizeof *out);
     out->failed_group = UINT32_MAX;
     uint32_t *order = malloc(((size_t)n + 1) * sizeof *order);
@@ -83,7 +90,7 @@ lmb_status lmb_place_rects(const lmb_rect_item *items, uint32_t n, uint32_t padd
         while (to < n && items[order[to]].group == items[order[from]].group)
             to++;
         shelf_state saved = s;
-        if (!place_group(items, order, from, to, W, max_size, padding, &s, out->x, out->y)) {
+        if (!place_group(items, order, from, to, W, max_size, padding, block, &s, out->x, out->y)) {
             int empty = saved.cx == 0 && saved.cy == 0;
             s = (shelf_state){0, 0, 0, 0};
             if (!empty) { /* close the atlas, retry in a new one */
@@ -91,7 +98,7 @@ lmb_status lmb_place_rects(const lmb_rect_item *items, uint32_t n, uint32_t padd
                 out->height[a] = saved.cy + saved.shelf;
                 a++;
             }
-            if (!place_group(items, order, from, to, W, max_size, padding, &s, out->x, out->y)) {
+            if (!place_group(items, order, from, to, W, max_size, padding, block, &s, out->x, out->y)) {
                 out->failed_group = items[order[from]].group;
                 st = lmb_error_set(err, LMB_ERR_INPUT, "rectangles of group %u do not fit one %ux%u atlas",
                                    out->failed_group, max_size, max_size);

@@ -23,11 +23,13 @@ typedef struct lmb_rect_result {
 } lmb_rect_result;
 
 /* Places items (grouped runs in the order given; within a group largest first) on shelves
- * `padding` texels apart in atlases of at most max_size a side. A group that does not fit
+ * `padding` texels apart in atlases of at most max_size a side; with block > 1 every item's
+ * corner on the block grid and the gaps rounded up to it (no block holds two items: a
+ * block-compressed lightmap's copies are encoded apart, as pack.h's charts are). A group that does not fit
  * what is left of the current atlas starts a new one; one that does not fit an empty atlas is
  * LMB_ERR_INPUT (out->failed_group). Free out with lmb_rect_result_free, also after an error. */
-lmb_status lmb_place_rects(const lmb_rect_item *items, uint32_t n, uint32_t padding, uint32_t max_size,
-                           lmb_rect_result *out, lmb_error *err);
+lmb_status lmb_place_rects(const lmb_rect_item *items, uint32_t n, uint32_t padding, uint32_t block,
+                           uint32_t max_size, lmb_rect_result *out, lmb_error *err);
 void lmb_rect_result_free(lmb_rect_result *r);
 
 #endif

@@ -254,10 +254,10 @@ uint8_t *lmb_ktx2_lookup_texels(const uint8_t *state, uint32_t w, uint32_t h)
     uint8_t *care = calloc((size_t)w * h + 1, 1);
     for (uint32_t y = 0; care && y < h; y++)
         for (uint32_t x = 0; x < w; x++) {
-            if (state[(size_t)y * w + x] != LMB_TEXEL_VALID)
+            if (state[(size_t)y * w + x] == LMB_TEXEL_EMPTY)
                 continue;
-            for (uint32_t yy = y ? y - 1 : 0; yy <= y + 1 && yy < h; yy++)
-                for (uint32_t xx = x ? x - 1 : 0; xx <= x + 1 && xx < w; xx++)
+            for (uint32_t yy = y > 1 ? y - 2 : 0; yy <= y + 2 && yy < h; yy++)
+                for (uint32_t xx = x > 1 ? x - 2 : 0; xx <= x + 2 && xx < w; xx++)
                     care[(size_t)yy * w + xx] = 1;
         }
     return care;

@@ -60,8 +60,10 @@ lmb_status lmb_ktx2_encode(uint32_t w, uint32_t h, const float *rgb, const lmb_k
 lmb_status lmb_ktx2_encode_3d(uint32_t w, uint32_t h, uint32_t d, const float *rgb, const lmb_ktx2_options *o,
                               uint8_t **out, size_t *size, lmb_ktx2_report *report, lmb_error *err);
 
-/* The texels a bilinear lookup at a surface point reads, from an atlas's texel states: the
- * valid texels and their 8 neighbours (w x h, 1 or 0; malloc'd, NULL when out of memory).
+/* The texels a bilinear lookup at a surface point reads, from an atlas's texel states: every
+ * texel within 2 (Chebyshev) of a chart's texel, valid or inside geometry (w x h, 1 or 0;
+ * malloc'd, NULL when out of memory). Two, not one: a chart's edge can cross texels that hold
+ * no gather point (empty, filled by dilation), and a lookup on that edge reads one further.
  * Block encoders spend their precision on these (lmb_ktx2_options.care). */
 uint8_t *lmb_ktx2_lookup_texels(const uint8_t *state, uint32_t w, uint32_t h);
 

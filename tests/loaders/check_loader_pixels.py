@@ -17,6 +17,8 @@ pixel, relative: against the file the page read, mean 0.1% (the .hdr: 0.5%, RGBE
 differ by half a mantissa step) and 99th percentile 1% (the GPU's bilinear weights are 8-bit
 fixed point); against the EXR, the file's own precision on top
 (E5B9G9R9 0.4%, .hdr 1%, BC6H and ASTC their mean error, docs/output.md): mean within 2%.
+Then per-copy rectangles (instanced(): 16 copies through EXT_mesh_gpu_instancing, both pages
+against their files and against each other) and Babylon's probe-lit sphere (probe_light()).
 """
 import json
 import os
@@ -63,17 +65,22 @@ def relative(got, want):
     return np.abs(got - want).sum(axis=1)[keep] / s[keep]
 
 
-def check(work, out, loader, fmt):
-    probe_file = os.path.join(work, "%s-%s.json" % (loader, fmt))
-    subprocess.run(["node", os.path.join(HERE, "loader_pixels.mjs"), loader, os.path.join(out, "CornellBox.gltf"),
-                    probe_file], check=True, env=dict(os.environ, NODE_PATH=os.path.join(ROOT, "node_modules")))
-    p = json.load(open(probe_file))
+def run_page(work, gltf, loader, tag, *extra):
+    probe_file = os.path.join(work, "%s-%s.json" % (loader, tag))
+    subprocess.run(["node", os.path.join(HERE, "loader_pixels.mjs"), loader, gltf, probe_file, "ktx2"] + list(extra),
+                   check=True, env=dict(os.environ, NODE_PATH=os.path.join(ROOT, "node_modules")))
+    return json.load(open(probe_file))
+
+
+def check(work, out, stem_name, loader, fmt, tag):
+    """One page on one bake against the file it read and the EXR; returns (ok, uv, lit)."""
+    p = run_page(work, os.path.join(out, stem_name + ".gltf"), loader, tag)
     value = np.array(p["value"], dtype=np.float64).reshape(-1, 4)
     uv = np.array(p["uv"], dtype=np.float64).reshape(-1, 4)
     lit = (uv[:, 3] > 0.5) & (value[:, 3] > 0.5)
     report = " ".join(p["logs"])
-    used_ktx2 = "from CornellBox-lightmap-0.ktx2" in report
-    stem = os.path.join(out, "CornellBox-lightmap-0")
+    used_ktx2 = ("from %s-lightmap-0.ktx2" % stem_name) in report
+    stem = os.path.join(out, stem_name + "-lightmap-0")
     ref_file = kb.decode(stem + ".ktx2", work)[1] if used_ktx2 else read_image(stem + ".hdr")
     exr = read_image(stem + ".exr")
     u, v = uv[lit, 0], uv[lit, 1]
@@ -93,13 +100,67 @@ def check(work, out, loader, fmt):
         problems.append("pixels off the file they read")
     if not rel_exr.mean() <= 0.02:
         problems.append("pixels off the EXR")
-    print("%s, %-9s: %d pixels from %s; against it mean %.4f%% p99 %.3f%% (bounds %g%%, 1%%); against the EXR "
-          "mean %.3f%% p99 %.2f%% (bound 2%%): %s" % (loader, fmt, lit.sum(), "the KTX2" if used_ktx2 else "the .hdr",
+    print("%s, %-9s %s: %d pixels from %s; against it mean %.4f%% p99 %.3f%% (bounds %g%%, 1%%); against the EXR "
+          "mean %.3f%% p99 %.2f%% (bound 2%%): %s" % (loader, fmt, stem_name, lit.sum(),
+                                                       "the KTX2" if used_ktx2 else "the .hdr",
                                                        100 * rel_file.mean(), 100 * np.percentile(rel_file, 99),
                                                        100 * mean_bound, 100 * rel_exr.mean(),
                                                        100 * np.percentile(rel_exr, 99),
                                                        "ok" if not problems else "FAIL: " + "; ".join(problems)), flush=True)
-    return not problems
+    return not problems, uv, lit
+
+
+def bake(lmbake, scene, out, cfg, text):
+    with open(cfg, "w") as f:
+        f.write(text)
+    subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "-q"], check=True)
+
+
+def instanced(lmbake, work, loaders):
+    """Per-copy rectangles (EXT_mesh_gpu_instancing): 16 copies of a prop on a ground, BC6H. Each
+    page against its files as above, and the two pages against each other: the same camera on
+    the same level, so each pixel lit in both has the same lightmap coordinates, in the copy's own
+    rectangle (a page that gave every copy the first copy's rectangle, or none, would differ by
+    whole rectangles)."""
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_levels.py"), work, "gpu:16"], check=True,
+                   stdout=subprocess.DEVNULL)
+    out, name = os.path.join(work, "out-instanced"), "level-gpu-16"
+    bake(lmbake, os.path.join(work, name + ".glb"), out, os.path.join(work, "instanced.yaml"),
+         "bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\natlas: {texels: 60000}\n"
+         "output: {formats: [exr, ktx2], directional: false, ktx2_format: bc6h, ktx2_supercompression: none}\n")
+    ok, uvs = True, {}
+    for loader in loaders:
+        good, uv, lit = check(work, out, name, loader, "bc6h", "instanced")
+        ok &= good
+        uvs[loader] = (uv, lit)
+    if len(uvs) == 2:
+        (ua, la), (ub, lb) = uvs.values()
+        h, w = read_image(os.path.join(out, name + "-lightmap-0.exr")).shape[:2]
+        both = la & lb
+        texels = np.hypot((ua[both, 0] - ub[both, 0]) * w, (ua[both, 1] - ub[both, 1]) * h)
+        agree = both.sum() / max(1, (la | lb).sum())
+        good = agree >= 0.9 and np.median(texels) <= 0.5 and np.percentile(texels, 90) <= 1.0
+        ok &= good
+        print("instanced %s: %d pixels lit in both pages (%.1f%% of those lit in either; bound 90%%); lightmap "
+              "coordinates apart by median %.3f texels, p90 %.3f, p99 %.2f (bounds 0.5, 1): %s"
+              % (" vs ".join(uvs), both.sum(), 100 * agree, np.median(texels), np.percentile(texels, 90),
+                 np.percentile(texels, 99), "ok" if good else "FAIL"), flush=True)
+    return ok
+
+
+def probe_light(work, out):
+    """Babylon's probe-lit sphere (lmbake-babylon-probes: a spherical polynomial on the sphere's
+    reflection texture) against lmbake-probes' irradiance at each pixel's normal, at the probes'
+    centroid, halfway to the farthest probe and at that probe: within 1% per pixel, 0.1% mean."""
+    p = run_page(work, os.path.join(out, "CornellBox.gltf"), "babylon", "probe-light", "--probe-light")
+    ok = True
+    for s in p["spheres"]:
+        good = s["pixels"] > 2000 and s["worst"] <= 0.01 and s["mean"] <= 0.001
+        ok &= good
+        print("babylon probe light at (%.3f, %.3f, %.3f): %d pixels, irradiance against lmbake-probes' worst %.4f%% "
+              "mean %.5f%% (bounds 1%%, 0.1%%): %s" % (tuple(s["point"]) + (s["pixels"], 100 * s["worst"],
+                                                         100 * s["mean"], "ok" if good else "FAIL")), flush=True)
+    return ok
 
 
 def main():
@@ -108,17 +169,20 @@ def main():
     ok = True
     for fmt, sc in FORMATS.items():
         out = os.path.join(work, "out-" + fmt)
-        cfg = os.path.join(work, fmt + ".yaml")
-        with open(cfg, "w") as f:
-            # the loaders are checked, not the light: one bounce, few rays
-            f.write("bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\natlas: {texels: 60000}\n"
-                    "output: {formats: [exr, ktx2], directional: "
-                    "false, ktx2_format: %s, ktx2_supercompression: %s}\n" % (fmt, sc))
-        subprocess.run([lmbake, "bake", SCENE, "-c", cfg, "-o", out, "-q"], check=True)
+        # the loaders are checked, not the light: one bounce, few rays; the E5B9G9R9 bake (which
+        # Babylon reads as the .hdr, covered by the ASTC bake) carries the probes for Babylon's
+        probes = "{auto: true}" if fmt == "e5b9g9r9" and "babylon" in loaders else "{auto: false}"
+        bake(lmbake, SCENE, out, os.path.join(work, fmt + ".yaml"),
+             "bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: %s\natlas: {texels: 60000}\n"
+             "output: {formats: [exr, ktx2], directional: false, ktx2_format: %s, ktx2_supercompression: %s}\n"
+             % (probes, fmt, sc))
         for loader in loaders:
             if (loader, fmt) in SKIP:
                 continue
-            ok &= check(work, out, loader, fmt)
+            ok &= check(work, out, "CornellBox", loader, fmt, fmt)[0]
+        if probes != "{auto: false}":
+            ok &= probe_light(work, out)
+    ok &= instanced(lmbake, work, loaders)
     sys.exit(0 if ok else 1)
 
 

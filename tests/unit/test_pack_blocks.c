@@ -6,12 +6,15 @@
  * and their 8 neighbours: what bilinear filtering reads), and two charts' records stay more
  * than `padding` texels apart, as without blocks. Also: the block grid's atlas area against
  * the texel grid's, within a bound measured here (small charts cost the most: a chart 3 texels
- * wide spans 2 blocks with its neighbours' reach).
+ * wide spans 2 blocks with its neighbours' reach). And instanced copies' rectangles
+ * (rects.h) on the block grid: corners on it, no block shared by two rectangles, at least
+ * `padding` texels apart.
  */
 #include "check.h"
 
 #include "../support/meshgen.h"
 #include "pack/pack.h"
+#include "pack/rects.h"
 #include "unwrap/unwrap.h"
 
 #include <math.h>
@@ -191,8 +194,43 @@ static int gen_quads(gen_mesh *m, uint32_t n, float side)
     return 0;
 }
 
+/* 40 rectangles of assorted sizes (whole blocks and not: copies at other scales) placed with
+ * padding 2 on the 4 x 4 grid. */
+static void rects_on_blocks(void)
+{
+    lmb_rect_item items[40];
+    for (uint32_t i = 0; i < 40; i++)
+        items[i] = (lmb_rect_item){8 + 4 * (i % 5) + (i % 3 == 2 ? 3 : 0), 12 + 4 * (i % 4) + (i % 7 == 3 ? 1 : 0),
+                                   i / 10};
+    lmb_rect_result r;
+    lmb_error err;
+    CHECK_INT(lmb_place_rects(items, 40, 2, 4, 256, &r, &err), LMB_OK);
+    uint32_t off_grid = 0, shared = 0, close = 0;
+    for (uint32_t i = 0; i < 40; i++) {
+        off_grid += r.x[i] % 4 != 0 || r.y[i] % 4 != 0;
+        for (uint32_t j = i + 1; j < 40; j++) {
+            if (r.atlas[i] != r.atlas[j])
+                continue;
+            /* blocks each covers: [x / 4, ceil((x + w) / 4)) */
+            int bx = r.x[i] / 4 < (r.x[j] + items[j].w + 3) / 4 && r.x[j] / 4 < (r.x[i] + items[i].w + 3) / 4;
+            int by = r.y[i] / 4 < (r.y[j] + items[j].h + 3) / 4 && r.y[j] / 4 < (r.y[i] + items[i].h + 3) / 4;
+            shared += bx && by;
+            int gx = r.x[i] < r.x[j] + items[j].w + 2 && r.x[j] < r.x[i] + items[i].w + 2;
+            int gy = r.y[i] < r.y[j] + items[j].h + 2 && r.y[j] < r.y[i] + items[i].h + 2;
+            close += gx && gy;
+        }
+    }
+    printf("rectangles on blocks: %u atlases; off the grid %u, pairs sharing a block %u, pairs closer than the "
+           "padding %u\n", r.atlas_count, off_grid, shared, close);
+    CHECK_INT(off_grid, 0);
+    CHECK_INT(shared, 0);
+    CHECK_INT(close, 0);
+    lmb_rect_result_free(&r);
+}
+
 int main(void)
 {
+    rects_on_blocks();
     gen_mesh g;
     /* bounds: the block grid's area over the texel grid's at these densities, measured with
      * some margin (docs/unwrap.md#block-compressed-atlases) */

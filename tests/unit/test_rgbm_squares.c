@@ -60,7 +60,7 @@ static void test_rects(void)
     const uint32_t n = 7, pad = 2, max = 128;
     lmb_rect_result r;
     lmb_error err;
-    CHECK_INT(lmb_place_rects(items, n, pad, max, &r, &err), LMB_OK);
+    CHECK_INT(lmb_place_rects(items, n, pad, 1, max, &r, &err), LMB_OK);
     CHECK(r.atlas_count >= 2); /* two 100s cannot share a 128 atlas */
     for (uint32_t i = 0; i < n; i++) {
         CHECK(r.atlas[i] < r.atlas_count);
@@ -81,7 +81,7 @@ static void test_rects(void)
     lmb_rect_result_free(&r);
     /* a group larger than an atlas: refused, naming it */
     const lmb_rect_item big[3] = {{10, 10, 0}, {100, 100, 1}, {100, 100, 1}};
-    CHECK_INT(lmb_place_rects(big, 3, pad, max, &r, &err), LMB_ERR_INPUT);
+    CHECK_INT(lmb_place_rects(big, 3, pad, 1, max, &r, &err), LMB_ERR_INPUT);
     CHECK_INT(r.failed_group, 1);
     lmb_rect_result_free(&r);
 }
