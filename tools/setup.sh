@@ -56,8 +56,9 @@ fi
 
 # npm pieces (package.json): the Khronos glTF validator and ktx-parse (an independent KTX2 reader) for the
 # tests, three.js and playwright-core for the preview, xatlasjs for the unwrap benchmark, glTF-Transform's
-# CLI and gltfpack for the optimised-level test's inputs, Babylon.js for lmbake-babylon's test
-if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ] || [ ! -d node_modules/xatlasjs ] || [ ! -d node_modules/@gltf-transform/cli ] || [ ! -d node_modules/gltfpack ] || [ ! -d node_modules/@babylonjs/core ] || [ ! -d node_modules/@babylonjs/loaders ]; then
+# CLI and gltfpack for the optimised-level test's inputs, Babylon.js for lmbake-babylon's test, lmbake-probes
+# (loaders/probes, linked) for the engine modules
+if [ ! -d node_modules/gltf-validator ] || [ ! -d node_modules/three ] || [ ! -d node_modules/playwright-core ] || [ ! -d node_modules/ktx-parse ] || [ ! -d node_modules/xatlasjs ] || [ ! -d node_modules/@gltf-transform/cli ] || [ ! -d node_modules/gltfpack ] || [ ! -d node_modules/@babylonjs/core ] || [ ! -d node_modules/@babylonjs/loaders ] || [ ! -e node_modules/lmbake-probes ]; then
   echo "setup: installing npm packages (package.json)"
   npm install --no-audit --no-fund --silent >/dev/null 2>&1 || { echo "setup: npm install failed"; exit 1; }
 fi

@@ -13,14 +13,19 @@
 // Babylon adds a lightmap to a PBR material's final colour as it is (radiance), where a
 // diffuse surface under irradiance E shows albedo / pi x E: the texture's level is intensity / pi
 // and a material plugin multiplies the lightmap by the surface's diffuse albedo.
-// Not read: the per-copy rectangles of EXT_mesh_gpu_instancing (Babylon's extension makes thin
-// instances without custom attributes): bake such levels with atlas.share_meshes false.
+// Light probes (asset.extras.lightmap.probes): read with the level, kept on the root mesh's
+// metadata (lmbakeProbes(result.meshes[0])); lmbake-babylon-probes.js lights meshes by them.
+// Per-copy rectangles: a node with EXT_mesh_gpu_instancing whose attributes hold _LIGHTMAP_SCALE
+// and _LIGHTMAP_OFFSET (VEC2, one per copy; docs/output.md) has its copies (Babylon's thin
+// instances) read the atlas at TEXCOORD_1 x scale_k + offset_k: a thin-instance buffer
+// lmbLightmapRect and a vertex plugin that recomputes the lightmap coordinates (WebGL's GLSL).
 import { Texture } from '@babylonjs/core/Materials/Textures/texture.js';
 import { RawTexture } from '@babylonjs/core/Materials/Textures/rawTexture.js';
 import { MaterialPluginBase } from '@babylonjs/core/Materials/materialPluginBase.js';
 import { RGBE_ReadHeader, RGBE_ReadPixels } from '@babylonjs/core/Misc/HighDynamicRange/hdr.js';
-import { GLTFLoader } from '@babylonjs/loaders/glTF/2.0/glTFLoader.js';
+import { GLTFLoader, ArrayItem } from '@babylonjs/loaders/glTF/2.0/glTFLoader.js';
 import { registerGLTFExtension, unregisterGLTFExtension } from '@babylonjs/loaders/glTF/2.0/glTFLoaderExtensionRegistry.js';
+import { loadProbes } from './lmbake-babylon-probes.js';
 
 const NAME = 'MOZ_lightmap';
 const TEXTUREFORMAT_RGBA = 5, TEXTURETYPE_HALF_FLOAT = 2, BILINEAR = 2;
@@ -41,6 +46,44 @@ class LightmapTimesAlbedo extends MaterialPluginBase {
   getCustomCode(shaderType) {
     if (shaderType !== 'fragment') return null;
     return { CUSTOM_FRAGMENT_BEFORE_FINALCOLORCOMPOSITION: '#if defined(LIGHTMAP) && defined(LMBAKE_LIGHTMAP)\nlightmapColor.rgb *= surfaceAlbedo;\n#endif\n' };
+  }
+}
+
+// The per-copy rectangle attribute: (scale u, scale v, offset u, offset v) per thin instance.
+export const INSTANCE_RECT = 'lmbLightmapRect';
+const INSTANCE_RECT_SOURCES = ['_LIGHTMAP_SCALE', '_LIGHTMAP_OFFSET'];
+
+const hasRects = (mesh) => !!(mesh && mesh._userThinInstanceBuffersStorage && mesh._userThinInstanceBuffersStorage.data[INSTANCE_RECT]);
+
+// Makes a thin-instanced mesh's copies read the lightmap at their own rectangles: the lightmap
+// coordinates (TEXCOORD_1, Babylon's uv2) x scale + offset, then the texture's matrix as Babylon
+// applies it (LIGHTMAPDIRECTUV 0), or as the coordinates themselves (LIGHTMAPDIRECTUV 2: the
+// lightmap reads vMainUV2, so other textures on TEXCOORD_1 of such a mesh move with it).
+class InstanceRectangles extends MaterialPluginBase {
+  constructor(material) {
+    super(material, 'LmbakeInstanceRectangles', 210, { LMBAKE_INSTANCE_RECT: false });
+    this._enable(true);
+  }
+
+  prepareDefines(defines, scene, mesh) { defines.LMBAKE_INSTANCE_RECT = hasRects(mesh); }
+
+  getAttributes(attributes, scene, mesh) { if (hasRects(mesh)) attributes.push(INSTANCE_RECT); }
+
+  getClassName() { return 'LmbakeInstanceRectangles'; }
+
+  getCustomCode(shaderType) {
+    if (shaderType !== 'vertex') return null;
+    return {
+      CUSTOM_VERTEX_DEFINITIONS: `#if defined(LMBAKE_INSTANCE_RECT) && defined(THIN_INSTANCES)\nattribute vec4 ${INSTANCE_RECT};\n#endif\n`,
+      CUSTOM_VERTEX_MAIN_END: `#if defined(LMBAKE_INSTANCE_RECT) && defined(THIN_INSTANCES) && defined(LIGHTMAP) && defined(UV2)
+#if LIGHTMAPDIRECTUV == 0
+vLightmapUV = vec2(lightmapMatrix * vec4(uv2Updated * ${INSTANCE_RECT}.xy + ${INSTANCE_RECT}.zw, 1.0, 0.0));
+#elif LIGHTMAPDIRECTUV == 2
+vMainUV2 = uv2Updated * ${INSTANCE_RECT}.xy + ${INSTANCE_RECT}.zw;
+#endif
+#endif
+`,
+    };
   }
 }
 
@@ -90,6 +133,7 @@ class MozLightmap {
       const tex = new Texture(null, this._loader.babylonScene, { noMipmap: true, invertY: false, samplingMode: BILINEAR, internalTexture: internal });
       tex.name = base.name;
       tex.wrapU = tex.wrapV = Texture.CLAMP_ADDRESSMODE;
+      tex.anisotropicFilteringLevel = 1; // bilinear, as baked: Babylon's default 4 taps across charts at grazing views
       const tt = ext.extensions && ext.extensions.KHR_texture_transform;
       tex.coordinatesIndex = (tt && tt.texCoord) ?? ext.texCoord ?? 1;
       tex.uRotationCenter = 0;
@@ -101,6 +145,40 @@ class MozLightmap {
       babylonMaterial.useLightmapAsShadowmap = false;
       if (!babylonMaterial.pluginManager || !babylonMaterial.pluginManager.getPlugin('LmbakeLightmapTimesAlbedo')) new LightmapTimesAlbedo(babylonMaterial);
     });
+  }
+
+  // After every node is made (Babylon's EXT_mesh_gpu_instancing has set the copies' matrices),
+  // before the load resolves: the light probes onto the root mesh's metadata, the per-copy
+  // rectangles onto the thin-instanced meshes.
+  async onReady() {
+    const json = this._loader.gltf, root = this._loader.rootBabylonMesh;
+    const probes = await loadProbes(this._loader);
+    if (probes && root) {
+      root.metadata = { ...(root.metadata || {}), lmbake: { probes } };
+      console.log(`lmbake-babylon: ${probes.count} light probes (lmbakeProbes(root))`);
+    }
+    for (const node of json.nodes || []) {
+      const ext = node.extensions && node.extensions.EXT_mesh_gpu_instancing, attrs = ext && ext.attributes;
+      if (!attrs || INSTANCE_RECT_SOURCES.every((k) => attrs[k] === undefined)) continue;
+      const context = `/nodes/${node.index}/extensions/EXT_mesh_gpu_instancing/attributes`;
+      if (INSTANCE_RECT_SOURCES.some((k) => attrs[k] === undefined)) throw new Error(`${context}: ${INSTANCE_RECT_SOURCES.join(' and ')} come together`);
+      const [scale, offset] = await Promise.all(INSTANCE_RECT_SOURCES.map((k) => {
+        const accessor = ArrayItem.Get(`${context}/${k}`, json.accessors, attrs[k]);
+        if (accessor.type !== 'VEC2') throw new Error(`${context}/${k}: accessor ${attrs[k]} is ${accessor.type}, not VEC2`);
+        return this._loader._loadFloatAccessorAsync(`/accessors/${accessor.index}`, accessor);
+      }));
+      const count = scale.length / 2;
+      if (offset.length !== scale.length) throw new Error(`${context}: ${count} scales and ${offset.length / 2} offsets`);
+      const rect = new Float32Array(4 * count);
+      for (let i = 0; i < count; i++) rect.set([scale[2 * i], scale[2 * i + 1], offset[2 * i], offset[2 * i + 1]], 4 * i);
+      for (const mesh of node._primitiveBabylonMeshes || []) {
+        if (mesh.thinInstanceCount !== count) throw new Error(`${context}: ${count} rectangles for ${mesh.thinInstanceCount} copies of '${mesh.name}'`);
+        mesh.thinInstanceSetBuffer(INSTANCE_RECT, rect, 4, true);
+        const m = mesh.material;
+        if (m && m.lightmapTexture && !(m.pluginManager && m.pluginManager.getPlugin('LmbakeInstanceRectangles'))) new InstanceRectangles(m);
+      }
+      console.log(`lmbake-babylon: node ${node.index}: ${count} copies at their own lightmap rectangles`);
+    }
   }
 
   _lightmap(context, index) {
@@ -156,6 +234,7 @@ class MozLightmap {
     }
     if (!texture) throw new Error(`${context}: lightmap texture ${index} has neither a BC6H KTX2 this GPU reads nor a .hdr`);
     texture.wrapU = texture.wrapV = Texture.CLAMP_ADDRESSMODE;
+    texture.anisotropicFilteringLevel = 1;
     return texture;
   }
 }

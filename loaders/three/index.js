@@ -1,4 +1,4 @@
 // lmbake-three: lmbake's lightmaps (lmbake-three.js) and light probes (lmbake-probes.js) in
 // three.js. README.md says how to load a bake.
 export { lmbakeLightmaps, applyLightmapRectangles, applyDirectionalLightmaps, gpuSamples } from './lmbake-three.js';
-export { loadProbes, interpolateSH, lightProbeAt, shIrradiance } from './lmbake-probes.js';
+export { loadProbes, findTetrahedron, interpolateSH, lightProbeAt, shIrradiance } from './lmbake-probes.js';

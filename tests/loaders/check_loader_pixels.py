@@ -72,26 +72,34 @@ def run_page(work, gltf, loader, tag, *extra):
     return json.load(open(probe_file))
 
 
-def check(work, out, stem_name, loader, fmt, tag):
+def check(work, out, stem_name, loader, fmt, tag, min_pixels=20000):
     """One page on one bake against the file it read and the EXR; returns (ok, uv, lit)."""
     p = run_page(work, os.path.join(out, stem_name + ".gltf"), loader, tag)
     value = np.array(p["value"], dtype=np.float64).reshape(-1, 4)
     uv = np.array(p["uv"], dtype=np.float64).reshape(-1, 4)
     lit = (uv[:, 3] > 0.5) & (value[:, 3] > 0.5)
     report = " ".join(p["logs"])
+    atlas = np.rint(uv[:, 2]).astype(int)  # the page writes each pixel's atlas beside its coordinates
     used_ktx2 = ("from %s-lightmap-0.ktx2" % stem_name) in report
-    stem = os.path.join(out, stem_name + "-lightmap-0")
-    ref_file = kb.decode(stem + ".ktx2", work)[1] if used_ktx2 else read_image(stem + ".hdr")
-    exr = read_image(stem + ".exr")
-    u, v = uv[lit, 0], uv[lit, 1]
+    want_file, want_exr = np.zeros((len(uv), 3)), np.zeros((len(uv), 3))
+    for a in np.unique(atlas[lit]):
+        stem = os.path.join(out, "%s-lightmap-%d" % (stem_name, a))
+        if used_ktx2 != (("from %s-lightmap-%d.ktx2" % (stem_name, a)) in report):
+            used_ktx2 = None  # atlases read from different files: reported below
+        ref_file = kb.decode(stem + ".ktx2", work)[1] if used_ktx2 else read_image(stem + ".hdr")
+        at = lit & (atlas == a)
+        want_file[at] = bilinear(ref_file, uv[at, 0], uv[at, 1])
+        want_exr[at] = bilinear(read_image(stem + ".exr"), uv[at, 0], uv[at, 1])
     got = value[lit, :3]
-    rel_file = relative(got, bilinear(ref_file, u, v))
-    rel_exr = relative(got, bilinear(exr, u, v))
+    rel_file = relative(got, want_file[lit])
+    rel_exr = relative(got, want_exr[lit])
     want = EXPECT[(loader, fmt)] or ("hdr" if "cannot sample" in report else "ktx2")
     problems = []
     if used_ktx2 != (want == "ktx2"):
         problems.append("read %s, expected the %s" % ("the KTX2" if used_ktx2 else "the .hdr", want))
-    if not lit.sum() > 20000:
+    if used_ktx2 is None:
+        problems.append("atlases read from different kinds of file")
+    if not lit.sum() > min_pixels:
         problems.append("only %d lightmapped pixels" % lit.sum())
     # RGBE decoders differ by half a mantissa step (three adds 0.5 before scaling, OIIO does
     # not): up to 0.4% at the smallest mantissa, so the .hdr's mean bound is 0.5%
@@ -130,7 +138,7 @@ def instanced(lmbake, work, loaders):
          "output: {formats: [exr, ktx2], directional: false, ktx2_format: bc6h, ktx2_supercompression: none}\n")
     ok, uvs = True, {}
     for loader in loaders:
-        good, uv, lit = check(work, out, name, loader, "bc6h", "instanced")
+        good, uv, lit = check(work, out, name, loader, "bc6h", "instanced", min_pixels=5000)
         ok &= good
         uvs[loader] = (uv, lit)
     if len(uvs) == 2:
@@ -151,14 +159,15 @@ def instanced(lmbake, work, loaders):
 def probe_light(work, out):
     """Babylon's probe-lit sphere (lmbake-babylon-probes: a spherical polynomial on the sphere's
     reflection texture) against lmbake-probes' irradiance at each pixel's normal, at the probes'
-    centroid, halfway to the farthest probe and at that probe: within 1% per pixel, 0.1% mean."""
+    centroid, halfway to the farthest probe and at that probe: within 0.1% per pixel, 0.01% mean
+    (32-bit floats on the GPU; 2e-6 seen)."""
     p = run_page(work, os.path.join(out, "CornellBox.gltf"), "babylon", "probe-light", "--probe-light")
     ok = True
     for s in p["spheres"]:
-        good = s["pixels"] > 2000 and s["worst"] <= 0.01 and s["mean"] <= 0.001
+        good = s["pixels"] > 2000 and s["worst"] <= 1e-3 and s["mean"] <= 1e-4
         ok &= good
         print("babylon probe light at (%.3f, %.3f, %.3f): %d pixels, irradiance against lmbake-probes' worst %.4f%% "
-              "mean %.5f%% (bounds 1%%, 0.1%%): %s" % (tuple(s["point"]) + (s["pixels"], 100 * s["worst"],
+              "mean %.5f%% (bounds 0.1%%, 0.01%%): %s" % (tuple(s["point"]) + (s["pixels"], 100 * s["worst"],
                                                          100 * s["mean"], "ok" if good else "FAIL")), flush=True)
     return ok
 
