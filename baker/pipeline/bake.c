@@ -14,6 +14,7 @@
 #include "steps/plan.h"
 #include "steps/runner.h"
 #include "watch/layout_cache.h"
+#include "watch/stages_out.h"
 #include "watch/validity_cache.h"
 #include "pipeline/lighting.h"
 #include "lights/direct.h"
@@ -275,10 +276,13 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         if (st == LMB_OK)
             lmb_direct_set_validity(direct, &validity);
     }
+    /* the lighting's hooks: progress, and each stage's light to the watch's folder when asked */
+    lmb_stages_out so = {cfg, log};
+    lmb_lighting_hooks hooks = {progress, user, cfg->stages_out[0] ? lmb_stages_out_stage : NULL, &so};
     if (st == LMB_OK && dark)
         st = dark_atlases(s, cfg, &l, &cache, stats, err);
     else if (st == LMB_OK)
-        st = lmb_light_atlases(cfg, direct, &cache, steps, progress, user, stats, &records, log, err);
+        st = lmb_light_atlases(cfg, direct, &cache, steps, &hooks, stats, &records, log, err);
     /* light probes: placed in every process alike, lit as a step from the finished cache (not
      * for bake --direct-of: the watch reads only its lightmaps) */
     if (st == LMB_OK && !cfg->direct_of_count)

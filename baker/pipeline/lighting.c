@@ -9,7 +9,6 @@
 #include "post/denoise_steps.h"
 #include "post/rim.h"
 #include "util/clock.h"
-#include "watch/stages_out.h"
 #include "util/lmb_math.h"
 
 #include <math.h>
@@ -30,6 +29,20 @@ static void work_free(atlas_work *w, uint32_t n)
         free(w[a].variance);
     }
     free(w);
+}
+
+lmb_status lmb_lighting_stage(const lmb_lighting_hooks *hooks, const char *stage, atlas_work *w, lmb_cache *cache,
+                              size_t field, lmb_error *err)
+{
+    lmb_status st = LMB_OK;
+    if (!hooks || !hooks->stage_light)
+        return LMB_OK;
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++)
+        st = hooks->stage_light(hooks->stage_user, stage, a, cache, &w[a].t, *(float **)((char *)&w[a] + field),
+                                w[a].deferred, err);
+    if (st == LMB_OK)
+        st = hooks->stage_light(hooks->stage_user, stage, LMB_STAGE_WHOLE, cache, NULL, NULL, NULL, err);
+    return st;
 }
 
 /* The cache := every atlas's result (dilated). */
@@ -421,9 +434,11 @@ static lmb_status light_directions(const pass_env *env, lmb_error *err)
 }
 
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache, lmb_steps *steps,
-                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, lmb_ic_points *records,
+                             const lmb_lighting_hooks *hooks, lmb_bake_stats *stats, lmb_ic_points *records,
                              const lmb_log *log, lmb_error *err)
 {
+    lmb_progress_fn progress = hooks ? hooks->progress : NULL;
+    void *user = hooks ? hooks->progress_user : NULL;
     uint32_t n = cache->atlas_count;
     atlas_work *w = calloc((size_t)n + 1, sizeof *w);
     if (!w)
@@ -458,13 +473,11 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
             beside += w[a].t.valid[i] && (w[a].t.edge[i] & LMB_EDGE_NEAR);
         }
         total += w[a].t.count;
-        if (st == LMB_OK && cfg->stages_out[0])
-            st = lmb_stages_out_write(cfg, "direct", cache, a, &w[a].t, w[a].direct, w[a].deferred, err);
-        if (st == LMB_OK)
-            st = lmb_cache_store(cache, a, &w[a].t, w[a].direct, err);
     }
-    if (st == LMB_OK && cfg->stages_out[0])
-        lmb_stages_out_done(cfg, "direct", log);
+    if (st == LMB_OK)
+        st = lmb_lighting_stage(hooks, "direct", w, cache, offsetof(atlas_work, direct), err);
+    for (uint32_t a = 0; a < n && st == LMB_OK; a++)
+        st = lmb_cache_store(cache, a, &w[a].t, w[a].direct, err);
     stats->rim_limited = rim.limited;
     stats->rim_energy = rim.total > 0 ? rim.removed / rim.total : 0;
     if (stats->texels > stats->valid_texels || beside)
@@ -488,7 +501,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     lmb_ic_records shared;
     lmb_ic_records_init(&shared, cfg->ic_error > 0 ? cfg->ic_error : 1);
     lmb_ic_own_texels own = {0};
-    pass_env env = {cfg, log, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL,
+    pass_env env = {cfg, log, hooks, &job, w, cache, stats, NULL, cfg->ic_records == LMB_IC_RECORDS_SHARED ? &shared : NULL,
                     &own};
     /* nothing emits: every texel is exactly 0 whatever the gather would do, so it does not run */
     int dark = !lmb_direct_any_light(direct);

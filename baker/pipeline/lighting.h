@@ -26,9 +26,30 @@
 #include "steps/runner.h"
 #include "irradiance_cache/ic_pass.h"
 #include "lights/direct.h"
+#include "texels/texels.h"
+
+/* A lighting stage's light, handed out as soon as it is whole (what `bake --stages-out` writes for
+ * the watch: watch/stages_out.h). Called per atlas with the stage ("direct": the direct stage's
+ * light; "bounces": all the light the bounce passes reached, before the final gather reads it),
+ * the atlas's texels, its light (3 floats per texel) and `deferred` (mixed lighting: the part of
+ * it the engine adds itself; else NULL), and the cache, whose image of atlas `atlas` it may use as
+ * scratch (the passes store the cache's next contents after); then once with atlas =
+ * LMB_STAGE_WHOLE (t, light, deferred NULL) when every atlas was given. Not LMB_OK stops the bake. */
+#define LMB_STAGE_WHOLE UINT32_MAX
+typedef lmb_status (*lmb_stage_light_fn)(void *user, const char *stage, uint32_t atlas, lmb_cache *cache,
+                                         const lmb_texels *t, const float *light, const float *deferred,
+                                         lmb_error *err);
+
+/* What the driver watches of the lighting: progress (may cancel) and the stages' light (NULL: not). */
+typedef struct lmb_lighting_hooks {
+    lmb_progress_fn progress;
+    void *progress_user;
+    lmb_stage_light_fn stage_light;
+    void *stage_user;
+} lmb_lighting_hooks;
 
 lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lmb_cache *cache, lmb_steps *steps,
-                             lmb_progress_fn progress, void *progress_user, lmb_bake_stats *stats,
-                             lmb_ic_points *records, const lmb_log *log, lmb_error *err);
+                             const lmb_lighting_hooks *hooks, lmb_bake_stats *stats, lmb_ic_points *records,
+                             const lmb_log *log, lmb_error *err);
 
 #endif

@@ -2,7 +2,6 @@
 #include "lighting_internal.h"
 
 #include "util/lmb_math.h"
-#include "watch/stages_out.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -167,11 +166,9 @@ lmb_status lmb_lighting_bounces(const pass_env *env, uint32_t *passes, lmb_error
             double v = sum[a][k] + (done ? w[a].result[k] * tail_factor[k % 3] : 0);
             w[a].result[k] = (float)(v > 0 ? v : 0);
         }
-    /* bake --stages-out: all the light the passes reached, before the final gather reads it */
-    for (uint32_t a = 0; a < n && st == LMB_OK && done && cfg->stages_out[0]; a++)
-        st = lmb_stages_out_write(cfg, "bounces", cache, a, &w[a].t, w[a].result, w[a].deferred, err);
-    if (st == LMB_OK && done && cfg->stages_out[0])
-        lmb_stages_out_done(cfg, "bounces", env->log);
+    /* the driver's stage hook: all the light the passes reached, before the final gather reads it */
+    if (st == LMB_OK && done)
+        st = lmb_lighting_stage(env->hooks, "bounces", w, cache, offsetof(atlas_work, result), err);
     if (st == LMB_OK)
         st = lmb_lighting_store(w, cache, err);
     for (uint32_t a = 0; sum && a < n; a++)

@@ -26,6 +26,7 @@ typedef struct atlas_work {
 typedef struct pass_env {
     const lmb_config *cfg;
     const lmb_log *log;
+    const lmb_lighting_hooks *hooks;
     lmb_gather_job *job;
     atlas_work *w;
     lmb_cache *cache;
@@ -37,6 +38,11 @@ typedef struct pass_env {
 
 /* The cache := every atlas's result (dilated). */
 lmb_status lmb_lighting_store(atlas_work *w, lmb_cache *cache, lmb_error *err);
+
+/* Hands stage `stage`'s light (field: offsetof(atlas_work, direct or result)) to the driver's
+ * stage hook, every atlas then LMB_STAGE_WHOLE; LMB_OK when there is no hook. */
+lmb_status lmb_lighting_stage(const lmb_lighting_hooks *hooks, const char *stage, atlas_work *w, lmb_cache *cache,
+                              size_t field, lmb_error *err);
 
 /* One gather pass over every atlas: result = gather(cache) (+ direct with add_direct: the
  * final gather, then filtered and refined), then (store) the cache := result. */

@@ -39,3 +39,14 @@ void lmb_stages_out_done(const lmb_config *cfg, const char *stage, const lmb_log
 {
     lmb_info(log, "stages: %s written to %s/%s", stage, cfg->stages_out, stage);
 }
+
+lmb_status lmb_stages_out_stage(void *user, const char *stage, uint32_t atlas, lmb_cache *cache, const lmb_texels *t,
+                                const float *light, const float *deferred, lmb_error *err)
+{
+    const lmb_stages_out *so = user;
+    if (atlas == UINT32_MAX) { /* LMB_STAGE_WHOLE */
+        lmb_stages_out_done(so->cfg, stage, so->log);
+        return LMB_OK;
+    }
+    return lmb_stages_out_write(so->cfg, stage, cache, atlas, t, light, deferred, err);
+}

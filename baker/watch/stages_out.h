@@ -28,4 +28,13 @@ lmb_status lmb_stages_out_write(const lmb_config *cfg, const char *stage, lmb_ca
 /* The log line that says stage `stage` is written whole. */
 void lmb_stages_out_done(const lmb_config *cfg, const char *stage, const lmb_log *log);
 
+/* The lighting's stage hook (pipeline/lighting.h lmb_stage_light_fn) that writes each stage under
+ * cfg->stages_out: user is an lmb_stages_out. */
+typedef struct lmb_stages_out {
+    const lmb_config *cfg;
+    const lmb_log *log;
+} lmb_stages_out;
+lmb_status lmb_stages_out_stage(void *user, const char *stage, uint32_t atlas, lmb_cache *cache, const lmb_texels *t,
+                                const float *light, const float *deferred, lmb_error *err);
+
 #endif

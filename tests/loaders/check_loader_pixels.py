@@ -17,8 +17,10 @@ pixel, relative: against the file the page read, mean 0.1% (the .hdr: 0.5%, RGBE
 differ by half a mantissa step) and 99th percentile 1% (the GPU's bilinear weights are 8-bit
 fixed point); against the EXR, the file's own precision on top
 (E5B9G9R9 0.4%, .hdr 1%, BC6H and ASTC their mean error, docs/output.md): mean within 2%.
-Then per-copy rectangles (instanced(): 16 copies through EXT_mesh_gpu_instancing, both pages
-against their files and against each other) and Babylon's probe-lit sphere (probe_light()).
+Then level-single-10 and 16 copies of a prop through EXT_mesh_gpu_instancing (per-copy
+rectangles), BC6H: each page against its files, and the two pages against each other (the same
+view: the same lightmap coordinates at every pixel, cross_check()); and Babylon's probe-lit
+sphere (probe_light()). Every page runs in one browser.
 """
 import json
 import os
@@ -65,16 +67,27 @@ def relative(got, want):
     return np.abs(got - want).sum(axis=1)[keep] / s[keep]
 
 
-def run_page(work, gltf, loader, tag, *extra):
-    probe_file = os.path.join(work, "%s-%s.json" % (loader, tag))
-    subprocess.run(["node", os.path.join(HERE, "loader_pixels.mjs"), loader, gltf, probe_file, "ktx2"] + list(extra),
-                   check=True, env=dict(os.environ, NODE_PATH=os.path.join(ROOT, "node_modules")))
-    return json.load(open(probe_file))
+def page_file(work, loader, tag):
+    return os.path.join(work, "%s-%s.json" % (loader, tag))
+
+
+def run_pages(work, jobs):
+    """Every page in one browser (tests/loaders/loader_pixels.mjs --jobs)."""
+    jobs_file = os.path.join(work, "jobs.json")
+    with open(jobs_file, "w") as f:
+        json.dump(jobs, f)
+    subprocess.run(["node", os.path.join(HERE, "loader_pixels.mjs"), "--jobs", jobs_file], check=True,
+                   env=dict(os.environ, NODE_PATH=os.path.join(ROOT, "node_modules")))
+
+
+def page_job(work, gltf, loader, tag, probe_light=False):
+    return {"loader": loader, "gltf": gltf, "out": page_file(work, loader, tag), "source": "ktx2",
+            "probeLight": probe_light}
 
 
 def check(work, out, stem_name, loader, fmt, tag, min_pixels=20000):
     """One page on one bake against the file it read and the EXR; returns (ok, uv, lit)."""
-    p = run_page(work, os.path.join(out, stem_name + ".gltf"), loader, tag)
+    p = json.load(open(page_file(work, loader, tag)))
     value = np.array(p["value"], dtype=np.float64).reshape(-1, 4)
     uv = np.array(p["uv"], dtype=np.float64).reshape(-1, 4)
     lit = (uv[:, 3] > 0.5) & (value[:, 3] > 0.5)
@@ -85,7 +98,7 @@ def check(work, out, stem_name, loader, fmt, tag, min_pixels=20000):
     for a in np.unique(atlas[lit]):
         stem = os.path.join(out, "%s-lightmap-%d" % (stem_name, a))
         if used_ktx2 != (("from %s-lightmap-%d.ktx2" % (stem_name, a)) in report):
-            used_ktx2 = None  # atlases read from different files: reported below
+            used_ktx2 = None  # atlases read from different kinds of file: reported below
         ref_file = kb.decode(stem + ".ktx2", work)[1] if used_ktx2 else read_image(stem + ".hdr")
         at = lit & (atlas == a)
         want_file[at] = bilinear(ref_file, uv[at, 0], uv[at, 1])
@@ -95,18 +108,18 @@ def check(work, out, stem_name, loader, fmt, tag, min_pixels=20000):
     rel_exr = relative(got, want_exr[lit])
     want = EXPECT[(loader, fmt)] or ("hdr" if "cannot sample" in report else "ktx2")
     problems = []
-    if used_ktx2 != (want == "ktx2"):
-        problems.append("read %s, expected the %s" % ("the KTX2" if used_ktx2 else "the .hdr", want))
     if used_ktx2 is None:
         problems.append("atlases read from different kinds of file")
+    elif used_ktx2 != (want == "ktx2"):
+        problems.append("read %s, expected the %s" % ("the KTX2" if used_ktx2 else "the .hdr", want))
     if not lit.sum() > min_pixels:
         problems.append("only %d lightmapped pixels" % lit.sum())
     # RGBE decoders differ by half a mantissa step (three adds 0.5 before scaling, OIIO does
     # not): up to 0.4% at the smallest mantissa, so the .hdr's mean bound is 0.5%
     mean_bound = 0.001 if used_ktx2 else 0.005
-    if not (rel_file.mean() <= mean_bound and np.percentile(rel_file, 99) <= 0.01):
+    if not (rel_file.size and rel_file.mean() <= mean_bound and np.percentile(rel_file, 99) <= 0.01):
         problems.append("pixels off the file they read")
-    if not rel_exr.mean() <= 0.02:
+    if not (rel_exr.size and rel_exr.mean() <= 0.02):
         problems.append("pixels off the EXR")
     print("%s, %-9s %s: %d pixels from %s; against it mean %.4f%% p99 %.3f%% (bounds %g%%, 1%%); against the EXR "
           "mean %.3f%% p99 %.2f%% (bound 2%%): %s" % (loader, fmt, stem_name, lit.sum(),
@@ -124,44 +137,35 @@ def bake(lmbake, scene, out, cfg, text):
     subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "-q"], check=True)
 
 
-def instanced(lmbake, work, loaders):
-    """Per-copy rectangles (EXT_mesh_gpu_instancing): 16 copies of a prop on a ground, BC6H. Each
-    page against its files as above, and the two pages against each other: the same camera on
-    the same level, so each pixel lit in both has the same lightmap coordinates, in the copy's own
-    rectangle (a page that gave every copy the first copy's rectangle, or none, would differ by
-    whole rectangles)."""
-    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_levels.py"), work, "gpu:16"], check=True,
-                   stdout=subprocess.DEVNULL)
-    out, name = os.path.join(work, "out-instanced"), "level-gpu-16"
-    bake(lmbake, os.path.join(work, name + ".glb"), out, os.path.join(work, "instanced.yaml"),
-         "bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\natlas: {texels: 60000}\n"
-         "output: {formats: [exr, ktx2], directional: false, ktx2_format: bc6h, ktx2_supercompression: none}\n")
-    ok, uvs = True, {}
-    for loader in loaders:
-        good, uv, lit = check(work, out, name, loader, "bc6h", "instanced", min_pixels=5000)
-        ok &= good
-        uvs[loader] = (uv, lit)
-    if len(uvs) == 2:
-        (ua, la), (ub, lb) = uvs.values()
-        h, w = read_image(os.path.join(out, name + "-lightmap-0.exr")).shape[:2]
-        both = la & lb
-        texels = np.hypot((ua[both, 0] - ub[both, 0]) * w, (ua[both, 1] - ub[both, 1]) * h)
-        agree = both.sum() / max(1, (la | lb).sum())
-        good = agree >= 0.9 and np.median(texels) <= 0.5 and np.percentile(texels, 90) <= 1.0
-        ok &= good
-        print("instanced %s: %d pixels lit in both pages (%.1f%% of those lit in either; bound 90%%); lightmap "
-              "coordinates apart by median %.3f texels, p90 %.3f, p99 %.2f (bounds 0.5, 1): %s"
-              % (" vs ".join(uvs), both.sum(), 100 * agree, np.median(texels), np.percentile(texels, 90),
-                 np.percentile(texels, 99), "ok" if good else "FAIL"), flush=True)
-    return ok
+# the loaders are checked, not the light: one bounce, few rays, 60,000 texels
+CHEAP = "bounces: 1\nsamples: {gather: 32, adaptive: false}\natlas: {texels: 60000}\n"
 
 
-def probe_light(work, out):
+def cross_check(work, out, name, loaders, uvs):
+    """The two pages against each other: the same camera on the same level, so each pixel lit in
+    both has the same lightmap coordinates (for instanced copies: in the copy's own rectangle; a
+    page that gave every copy the first copy's rectangle, or none, would differ by whole
+    rectangles)."""
+    (ua, la), (ub, lb) = (uvs[k] for k in loaders)
+    h, w = read_image(os.path.join(out, name + "-lightmap-0.exr")).shape[:2]
+    both = la & lb
+    texels = np.hypot((ua[both, 0] - ub[both, 0]) * w, (ua[both, 1] - ub[both, 1]) * h)
+    agree = both.sum() / max(1, (la | lb).sum())
+    good = agree >= 0.9 and texels.size > 0 and np.median(texels) <= 0.5 and np.percentile(texels, 90) <= 1.0
+    print("%s, %s: %d pixels lit in both pages (%.1f%% of those lit in either; bound 90%%); lightmap "
+          "coordinates apart by median %.3f texels, p90 %.3f, p99 %.2f (bounds 0.5, 1): %s"
+          % (name, " vs ".join(loaders), both.sum(), 100 * agree, np.median(texels) if texels.size else -1,
+             np.percentile(texels, 90) if texels.size else -1, np.percentile(texels, 99) if texels.size else -1,
+             "ok" if good else "FAIL"), flush=True)
+    return good
+
+
+def probe_light(work):
     """Babylon's probe-lit sphere (lmbake-babylon-probes: a spherical polynomial on the sphere's
     reflection texture) against lmbake-probes' irradiance at each pixel's normal, at the probes'
     centroid, halfway to the farthest probe and at that probe: within 0.1% per pixel, 0.01% mean
     (32-bit floats on the GPU; 2e-6 seen)."""
-    p = run_page(work, os.path.join(out, "CornellBox.gltf"), "babylon", "probe-light", "--probe-light")
+    p = json.load(open(page_file(work, "babylon", "probe-light")))
     ok = True
     for s in p["spheres"]:
         good = s["pixels"] > 2000 and s["worst"] <= 1e-3 and s["mean"] <= 1e-4
@@ -175,23 +179,48 @@ def probe_light(work, out):
 def main():
     lmbake, work, loaders = sys.argv[1], sys.argv[2], sys.argv[3].split(",")
     os.makedirs(work, exist_ok=True)
-    ok = True
+    jobs, checks = [], []  # checks: (out, stem, loader, format, tag, min pixels)
     for fmt, sc in FORMATS.items():
         out = os.path.join(work, "out-" + fmt)
-        # the loaders are checked, not the light: one bounce, few rays; the E5B9G9R9 bake (which
-        # Babylon reads as the .hdr, covered by the ASTC bake) carries the probes for Babylon's
+        # the E5B9G9R9 bake (which Babylon reads as the .hdr, covered by the ASTC bake) carries
+        # the probes for Babylon's probe-lit sphere
         probes = "{auto: true}" if fmt == "e5b9g9r9" and "babylon" in loaders else "{auto: false}"
         bake(lmbake, SCENE, out, os.path.join(work, fmt + ".yaml"),
-             "bounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: %s\natlas: {texels: 60000}\n"
-             "output: {formats: [exr, ktx2], directional: false, ktx2_format: %s, ktx2_supercompression: %s}\n"
-             % (probes, fmt, sc))
+             CHEAP + "probes: %s\noutput: {formats: [exr, ktx2], directional: false, ktx2_format: %s, "
+             "ktx2_supercompression: %s}\n" % (probes, fmt, sc))
         for loader in loaders:
-            if (loader, fmt) in SKIP:
-                continue
-            ok &= check(work, out, "CornellBox", loader, fmt, fmt)[0]
+            if (loader, fmt) not in SKIP:
+                jobs.append(page_job(work, os.path.join(out, "CornellBox.gltf"), loader, fmt))
+                checks.append((out, "CornellBox", loader, fmt, fmt, 20000))
         if probes != "{auto: false}":
-            ok &= probe_light(work, out)
-    ok &= instanced(lmbake, work, loaders)
+            jobs.append(page_job(work, os.path.join(out, "CornellBox.gltf"), "babylon", "probe-light", True))
+    # level-single-10 (58k triangles, 100 rooms, 11 lamps) and 16 copies of a prop through
+    # EXT_mesh_gpu_instancing on a ground (two atlases: the ground's, the copies'), BC6H without
+    # supercompression (both modules read it); each page against its files, and the pages
+    # against each other
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_levels.py"), work, "single:10", "gpu:16"],
+                   check=True, stdout=subprocess.DEVNULL)
+    levels = [("level-single-10", 1000), ("level-gpu-16", 5000)]  # level-single-10 seen from outside: 1,912 lightmapped pixels
+    for name, min_pixels in levels:
+        out = os.path.join(work, "out-" + name)
+        bake(lmbake, os.path.join(work, name + ".glb"), out, os.path.join(work, name + ".yaml"),
+             CHEAP + "probes: {auto: false}\noutput: {formats: [exr, ktx2], directional: false, ktx2_format: bc6h, "
+             "ktx2_supercompression: none}\n")
+        for loader in loaders:
+            jobs.append(page_job(work, os.path.join(out, name + ".gltf"), loader, name))
+            checks.append((out, name, loader, "bc6h", name, min_pixels))
+    run_pages(work, jobs)
+    ok, uvs = True, {}
+    for out, stem, loader, fmt, tag, min_pixels in checks:
+        good, uv, lit = check(work, out, stem, loader, fmt, tag, min_pixels)
+        ok &= good
+        uvs[(stem, loader)] = (uv, lit)
+    if "babylon" in loaders:
+        ok &= probe_light(work)
+    for name, _ in levels:
+        if len(loaders) == 2:
+            ok &= cross_check(work, os.path.join(work, "out-" + name), name, loaders,
+                              {k: uvs[(name, k)] for k in loaders})
     sys.exit(0 if ok else 1)
 
 

@@ -3,14 +3,15 @@
 // spheres. The probes come from the bake's glTF (asset.extras.lightmap.probes: positions, SH L2
 // irradiance). The sphere's shader evaluates the interpolated irradiance SH at each normal and
 // shows albedo / pi x E, the same light a lightmapped surface shows; it gets no other light,
-// and nothing else gets the probes' light. Reading and interpolating the probes is lmbake's
-// three.js module's (loaders/three/lmbake-probes.js), which engine projects use too.
+// and nothing else gets the probes' light. Reading the probes is lmbake's three.js module's
+// (loaders/three/lmbake-probes.js), interpolating them lmbake-probes' (loaders/probes), which
+// engine projects use too.
 import * as THREE from 'three';
 import { loadProbes, findTetrahedron, interpolateSH, shIrradiance } from '/loaders/three/lmbake-probes.js';
 
 export { loadProbes, findTetrahedron, interpolateSH, shIrradiance };
 
-// E(n) from an irradiance SH in GLSL (lmbake-probes.js's basis), for the materials below.
+// E(n) from an irradiance SH in GLSL (lmbake-probes' basis, loaders/probes/probe-field.js), for the materials below.
 const SH_GLSL = /* glsl */`
   vec3 shIrradiance(vec3 sh[9], vec3 n) {
     return sh[0] * 0.282095 + sh[1] * 0.488603 * n.y + sh[2] * 0.488603 * n.z + sh[3] * 0.488603 * n.x
