@@ -8,7 +8,7 @@ of the file the loader used at those coordinates, decoded by a decoder lmbake di
 usage: check_loader_pixels.py LMBAKE WORKDIR LOADER[,LOADER...]
 
 bevy's Cornell box (one bounce, few rays, 60,000 texels: the loaders are checked, not the light;
-a texel still covers about one pixel of the 320 x 240 probe), once per KTX2
+the 160 x 120 probe: about four texels per pixel, each pixel checked at its own coordinates), once per KTX2
 format: E5B9G9R9 with Zstandard, BC6H without, ASTC HDR with; each loader's page on each bake.
 Which file a loader must read: the KTX2 when it reads that format and the GPU samples it, else
 the .hdr, and the page must say why (EXPECT below; Chromium's SwiftShader has BC6H and no ASTC
@@ -85,7 +85,7 @@ def page_job(work, gltf, loader, tag, probe_light=False):
             "probeLight": probe_light}
 
 
-def check(work, out, stem_name, loader, fmt, tag, min_pixels=20000):
+def check(work, out, stem_name, loader, fmt, tag, min_pixels=10000):
     """One page on one bake against the file it read and the EXR; returns (ok, uv, lit)."""
     p = json.load(open(page_file(work, loader, tag)))
     value = np.array(p["value"], dtype=np.float64).reshape(-1, 4)
@@ -168,7 +168,7 @@ def probe_light(work):
     p = json.load(open(page_file(work, "babylon", "probe-light")))
     ok = True
     for s in p["spheres"]:
-        good = s["pixels"] > 2000 and s["worst"] <= 1e-3 and s["mean"] <= 1e-4
+        good = s["pixels"] > 1000 and s["worst"] <= 1e-3 and s["mean"] <= 1e-4
         ok &= good
         print("babylon probe light at (%.3f, %.3f, %.3f): %d pixels, irradiance against lmbake-probes' worst %.4f%% "
               "mean %.5f%% (bounds 0.1%%, 0.01%%): %s" % (tuple(s["point"]) + (s["pixels"], 100 * s["worst"],
@@ -191,7 +191,7 @@ def main():
         for loader in loaders:
             if (loader, fmt) not in SKIP:
                 jobs.append(page_job(work, os.path.join(out, "CornellBox.gltf"), loader, fmt))
-                checks.append((out, "CornellBox", loader, fmt, fmt, 20000))
+                checks.append((out, "CornellBox", loader, fmt, fmt, 10000))
         if probes != "{auto: false}":
             jobs.append(page_job(work, os.path.join(out, "CornellBox.gltf"), "babylon", "probe-light", True))
     # level-single-10 (58k triangles, 100 rooms, 11 lamps) and 16 copies of a prop through
@@ -200,7 +200,7 @@ def main():
     # against each other
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_levels.py"), work, "single:10", "gpu:16"],
                    check=True, stdout=subprocess.DEVNULL)
-    levels = [("level-single-10", 1000), ("level-gpu-16", 5000)]  # level-single-10 seen from outside: 1,912 lightmapped pixels
+    levels = [("level-single-10", 300), ("level-gpu-16", 1500)]  # level-single-10 seen from outside: ~480 lightmapped pixels
     for name, min_pixels in levels:
         out = os.path.join(work, "out-" + name)
         bake(lmbake, os.path.join(work, name + ".glb"), out, os.path.join(work, name + ".yaml"),

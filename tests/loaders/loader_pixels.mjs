@@ -4,8 +4,8 @@
 // atlas, rendered as the loader set the materials up) written as JSON, with the page's own
 // report (which file each lightmap came from); with probeLight (Babylon), window.lmbProbeLight
 // (0..2) instead: a probe-lit sphere's irradiance against lmbake-probes' at three points.
-// tests/loaders/check_loader_pixels.py compares the values with the lightmap files. One browser
-// for every page (a launch costs seconds), one server per bake.
+// tests/loaders/check_loader_pixels.py compares the values with the lightmap files. One browser,
+// one context and one server for every page (the engines' modules fetched once).
 //   usage: node tests/loaders/loader_pixels.mjs three|babylon BAKE.gltf OUT.json [source] [--probe-light]
 //          node tests/loaders/loader_pixels.mjs --jobs JOBS.json   ([{loader, gltf, out, source, probeLight}])
 import fs from 'node:fs';
@@ -21,15 +21,15 @@ function jobsFromArgs(argv) {
   return [{ loader, gltf, out, source, probeLight: argv.includes('--probe-light') }];
 }
 
-async function runJob(browser, { loader, gltf, out, source = 'ktx2', probeLight = false }) {
-  const srv = await startServer(gltf);
-  const context = await browser.newContext({ viewport: { width: 640, height: 480 } });
+// One page: the example of `loader` on the bake at gltf (served under the server's /bake/ root).
+async function runJob(context, srv, root, { loader, gltf, out, source = 'ktx2', probeLight = false }) {
+  const page = await context.newPage();
   try {
-    const page = await context.newPage();
     const errors = [], logs = [];
     page.on('pageerror', (e) => errors.push(e.message));
     page.on('console', (m) => (m.type() === 'error' ? errors : logs).push(m.text()));
-    const url = `${srv.url}loaders/${loader}/example/index.html?` + new URLSearchParams({ gltf: '/bake/' + encodeURIComponent(path.basename(gltf)), source, probe: '1' });
+    const rel = path.relative(root, path.resolve(gltf)).split(path.sep).map(encodeURIComponent).join('/');
+    const url = `${srv.url}loaders/${loader}/example/index.html?` + new URLSearchParams({ gltf: '/bake/' + rel, source, probe: '1' });
     await page.goto(url);
     await page.waitForFunction(() => window.lmbReady === true, null, { timeout: 60000, polling: 100 }).catch(() => errors.push('not ready after 60 s'));
     if (errors.length) throw new Error(`${url}: ${errors.join('; ')}`);
@@ -44,20 +44,34 @@ async function runJob(browser, { loader, gltf, out, source = 'ktx2', probeLight 
       console.log(`${loader} on ${path.basename(gltf)}: ${probe.width}x${probe.height} probed; ${logs.filter((l) => /atlas|copies/.test(l)).join(' | ')}`);
     }
   } finally {
-    await context.close();
-    await srv.close();
+    await page.close();
   }
 }
 
+// The folder holding every job's bake (served at /bake/)
+function commonRoot(files) {
+  let root = path.dirname(path.resolve(files[0]));
+  while (!files.every((f) => path.resolve(f).startsWith(root + path.sep))) root = path.dirname(root);
+  return root;
+}
+
 const jobs = jobsFromArgs(process.argv.slice(2));
+const root = commonRoot(jobs.map((j) => j.gltf));
+const srv = await startServer(jobs[0].gltf, { bakeRoot: root, cacheModules: true });
 const browser = await launchBrowser();
+const context = await browser.newContext({ viewport: { width: 640, height: 480 } });
 let code = 0;
 try {
-  for (const job of jobs) await runJob(browser, job);
+  for (const job of jobs) {
+    const t0 = Date.now();
+    await runJob(context, srv, root, job);
+    console.log(`  (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
+  }
 } catch (e) {
   console.error(String(e.stack || e));
   code = 1;
 } finally {
   await browser.close();
+  await srv.close();
 }
 process.exit(code);

@@ -57,10 +57,13 @@ export function resolveFile(roots, urlPath) {
   return null;
 }
 
-// Starts the server for one bake; resolves to {server, port, url, close()}.
-export function startServer(gltfFile, { port = 0, log = () => {} } = {}) {
+// Starts the server for one bake; resolves to {server, port, url, close()}. bakeRoot: the folder
+// served at /bake/ (default: the glTF's; the loaders' test serves several bakes under one);
+// cacheModules: three.js, Babylon.js and lmbake's loaders may be cached by the browser (one
+// browser loading many pages fetches them once), everything else is sent no-store.
+export function startServer(gltfFile, { port = 0, log = () => {}, bakeRoot = null, cacheModules = false } = {}) {
   const gltf = checkGltf(gltfFile);
-  const bakeDir = path.dirname(gltf);
+  const bakeDir = bakeRoot ? path.resolve(bakeRoot) : path.dirname(gltf);
   const three = path.join(projectRoot, 'node_modules', 'three');
   if (!fs.existsSync(path.join(three, 'build', 'three.module.js'))) {
     throw new Error(`three.js is not installed (${three}): run npm install in ${projectRoot}`);
@@ -78,7 +81,8 @@ export function startServer(gltfFile, { port = 0, log = () => {} } = {}) {
 
   const server = http.createServer((req, res) => {
     const send = (code, type, body) => {
-      res.writeHead(code, { 'Content-Type': type, 'Cache-Control': 'no-store', 'X-Content-Type-Options': 'nosniff' });
+      const cache = cacheModules && code === 200 && /^\/(three|babylon|loaders)\//.test(req.url) ? 'max-age=3600' : 'no-store';
+      res.writeHead(code, { 'Content-Type': type, 'Cache-Control': cache, 'X-Content-Type-Options': 'nosniff' });
       res.end(req.method === 'HEAD' ? undefined : body);
     };
     if (req.method !== 'GET' && req.method !== 'HEAD') { res.setHeader('Allow', 'GET, HEAD'); return send(405, 'text/plain', 'read-only\n'); }

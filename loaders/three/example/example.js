@@ -22,14 +22,14 @@ const box = new THREE.Box3().setFromObject(gltf.scene), size = box.getSize(new T
 const camera = new THREE.PerspectiveCamera(50, 640 / 480, 0.01 * size.length(), 10 * size.length());
 camera.position.copy(centre).add(new THREE.Vector3(0, 0.15 * size.y, 0.5 * size.length() + 0.5 * size.z));
 camera.lookAt(centre);
-renderer.render(scene, camera);
+if (!params.get('probe')) renderer.render(scene, camera); // with ?probe=1 (the loaders' test) only its float targets
 
 // The loaders' test: each pixel's lightmap value (E in lux: the lightmap times its intensity,
 // three's lightMap as a MeshBasicMaterial shows it, x pi) and its lightmap coordinates (u, v,
 // atlas) from the same camera, into float targets, as the materials lmbake-three made them
 // (their lightMap, intensity, rectangles and per-copy patches).
 window.lmbProbe = () => {
-  const w = 320, h = 240, target = new THREE.WebGLRenderTarget(w, h, { type: THREE.FloatType });
+  const w = 160, h = 120, target = new THREE.WebGLRenderTarget(w, h, { type: THREE.FloatType });
   const read = (make) => {
     const saved = new Map();
     gltf.scene.traverse((o) => { if (o.isMesh) { saved.set(o, o.material); o.material = make(o.material); } });
