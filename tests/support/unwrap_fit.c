@@ -1,6 +1,7 @@
 /* Unwrap + pack a generated mesh into one ~size x size atlas (see unwrap_fit.h). */
 #include "util/clock.h"
 #include "unwrap_fit.h"
+#include "charts_at.h"
 
 #include "pack/pack.h"
 #include "unwrap/metrics.h"
@@ -12,37 +13,24 @@
 
 typedef struct packed {
     lmb_pack_result r;
-    double *uv; /* scaled chart uvs, chart order */
-    lmb_pack_chart *charts;
+    charts_at at; /* the charts at the density packed */
 } packed;
 
 static void packed_free(packed *p)
 {
     lmb_pack_result_free(&p->r);
-    free(p->uv);
-    free(p->charts);
-    memset(p, 0, sizeof *p);
+    charts_at_free(&p->at);
 }
 
 /* Packs at density d; returns 1 if it fits one atlas of size x size. */
 static int try_pack(const lmb_charts *c, double d, uint32_t size, uint32_t padding, packed *p)
 {
     memset(p, 0, sizeof *p);
-    uint32_t n = c->first[c->chart_count];
-    p->uv = malloc(sizeof(double) * 6 * n + 1);
-    p->charts = calloc(c->chart_count + 1, sizeof *p->charts);
-    if (!p->uv || !p->charts)
+    if (!charts_at_density(c, d, &p->at))
         return 0;
-    for (uint32_t i = 0; i < n; i++)
-        for (int k = 0; k < 6; k++)
-            p->uv[6 * i + k] = c->uv[6 * c->order[i] + k] * d;
-    for (uint32_t k = 0; k < c->chart_count; k++) {
-        p->charts[k].triangle_count = c->first[k + 1] - c->first[k];
-        p->charts[k].uv = p->uv + 6 * c->first[k];
-    }
     lmb_pack_options o = {size, padding, 0, 0, 1};
     lmb_error err;
-    if (lmb_pack_charts(p->charts, c->chart_count, &o, &p->r, &err) != LMB_OK)
+    if (lmb_pack_charts(p->at.charts, c->chart_count, &o, &p->r, &err) != LMB_OK)
         return 0;
     return p->r.atlas_count == 1;
 }
@@ -65,7 +53,7 @@ static int measure(const gen_mesh *g, const lmb_charts *c, double d, uint32_t si
         for (uint32_t i = c->first[k]; i < c->first[k + 1]; i++) {
             uint32_t f = c->order[i];
             for (int v = 0; v < 3; v++) {
-                double x = p.uv[6 * i + 2 * v], y = p.uv[6 * i + 2 * v + 1];
+                double x = p.at.uv[6 * i + 2 * v], y = p.at.uv[6 * i + 2 * v + 1];
                 uv[6 * i + 2 * v] = m[0] * x + m[1] * y + m[2];
                 uv[6 * i + 2 * v + 1] = m[3] * x + m[4] * y + m[5];
                 for (int q = 0; q < 3; q++)

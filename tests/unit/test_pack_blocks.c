@@ -12,6 +12,7 @@
  */
 #include "check.h"
 
+#include "../support/charts_at.h"
 #include "../support/meshgen.h"
 #include "pack/pack.h"
 #include "pack/rects.h"
@@ -94,16 +95,14 @@ static uint64_t pack(const char *name, const gen_mesh *g, double density, uint32
         check_failed_count++;
         return 0;
     }
-    uint32_t n = c.first[c.chart_count], padding = 2;
-    double *uv = malloc(sizeof(double) * 6 * n + 1);
-    lmb_pack_chart *charts = calloc(c.chart_count + 1, sizeof *charts);
-    for (uint32_t i = 0; i < n; i++)
-        for (int k = 0; k < 6; k++)
-            uv[6 * i + k] = c.uv[6 * c.order[i] + k] * density;
-    for (uint32_t k = 0; k < c.chart_count; k++) {
-        charts[k].triangle_count = c.first[k + 1] - c.first[k];
-        charts[k].uv = uv + 6 * c.first[k];
+    uint32_t padding = 2;
+    charts_at at;
+    if (!charts_at_density(&c, density, &at)) {
+        check_failed_count++;
+        lmb_charts_free(&c);
+        return 0;
     }
+    const lmb_pack_chart *charts = at.charts;
     lmb_pack_options po = {2048, padding, 0, 0, block};
     lmb_pack_result r;
     uint64_t area = 0;
@@ -168,8 +167,7 @@ static uint64_t pack(const char *name, const gen_mesh *g, double density, uint32
     CHECK(block <= 1 || (r.atlas_count > 0 && r.width[0] % block == 0 && r.height[0] % block == 0));
     lmb_pack_result_free(&r);
     lmb_charts_free(&c);
-    free(uv);
-    free(charts);
+    charts_at_free(&at);
     return area;
 }
 

@@ -6,6 +6,7 @@
  */
 #include "check.h"
 
+#include "../support/charts_at.h"
 #include "../support/meshgen.h"
 #include "pack/pack.h"
 #include "unwrap/metrics.h"
@@ -27,18 +28,16 @@ static void check(const char *name, const gen_mesh *g, double density, double mi
         return;
     }
     uint32_t n = c.first[c.chart_count];
-    double *uv = malloc(sizeof(double) * 6 * n + 1), *pos = malloc(sizeof(double) * 9 * n + 1);
-    lmb_pack_chart *charts = calloc(c.chart_count + 1, sizeof *charts);
-    for (uint32_t i = 0; i < n; i++)
-        for (int k = 0; k < 6; k++)
-            uv[6 * i + k] = c.uv[6 * c.order[i] + k] * density;
-    for (uint32_t k = 0; k < c.chart_count; k++) {
-        charts[k].triangle_count = c.first[k + 1] - c.first[k];
-        charts[k].uv = uv + 6 * c.first[k];
+    double *pos = malloc(sizeof(double) * 9 * n + 1);
+    charts_at at;
+    if (!charts_at_density(&c, density, &at)) {
+        check_failed_count++;
+        return;
     }
+    double *uv = at.uv;
     lmb_pack_options po = {1024, 2, 0, 0, 1};
     lmb_pack_result r;
-    CHECK_INT(lmb_pack_charts(charts, c.chart_count, &po, &r, &err), LMB_OK);
+    CHECK_INT(lmb_pack_charts(at.charts, c.chart_count, &po, &r, &err), LMB_OK);
     CHECK_INT(r.atlas_count, 1);
     for (uint32_t k = 0; k < c.chart_count; k++)
         for (uint32_t i = c.first[k]; i < c.first[k + 1]; i++)
@@ -62,9 +61,8 @@ static void check(const char *name, const gen_mesh *g, double density, double mi
     CHECK(m.l2_stretch <= 1.01);
     lmb_pack_result_free(&r);
     lmb_charts_free(&c);
-    free(uv);
+    charts_at_free(&at);
     free(pos);
-    free(charts);
 }
 
 int main(void)
