@@ -38,9 +38,9 @@
  * with the light count. Directional lights are always evaluated. */
 #define EXACT_LOCAL_LIGHTS 8
 
-const lmb_config *lmb_direct_config(const lmb_direct *d)
+const lmb_direct_options *lmb_direct_opts(const lmb_direct *d)
 {
-    return d->cfg;
+    return &d->opt;
 }
 
 const lmb_rt *lmb_direct_rt(const lmb_direct *d)
@@ -50,13 +50,13 @@ const lmb_rt *lmb_direct_rt(const lmb_direct *d)
 
 int lmb_direct_any_light(const lmb_direct *d)
 {
-    return (d->lights.local_count + d->lights.directional_count > 0 && d->cfg->light_intensity_scale > 0) ||
+    return (d->lights.local_count + d->lights.directional_count > 0 && d->opt.light_scale > 0) ||
            lmb_emitters_count(d->emitters) > 0 || d->sky != NULL;
 }
 
 int lmb_direct_has_sampled(const lmb_direct *d)
 {
-    return (d->lights.directional_count > 0 && d->cfg->sun_angle > 0) || d->lights.local_count > EXACT_LOCAL_LIGHTS ||
+    return (d->lights.directional_count > 0 && d->opt.sun_angle > 0) || d->lights.local_count > EXACT_LOCAL_LIGHTS ||
            lmb_emitters_count(d->emitters) > 0 || d->sky != NULL;
 }
 
@@ -152,7 +152,7 @@ static int punctual_reaches(const point_ctx *c, const lmb_light *l, double d[3],
 /* Adds the light's contribution times `weight` to e. */
 static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3])
 {
-    double scale = c->d->cfg->light_intensity_scale, d[3], dist, cosang, w;
+    double scale = c->d->opt.light_scale, d[3], dist, cosang, w;
     if (!punctual_reaches(c, l, d, &dist, &cosang, &w))
         return;
     c->rays++;
@@ -166,9 +166,9 @@ static void punctual(point_ctx *c, const lmb_light *l, double weight, double e[3
     add_light(c, l, d, rgb, e);
 }
 
-void lmb_sun_disc_init(const lmb_config *cfg, const lmb_light *l, lmb_sun_disc *disc)
+void lmb_sun_disc_init(double sun_angle, const lmb_light *l, lmb_sun_disc *disc)
 {
-    disc->cos_max = cos(0.5 * cfg->sun_angle * LMB_PI / 180.0);
+    disc->cos_max = cos(0.5 * sun_angle * LMB_PI / 180.0);
     for (int k = 0; k < 3; k++)
         disc->axis[k] = -l->direction[k];
     lmb_frame(disc->axis, disc->t, disc->b);
@@ -187,9 +187,9 @@ void lmb_sun_disc_direction(const lmb_sun_disc *disc, double u1, double u2, doub
 static void sun_disc(point_ctx *c, const lmb_light *l, uint32_t which, double e[3])
 {
     lmb_sun_disc disc;
-    lmb_sun_disc_init(c->d->cfg, l, &disc);
+    lmb_sun_disc_init(c->d->opt.sun_angle, l, &disc);
     uint32_t n = c->samples;
-    double scale = c->d->cfg->light_intensity_scale * l->intensity / (0.5 * (1 + disc.cos_max)) / n;
+    double scale = c->d->opt.light_scale * l->intensity / (0.5 * (1 + disc.cos_max)) / n;
     lmb_qmc_seq seq = lmb_qmc_sequence(lmb_mix64(c->sequence ^ (0x53554e00ull + which)));
     for (uint32_t s = 0; s < n; s++) {
         double u[2], d[3];
@@ -447,16 +447,16 @@ uint32_t lmb_direct_eval(const lmb_direct *d, const lmb_shading_point *sp, const
 {
     point_ctx c;
     lmb_point_init(&c, d, sp);
-    c.samples = draw->samples ? draw->samples : d->cfg->direct_samples;
+    c.samples = draw->samples ? draw->samples : d->opt.samples;
     c.sequence = draw->sequence;
     c.first = draw->first;
     int exact = (draw->parts & LMB_DIRECT_EXACT) != 0, sampled = (draw->parts & LMB_DIRECT_SAMPLED) != 0;
     e[0] = e[1] = e[2] = 0;
     for (uint32_t l = 0; l < d->lights.directional_count; l++) {
         const lmb_light *sun = &d->scene->lights[d->lights.directional[l]];
-        if (d->cfg->sun_angle > 0 && sampled)
+        if (d->opt.sun_angle > 0 && sampled)
             sun_disc(&c, sun, l, e);
-        else if (d->cfg->sun_angle <= 0 && exact)
+        else if (d->opt.sun_angle <= 0 && exact)
             punctual(&c, sun, 1.0, e);
     }
     if (d->lights.local_count <= EXACT_LOCAL_LIGHTS ? exact : sampled)
@@ -465,7 +465,7 @@ uint32_t lmb_direct_eval(const lmb_direct *d, const lmb_shading_point *sp, const
         area_lights(&c, e);
     if (d->sky && sampled)
         c.rays += lmb_sky_irradiance(d->sky, d->rt, c.o, c.n, c.ng, c.eps,
-                                     draw->sky_samples ? draw->sky_samples : d->cfg->sky_samples, rng, e, c.dir);
+                                     draw->sky_samples ? draw->sky_samples : d->opt.sky_samples, rng, e, c.dir);
     if (dir)
         memcpy(dir, c.dir, sizeof c.dir);
     if (deferred)
@@ -569,7 +569,7 @@ static void light_set_free(light_set *ls)
     free(ls->cdf);
 }
 
-lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, const lmb_rt *rt,
+lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_direct_options *opt, const lmb_rt *rt,
                              const lmb_emitters *emitters, const lmb_sky *sky, lmb_direct **out, lmb_error *err)
 {
     lmb_direct *d = calloc(1, sizeof *d);
@@ -580,7 +580,7 @@ lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, cons
         return lmb_error_set(err, LMB_ERR_INTERNAL, "direct: out of memory");
     }
     d->scene = scene;
-    d->cfg = cfg;
+    d->opt = *opt;
     d->rt = rt;
     d->emitters = emitters;
     d->sky = sky;

@@ -26,9 +26,27 @@ uint32_t lmb_emitters_count(const lmb_emitters *e);
 
 typedef struct lmb_direct lmb_direct; /* opaque: a scene's lights ready to evaluate at any point */
 
+/* What the direct stage takes of the bake's config (the driver fills it from lmb_config:
+ * pipeline/stage_options.h). The sampling inputs come first; what an artist dials about the
+ * light itself (light_scale) is kept apart, so that no sampling decision need read it. */
+typedef struct lmb_direct_options {
+    uint32_t samples;       /* samples.direct: area-light, sun-disc and many-light samples per point */
+    uint32_t sky_samples;   /* sky.samples */
+    uint32_t texel_samples; /* samples.texel: gather points per texel */
+    double sun_angle;       /* lights.sun_angle, degrees: the sun's disc (0: a direction) */
+    uint64_t seed;          /* the bake's seed: keys every random stream */
+    uint32_t threads;       /* 0: OpenMP's default */
+    int directional;        /* output.directional: keep each texel's light direction */
+    int adaptive;           /* samples.adaptive: more rounds where a texel's noise is above noise_target */
+    double noise_target;    /* samples.noise */
+    uint32_t max_rays;      /* samples.max_rays: a texel's most rays */
+    double light_scale;     /* lights.intensity_scale: multiplies every punctual light's intensity */
+} lmb_direct_options;
+
 /* The lights of scene (punctual from scene->lights, area from emitters, the sky if not NULL),
- * for any number of threads at once. Borrows everything it is given; free with lmb_direct_free. */
-lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_config *cfg, const lmb_rt *rt,
+ * for any number of threads at once. Copies opt; borrows everything else it is given; free with
+ * lmb_direct_free. */
+lmb_status lmb_direct_create(const lmb_scene *scene, const lmb_direct_options *opt, const lmb_rt *rt,
                              const lmb_emitters *emitters, const lmb_sky *sky, lmb_direct **out, lmb_error *err);
 void lmb_direct_free(lmb_direct *d);
 
@@ -108,8 +126,8 @@ int lmb_point_inside_geometry(const lmb_direct *d, const lmb_shading_point *sp, 
 struct lmb_point_validity;
 void lmb_direct_set_validity(lmb_direct *d, struct lmb_point_validity *validity);
 
-/* The config the lights were made with (borrowed). */
-const lmb_config *lmb_direct_config(const lmb_direct *d);
+/* The options the lights were made with. */
+const lmb_direct_options *lmb_direct_opts(const lmb_direct *d);
 const lmb_rt *lmb_direct_rt(const lmb_direct *d);
 
 /* Gather point k of listed texel i of t as a shading point (offset scaled to the texel). */
@@ -143,7 +161,7 @@ lmb_status lmb_direct_compute_bands(const lmb_direct_job *jobs, lmb_texels *t, f
                                     uint64_t *rays, uint64_t *samples, lmb_error *err);
 
 /* Samples per point in one round of the sampled lights: half samples.direct (rounded up). */
-uint32_t lmb_direct_round_samples(const lmb_config *cfg);
+uint32_t lmb_direct_round_samples(const lmb_direct_options *opt);
 
 /* 1 when some light is sampled (emissive triangles, sun discs, more than 8 point lights, the sky):
  * direct light has noise, and adaptive sampling has something to do. */

@@ -37,7 +37,7 @@ struct lmb_emitters {
 
 struct lmb_direct {
     const lmb_scene *scene;
-    const lmb_config *cfg;
+    lmb_direct_options opt;
     const lmb_rt *rt;
     const lmb_emitters *emitters;
     const lmb_sky *sky;
@@ -89,7 +89,7 @@ typedef struct lmb_sun_disc {
     double cos_max, axis[3], t[3], b[3];
 } lmb_sun_disc;
 
-void lmb_sun_disc_init(const lmb_config *cfg, const lmb_light *l, lmb_sun_disc *disc);
+void lmb_sun_disc_init(double sun_angle, const lmb_light *l, lmb_sun_disc *disc);
 
 /* Direction (unit, toward the sun) of the sample (u1, u2) of the disc: uniform in its cone of
  * directions. */

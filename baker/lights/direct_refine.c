@@ -19,7 +19,7 @@
 #define REFINE_BUDGET 1.0
 
 typedef struct refine_ctx {
-    const lmb_config *cfg;
+    const lmb_direct_options *opt;
     const lmb_direct *direct;
     const lmb_scene *scene;
     const lmb_layout *layout;
@@ -35,14 +35,14 @@ typedef struct refine_ctx {
 /* The rounds texel i needs: its standard error after R rounds is sqrt(variance / R); R is the
  * least with that under k x samples.noise x the light shown, at most samples.max_rays samples
  * (counting every point of the texel). 0: two rounds (the direct step's) are enough. */
-static uint32_t rounds_needed(const lmb_config *cfg, double k, double variance, double shown, int *capped)
+static uint32_t rounds_needed(const lmb_direct_options *opt, double k, double variance, double shown, int *capped)
 {
     *capped = 0;
-    double target = k * cfg->noise_target * shown;
+    double target = k * opt->noise_target * shown;
     if (!(variance > 0) || !(target > 0) || variance <= 2 * target * target)
         return 0;
     double want = ceil(variance / (target * target));
-    double most = floor((double)cfg->max_rays / ((double)cfg->texel_samples * lmb_direct_round_samples(cfg)));
+    double most = floor((double)opt->max_rays / ((double)opt->texel_samples * lmb_direct_round_samples(opt)));
     if (want > most) {
         want = most;
         *capped = 1;
@@ -91,7 +91,7 @@ static int neighbourhood_means(const lmb_direct_atlas *da, const double *shown, 
 /* rounds[i] := the rounds every texel needs at k x samples.noise, from its neighbourhood's
  * variance and light (rim texels keep the limit post/rim.c set); returns their sum; with noise,
  * counts the refined and capped texels. In parallel: the sums are of integers, exact in any order. */
-static double plan_rounds(const lmb_config *cfg, const lmb_direct_atlas *da, const float *mean_var,
+static double plan_rounds(const lmb_direct_options *opt, const lmb_direct_atlas *da, const float *mean_var,
                           const float *mean_lum, double k, int threads, uint32_t *rounds, lmb_direct_noise *noise)
 {
     uint64_t sum = 0, refined = 0, capped = 0;
@@ -101,7 +101,7 @@ static double plan_rounds(const lmb_config *cfg, const lmb_direct_atlas *da, con
         if (!da->t.valid[i] || !(da->variance[i] > 0) || (da->t.edge[i] & LMB_EDGE_COVERED))
             continue;
         int was_capped;
-        rounds[i] = rounds_needed(cfg, k, mean_var[i], mean_lum[i], &was_capped);
+        rounds[i] = rounds_needed(opt, k, mean_var[i], mean_lum[i], &was_capped);
         sum += rounds[i];
         refined += rounds[i] > 0;
         capped += rounds[i] > 0 && was_capped;
@@ -168,7 +168,7 @@ static lmb_status refine_group(const refine_ctx *c, uint64_t b0, uint64_t b1, co
                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
     uint32_t n = (uint32_t)(b1 - b0), used = 0;
-    lmb_status st = lmb_direct_build_bands(c->cfg, c->scene, c->layout, c->atlas, c->rows, b0, b1, &c->instance_rows,
+    lmb_status st = lmb_direct_build_bands(c->opt, c->scene, c->layout, c->atlas, c->rows, b0, b1, &c->instance_rows,
                                            skip, texels, err);
     for (uint32_t k = 0; k < n && st == LMB_OK; k++) { /* r owns the texels from here */
         r[k].i0 = c->first[b0 + k];
@@ -215,7 +215,7 @@ static lmb_status refine_bands(void *user, uint64_t first, uint64_t last, lmb_bu
                                uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
     const refine_ctx *c = user;
-    uint32_t group = lmb_direct_group_bands(c->cfg);
+    uint32_t group = lmb_direct_group_bands(c->opt);
     uint64_t most = last - first;
     band_refined *r = calloc(most + 1, sizeof *r);
     uint8_t *skip = calloc(most + 1, 1);
@@ -271,11 +271,12 @@ static lmb_status take_refined(lmb_buf *in, uint64_t bands, lmb_direct_atlas *da
     return LMB_OK;
 }
 
-lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
+lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_direct *direct,
                                   const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const double *shown,
                                   lmb_progress_fn progress, void *progress_user, lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
                                   uint64_t *estimate_count, lmb_error *err)
 {
+    const lmb_direct_options *opt = lmb_direct_opts(direct);
     uint32_t count = da->t.count, width = layout->width[a], height = layout->height[a];
     uint32_t rows = width ? (LMB_DIRECT_BAND_TEXELS + width - 1) / width : 1;
     rows = rows ? rows : 1;
@@ -292,7 +293,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
         free(cost);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "direct light: out of memory refining atlas %u", a);
     }
-    double per_texel = (double)cfg->texel_samples * lmb_direct_round_samples(cfg), step_rays = 0;
+    double per_texel = (double)opt->texel_samples * lmb_direct_round_samples(opt), step_rays = 0;
     uint64_t b = 0;
     for (uint32_t i = 0; i < count; i++) {
         while (b < bands && da->t.texel[i] >= (uint64_t)(b + 1) * rows * width)
@@ -308,7 +309,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     uint64_t sampled = noise_texels_here(da);
     double round_rays = sampled ? (double)da->rays / (2.0 * (double)sampled) : 0;
     double budget = REFINE_BUDGET * (double)da->rays, k = 1;
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    int threads = opt->threads ? (int)opt->threads : omp_get_max_threads();
     float *mean_var = malloc(((size_t)count + 1) * sizeof *mean_var), *mean_lum = malloc(((size_t)count + 1) * sizeof *mean_lum);
     if (!mean_var || !mean_lum || !neighbourhood_means(da, shown, width, height, threads, mean_var, mean_lum)) {
         free(mean_var);
@@ -318,13 +319,13 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
         free(cost);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "direct light: out of memory refining atlas %u", a);
     }
-    if (cfg->adaptive && plan_rounds(cfg, da, mean_var, mean_lum, 1, threads, rounds, NULL) * round_rays > budget) {
+    if (opt->adaptive && plan_rounds(opt, da, mean_var, mean_lum, 1, threads, rounds, NULL) * round_rays > budget) {
         double lo = 1, hi = 2;
-        while (hi < 1e6 && plan_rounds(cfg, da, mean_var, mean_lum, hi, threads, rounds, NULL) * round_rays > budget)
+        while (hi < 1e6 && plan_rounds(opt, da, mean_var, mean_lum, hi, threads, rounds, NULL) * round_rays > budget)
             hi *= 2;
         for (int it = 0; it < 40 && hi < 1e6; it++) {
             double mid = 0.5 * (lo + hi);
-            if (plan_rounds(cfg, da, mean_var, mean_lum, mid, threads, rounds, NULL) * round_rays > budget)
+            if (plan_rounds(opt, da, mean_var, mean_lum, mid, threads, rounds, NULL) * round_rays > budget)
                 lo = mid;
             else
                 hi = mid;
@@ -334,8 +335,8 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     }
     if (k > noise->loosened)
         noise->loosened = k;
-    if (cfg->adaptive)
-        plan_rounds(cfg, da, mean_var, mean_lum, k < 1e6 ? k : 1e300, threads, rounds, noise);
+    if (opt->adaptive)
+        plan_rounds(opt, da, mean_var, mean_lum, k < 1e6 ? k : 1e300, threads, rounds, noise);
     free(mean_var);
     free(mean_lum);
     for (uint32_t i = 0, bb = 0; i < count; i++) {
@@ -347,7 +348,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
     }
     lmb_status st = LMB_OK;
     if (noise->refined) {
-        refine_ctx c = {cfg, direct, scene, layout, a, width, height, rows, da, rounds, first, {0},
+        refine_ctx c = {opt, direct, scene, layout, a, width, height, rows, da, rounds, first, {0},
                         progress, progress_user};
         st = lmb_instance_rows_make(scene, layout, a, rows, &c.instance_rows, err);
         char name[64];
@@ -387,7 +388,7 @@ void lmb_direct_noise_finish(lmb_direct_noise *noise, float *estimates, uint64_t
     free(estimates);
 }
 
-void lmb_direct_noise_report(const lmb_direct_noise *noise, const lmb_config *cfg, lmb_bake_stats *stats,
+void lmb_direct_noise_report(const lmb_direct_noise *noise, const lmb_direct_options *opt, lmb_bake_stats *stats,
                              const lmb_log *log)
 {
     if (!noise->texels)
@@ -400,12 +401,12 @@ void lmb_direct_noise_report(const lmb_direct_noise *noise, const lmb_config *cf
              "direct light: estimated noise per texel median %.2f%%, p95 %.2f%% of the light (samples.noise %g%%%s); "
              "%llu of %llu texels (%.1f%%) took more samples (%.1f per texel on average), %llu of them stopped at "
              "samples.max_rays %u",
-             100.0 * noise->median, 100.0 * noise->p95, 100.0 * cfg->noise_target, cfg->adaptive ? "" : ", not adaptive",
+             100.0 * noise->median, 100.0 * noise->p95, 100.0 * opt->noise_target, opt->adaptive ? "" : ", not adaptive",
              (unsigned long long)noise->refined, (unsigned long long)noise->texels,
              100.0 * (double)noise->refined / (double)noise->texels,
              noise->refined ? (double)noise->samples / (double)noise->refined : 0.0, (unsigned long long)noise->capped,
-             cfg->max_rays);
+             opt->max_rays);
     if (noise->budget_limited)
         lmb_info(log, "direct light: samples.noise asked for more rays than the direct step's; the texels were refined "
-                 "to %.2f%% instead (raise samples.direct for more)", 100.0 * noise->loosened * cfg->noise_target);
+                 "to %.2f%% instead (raise samples.direct for more)", 100.0 * noise->loosened * opt->noise_target);
 }

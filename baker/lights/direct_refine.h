@@ -28,7 +28,7 @@ typedef struct lmb_direct_noise {
  * direct - deferred) before refining. With samples.adaptive off nothing is refined, only measured.
  * Adds to *rays and to noise (median and p95 are set by lmb_direct_noise_finish). Afterwards
  * da->variance holds each texel's estimate's variance (a round's over its rounds), not a round's. */
-lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
+lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_direct *direct,
                                   const lmb_scene *scene, const lmb_layout *layout, uint32_t a, const double *shown,
                                   lmb_progress_fn progress, void *progress_user, lmb_direct_atlas *da, uint64_t *rays, lmb_direct_noise *noise, float **estimates,
                                   uint64_t *estimate_count, lmb_error *err);
@@ -37,7 +37,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_config *cfg, const
 void lmb_direct_noise_finish(lmb_direct_noise *noise, float *estimates, uint64_t count);
 
 /* stats and the log: what the bake reached (nothing when no texel has sampled light). */
-void lmb_direct_noise_report(const lmb_direct_noise *noise, const lmb_config *cfg, lmb_bake_stats *stats,
+void lmb_direct_noise_report(const lmb_direct_noise *noise, const lmb_direct_options *opt, lmb_bake_stats *stats,
                              const lmb_log *log);
 
 #endif

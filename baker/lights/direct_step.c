@@ -10,7 +10,7 @@
 
 
 typedef struct band_ctx {
-    const lmb_config *cfg;
+    const lmb_direct_options *opt;
     const lmb_direct *direct;
     const lmb_scene *scene;
     const lmb_layout *layout;
@@ -20,13 +20,13 @@ typedef struct band_ctx {
     lmb_instance_rows instance_rows;     /* which instances a band visits */
 } band_ctx;
 
-uint32_t lmb_direct_group_bands(const lmb_config *cfg)
+uint32_t lmb_direct_group_bands(const lmb_direct_options *opt)
 {
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    int threads = opt->threads ? (int)opt->threads : omp_get_max_threads();
     return 4 * (uint32_t)(threads > 0 ? threads : 1);
 }
 
-lmb_status lmb_direct_build_bands(const lmb_config *cfg, const lmb_scene *scene, const lmb_layout *layout,
+lmb_status lmb_direct_build_bands(const lmb_direct_options *opt, const lmb_scene *scene, const lmb_layout *layout,
                                   uint32_t atlas, uint32_t rows, uint64_t first, uint64_t last,
                                   const lmb_instance_rows *instance_rows, const uint8_t *skip, lmb_texels *out,
                                   lmb_error *err)
@@ -37,14 +37,14 @@ lmb_status lmb_direct_build_bands(const lmb_config *cfg, const lmb_scene *scene,
     if (!errs)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", atlas);
     memset(out, 0, (size_t)n * sizeof *out);
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    int threads = opt->threads ? (int)opt->threads : omp_get_max_threads();
     /* one band per thread at a time: a band's texels are built on one thread, the bands at once */
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (int64_t k = 0; k < n; k++) {
         if (skip && skip[k])
             continue;
         uint32_t y0 = (uint32_t)(first + (uint64_t)k) * rows, y1 = y0 + rows < height ? y0 + rows : height;
-        if (lmb_texels_build_rows(scene, layout, atlas, cfg->texel_samples, y0, y1, instance_rows, &out[k],
+        if (lmb_texels_build_rows(scene, layout, atlas, opt->texel_samples, y0, y1, instance_rows, &out[k],
                                   &errs[k]) != LMB_OK) {
             memset(&out[k], 0, sizeof out[k]);
 #pragma omp critical(lmb_build_bands_failed)
@@ -125,7 +125,7 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
 {
     band_ctx *c = user;
     lmb_status st = LMB_OK;
-    uint32_t group = lmb_direct_group_bands(c->cfg);
+    uint32_t group = lmb_direct_group_bands(c->opt);
     lmb_texels *bands = calloc(group, sizeof *bands);
     band_light *light = calloc(group, sizeof *light);
     lmb_direct_job *jobs = calloc(group, sizeof *jobs);
@@ -135,7 +135,7 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
     int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
     for (uint64_t g = first; g < last && st == LMB_OK; g += group) {
         uint32_t n = (uint32_t)(last - g < group ? last - g : group);
-        st = lmb_direct_build_bands(c->cfg, c->scene, c->layout, c->atlas, c->rows, g, g + n, &c->instance_rows, NULL,
+        st = lmb_direct_build_bands(c->opt, c->scene, c->layout, c->atlas, c->rows, g, g + n, &c->instance_rows, NULL,
                                     bands, err);
         if (st != LMB_OK)
             break;
@@ -145,10 +145,10 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
             memset(l, 0, sizeof *l);
             l->e = calloc(3 * count + 1, sizeof *l->e);
             l->variance = calloc(count + 1, sizeof *l->variance);
-            l->dir = c->cfg->directional ? calloc(3 * count + 1, sizeof *l->dir) : NULL;
+            l->dir = c->opt->directional ? calloc(3 * count + 1, sizeof *l->dir) : NULL;
             l->deferred = has_deferred ? calloc(3 * count + 1, sizeof *l->deferred) : NULL;
             l->mask = has_mask ? calloc(LMB_SHADOWMASK_CHANNELS * count + 1, sizeof *l->mask) : NULL;
-            if (!l->e || !l->variance || (c->cfg->directional && !l->dir) || (has_deferred && !l->deferred) ||
+            if (!l->e || !l->variance || (c->opt->directional && !l->dir) || (has_deferred && !l->deferred) ||
                 (has_mask && !l->mask))
                 st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
             jobs[k] = (lmb_direct_job){c->direct, c->atlas, l->dir, l->deferred, l->mask, l->variance, NULL};
@@ -168,7 +168,7 @@ static lmb_status compute_bands(void *user, uint64_t first, uint64_t last, lmb_b
                 offset[k + 1] = offset[k] + band_bytes(&bands[k], &light[k]);
             if (!offset)
                 st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
-            int threads = c->cfg->threads ? (int)c->cfg->threads : omp_get_max_threads();
+            int threads = c->opt->threads ? (int)c->opt->threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
             for (uint32_t k = 0; k < (offset ? n : 0); k++)
                 put_band(&bands[k], &light[k], out->data + at + offset[k]);
@@ -273,7 +273,7 @@ static lmb_status take_bands(void *user, lmb_buf *bytes, lmb_error *err)
     bands_taken *bt = user;
     lmb_status st = LMB_OK;
     for (; bytes->read < bytes->size && st == LMB_OK; bt->bands++)
-        st = take_band(bytes, bt->c->cfg->directional, bt->out, bt->c, err);
+        st = take_band(bytes, bt->c->opt->directional, bt->out, bt->c, err);
     return st;
 }
 
@@ -312,12 +312,13 @@ static void band_costs(const lmb_layout *layout, uint32_t a, uint32_t width, uin
     }
 }
 
-lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
+lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_direct *direct,
                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, lmb_progress_fn progress,
                                  void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err)
 {
+    const lmb_direct_options *opt = lmb_direct_opts(direct);
     memset(out, 0, sizeof *out);
-    band_ctx c = {cfg, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user,
+    band_ctx c = {opt, direct, scene, layout, a, layout->width[a], layout->height[a], 1, progress, progress_user,
                   {0}};
     c.rows = c.width ? (LMB_DIRECT_BAND_TEXELS + c.width - 1) / c.width : c.height;
     if (!c.rows)
@@ -335,14 +336,14 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
     char name[64];
     snprintf(name, sizeof name, "direct, atlas %u", a);
     /* rays: sub-samples x shadow rays, over the atlas's area (an upper bound: not every texel is used) */
-    lmb_step_desc d = {name, bands, cost, (double)c.width * c.height * cfg->texel_samples * cfg->direct_samples,
+    lmb_step_desc d = {name, bands, cost, (double)c.width * c.height * opt->texel_samples * opt->samples,
                        compute_bands, &c};
     uint64_t counters[LMB_STEP_COUNTERS];
     bands_taken taken = {out, &c, 0};
     if (progress) /* the stage starts now, not when its first group is done */
         progress(progress_user, "direct", 0, (uint64_t)c.height * c.width);
     /* a group of bands at a time (compute_bands): the bytes of one group are held at once */
-    st = lmb_steps_run_streamed(steps, &d, lmb_direct_group_bands(cfg), take_bands, &taken, counters, err);
+    st = lmb_steps_run_streamed(steps, &d, lmb_direct_group_bands(opt), take_bands, &taken, counters, err);
     *rays += counters[0];
     out->rays = counters[0];
     if (st == LMB_OK && taken.bands != bands)
@@ -364,9 +365,9 @@ lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const 
         out->deferred = calloc(1, sizeof *out->deferred);
     if (st == LMB_OK && lmb_direct_shadowmask_channels(direct) && !out->shadowmask)
         out->shadowmask = calloc(1, sizeof *out->shadowmask);
-    if (st == LMB_OK && cfg->directional && !out->direction)
+    if (st == LMB_OK && opt->directional && !out->direction)
         out->direction = calloc(1, sizeof *out->direction);
-    if (st == LMB_OK && (!out->direct || !out->variance || (cfg->directional && !out->direction)))
+    if (st == LMB_OK && (!out->direct || !out->variance || (opt->directional && !out->direction)))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", a);
     free(cost);
     lmb_instance_rows_free(&c.instance_rows);

@@ -31,18 +31,18 @@ typedef struct lmb_direct_atlas {
 
 /* Bands lit at once by the direct step and its refinement: 4 per thread, so that a band's
  * serial set-up (its texels) runs beside the others and the texels' loop has enough work. */
-uint32_t lmb_direct_group_bands(const lmb_config *cfg);
+uint32_t lmb_direct_group_bands(const lmb_direct_options *opt);
 
 /* out[k] := the texels of band first + k of atlas `atlas` (rows per band `rows`), for k in
  * [0, last - first), built in parallel (a band per thread); skip (NULL: none): per band, 1
  * leaves out[k] empty. On error nothing is left allocated and err is the first band's error. */
-lmb_status lmb_direct_build_bands(const lmb_config *cfg, const lmb_scene *scene, const lmb_layout *layout,
+lmb_status lmb_direct_build_bands(const lmb_direct_options *opt, const lmb_scene *scene, const lmb_layout *layout,
                                   uint32_t atlas, uint32_t rows, uint64_t first, uint64_t last,
                                   const lmb_instance_rows *instance_rows, const uint8_t *skip, lmb_texels *out,
                                   lmb_error *err);
 
 /* *out := atlas a's texels and direct light (owned: free its arrays and lmb_texels_free). */
-lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_config *cfg, const lmb_direct *direct,
+lmb_status lmb_direct_atlas_step(lmb_steps *steps, const lmb_direct *direct,
                                  const lmb_scene *scene, const lmb_layout *layout, uint32_t a, lmb_progress_fn progress,
                                  void *progress_user, lmb_direct_atlas *out, uint64_t *rays, lmb_error *err);
 

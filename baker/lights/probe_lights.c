@@ -29,7 +29,7 @@ uint32_t lmb_direct_deltas_at(const lmb_direct *d, const double p[3], lmb_delta_
         double dir[3], dist;
         if (!lmb_light_direction(&c, l, dir, &dist))
             continue;
-        double w = lmb_punctual_falloff(l, dir, dist) * d->cfg->light_intensity_scale * l->intensity;
+        double w = lmb_punctual_falloff(l, dir, dist) * d->opt.light_scale * l->intensity;
         if (!(w > 0))
             continue;
         rays++;

@@ -24,10 +24,10 @@ static double seen_through(point_ctx *c, const double d[3], double tmax)
 static double visibility(point_ctx *c, const lmb_light *l, lmb_rng *rng)
 {
     double d[3], dist = 1e300;
-    if (l->type == LMB_LIGHT_DIRECTIONAL && c->d->cfg->sun_angle > 0) {
+    if (l->type == LMB_LIGHT_DIRECTIONAL && c->d->opt.sun_angle > 0) {
         double seen = 0;
         lmb_sun_disc disc;
-        lmb_sun_disc_init(c->d->cfg, l, &disc);
+        lmb_sun_disc_init(c->d->opt.sun_angle, l, &disc);
         for (uint32_t s = 0; s < c->samples; s++) {
             double u1 = lmb_rng_next(rng), u2 = lmb_rng_next(rng);
             lmb_sun_disc_direction(&disc, u1, u2, d);
@@ -49,7 +49,7 @@ uint32_t lmb_shadowmask_at(const lmb_direct *d, const lmb_shading_point *sp, lmb
 {
     point_ctx c;
     lmb_point_init(&c, d, sp);
-    c.samples = d->cfg->direct_samples;
+    c.samples = d->opt.samples;
     for (uint32_t k = 0; k < LMB_SHADOWMASK_CHANNELS; k++)
         vis[k] = k < d->lights.mask_channels ? visibility(&c, &d->scene->lights[d->lights.mask_light[k]], rng) : 0;
     return (uint32_t)c.rays;

@@ -44,9 +44,9 @@ static double round_variance(const point_sum *ps, uint32_t used, uint32_t rounds
     return used ? var / ((double)used * used) : 0;
 }
 
-uint32_t lmb_direct_round_samples(const lmb_config *cfg)
+uint32_t lmb_direct_round_samples(const lmb_direct_options *opt)
 {
-    return cfg->direct_samples > 1 ? (cfg->direct_samples + 1) / 2 : 1;
+    return opt->samples > 1 ? (opt->samples + 1) / 2 : 1;
 }
 
 /*
@@ -137,7 +137,7 @@ static int thin_wall_beside(const lmb_direct *d, const lmb_shading_point *sp, do
 static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, uint32_t first, uint32_t rounds,
                          float *out, uint64_t *rays, point_sum *ps, uint64_t *samples)
 {
-    const lmb_config *cfg = lmb_direct_config(job->direct);
+    const lmb_direct_options *opt = lmb_direct_opts(job->direct);
     double mask_sum[LMB_SHADOWMASK_CHANNELS] = {0};
     uint32_t used = 0, r = 0;
     int near_back = 0, near = 0;
@@ -147,7 +147,7 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         memset(p, 0, sizeof *p);
         p->k = k;
         lmb_texel_shading_point(job->direct, t, i, k, &p->sp);
-        p->rng = lmb_rng_make(cfg->seed, key, k);
+        p->rng = lmb_rng_make(opt->seed, key, k);
         if (lmb_texel_point_cut(job->direct, t, i, k))
             continue;
         lmb_point_sight sight = {LMB_NEAR_TEXELS * t->texel_size[i], 0, 0};
@@ -169,17 +169,17 @@ static void texel_direct(const lmb_direct_job *job, lmb_texels *t, uint32_t i, u
         lmb_direct_draw exact = {LMB_DIRECT_EXACT, 0, 0, p->sequence, 0};
         r += lmb_direct_eval(job->direct, &p->sp, &exact, &p->rng, p->e, p->dir, p->deferred);
         if (first) /* the refinement's own stream for the sky and many lights (drawn by power past 256) */
-            p->rng = lmb_rng_make(cfg->seed, key, 0x6000u + p->k);
+            p->rng = lmb_rng_make(opt->seed, key, 0x6000u + p->k);
         if (job->shadowmask) { /* a stream of its own: the lightmap does not change with output.shadowmask */
-            lmb_rng mask_rng = lmb_rng_make(cfg->seed, key, 0x5000u + p->k);
+            lmb_rng mask_rng = lmb_rng_make(opt->seed, key, 0x5000u + p->k);
             double vis[LMB_SHADOWMASK_CHANNELS];
             r += lmb_shadowmask_at(job->direct, &p->sp, &mask_rng, vis);
             for (int c = 0; c < LMB_SHADOWMASK_CHANNELS; c++)
                 mask_sum[c] += vis[c];
         }
     }
-    uint32_t per_round = lmb_direct_round_samples(cfg);
-    uint32_t sky_round = cfg->sky_samples > 1 ? (cfg->sky_samples + 1) / 2 : 1;
+    uint32_t per_round = lmb_direct_round_samples(opt);
+    uint32_t sky_round = opt->sky_samples > 1 ? (opt->sky_samples + 1) / 2 : 1;
     if (!used || !lmb_direct_has_sampled(job->direct))
         rounds = 0;
     for (uint32_t round = 0; round < rounds; round++)
@@ -238,8 +238,8 @@ lmb_status lmb_direct_compute_bands(const lmb_direct_job *jobs, lmb_texels *t, f
 {
     if (!bands)
         return LMB_OK;
-    const lmb_config *cfg = lmb_direct_config(jobs[0].direct);
-    int threads = cfg->threads ? (int)cfg->threads : omp_get_max_threads();
+    const lmb_direct_options *opt = lmb_direct_opts(jobs[0].direct);
+    int threads = opt->threads ? (int)opt->threads : omp_get_max_threads();
     int refine = jobs[0].rounds != NULL;
     /* the work: (band << 32 | texel), with the refinement's rounds beside it for the order */
     uint64_t n = 0;

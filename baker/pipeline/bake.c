@@ -17,6 +17,7 @@
 #include "watch/stages_out.h"
 #include "watch/validity_cache.h"
 #include "pipeline/lighting.h"
+#include "pipeline/stage_options.h"
 #include "lights/direct.h"
 #include "load/gltf_adapter.h"
 #include "load/textures.h"
@@ -245,8 +246,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
                  (unsigned long long)rt.cut_triangles, (unsigned long long)rt.partial_triangles);
     if (st == LMB_OK)
         st = lmb_emitters_build(s, cfg, &tx, &em, err);
+    lmb_direct_options direct_opt = lmb_direct_options_of(cfg);
     if (st == LMB_OK)
-        st = lmb_direct_create(s, cfg, &rt, em, sky, &direct, err);
+        st = lmb_direct_create(s, &direct_opt, &rt, em, sky, &direct, err);
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     cache.threads = cfg->threads;

@@ -262,7 +262,6 @@ static lmb_status gather_step(const pass_env *env, lmb_gather_stats *gs, lmb_err
  * is 0: result holds the gathered light only) ; stats and the log get what the bake reached. */
 static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_error *err)
 {
-    const lmb_config *cfg = env->cfg;
     lmb_direct_noise noise = {0};
     float *estimates = NULL;
     uint64_t estimate_count = 0;
@@ -285,14 +284,14 @@ static lmb_status refine_direct(const pass_env *env, int result_has_direct, lmb_
             shown[i] = lmb_luminance_f(rgb);
         }
         lmb_direct_atlas da = {w->t, w->direct, w->direct_dir, w->deferred, NULL, w->variance, w->direct_rays};
-        st = lmb_direct_refine_step(env->job->steps, cfg, env->job->direct, env->cache->scene, env->cache->layout, a,
+        st = lmb_direct_refine_step(env->job->steps, env->job->direct, env->cache->scene, env->cache->layout, a,
                                     shown, env->job->progress, env->job->progress_user, &da, &env->stats->rays, &noise,
                                     &estimates, &estimate_count, err);
         free(shown);
     }
     lmb_direct_noise_finish(&noise, estimates, estimate_count);
     if (st == LMB_OK)
-        lmb_direct_noise_report(&noise, cfg, env->stats, env->log);
+        lmb_direct_noise_report(&noise, lmb_direct_opts(env->job->direct), env->stats, env->log);
     return st;
 }
 
@@ -449,7 +448,7 @@ lmb_status lmb_light_atlases(const lmb_config *cfg, const lmb_direct *direct, lm
     /* gather points and direct light, atlas by atlas */
     for (uint32_t a = 0; a < n && st == LMB_OK; a++) {
         lmb_direct_atlas da;
-        st = lmb_direct_atlas_step(steps, cfg, direct, cache->scene, cache->layout, a, progress, user, &da, &stats->rays,
+        st = lmb_direct_atlas_step(steps, direct, cache->scene, cache->layout, a, progress, user, &da, &stats->rays,
                                    err);
         w[a].t = da.t;
         w[a].direct = da.direct;
