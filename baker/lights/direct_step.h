@@ -15,7 +15,7 @@
 /* Texels per band of the direct step and of its refinement (rows of about this many texels):
  * small enough that a step of 16 shards still deals each several bands (docs/farm.md#balance);
  * a texel's light does not depend on its band. */
-#define LMB_DIRECT_BAND_TEXELS 4096
+#define LMB_DIRECT_BAND_TEXELS 1024
 
 typedef struct lmb_direct_atlas {
     lmb_texels t;        /* the atlas's listed texels, one gather point each */
