@@ -17,9 +17,17 @@
 
 typedef struct lmb_emitters lmb_emitters; /* opaque: emissive triangles and their power CDF */
 
+/* What the emitters take of the config: emission_sides (lights.emission_sides: front only, or
+ * both where the material is double-sided) and scale (lights.emissive_scale, an intensity:
+ * multiplies every emissive material's emission; 0: nothing emits). */
+typedef struct lmb_emitter_options {
+    lmb_emission_sides emission_sides;
+    double scale;
+} lmb_emitter_options;
+
 /* Emissive triangles of every instance; `textures` (may be NULL) holds decoded emissive
  * textures, which multiply the material's emissive factor x strength. */
-lmb_status lmb_emitters_build(const lmb_scene *scene, const lmb_config *cfg, const lmb_textures *textures,
+lmb_status lmb_emitters_build(const lmb_scene *scene, const lmb_emitter_options *opt, const lmb_textures *textures,
                               lmb_emitters **out, lmb_error *err);
 void lmb_emitters_free(lmb_emitters *e);
 uint32_t lmb_emitters_count(const lmb_emitters *e);

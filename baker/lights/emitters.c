@@ -57,14 +57,14 @@ static const lmb_texture *emitter_texture(const lmb_textures *tx, const lmb_mate
     return t;
 }
 
-lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const lmb_textures *tx, lmb_emitters **out,
+lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_emitter_options *opt, const lmb_textures *tx, lmb_emitters **out,
                               lmb_error *err)
 {
     lmb_emitters *es = calloc(1, sizeof *es);
     uint32_t cap = 0;
     lmb_status st = es ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "emitters: out of memory");
     /* lights.emissive_scale 0 (or bake --direct-of): no surface emits */
-    for (uint32_t i = 0; st == LMB_OK && cfg->emissive_scale > 0 && i < s->instance_count; i++) {
+    for (uint32_t i = 0; st == LMB_OK && opt->scale > 0 && i < s->instance_count; i++) {
         const lmb_instance *in = &s->instances[i];
         const lmb_mesh *m = &s->meshes[in->mesh];
         for (uint32_t p = 0; st == LMB_OK && p < m->primitive_count; p++) {
@@ -88,8 +88,8 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_config *cfg, const l
                     x.n[k] = (in->flips_winding ? -c[k] : c[k]) / len;
                 x.area = 0.5 * len;
                 for (int k = 0; k < 3; k++)
-                    x.le[k] = (float)(mat->emissive[k] * cfg->emissive_scale);
-                x.two_sided = cfg->emission_sides == LMB_EMIT_MATERIAL && mat->double_sided;
+                    x.le[k] = (float)(mat->emissive[k] * opt->scale);
+                x.two_sided = opt->emission_sides == LMB_EMIT_MATERIAL && mat->double_sided;
                 x.tex = emitter_texture(tx, mat, pr, f, x.uv);
                 x.instance = i;
                 x.primitive = m->first_primitive + p;

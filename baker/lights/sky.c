@@ -160,29 +160,29 @@ static lmb_status build_tables(lmb_sky *s, lmb_error *err)
     return LMB_OK;
 }
 
-lmb_status lmb_sky_image_path(const lmb_config *cfg, char *real, size_t size, lmb_error *err)
+lmb_status lmb_sky_image_path(const char *config_path, const char *image, char *real, size_t size, lmb_error *err)
 {
     char dir[4096], rel[4096], path[8300];
-    const char *cfg_name = cfg->config_path[0] ? cfg->config_path : "config";
-    const char *slash = strrchr(cfg->config_path, '/');
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - cfg->config_path) : 1, slash ? cfg->config_path : ".");
-    lmb_uri_kind kind = lmb_uri_check(cfg->sky_image, rel, sizeof rel);
+    const char *cfg_name = config_path[0] ? config_path : "config";
+    const char *slash = strrchr(config_path, '/');
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - config_path) : 1, slash ? config_path : ".");
+    lmb_uri_kind kind = lmb_uri_check(image, rel, sizeof rel);
     if (kind != LMB_URI_INSIDE)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' %s; the map must be a file in the "
-                             "config's folder or below", cfg_name, cfg->sky_image, lmb_uri_refusal(kind));
+                             "config's folder or below", cfg_name, image, lmb_uri_refusal(kind));
     snprintf(path, sizeof path, "%s/%s", dir, rel);
     if (!lmb_path_inside(dir, path, real, size))
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' is not a file inside the config's folder "
-                             "'%s'", cfg_name, cfg->sky_image, dir);
+                             "'%s'", cfg_name, image, dir);
     return LMB_OK;
 }
 
-/* The image at cfg->sky_image, inside the config's folder, as radiance times colour x intensity. */
-static lmb_status read_image(const lmb_config *cfg, const lmb_log *log, lmb_sky *s, lmb_error *err)
+/* The image at opt->image, inside the config's folder, as radiance times colour x intensity. */
+static lmb_status read_image(const lmb_sky_options *opt, const lmb_log *log, lmb_sky *s, lmb_error *err)
 {
     char real[4096];
-    const char *cfg_name = cfg->config_path[0] ? cfg->config_path : "config";
-    lmb_status st = lmb_sky_image_path(cfg, real, sizeof real, err);
+    const char *cfg_name = opt->config_path[0] ? opt->config_path : "config";
+    lmb_status st = lmb_sky_image_path(opt->config_path, opt->image, real, sizeof real, err);
     if (st != LMB_OK)
         return st;
     float *rgb = NULL;
@@ -192,7 +192,7 @@ static lmb_status read_image(const lmb_config *cfg, const lmb_log *log, lmb_sky 
     if (s->w != 2 * s->h) {
         free(rgb);
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' is %ux%u: an equirectangular map is twice "
-                             "as wide as it is high", cfg_name, cfg->sky_image, s->w, s->h);
+                             "as wide as it is high", cfg_name, opt->image, s->w, s->h);
     }
     uint64_t replaced = 0;
     for (size_t k = 0; k < 3 * (size_t)s->w * s->h; k++) {
@@ -200,22 +200,22 @@ static lmb_status read_image(const lmb_config *cfg, const lmb_log *log, lmb_sky 
             rgb[k] = 0;
             replaced++;
         }
-        rgb[k] = (float)(rgb[k] * cfg->sky_color[k % 3] * cfg->sky_intensity);
+        rgb[k] = (float)(rgb[k] * opt->color[k % 3] * opt->intensity);
     }
     if (replaced)
         lmb_warn(log, "sky.image '%s': %llu texel value(s) that were not finite or were negative replaced by 0",
-                 cfg->sky_image, (unsigned long long)replaced);
+                 opt->image, (unsigned long long)replaced);
     s->radiance = rgb;
-    s->has_map = !cfg->sky_cosine_only;
+    s->has_map = !opt->cosine_only;
     return LMB_OK;
 }
 
 /* east, up, south: up = sky.up; for up = +Y exactly +X, +Y, +Z. */
-static void sky_frame(const lmb_config *cfg, lmb_sky *s)
+static void sky_frame(const lmb_sky_options *opt, lmb_sky *s)
 {
-    double len = sqrt(lmb_dot3(cfg->sky_up, cfg->sky_up)), ref[3] = {0, 0, 1};
+    double len = sqrt(lmb_dot3(opt->up, opt->up)), ref[3] = {0, 0, 1};
     for (int k = 0; k < 3; k++)
-        s->up[k] = cfg->sky_up[k] / len;
+        s->up[k] = opt->up[k] / len;
     if (fabs(lmb_dot3(ref, s->up)) > 0.99) {
         ref[0] = 1;
         ref[2] = 0;
@@ -270,12 +270,12 @@ static lmb_status sky_from_ibl(const lmb_gltf_ibl *ibl, lmb_sky *s, lmb_error *e
     return LMB_OK;
 }
 
-lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
+lmb_status lmb_sky_create(const lmb_sky_options *opt, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
                           lmb_error *err)
 {
     *out = NULL;
     const lmb_gltf_ibl *ibl = scene && scene->doc ? &lmb_gltf_get_view(scene->doc)->ibl : NULL;
-    if (!(cfg->sky_intensity > 0) && ibl && ibl->present) {
+    if (!(opt->intensity > 0) && ibl && ibl->present) {
         if (!ibl->usable)
             return lmb_error_set(err, LMB_ERR_INPUT, "%s: EXT_lights_image_based: %s", scene->path, ibl->problem);
         lmb_sky *s = calloc(1, sizeof *s);
@@ -297,20 +297,20 @@ lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const l
         *out = s;
         return LMB_OK;
     }
-    if (!(cfg->sky_intensity > 0))
+    if (!(opt->intensity > 0))
         return LMB_OK;
     if (ibl && ibl->present)
         lmb_info(log, "sky: from the config (sky.intensity %g); the file's EXT_lights_image_based light '%s' is not "
-                 "used", cfg->sky_intensity, ibl->name);
+                 "used", opt->intensity, ibl->name);
     lmb_sky *s = calloc(1, sizeof *s);
     if (!s)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "sky: out of memory");
-    sky_frame(cfg, s);
-    s->rotation = cfg->sky_rotation * LMB_PI / 180.0;
+    sky_frame(opt, s);
+    s->rotation = opt->rotation * LMB_PI / 180.0;
     lmb_status st = LMB_OK;
-    int ground = cfg->sky_ground[0] >= 0;
-    if (cfg->sky_image[0]) {
-        st = read_image(cfg, log, s, err);
+    int ground = opt->ground[0] >= 0;
+    if (opt->image[0]) {
+        st = read_image(opt, log, s, err);
     } else {
         s->w = 1;
         s->h = 2;
@@ -318,18 +318,18 @@ lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const l
         if (!s->radiance)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "sky: out of memory");
         for (int k = 0; k < 3 && st == LMB_OK; k++)
-            s->radiance[k] = (float)(cfg->sky_color[k] * cfg->sky_intensity);
+            s->radiance[k] = (float)(opt->color[k] * opt->intensity);
     }
     /* the ground colour replaces the rows whose centre is below the horizon */
     for (uint32_t j = s->h / 2; ground && st == LMB_OK && j < s->h; j++)
         for (uint32_t i = 0; i < s->w; i++)
             for (int k = 0; k < 3; k++)
-                s->radiance[3 * ((size_t)j * s->w + i) + (size_t)k] = (float)(cfg->sky_ground[k] * cfg->sky_intensity);
+                s->radiance[3 * ((size_t)j * s->w + i) + (size_t)k] = (float)(opt->ground[k] * opt->intensity);
     if (st == LMB_OK)
         st = build_tables(s, err);
     if (st == LMB_OK && !(s->row_cdf[s->h] > 0)) {
-        lmb_warn(log, "sky: intensity %g, but its colour%s is black everywhere: no sky light", cfg->sky_intensity,
-                 cfg->sky_image[0] ? " times the image" : "");
+        lmb_warn(log, "sky: intensity %g, but its colour%s is black everywhere: no sky light", opt->intensity,
+                 opt->image[0] ? " times the image" : "");
         lmb_sky_free(s);
         return LMB_OK;
     }
@@ -337,12 +337,12 @@ lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const l
         lmb_sky_free(s);
         return st;
     }
-    if (cfg->sky_image[0])
+    if (opt->image[0])
         lmb_info(log, "sky: image '%s' (%ux%u, importance-sampled at full resolution) x colour x intensity %g nits%s",
-                 cfg->sky_image, s->w, s->h, cfg->sky_intensity, ground ? ", ground colour below the horizon" : "");
+                 opt->image, s->w, s->h, opt->intensity, ground ? ", ground colour below the horizon" : "");
     else
-        lmb_info(log, "sky: uniform, colour [%g, %g, %g] x intensity %g nits, %s below the horizon", cfg->sky_color[0],
-                 cfg->sky_color[1], cfg->sky_color[2], cfg->sky_intensity, ground ? "ground colour" : "black");
+        lmb_info(log, "sky: uniform, colour [%g, %g, %g] x intensity %g nits, %s below the horizon", opt->color[0],
+                 opt->color[1], opt->color[2], opt->intensity, ground ? "ground colour" : "black");
     *out = s;
     return LMB_OK;
 }

@@ -19,16 +19,30 @@
 
 typedef struct lmb_sky lmb_sky; /* opaque, read-only once made: any number of threads at once */
 
-/* The sky cfg describes; when it sets none (sky.intensity 0), the scene's EXT_lights_image_based
+/* The sky's options (the driver fills them from the config's sky.* keys: pipeline/stage_options.h).
+ * intensity and color are what an artist dials; the strings are borrowed. */
+typedef struct lmb_sky_options {
+    double intensity;        /* sky.intensity, nits; 0: no sky of the config's (the file's IBL, if any) */
+    double color[3];         /* sky.color, linear RGB, times intensity (and the image) */
+    double ground[3];        /* sky.ground: radiance below the horizon, times intensity; [0] < 0: none */
+    const char *image;       /* sky.image: equirectangular HDR/EXR relative to config_path's folder; "": none */
+    const char *config_path; /* the config file it was given in ("": none; the image is then relative to ".") */
+    double rotation;         /* sky.rotation, degrees about up */
+    double up[3];            /* sky.up */
+    int cosine_only;         /* sky.sampling: cosine (no map samples) */
+} lmb_sky_options;
+
+/* The sky opt describes; when it sets none (intensity 0), the scene's EXT_lights_image_based
  * light if it has one (its irradiance spherical harmonics as a radiance map); else *out = NULL.
- * The log says which. sky.image is read from the folder of cfg->config_path under the input
+ * The log says which. opt->image is read from the folder of opt->config_path under the input
  * rules (relative, inside that folder); non-finite or negative texels are replaced by 0 with a
  * warning naming how many. */
-lmb_status lmb_sky_create(const lmb_config *cfg, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
+lmb_status lmb_sky_create(const lmb_sky_options *opt, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
                           lmb_error *err);
-/* Where cfg->sky_image lies: a file in the config's folder or below, resolved into real; else
- * LMB_ERR_INPUT naming the config and the key (read or not: lmb_config_lint checks it too). */
-lmb_status lmb_sky_image_path(const lmb_config *cfg, char *real, size_t size, lmb_error *err);
+/* Where sky.image `image` lies: a file in the folder of config_path (the config file; "" for
+ * none) or below, resolved into real; else LMB_ERR_INPUT naming the config and the key (read or
+ * not: lmb_config_lint checks it too). */
+lmb_status lmb_sky_image_path(const char *config_path, const char *image, char *real, size_t size, lmb_error *err);
 void lmb_sky_free(lmb_sky *s);
 
 /* Radiance (nits, RGB) of the sky seen looking along world direction w (unit). */

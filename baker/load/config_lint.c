@@ -32,7 +32,7 @@ lmb_status lmb_config_lint(const lmb_config *c, const lmb_log *log, lmb_error *e
     int sky = c->sky_intensity > 0;
     if (c->sky_image[0]) {
         char real[4096];
-        lmb_status st = lmb_sky_image_path(c, real, sizeof real, err);
+        lmb_status st = lmb_sky_image_path(c->config_path, c->sky_image, real, sizeof real, err);
         if (st != LMB_OK)
             return st;
         if (!sky)

@@ -208,7 +208,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     memset(&rt, 0, sizeof rt);
     memset(&tx, 0, sizeof tx);
     memset(&cache, 0, sizeof cache);
-    st = lmb_sky_create(cfg, s, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
+    lmb_sky_options sky_opt = lmb_sky_options_of(cfg);
+    st = lmb_sky_create(&sky_opt, s, log, &sky, err); /* before the layout: a bad sky.image stops the bake at once */
     if (st == LMB_OK && !plan_path)
         st = texels_fit_memory(cfg, cfg->texel_density > 0 ? 0 : lmb_config_atlas_texels(cfg), err);
     if (st == LMB_OK && plan_path) /* the plan stage's layout (steps/plan.h), checked against this scene and config */
@@ -244,8 +245,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_info(log, "materials: %llu placed triangles have alpha cut-outs (alphaMode MASK), %llu let light through "
                  "in part (alphaMode BLEND, KHR_materials_transmission); every ray sees them as their material says",
                  (unsigned long long)rt.cut_triangles, (unsigned long long)rt.partial_triangles);
+    lmb_emitter_options emitter_opt = lmb_emitter_options_of(cfg);
     if (st == LMB_OK)
-        st = lmb_emitters_build(s, cfg, &tx, &em, err);
+        st = lmb_emitters_build(s, &emitter_opt, &tx, &em, err);
     lmb_direct_options direct_opt = lmb_direct_options_of(cfg);
     if (st == LMB_OK)
         st = lmb_direct_create(s, &direct_opt, &rt, em, sky, &direct, err);

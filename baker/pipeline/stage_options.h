@@ -11,8 +11,15 @@
 #include <lmbake/lmbake.h>
 
 #include "lights/direct.h"
+#include "lights/sky.h"
 
 /* The direct stage's options (lights/direct.h) from cfg. */
 lmb_direct_options lmb_direct_options_of(const lmb_config *cfg);
+
+/* The emitters' options (lights/direct.h) from cfg. */
+lmb_emitter_options lmb_emitter_options_of(const lmb_config *cfg);
+
+/* The sky's options (lights/sky.h) from cfg: its strings point into cfg. */
+lmb_sky_options lmb_sky_options_of(const lmb_config *cfg);
 
 #endif
