@@ -142,7 +142,7 @@ def superposition(lmbake, work):
 
 def shadowmask(lmbake, work):
     scene = os.path.join(scenes(work), "sun-plate.gltf")
-    base = ("texel_density: 64\nbounces: 0\nsamples: {texel: 4, direct: 64}\noutput: {formats: [exr], directional: false, "
+    base = ("texel_density: 40\nbounces: 0\nsamples: {texel: 4, direct: 64}\noutput: {formats: [exr], directional: false, "
             "shadowmask: true}\nlights: {sun_angle: %g, modes: [{match: sun, mode: indirect}]}\n")
     d = PLATE_HEIGHT
     for angle in (0.0, 8.0):
