@@ -11,7 +11,9 @@ usage: check_leaks.py LMBAKE WORKDIR CASE
         others:   the crate on a floor, the thin ceiling slab under a sunlit roof, the closed hut
                   in a sunlit courtyard
         lit-side: the lit room's floor along the wall, defaults against the path-traced
-                  --reference at the same 5 cm texels (no darkening bought by killing light)
+                  --reference at the same 5 cm texels (no darkening bought by killing light),
+                  stored in data/two-rooms-lit-side-reference.json
+        lit-side-reference: makes that file (8192 paths per texel, about 4 minutes)
 
 Asserted in every dark region, as a share of the lit region's lightmap mean: the lightmap's mean,
 every texel more than a texel from the region's faces, every probe in it, and probe-lit points a
@@ -121,28 +123,54 @@ def others(lmbake, work):
         assert_dark(r, scene, asserted)
 
 
-def lit_side(lmbake, work):
-    """The lit room's floor within 15 cm of the wall: defaults against the reference."""
+REFERENCE = os.path.join(HERE, "data", "two-rooms-lit-side-reference.json")
+REFERENCE_RAYS = 8192
+
+
+def lit_strip(lmbake, work, name, args):
+    """The lit room's floor within 15 cm of the 2 cm wall, at 5 cm texels (2.5 times the wall; the
+    same texels in every bake: a mean over texel centres near a wall depends on where they fall):
+    (mean lux, texel count) of a bake with `args`."""
     scenes = os.path.join(work, "scenes-lit")
     os.makedirs(scenes, exist_ok=True)
     scale, t_cm = 0.25, 2
     leak_scenes.two_rooms(scenes, t_cm, scale)
     scene = os.path.join(scenes, "two-rooms-%d.gltf" % t_cm)
-    means = {}
-    # both at 5 cm texels, 2.5 times the wall (the same texels: a mean over texel centres near a
-    # wall depends on where the centres fall), the reference path-traced
-    for name, config, args in (("defaults", "texel_density: 20\n", ()),
-                               ("reference", "texel_density: 20\n", ("--reference", "--rays", "1024"))):
-        out, _ = bake(lmbake, work, scene, "lit-" + name, config, *args)
-        doc = json.load(open(os.path.join(out, [f for f in os.listdir(out) if f.endswith(".gltf")][0])))
-        blobs = [open(os.path.join(out, b["uri"]), "rb").read() for b in doc["buffers"]]
-        lum, pts, size = leak_measure.lightmap_texels(out, doc, blobs)
-        t = t_cm / 100.0
-        d = leak_scenes.ROOM[2] * scale
-        strip = (np.abs(pts[:, 1]) < 1e-4) & (pts[:, 0] < -t / 2) & (pts[:, 0] > -t / 2 - 0.15) & \
-            (np.abs(pts[:, 2]) < d / 2 - 0.05)
-        means[name] = float(lum[strip].mean())
-        print("%s: %d floor texels within 15 cm of the wall, mean %.2f lux" % (name, strip.sum(), means[name]))
+    out, _ = bake(lmbake, work, scene, "lit-" + name, "texel_density: 20\n", *args)
+    doc = json.load(open(os.path.join(out, [f for f in os.listdir(out) if f.endswith(".gltf")][0])))
+    blobs = [open(os.path.join(out, b["uri"]), "rb").read() for b in doc["buffers"]]
+    lum, pts, size = leak_measure.lightmap_texels(out, doc, blobs)
+    t = t_cm / 100.0
+    d = leak_scenes.ROOM[2] * scale
+    strip = (np.abs(pts[:, 1]) < 1e-4) & (pts[:, 0] < -t / 2) & (pts[:, 0] > -t / 2 - 0.15) & \
+        (np.abs(pts[:, 2]) < d / 2 - 0.05)
+    return float(lum[strip].mean()), int(strip.sum())
+
+
+def lit_side_reference(lmbake, work):
+    """Writes the stored reference lit_side compares with: lmbake bake --reference at
+    REFERENCE_RAYS paths per texel (about 4 minutes on 2 cores)."""
+    mean, count = lit_strip(lmbake, work, "reference", ("--reference", "--rays", str(REFERENCE_RAYS)))
+    with open(REFERENCE, "w") as f:
+        json.dump({"scene": "tools/leak_scenes.py two_rooms(wall 2 cm, scale 0.25), texel_density 20",
+                   "made_by": "tests/bake/check_leaks.py LMBAKE WORKDIR lit-side-reference",
+                   "rays": REFERENCE_RAYS, "strip_texels": count, "strip_mean_lux": mean}, f, indent=1)
+        f.write("\n")
+    print("reference: %d floor texels within 15 cm of the wall, mean %.2f lux (%d paths): %s" %
+          (count, mean, REFERENCE_RAYS, REFERENCE))
+
+
+def lit_side(lmbake, work):
+    """The lit room's floor within 15 cm of the wall: the defaults against a stored path-traced
+    reference of the same texels (tests/bake/data/two-rooms-lit-side-reference.json)."""
+    ref = json.load(open(REFERENCE))
+    mean, count = lit_strip(lmbake, work, "defaults", ())
+    if count != ref["strip_texels"]:
+        sys.exit("lit-side: %d strip texels, the reference has %d: the layout changed; remake it with "
+                 "'%s'" % (count, ref["strip_texels"], ref["made_by"]))
+    means = {"defaults": mean, "reference": ref["strip_mean_lux"]}
+    print("defaults: %d floor texels within 15 cm of the wall, mean %.2f lux; reference (%d paths, stored) %.2f lux" %
+          (count, mean, ref["rays"], ref["strip_mean_lux"]))
     rel = means["defaults"] / means["reference"] - 1
     check(abs(rel) <= 0.02, "lit floor along the wall: defaults %.2f lux vs reference %.2f lux (%+.2f%%, bound 2%%)" %
           (means["defaults"], means["reference"], 100 * rel))
@@ -151,7 +179,8 @@ def lit_side(lmbake, work):
 def main():
     lmbake, work, case = sys.argv[1:4]
     os.makedirs(work, exist_ok=True)
-    {"walls": walls, "others": others, "lit-side": lit_side}[case](lmbake, work)
+    {"walls": walls, "others": others, "lit-side": lit_side,
+     "lit-side-reference": lit_side_reference}[case](lmbake, work)
     sys.exit(0 if ok else 1)
 
 
