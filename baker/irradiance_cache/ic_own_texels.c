@@ -34,18 +34,29 @@ static uint32_t instance_of(const lmb_texels *t, uint32_t i)
 /* Per listed texel of atlas a: 1 when it is gathered on its own. A valid texel is one when at
  * least two of its four atlas neighbours (listed, valid, same instance) turn and at most one
  * does not: a surface curved both ways at the texel's scale (a cylinder's texels along its
- * axis keep two neighbours that do not turn, and interpolate). */
+ * axis keep two neighbours that do not turn, and interpolate). Each valid texel's normal is
+ * made once (a texel is its neighbours' neighbour four times over). */
 static lmb_status mark_atlas(const pass_ctx *c, uint32_t a, uint8_t *own, lmb_error *err)
 {
     const lmb_texels *t = c->t[a];
     size_t cells = (size_t)t->width * t->height;
     uint32_t *at = calloc(cells + 1, sizeof *at); /* texel + 1 per atlas cell, 0: none */
-    if (!at)
+    double *normal = malloc((3 * (size_t)t->count + 1) * sizeof *normal);
+    if (!at || !normal) {
+        free(at);
+        free(normal);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "irradiance cache: out of memory for a %ux%u atlas", t->width,
                              t->height);
+    }
     for (uint32_t i = 0; i < t->count; i++)
         if (t->valid[i])
             at[t->texel[i]] = i + 1;
+#pragma omp parallel for num_threads(c->threads) schedule(dynamic, 4096)
+    for (uint32_t i = 0; i < t->count; i++) {
+        double p[3];
+        if (t->valid[i])
+            lmb_ic_texel_point(c, (texel_at){a, i}, p, normal + 3 * (size_t)i);
+    }
     const double limit = c->records.normal_limit;
 #pragma omp parallel for num_threads(c->threads) schedule(dynamic, 4096)
     for (uint32_t i = 0; i < t->count; i++) {
@@ -54,8 +65,6 @@ static lmb_status mark_atlas(const pass_ctx *c, uint32_t a, uint8_t *own, lmb_er
             continue;
         uint32_t x = t->texel[i] % t->width, y = t->texel[i] / t->width, inst = instance_of(t, i);
         int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1}, present = 0, turning = 0;
-        double p[3], n[3];
-        lmb_ic_texel_point(c, (texel_at){a, i}, p, n);
         for (int k = 0; k < 4; k++) {
             int64_t xx = (int64_t)x + dx[k], yy = (int64_t)y + dy[k];
             if (xx < 0 || yy < 0 || xx >= t->width || yy >= t->height)
@@ -63,13 +72,12 @@ static lmb_status mark_atlas(const pass_ctx *c, uint32_t a, uint8_t *own, lmb_er
             uint32_t j = at[(size_t)yy * t->width + (size_t)xx];
             if (!j || instance_of(t, j - 1) != inst)
                 continue;
-            double q[3], m[3];
-            lmb_ic_texel_point(c, (texel_at){a, j - 1}, q, m);
             present++;
-            turning += turns(n, m, limit);
+            turning += turns(normal + 3 * (size_t)i, normal + 3 * (size_t)(j - 1), limit);
         }
         own[i] = turning >= 2 && turning + 1 >= present;
     }
+    free(normal);
     free(at);
     return LMB_OK;
 }

@@ -199,8 +199,54 @@ static int grow_floats(float **arr, size_t total, size_t per)
     return p != NULL;
 }
 
-/* Appends the next band of `in` to out (exact growth, as lmb_texels_append). */
-static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out, const band_ctx *c, lmb_error *err)
+/* Floats per texel a band's bytes hold after its texels: direct (3), direction (3), deferred (3),
+ * shadowmask (4) when present, variance (1). */
+static size_t band_floats(int directional, int has_deferred, int has_mask)
+{
+    return 3 + (directional ? 3 : 0) + (has_deferred ? 3 : 0) + (has_mask ? LMB_SHADOWMASK_CHANNELS : 0) + 1;
+}
+
+/* Texels in the bands of `in` from its read position (0 when they do not parse: take_band then
+ * names the fault). */
+static uint64_t bands_texels(const lmb_buf *in, size_t floats)
+{
+    uint64_t total = 0;
+    size_t at = in->read, per = 4 + 4 + sizeof(lmb_point_ref) + 2 + floats * sizeof(float);
+    while (in->size - at >= 4) {
+        uint32_t n;
+        memcpy(&n, in->data + at, 4);
+        if ((uint64_t)n * per > in->size - at - 4)
+            return 0;
+        at += 4 + (size_t)n * per;
+        total += n;
+    }
+    return total;
+}
+
+/* Room in out's arrays for `more` texels beyond those it holds: the bands in one buffer are then
+ * appended without moving anything (each array grown exactly once per buffer, not once per band). */
+static lmb_status reserve_bands(lmb_direct_atlas *out, uint64_t more, int directional, int has_deferred, int has_mask,
+                                uint32_t atlas, lmb_error *err)
+{
+    size_t total = (size_t)out->t.count + more;
+    if (!more || total > UINT32_MAX)
+        return LMB_OK;
+    float *d = realloc(out->direct, (3 * total + 1) * sizeof *d);
+    if (d)
+        out->direct = d;
+    float *nz = realloc(out->variance, (total + 1) * sizeof *nz);
+    if (nz)
+        out->variance = nz;
+    if (!d || !nz || (directional && !grow_floats(&out->direction, total, 3)) ||
+        (has_deferred && !grow_floats(&out->deferred, total, 3)) ||
+        (has_mask && !grow_floats(&out->shadowmask, total, LMB_SHADOWMASK_CHANNELS)))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", atlas);
+    return lmb_texels_reserve(&out->t, (uint32_t)total, err);
+}
+
+/* Appends the next band of `in` to out (its arrays grown exactly, unless reserve_bands made room). */
+static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out, const band_ctx *c, size_t room,
+                            lmb_error *err)
 {
     int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
     uint32_t n;
@@ -221,13 +267,14 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     band.edge = malloc((size_t)n + 1);
     band.gather_at = calloc((size_t)n + 1, 1);
     size_t total = (size_t)out->t.count + n;
-    float *d = realloc(out->direct, (3 * total + 1) * sizeof *d);
+    int fits = total <= room;
+    float *d = fits ? out->direct : realloc(out->direct, (3 * total + 1) * sizeof *d);
     if (d)
         out->direct = d;
-    float *nz = realloc(out->variance, (total + 1) * sizeof *nz);
+    float *nz = fits ? out->variance : realloc(out->variance, (total + 1) * sizeof *nz);
     if (nz)
         out->variance = nz;
-    float *dd = directional ? realloc(out->direction, (3 * total + 1) * sizeof *dd) : NULL;
+    float *dd = !directional ? NULL : fits ? out->direction : realloc(out->direction, (3 * total + 1) * sizeof *dd);
     if (dd)
         out->direction = dd;
     lmb_status st = LMB_OK;
@@ -243,8 +290,8 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
         band.valid[i] = flags[0];
         band.edge[i] = flags[1];
     }
-    if (st == LMB_OK && ((has_deferred && !grow_floats(&out->deferred, total, 3)) ||
-                         (has_mask && !grow_floats(&out->shadowmask, total, LMB_SHADOWMASK_CHANNELS))))
+    if (st == LMB_OK && !fits && ((has_deferred && !grow_floats(&out->deferred, total, 3)) ||
+                                  (has_mask && !grow_floats(&out->shadowmask, total, LMB_SHADOWMASK_CHANNELS))))
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
     if (st == LMB_OK && (!lmb_buf_take(in, out->direct + 3 * (size_t)out->t.count, 3 * sizeof(float) * n) ||
                          (directional && !lmb_buf_take(in, out->direction + 3 * (size_t)out->t.count,
@@ -271,9 +318,14 @@ typedef struct bands_taken {
 static lmb_status take_bands(void *user, lmb_buf *bytes, lmb_error *err)
 {
     bands_taken *bt = user;
-    lmb_status st = LMB_OK;
+    const band_ctx *c = bt->c;
+    int directional = c->opt->directional, has_deferred = lmb_direct_has_deferred(c->direct);
+    int has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
+    uint64_t more = bands_texels(bytes, band_floats(directional, has_deferred, has_mask));
+    lmb_status st = reserve_bands(bt->out, more, directional, has_deferred, has_mask, c->atlas, err);
+    size_t room = st == LMB_OK && more ? (size_t)bt->out->t.count + more : 0;
     for (; bytes->read < bytes->size && st == LMB_OK; bt->bands++)
-        st = take_band(bytes, bt->c->opt->directional, bt->out, bt->c, err);
+        st = take_band(bytes, directional, bt->out, c, room, err);
     return st;
 }
 

@@ -26,8 +26,21 @@ static void copy_band(lmb_texels *dst, const lmb_texels *band);
 lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err)
 {
     uint32_t n = dst->count + band->count;
-    /* exact growth: large blocks are mmap'd and realloc moves them with mremap, not a copy,
-     * and no slack is left behind (memory per texel, docs/defaults.md) */
+    if (n <= dst->capacity) {
+        copy_band(dst, band);
+        return LMB_OK;
+    }
+    lmb_status st = lmb_texels_reserve(dst, n, err);
+    if (st == LMB_OK)
+        copy_band(dst, band);
+    return st;
+}
+
+lmb_status lmb_texels_reserve(lmb_texels *dst, uint32_t n, lmb_error *err)
+{
+    if (n <= dst->capacity || n < dst->count)
+        return LMB_OK;
+    /* exact growth: no slack is left behind (memory per texel, docs/defaults.md) */
     uint32_t *texel = realloc(dst->texel, ((size_t)n + 1) * sizeof *texel);
     if (texel) dst->texel = texel;
     uint8_t *points_in = realloc(dst->points_in, (size_t)n + 1);
@@ -44,7 +57,7 @@ lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error 
     if (partly) dst->edge = partly;
     if (!texel || !points_in || !size || !refs || !valid || !gather_at || !partly)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "texels: out of memory for %u texels", n);
-    copy_band(dst, band);
+    dst->capacity = n;
     return LMB_OK;
 }
 

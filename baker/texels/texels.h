@@ -55,6 +55,7 @@ typedef struct lmb_texels {
     uint8_t *gather_at;        /* per listed texel: its first point outside geometry, where indirect
                                   light is gathered (set by the lights stage) */
     uint8_t *edge;             /* per listed texel: LMB_EDGE_* flags (set by the lights stage) */
+    uint32_t capacity;         /* texels the per-texel arrays hold room for (lmb_texels_reserve); 0: count */
 } lmb_texels;
 
 /* Gather points for atlas `atlas` of layout l. `samples` per texel, 1..256. */
@@ -91,6 +92,12 @@ lmb_status lmb_texels_build_rows(const lmb_scene *scene, const lmb_layout *l, ui
  * at (band->gather_at, set by the lights stage), as a 16-byte reference: dst then has
  * samples = 1 and no expanded points (memory: about 60 bytes per texel in all). */
 lmb_status lmb_texels_append(lmb_texels *dst, const lmb_texels *band, lmb_error *err);
+
+/* Room for n texels in dst's per-texel arrays (of one point each, as lmb_texels_append keeps
+ * them), so that the appends up to n move nothing: a step's bands appended one by one grew every
+ * array exactly each time, a copy of the whole atlas's arrays per band once they no longer fit
+ * in place. Reserve what the bands hold, no more: no slack is left behind. */
+lmb_status lmb_texels_reserve(lmb_texels *dst, uint32_t n, lmb_error *err);
 
 void lmb_texels_free(lmb_texels *t);
 
