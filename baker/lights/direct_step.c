@@ -81,11 +81,12 @@ static void band_light_free(band_light *l)
  * deferred light (mixed lighting) and 4 f32 shadowmask visibilities when those are on; 1 f32
  * round variance per texel (lmb_direct_job). band_bytes is their size, put_band writes them
  * at dst (any band on any thread: each owns its range of the step's bytes). */
+static size_t band_floats(int directional, int has_deferred, int has_mask);
+static size_t band_texel_bytes(size_t floats);
+
 static size_t band_bytes(const lmb_texels *t, const band_light *l)
 {
-    size_t per = 4 + 4 + sizeof(lmb_point_ref) + 2 + 12 + 4;
-    per += (l->dir ? 12 : 0) + (l->deferred ? 12 : 0) + (l->mask ? 4 * LMB_SHADOWMASK_CHANNELS : 0);
-    return 4 + per * t->count;
+    return 4 + band_texel_bytes(band_floats(l->dir != NULL, l->deferred != NULL, l->mask != NULL)) * t->count;
 }
 
 static void put_band(const lmb_texels *t, const band_light *l, uint8_t *dst)
@@ -206,17 +207,24 @@ static size_t band_floats(int directional, int has_deferred, int has_mask)
     return 3 + (directional ? 3 : 0) + (has_deferred ? 3 : 0) + (has_mask ? LMB_SHADOWMASK_CHANNELS : 0) + 1;
 }
 
-/* Texels in the bands of `in` from its read position (0 when they do not parse: take_band then
- * names the fault). */
+/* Bytes per texel of a band: its texel, size, point reference and flags, then its floats. */
+static size_t band_texel_bytes(size_t floats)
+{
+    return 4 + 4 + sizeof(lmb_point_ref) + 2 + floats * sizeof(float);
+}
+
+/* Texels in the bands of `in` from its read position; UINT64_MAX when they do not parse whole. */
 static uint64_t bands_texels(const lmb_buf *in, size_t floats)
 {
     uint64_t total = 0;
-    size_t at = in->read, per = 4 + 4 + sizeof(lmb_point_ref) + 2 + floats * sizeof(float);
-    while (in->size - at >= 4) {
+    size_t at = in->read, per = band_texel_bytes(floats);
+    while (at < in->size) {
         uint32_t n;
+        if (in->size - at < 4)
+            return UINT64_MAX;
         memcpy(&n, in->data + at, 4);
         if ((uint64_t)n * per > in->size - at - 4)
-            return 0;
+            return UINT64_MAX;
         at += 4 + (size_t)n * per;
         total += n;
     }
@@ -224,13 +232,16 @@ static uint64_t bands_texels(const lmb_buf *in, size_t floats)
 }
 
 /* Room in out's arrays for `more` texels beyond those it holds: the bands in one buffer are then
- * appended without moving anything (each array grown exactly once per buffer, not once per band). */
+ * appended without moving anything (each array grown exactly once per buffer, not once per band:
+ * grown band by band they were copied whole once they no longer fit in place). */
 static lmb_status reserve_bands(lmb_direct_atlas *out, uint64_t more, int directional, int has_deferred, int has_mask,
                                 uint32_t atlas, lmb_error *err)
 {
     size_t total = (size_t)out->t.count + more;
-    if (!more || total > UINT32_MAX)
+    if (!more)
         return LMB_OK;
+    if (total > UINT32_MAX)
+        return lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: more than 4 billion texels", atlas);
     float *d = realloc(out->direct, (3 * total + 1) * sizeof *d);
     if (d)
         out->direct = d;
@@ -244,14 +255,14 @@ static lmb_status reserve_bands(lmb_direct_atlas *out, uint64_t more, int direct
     return lmb_texels_reserve(&out->t, (uint32_t)total, err);
 }
 
-/* Appends the next band of `in` to out (its arrays grown exactly, unless reserve_bands made room). */
-static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out, const band_ctx *c, size_t room,
-                            lmb_error *err)
+/* Appends the next band of `in` to out, whose arrays reserve_bands made room in (the buffer's
+ * bands were checked whole by bands_texels). */
+static lmb_status take_band(lmb_buf *in, int directional, int has_deferred, int has_mask, lmb_direct_atlas *out,
+                            const band_ctx *c, lmb_error *err)
 {
-    int has_deferred = lmb_direct_has_deferred(c->direct), has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
     uint32_t n;
-    if (!lmb_buf_take(in, &n, 4) || (uint64_t)n * 26 > in->size - in->read)
-        return lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
+    if (!lmb_buf_take(in, &n, 4) || (size_t)out->t.count + n > out->t.capacity)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "direct light of atlas %u: a band beyond the room made", c->atlas);
     lmb_texels band;
     memset(&band, 0, sizeof band);
     band.width = c->width;
@@ -266,20 +277,8 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
     band.valid = malloc((size_t)n + 1);
     band.edge = malloc((size_t)n + 1);
     band.gather_at = calloc((size_t)n + 1, 1);
-    size_t total = (size_t)out->t.count + n;
-    int fits = total <= room;
-    float *d = fits ? out->direct : realloc(out->direct, (3 * total + 1) * sizeof *d);
-    if (d)
-        out->direct = d;
-    float *nz = fits ? out->variance : realloc(out->variance, (total + 1) * sizeof *nz);
-    if (nz)
-        out->variance = nz;
-    float *dd = !directional ? NULL : fits ? out->direction : realloc(out->direction, (3 * total + 1) * sizeof *dd);
-    if (dd)
-        out->direction = dd;
     lmb_status st = LMB_OK;
-    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.edge || !band.gather_at || !d || !nz ||
-        (directional && !dd))
+    if (!band.texel || !band.texel_size || !band.refs || !band.valid || !band.edge || !band.gather_at)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
     for (uint32_t i = 0; i < n && st == LMB_OK; i++) {
         uint8_t flags[2];
@@ -290,10 +289,7 @@ static lmb_status take_band(lmb_buf *in, int directional, lmb_direct_atlas *out,
         band.valid[i] = flags[0];
         band.edge[i] = flags[1];
     }
-    if (st == LMB_OK && !fits && ((has_deferred && !grow_floats(&out->deferred, total, 3)) ||
-                                  (has_mask && !grow_floats(&out->shadowmask, total, LMB_SHADOWMASK_CHANNELS))))
-        st = lmb_error_set(err, LMB_ERR_INTERNAL, "lighting: out of memory for atlas %u", c->atlas);
-    if (st == LMB_OK && (!lmb_buf_take(in, out->direct + 3 * (size_t)out->t.count, 3 * sizeof(float) * n) ||
+    if (st == LMB_OK && n && (!lmb_buf_take(in, out->direct + 3 * (size_t)out->t.count, 3 * sizeof(float) * n) ||
                          (directional && !lmb_buf_take(in, out->direction + 3 * (size_t)out->t.count,
                                                        3 * sizeof(float) * n)) ||
                          (has_deferred && !lmb_buf_take(in, out->deferred + 3 * (size_t)out->t.count,
@@ -322,10 +318,11 @@ static lmb_status take_bands(void *user, lmb_buf *bytes, lmb_error *err)
     int directional = c->opt->directional, has_deferred = lmb_direct_has_deferred(c->direct);
     int has_mask = lmb_direct_shadowmask_channels(c->direct) > 0;
     uint64_t more = bands_texels(bytes, band_floats(directional, has_deferred, has_mask));
+    if (more == UINT64_MAX)
+        return lmb_error_set(err, LMB_ERR_INPUT, "direct light of atlas %u: truncated band", c->atlas);
     lmb_status st = reserve_bands(bt->out, more, directional, has_deferred, has_mask, c->atlas, err);
-    size_t room = st == LMB_OK && more ? (size_t)bt->out->t.count + more : 0;
     for (; bytes->read < bytes->size && st == LMB_OK; bt->bands++)
-        st = take_band(bytes, directional, bt->out, c, room, err);
+        st = take_band(bytes, directional, has_deferred, has_mask, bt->out, c, err);
     return st;
 }
 
