@@ -8,7 +8,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
-import { launchBrowser, openPreview, VIEWPORT } from '../../tools/preview/browser.mjs';
+import { launchBrowser, openPreview, showPreview, VIEWPORT } from '../../tools/preview/browser.mjs';
 import { decodePng, readImage, lightmapTriangles, srgb, luma } from './lib.mjs';
 
 const [gltfPath, imgPath, shotsDir] = process.argv.slice(2);
@@ -49,8 +49,10 @@ fs.mkdirSync(shotsDir, { recursive: true });
 const srv = await startServer(gltfPath);
 const browser = await launchBrowser();
 let failedToLoad = false;
+let page0 = null; // every view after the first is the same page with other parameters (showPreview)
 async function view(name, params) {
-  const v = await openPreview(browser, srv.url, { lightmap: 'hdr', ...params }); // the .hdr, which the checks read, even beside a KTX2
+  params = { lightmap: 'hdr', ...params }; // the .hdr, which the checks read, even beside a KTX2
+  const v = page0 ? await showPreview(page0, params) : (page0 = await openPreview(browser, srv.url, params));
   const file = path.join(shotsDir, `preview-${name}.png`);
   v.png = decodePng(await v.page.screenshot({ path: file }));
   console.log(`shot ${file} (${v.url.replace(srv.url, '/')})`);
@@ -204,8 +206,8 @@ try {
   for (const v of [lit, lm, al, ck, iv, c3, i3, rv]) {
     const late = v.errors.filter((e) => !e.startsWith('note'));
     if (late.length) check(`no page errors in ${v.url}`, false, late.join('; '));
-    await v.context.close();
   }
+  if (page0) await page0.context.close();
 } catch (e) {
   failedToLoad = true;
   check('preview loads and renders', false, e.message);

@@ -31,7 +31,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
-import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
+import { launchBrowser, openPreview, showPreview } from '../../tools/preview/browser.mjs';
 import { decodePng, readImage, gltfAccessors, srgb, luma } from './lib.mjs';
 
 const [instGltf, seamsGltf, shotsDir] = process.argv.slice(2);
@@ -93,14 +93,7 @@ async function instanced(gltfPath) {
 
   const srv = await startServer(gltfPath);
   try {
-    const views = {};
-    for (const mode of ['lightmap', 'invalid', 'lit', 'checker']) {
-      const v = await openPreview(browser, srv.url, { mode, ev: INST_EV, tonemap: 'none', cam: INST_CAM, lightmap: 'hdr' });
-      const file = path.join(shotsDir, `preview-instancing-${mode}.png`);
-      v.png = decodePng(await v.page.screenshot({ path: file }));
-      views[mode] = v;
-      console.log(`shot ${file} (${v.url.replace(srv.url, '/')})`);
-    }
+    const views = await shootModes(srv.url, () => ({ ev: INST_EV, tonemap: 'none', cam: INST_CAM, lightmap: 'hdr' }), 'preview-instancing');
     const lm = views.lightmap, ev = lm.info.ev, gain = intensity * 2 ** ev / Math.PI;
     // the page's InstancedMesh: every copy, both attributes per instance, its own patched material
     const im = lm.info.instancedMeshes || [];
@@ -150,7 +143,7 @@ async function instanced(gltfPath) {
       `${probes.length} picks: ${instanceOff} name a copy whose box does not hold the point; ${texelOff} of ${n} probes name another texel`);
     check('copies: the invalid view shows the same texels', n > 0 && invalidOff === 0, `${invalidOff} of ${n} probes differ by > ${TOL} levels from the lightmap view`);
     await roundTrip(lm.page, probed.filter((p) => texelOnFace(tris, rect(p.instance), img, p.texel)), 'instance', 'copies', n);
-    await checkerAgrees(srv.url, views.checker.png, probed, 'copies', 'preview-instancing', [img.width, img.height]);
+    await checkerAgrees(lm, views.checker.png, probed, 'copies', 'preview-instancing', [img.width, img.height]);
     // lit: the top of every copy under the roof darker than the top of every copy in the open
     const top = [...copies].map(([k, t]) => ({ k, roof: roof(k), lit: median(t.lit), lm: median(t.lm) }));
     const under = top.filter((t) => t.roof), open = top.filter((t) => !t.roof);
@@ -158,7 +151,7 @@ async function instanced(gltfPath) {
     check('copies: in the lit view every copy\'s top under the roof is darker than every copy\'s top in the open', under.length >= 3 && open.length >= 3 && maxUnder < minOpen,
       `tops seen: ${under.length} under the roof, lit luma ${range(under.map((t) => t.lit))} (lightmap view ${range(under.map((t) => t.lm))}); ` +
       `${open.length} in the open, lit ${range(open.map((t) => t.lit))} (lightmap view ${range(open.map((t) => t.lm))}); 8-bit levels`);
-    for (const v of Object.values(views)) await v.context.close();
+    await lm.context.close();
   } finally {
     await srv.close();
   }
@@ -196,15 +189,7 @@ async function sharedMesh(gltfPath) {
     const texture = [...nodes.values()][0].texture, img = reference(g, dir, texture);
     const srv = await startServer(file);
     try {
-      const views = {};
-      for (const mode of ['lightmap', 'invalid', 'lit', 'checker']) {
-        const ev = views.lightmap ? views.lightmap.info.ev : 'auto';
-        const v = await openPreview(browser, srv.url, { mode, ev, tonemap: 'none', cam: SEAMS_CAM, lightmap: 'hdr' });
-        const f = path.join(shotsDir, `preview-shared-mesh-${mode}.png`);
-        v.png = decodePng(await v.page.screenshot({ path: f }));
-        views[mode] = v;
-        console.log(`shot ${f} (${v.url.replace(srv.url, '/')})`);
-      }
+      const views = await shootModes(srv.url, (lm) => ({ ev: lm ? lm.info.ev : 'auto', tonemap: 'none', cam: SEAMS_CAM, lightmap: 'hdr' }), 'preview-shared-mesh');
       const lm = views.lightmap, ev = lm.info.ev;
       const pr = lm.info.perNodeRectangles || [];
       check('shared mesh: the page gives each node its own rectangle (lmbInfo.perNodeRectangles)',
@@ -239,24 +224,26 @@ async function sharedMesh(gltfPath) {
       check('shared mesh: the invalid view shows the same texels', n > 0 && invalidOff === 0, `${invalidOff} of ${n} probes differ by > ${TOL} levels from the lightmap view`);
       const tris = new Map([...nodes.keys()].map((i) => [i, primitiveTriangles(read, g.meshes[g.nodes[i].mesh].primitives[0])]));
       await roundTrip(lm.page, probed.filter((p) => texelOnFace(tris.get(p.node), nodes.get(p.node).so, img, p.texel)), 'node', 'shared mesh', n);
-      await checkerAgrees(srv.url, views.checker.png, probed, 'shared mesh', 'preview-shared-mesh', [img.width, img.height]);
+      await checkerAgrees(lm, views.checker.png, probed, 'shared mesh', 'preview-shared-mesh', [img.width, img.height]);
       // made by hand from a bake: the same texels on the same triangles, so the same pictures
       if (made && made.exact) {
         const ref = await startServer(gltfPath);
         try {
+          let v = null;
           for (const mode of ['lightmap', 'lit']) {
-            const v = await openPreview(browser, ref.url, { mode, ev, tonemap: 'none', cam: SEAMS_CAM, lightmap: 'hdr' });
+            const params = { mode, ev, tonemap: 'none', cam: SEAMS_CAM, lightmap: 'hdr' };
+            v = v ? await showPreview(v, params) : await openPreview(browser, ref.url, params);
             const png = decodePng(await v.page.screenshot({ path: path.join(shotsDir, `preview-shared-mesh-${mode}-original.png`) }));
-            await v.context.close();
             const d = diff(png, views[mode].png);
             check(`shared mesh made by hand: its ${mode} shot = the original bake's`, d.max <= TOL,
               `max |diff| ${d.max} levels, ${d.over} pixels over 0${d.worst ? `, worst at (${d.worst.x}, ${d.worst.y}): ${d.worst.a} vs ${d.worst.b}` : ''}`);
           }
+          await v.context.close();
         } finally {
           await ref.close();
         }
       }
-      for (const v of Object.values(views)) await v.context.close();
+      await lm.context.close();
     } finally {
       await srv.close();
     }
@@ -343,6 +330,24 @@ function texelOnFace({ uv, idx, nrm }, [su, sv, ou, ov], img, [x, y]) {
 // (key: 'instance' or 'node'), seen there (a pick names it), or hidden behind something nearer
 // (another copy's edge: the probe saw part of the texel), or off screen (a probe at the view's
 // edge); at least 90% seen.
+// The page in the lightmap, invalid, lit and checker modes, one page (showPreview): each mode's
+// screenshot (png) and view; paramsOf(lightmap view or null) gives the other parameters. The page
+// is left in the lightmap mode (its picks, projections and info: views.lightmap).
+async function shootModes(url, paramsOf, prefix) {
+  const views = {};
+  let v = null;
+  for (const mode of ['lightmap', 'invalid', 'lit', 'checker']) {
+    const params = { mode, ...paramsOf(views.lightmap || null) };
+    v = v ? await showPreview(v, params) : await openPreview(browser, url, params);
+    const file = path.join(shotsDir, `${prefix}-${mode}.png`);
+    views[mode] = { ...v, png: decodePng(await v.page.screenshot({ path: file })) };
+    console.log(`shot ${file} (${v.url.replace(url, '/')})`);
+  }
+  const lm = views.lightmap;
+  views.lightmap = { ...(await showPreview(v, lm.params)), png: lm.png };
+  return views;
+}
+
 async function roundTrip(page, inside, key, what, n) {
   const round = await page.evaluate(([ps, key]) => ps.map((p) => {
     const s = window.lmbTexelToScreen(p.atlas, p.texel[0], p.texel[1]);
@@ -409,7 +414,7 @@ function gridProbes(page, nodes, step) {
 // checker darkens as a grid line (within 1.5 px of a texel's top-left edge where a texel spans
 // 3 px or more) or draws as a chart border; atlas-view pixels drawn as a chart border (within
 // 1.5 px, 0.19 texel, of a chart's edge: a chart of a few texels has many) are counted apart.
-async function checkerAgrees(url, c3Png, probed, what, prefix, atlasSize) {
+async function checkerAgrees(lm, c3Png, probed, what, prefix, atlasSize) {
   const ZOOM = 8, VIEW = [960, 720]; // browser.mjs VIEWPORT
   const atlas = probed.length ? probed[0].atlas : 0;
   const todo = probed.filter((p) => {
@@ -424,9 +429,8 @@ async function checkerAgrees(url, c3Png, probed, what, prefix, atlasSize) {
     const rest = [...left], cand = rest.filter((_, i) => i % Math.max(1, Math.floor(rest.length / 400)) === 0);
     const near = (c) => rest.reduce((k, p) => k + (Math.abs(p.texel[0] - c.texel[0]) < VIEW[0] / ZOOM / 2 - 1 && Math.abs(p.texel[1] - c.texel[1]) < VIEW[1] / ZOOM / 2 - 1), 0);
     const c = cand.reduce((best, q) => { const k = near(q); return k > best.k ? { q, k } : best; }, { q: cand[0], k: -1 }).q;
-    const ck = await openPreview(browser, url, { mode: 'atlas', layer: 'checker', atlas, zoom: ZOOM, at: c.texel.join(',') });
+    const ck = await showPreview(lm, { mode: 'atlas', layer: 'checker', atlas, zoom: ZOOM, at: c.texel.join(','), lightmap: lm.params.lightmap });
     const ckPng = decodePng(await ck.page.screenshot({ path: path.join(shotsDir, `${prefix}-atlas-checker-${shots}.png`) }));
-    await ck.context.close();
     shots++;
     const av = ck.info.atlasView;
     for (const p of [...left]) {

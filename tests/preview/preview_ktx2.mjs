@@ -22,7 +22,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
-import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
+import { launchBrowser, openPreview, previewPages } from '../../tools/preview/browser.mjs';
 import { decodePng, readHdr, srgb } from './lib.mjs';
 
 const [bakeGltf, keepGltf, shotsDir] = process.argv.slice(2);
@@ -84,15 +84,14 @@ async function sourcesAgree(gltfPath) {
   if (!named.length) return;
   const srv = await startServer(gltfPath);
   try {
-    const first = await openPreview(browser, srv.url, { mode: 'lightmap', tonemap: 'none', view: 'front', lightmap: 'hdr' });
+    const pages = previewPages(browser, srv.url); // a page per lightmap source
+    const first = await pages.show({ mode: 'lightmap', tonemap: 'none', view: 'front', lightmap: 'hdr' });
     const ev = first.info.ev; // ev auto of the .hdr, for every shot
-    await first.context.close();
     const shots = {};
     for (const mode of ['lit', 'lightmap']) for (const src of ['hdr', 'ktx2']) {
-      const v = await openPreview(browser, srv.url, { mode, ev, tonemap: 'none', view: 'front', lightmap: src });
+      const v = await pages.show({ mode, ev, tonemap: 'none', view: 'front', lightmap: src });
       const file = path.join(shotsDir, `preview-ktx2-${mode}-${src}.png`);
-      v.png = decodePng(await v.page.screenshot({ path: file }));
-      shots[`${mode}-${src}`] = v;
+      shots[`${mode}-${src}`] = { ...v, png: decodePng(await v.page.screenshot({ path: file })) };
       console.log(`shot ${file} (${v.url.replace(srv.url, '/')})`);
     }
     // the page says which files it read, and with which three.js loader
@@ -136,7 +135,7 @@ async function sourcesAgree(gltfPath) {
         `(2^-7 x the largest channel + the KTX2's rounding), there 2^${Math.log2(worstRel || 2 ** -99).toFixed(2)} x the largest channel; ${bad} channels over${first ? ' (first ' + first + ')' : ''}; ` +
         `${zeroHdr} texels 0 in the .hdr (${zeroMiss} not 0 in the KTX2), ${tiny} below the floor`);
     }
-    for (const v of Object.values(shots)) await v.context.close();
+    await pages.close();
   } finally {
     await srv.close();
   }
@@ -216,16 +215,16 @@ async function rectangles(gltfPath) {
   }
   const srv = await startServer(gltfPath);
   try {
-    const views = {};
+    const views = {}, pages = previewPages(browser, srv.url); // a page per lightmap source
     for (const [name, params] of [['lightmap-hdr', { mode: 'lightmap', lightmap: 'hdr' }], ['lightmap-ktx2', { mode: 'lightmap', lightmap: 'ktx2' }], ['invalid-hdr', { mode: 'invalid', lightmap: 'hdr' }]]) {
       const ev = views['lightmap-hdr'] ? views['lightmap-hdr'].info.ev : 'auto';
-      const v = await openPreview(browser, srv.url, { ...params, ev, tonemap: 'none', view: 'front' });
+      const v = await pages.show({ ...params, ev, tonemap: 'none', view: 'front' });
       const file = path.join(shotsDir, `preview-keep-uv1-${name}.png`);
-      v.png = decodePng(await v.page.screenshot({ path: file }));
-      views[name] = v;
+      views[name] = { ...v, png: decodePng(await v.page.screenshot({ path: file })) };
       console.log(`shot ${file} (${v.url.replace(srv.url, '/')})`);
     }
-    const lm = views['lightmap-hdr'], ev = lm.info.ev, gain = 2 ** ev / Math.PI;
+    // the .hdr page back in the lightmap view, for the picks and projections below
+    const lm = { ...(await pages.show(views['lightmap-hdr'].params)), png: views['lightmap-hdr'].png }, ev = lm.info.ev, gain = 2 ** ev / Math.PI;
     // probes: a grid of pixels on lightmapped nodes, away from edges (the 4 neighbours see the same object within 1.5 texels)
     const grid = [];
     for (let y = 4; y < lm.png.height - 4; y += 9) for (let x = 4; x < lm.png.width - 4; x += 9) grid.push([x, y]);
@@ -276,9 +275,9 @@ async function rectangles(gltfPath) {
     // parity and its 8x8 block: a probe's pixel in 3D and its texel's pixel in the atlas view
     // match when both place the node's triangles at its rectangle (chart borders are drawn
     // within 1.5 pixels of a chart's edge in each, at different places: a few may differ)
-    const c3 = await openPreview(browser, srv.url, { mode: 'checker', tonemap: 'none', view: 'front' });
+    const c3 = await pages.show({ mode: 'checker', tonemap: 'none', view: 'front', lightmap: 'hdr' });
     const c3Png = decodePng(await c3.page.screenshot({ path: path.join(shotsDir, 'preview-keep-uv1-checker.png') }));
-    const ck = await openPreview(browser, srv.url, { mode: 'atlas', layer: 'checker', atlas: probed.length ? probed[0].atlas : 0, zoom: 1 });
+    const ck = await pages.show({ mode: 'atlas', layer: 'checker', atlas: probed.length ? probed[0].atlas : 0, zoom: 1, lightmap: 'hdr' });
     const ckPng = decodePng(await ck.page.screenshot({ path: path.join(shotsDir, 'preview-keep-uv1-atlas-checker.png') }));
     const av = ck.info.atlasView;
     let onScreen = 0, differ = 0, background = 0;
@@ -292,12 +291,10 @@ async function rectangles(gltfPath) {
     }
     check('keep_uv1: the atlas checker view draws a probe\'s texel as the 3D checker view draws its pixel', onScreen >= 100 && differ <= 0.05 * onScreen,
       `${differ} of ${onScreen} probe texels on screen (zoom 1) differ by > 3 levels (allowed 5%: chart borders), ${background} show the background`);
-    await c3.context.close();
-    await ck.context.close();
     const d = diff(lm.png, views['lightmap-ktx2'].png);
     check('keep_uv1: lightmap=ktx2 shot = lightmap=hdr shot', views['lightmap-ktx2'].info.atlases.every((a) => a.source === 'ktx2' && a.loader === 'KTX2Loader') && d.over <= PIX_FRAC * d.n && d.max.every((m) => m <= PIX_MAX),
       `sources ${views['lightmap-ktx2'].info.atlases.map((a) => `${a.uri} ${a.source} ${a.loader}, ${a.gpu}`).join('; ')}; max |diff| ${d.max.join(' ')}, mean ${d.mean.map((m) => m.toFixed(4)).join(' ')}; ${d.over} pixels off by > ${PIX_TOL}`);
-    for (const v of Object.values(views)) await v.context.close();
+    await pages.close();
   } finally {
     await srv.close();
   }

@@ -11,7 +11,7 @@
 import fs from 'node:fs';
 import path from 'node:path';
 import { startServer } from '../../tools/preview/server.mjs';
-import { launchBrowser, openPreview } from '../../tools/preview/browser.mjs';
+import { launchBrowser, openPreview, showPreview } from '../../tools/preview/browser.mjs';
 import { decodePng, readProbes } from './lib.mjs';
 
 const [gltfFile, shotsDir] = process.argv.slice(2);
@@ -30,7 +30,7 @@ const srv = await startServer(gltfFile);
 let failures = 0;
 const report = (ok, text) => { failures += !ok; console.log(`${ok ? 'ok' : 'FAIL'}: ${text}`); };
 try {
-  const { page, context, info } = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: 0 });
+  const opened = await openPreview(browser, srv.url, { mode: 'lit', tonemap: 'none', ev: 0 }), { page, context, info } = opened;
   const props = info.probeLit.find((p) => p.copies === 60);
   report(!!props, `probe-lit meshes: ${JSON.stringify(info.probeLit)}`);
   if (props) {
@@ -54,7 +54,7 @@ try {
     const picks = [tops[0], tops[tops.length - 1]];
     report(picks[0].e > 1.05 * picks[1].e, `the copies' light differs: E(+Y) ${picks[0].e.toFixed(4)} and ${picks[1].e.toFixed(4)}`);
     for (const mode of ['lit', 'lightmap']) {
-      const view = mode === 'lit' ? { page } : await openPreview(browser, srv.url, { mode, tonemap: 'none', ev: 0 });
+      const view = mode === 'lit' ? { page } : await showPreview(opened, { mode, tonemap: 'none', ev: 0 }); // the same page
       for (const { k, c } of picks) {
         // from above, a little to the side of the pole (the triangle fan there leans every way)
         const top = [c.centre[0] + 0.3, c.centre[1] + 4, c.centre[2] + 0.2];
@@ -76,7 +76,6 @@ try {
           `${mode}: copy ${k} from above: pixel ${got.map((x) => x.toFixed(4)).join(' ')} against albedo / pi x E(n) ${want.map((x) => x.toFixed(4)).join(' ')} ` +
           `(off ${(100 * off).toFixed(1)}%, bound ${100 * TOL}%; picked ${hit ? `${hit.object} #${hit.instance}` : 'nothing'}); shot ${file}`);
       }
-      if (view.context) await view.context.close();
     }
   }
   await context.close();

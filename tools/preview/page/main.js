@@ -3,7 +3,7 @@
 // (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
 // directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr, sphere=x,y,z: the probe-lit
 // sphere there, probes=1: the probes as markers) and the page exposes hooks for tests: window.lmbReady, lmbInfo,
-// lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView, lmbCamera;
+// lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView, lmbSet, lmbCamera;
 // gen, kind and rev: the bake of `preview --watch` to show (page/watch.js sets them).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
@@ -84,16 +84,17 @@ if (records) scene.add(records.points);
 
 // ev=auto (the default): the median E/pi of the non-zero texels maps to 0.18 (middle grey),
 // rounded to half an EV. Measured on every 7th texel of every atlas.
-const evAuto = state.ev === 'auto';
-if (evAuto) {
+function autoEv() {
   const v = [];
   for (const a of atlases) if (a) for (let i = 0; i < a.data.length; i += 28) {
     const l = (0.2126 * a.data[i] + 0.7152 * a.data[i + 1] + 0.0722 * a.data[i + 2]) * a.toLux / Math.PI;
     if (l > 0) v.push(l);
   }
   v.sort((x, y) => x - y);
-  state.ev = v.length ? Math.max(-12, Math.min(12, Math.round(2 * Math.log2(0.18 / v[v.length >> 1])) / 2)) : 0;
+  return v.length ? Math.max(-12, Math.min(12, Math.round(2 * Math.log2(0.18 / v[v.length >> 1])) / 2)) : 0;
 }
+let evAuto = state.ev === 'auto';
+if (evAuto) state.ev = autoEv();
 
 // The glTF node index an object belongs to (a multi-primitive mesh's meshes are children of
 // the node's group), or -1
@@ -182,21 +183,25 @@ function frontView() {
   controls.target.copy(pose.target);
   camera.lookAt(pose.target);
 }
-if (state.cam) {
-  const c = state.cam.split(',').map(Number);
-  if (c.length !== 6 || c.some((v) => !Number.isFinite(v))) throw new Error(`cam wants px,py,pz,tx,ty,tz`);
-  camera.position.set(c[0], c[1], c[2]); controls.target.set(c[3], c[4], c[5]); camera.lookAt(controls.target);
-} else if (state.view === 'front') frontView();
-else if (state.view === 'start') {
-  const start = startView(gltf, root, box, camera.aspect, FOV);
-  if (start) {
-    camera.position.copy(start.position); controls.target.copy(start.target); camera.lookAt(start.target);
-  } else frontView();
-  info.startView = start ? start.from : 'front';
-  info.startProbe = startView.last || null; // the candidates: eye, blocked, walls met of 16, median distance
-  info.startScores = startView.scores || null; // inside against front: what each view shows (viewScore)
-} else throw new Error(`unknown view '${state.view}' (start, front, or cam=px,py,pz,tx,ty,tz)`);
-controls.update();
+// The camera for view (start, front) or cam (px,py,pz,tx,ty,tz, which wins): at load and lmbSet
+function placeCamera(view, cam) {
+  if (cam) {
+    const c = cam.split(',').map(Number);
+    if (c.length !== 6 || c.some((v) => !Number.isFinite(v))) throw new Error(`cam wants px,py,pz,tx,ty,tz`);
+    camera.position.set(c[0], c[1], c[2]); controls.target.set(c[3], c[4], c[5]); camera.lookAt(controls.target);
+  } else if (view === 'front') frontView();
+  else if (view === 'start') {
+    const start = startView(gltf, root, box, camera.aspect, FOV);
+    if (start) {
+      camera.position.copy(start.position); controls.target.copy(start.target); camera.lookAt(start.target);
+    } else frontView();
+    info.startView = start ? start.from : 'front';
+    info.startProbe = startView.last || null; // the candidates: eye, blocked, walls met of 16, median distance
+    info.startScores = startView.scores || null; // inside against front: what each view shows (viewScore)
+  } else throw new Error(`unknown view '${view}' (start, front, or cam=px,py,pz,tx,ty,tz)`);
+  controls.update();
+}
+placeCamera(state.view, state.cam);
 
 // Applying the state
 let dirty = true;
@@ -401,6 +406,28 @@ window.lmbSetView = (cam, ev) => {
   controls.update();
   if (ev !== undefined) state.ev = ev;
   apply();
+};
+// The view parameters of the URL (mode, ev, tonemap, view|cam, atlas, layer, zoom, at) without a
+// reload, each missing one at its default as in a fresh page; those read at load only (lightmap,
+// directional, sphere, probes, ui) cannot change. A test's shots of one bake share a page this way
+// (a page takes ~2 s to open in SwiftShader, a switch ~0.3 s). Returns lmbInfo after the frame.
+window.lmbSet = (p) => {
+  for (const k of Object.keys(p)) if (!['mode', 'ev', 'tonemap', 'view', 'cam', 'atlas', 'layer', 'zoom', 'at'].includes(k)) throw new Error(`lmbSet: '${k}' is read at load only`);
+  const mode = p.mode ?? 'lit', tonemap = p.tonemap ?? 'agx', layer = p.layer ?? 'lightmap', atlas = Number(p.atlas ?? 0);
+  const ev = p.ev === undefined || p.ev === 'auto' ? 'auto' : Number(p.ev);
+  if (!MODES.includes(mode)) throw new Error(`unknown mode '${mode}' (one of ${MODES.join(', ')})`);
+  if (!(tonemap in TONEMAPS)) throw new Error(`unknown tonemap '${tonemap}' (one of ${Object.keys(TONEMAPS).join(', ')})`);
+  if (ev !== 'auto' && !Number.isFinite(ev)) throw new Error('ev must be a number or auto');
+  if (!['lightmap', 'invalid', 'checker'].includes(layer)) throw new Error(`unknown layer '${layer}'`);
+  if (mode === 'atlas' && !atlases[atlas]) throw new Error(`atlas ${atlas} does not exist or has no .hdr or KTX2 file`);
+  placeCamera(p.view ?? 'start', p.cam ?? null);
+  Object.assign(state, { mode, tonemap, layer, atlas, view: p.view ?? 'start', cam: p.cam ?? null,
+    zoom: p.zoom !== undefined ? Number(p.zoom) : null, at: p.at !== undefined ? String(p.at).split(',').map(Number) : null,
+    ev: ev === 'auto' ? autoEv() : ev });
+  evAuto = ev === 'auto';
+  sync(); apply();
+  render(); dirty = false;
+  return JSON.parse(JSON.stringify(info));
 };
 // The camera now (the watch page carries it over to the next bake's frame).
 window.lmbCamera = () => ({ position: camera.position.toArray(), target: controls.target.toArray() });
