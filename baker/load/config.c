@@ -33,6 +33,8 @@ static lmb_status set_material_overrides(parse_ctx *c, const key_spec *k, const 
 static const schema material_override_schema;
 static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
 static const schema light_mode_schema;
+static lmb_status set_light_groups(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base);
+static const schema light_group_schema;
 
 #define OFF(f) offsetof(lmb_config, f)
 #define FLOAT(p, off, lo, hi, op) {.path = p, .set = lmb_cfg_set_float, .offset = off, .flo = lo, .fhi = hi, .open = op}
@@ -128,6 +130,9 @@ static const key_spec config_keys[] = {
     {.path = "lights.modes", .set = set_light_modes, .offset = OFF(light_modes), .count_offset = OFF(light_mode_count),
      .max_items = LMB_MAX_PATTERNS, .items = &light_mode_schema, .item_size = sizeof(lmb_light_mode_rule)},
     BOOL("output.shadowmask", OFF(shadowmask)),
+    {.path = "output.light_groups", .set = set_light_groups, .offset = OFF(light_groups),
+     .count_offset = OFF(light_group_count), .max_items = LMB_MAX_LIGHT_GROUPS, .items = &light_group_schema,
+     .item_size = sizeof(lmb_light_group_spec)},
     FLOAT("sky.intensity", OFF(sky_intensity), 0, 1e9, 0),
     RGB("sky.color", OFF(sky_color), 0, 1e9, 0),
     RGB("sky.ground_color", OFF(sky_ground), 0, 1e9, OPEN_NONE),
@@ -177,6 +182,16 @@ static const key_spec light_mode_keys[] = {
     ENUM("lights.modes.mode", offsetof(lmb_light_mode_rule, mode), light_mode_names),
 };
 static const schema light_mode_schema = {light_mode_keys, sizeof light_mode_keys / sizeof *light_mode_keys};
+
+/* One output.light_groups entry, filled into an lmb_light_group_spec. */
+static const key_spec light_group_keys[] = {
+    STRING("output.light_groups.name", offsetof(lmb_light_group_spec, name)),
+    STRING("output.light_groups.match", offsetof(lmb_light_group_spec, pattern)),
+    BOOL("output.light_groups.sky", offsetof(lmb_light_group_spec, sky)),
+    BOOL("output.light_groups.emissive", offsetof(lmb_light_group_spec, emissive)),
+    FLOAT("output.light_groups.scale", offsetof(lmb_light_group_spec, scale), 0, 1e9, 0),
+};
+static const schema light_group_schema = {light_group_keys, sizeof light_group_keys / sizeof *light_group_keys};
 
 static const schema material_override_schema = {material_override_keys,
                                                 sizeof material_override_keys / sizeof *material_override_keys};
@@ -324,6 +339,37 @@ static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_no
 {
     uint32_t count = 0;
     lmb_status st = lmb_cfg_each_item(c, k, n, base, light_mode_item, &count);
+    return lmb_cfg_set_count(k, base, count, st);
+}
+
+/* {name: NAME, match: GLOB, sky: BOOL, emissive: BOOL, scale: S}: name required (letters, digits,
+ * '_', '-'; the group's files carry it), unique; scale 1 unless given */
+static lmb_status light_group_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
+{
+    lmb_light_group_spec *all = (lmb_light_group_spec *)(void *)(base + k->offset), *o = all + index;
+    memset(o, 0, sizeof *o);
+    o->scale = 1;
+    o->line = (uint32_t)lmb_cfg_line_of(item);
+    if (item->type != YAML_MAPPING_NODE)
+        return lmb_cfg_bad_value(c, k, item, "a mapping {name: NAME, match: GLOB, sky: BOOL, emissive: BOOL, scale: S}");
+    lmb_status st = walk_mapping(c, &light_group_schema, item, k->path, (char *)o);
+    if (st == LMB_OK && !o->name[0])
+        return lmb_cfg_key_error(c, item, k->path, "each entry needs a name");
+    for (const char *p = o->name; st == LMB_OK && *p; p++)
+        if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') || *p == '_' || *p == '-'))
+            return lmb_cfg_key_error(c, item, k->path, "name '%s': letters, digits, '_' and '-' only (it names the "
+                                     "group's files)", o->name);
+    for (uint32_t j = 0; st == LMB_OK && j < index; j++)
+        if (!strcmp(all[j].name, o->name))
+            return lmb_cfg_key_error(c, item, k->path, "name '%s' is given twice (lines %u and %u)", o->name,
+                                     all[j].line, o->line);
+    return st;
+}
+
+static lmb_status set_light_groups(parse_ctx *c, const key_spec *k, const yaml_node_t *n, char *base)
+{
+    uint32_t count = 0;
+    lmb_status st = lmb_cfg_each_item(c, k, n, base, light_group_item, &count);
     return lmb_cfg_set_count(k, base, count, st);
 }
 

@@ -177,10 +177,11 @@ void fill_meshes(lmb_gltf_doc &d)
     }
 }
 
-/* extras.lightmap_mode as written: "" when absent, "?" when not a string (the loader names it). */
-const char *mode_string(const tinygltf::Value &extras)
+/* A string extra (lightmap_mode, lightmap_group) as written: "" when absent, "?" when not a
+ * string (the loader names it). */
+const char *extras_string(const tinygltf::Value &extras, const char *key)
 {
-    const tinygltf::Value *v = extras.IsObject() ? member(extras, "lightmap_mode") : nullptr;
+    const tinygltf::Value *v = extras.IsObject() ? member(extras, key) : nullptr;
     if (!v)
         return "";
     return v->IsString() ? v->Get<std::string>().c_str() : "?";
@@ -232,7 +233,8 @@ void fill_node(lmb_gltf_doc &d, const tinygltf::Node &n, lmb_gltf_node &c)
         else if (flag && flag->IsNumber())
             c.extras_lightmap = flag->GetNumberAsDouble() != 0.0;
     }
-    c.lightmap_mode = mode_string(n.extras);
+    c.lightmap_mode = extras_string(n.extras, "lightmap_mode");
+    c.lightmap_group = extras_string(n.extras, "lightmap_group");
     probe_resolution(n.extras, c.lightmap_probes);
     const tinygltf::Value *gpu = extension(n.extensions, "EXT_mesh_gpu_instancing");
     const tinygltf::Value *attrs = gpu ? member(*gpu, "attributes") : nullptr;
@@ -377,7 +379,8 @@ void fill_lights(lmb_gltf_doc &d)
         c.range = l.range;
         c.inner_cone = l.spot.innerConeAngle;
         c.outer_cone = l.spot.outerConeAngle;
-        c.lightmap_mode = mode_string(l.extras);
+        c.lightmap_mode = extras_string(l.extras, "lightmap_mode");
+        c.lightmap_group = extras_string(l.extras, "lightmap_group");
         d.lights.push_back(c);
     }
 }

@@ -65,6 +65,7 @@ typedef struct lmb_gltf_node {
     int32_t gpu_translation, gpu_rotation, gpu_scale; /* EXT_mesh_gpu_instancing accessors, -1 */
     int has_gpu_instancing;
     const char *lightmap_mode; /* extras.lightmap_mode as written ("" absent, "?" not a string): the mode of its light */
+    const char *lightmap_group; /* extras.lightmap_group as written ("" absent, "?" not a string): its light's group */
     int32_t lightmap_probes[3]; /* extras.lightmap_probes: a volume's resolution; 0 0 0 absent, -1 -1 -1 malformed */
     int skinned;      /* node.skin is set */
     int morphing;     /* its mesh has morph targets */
@@ -127,6 +128,7 @@ typedef struct lmb_gltf_light {
     double intensity, range;
     double inner_cone, outer_cone;
     const char *lightmap_mode; /* extras.lightmap_mode as written ("" absent, "?" not a string) */
+    const char *lightmap_group; /* extras.lightmap_group as written ("" absent, "?" not a string) */
 } lmb_gltf_light;
 
 typedef struct lmb_gltf_image {

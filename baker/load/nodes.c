@@ -250,6 +250,11 @@ static lmb_status add_light(walk *w, uint32_t node, const double world[16], lmb_
                              "%s: %s (node %u): extras.lightmap_mode is %s%s%s; expected \"baked\", \"indirect\" or \"realtime\"",
                              w->ctx->path, label, node, strcmp(mode, "?") ? "'" : "", strcmp(mode, "?") ? mode : "not a string",
                              strcmp(mode, "?") ? "'" : "");
+    /* extras.lightmap_group: the light's own, else its node's (docs/light-groups.md) */
+    const char *group = gl->lightmap_group && *gl->lightmap_group ? gl->lightmap_group : n->lightmap_group;
+    if (group && !strcmp(group, "?"))
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %s (node %u): extras.lightmap_group is not a string; expected a "
+                             "light group's name", w->ctx->path, label, node);
     void *p = grow(s->lights, &w->light_cap, s->light_count + 1, sizeof *s->lights);
     if (!p)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", w->ctx->path);
@@ -258,9 +263,11 @@ static lmb_status add_light(walk *w, uint32_t node, const double world[16], lmb_
     char node_label[160];
     lmb_object_label(node_label, "node", node, n->name);
     l.node_name = lmb_strdup(n->name && *n->name ? n->name : node_label);
-    if (!l.name || !l.node_name) {
+    l.group = lmb_strdup(group ? group : "");
+    if (!l.name || !l.node_name || !l.group) {
         free(l.name);
         free(l.node_name);
+        free(l.group);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: out of memory", w->ctx->path);
     }
     l.gltf_light = (uint32_t)n->light;

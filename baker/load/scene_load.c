@@ -170,6 +170,7 @@ void lmb_scene_free(lmb_scene *s)
     for (uint32_t i = 0; i < s->light_count; i++) {
         free(s->lights[i].name);
         free(s->lights[i].node_name);
+        free(s->lights[i].group);
     }
     free(s->primitives);
     free(s->meshes);

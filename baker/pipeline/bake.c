@@ -16,9 +16,11 @@
 #include "watch/layout_cache.h"
 #include "watch/stages_out.h"
 #include "watch/validity_cache.h"
+#include "pipeline/group_lighting.h"
 #include "pipeline/lighting.h"
 #include "pipeline/stage_options.h"
 #include "lights/direct.h"
+#include "lights/light_groups.h"
 #include "load/gltf_adapter.h"
 #include "load/textures.h"
 #include "pack/coverage.h"
@@ -201,6 +203,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_ic_points records = {NULL, 0};
     lmb_probe_set probes;
     memset(&probes, 0, sizeof probes);
+    lmb_light_groups groups; /* output.light_groups: none unless the level has some */
+    memset(&groups, 0, sizeof groups);
+    lmb_group_light group_light;
+    memset(&group_light, 0, sizeof group_light);
     lmb_point_validity validity; /* with a layout cache: the gather points' validity kept between bakes */
     memset(&validity, 0, sizeof validity);
     uint64_t validity_read = 0;
@@ -251,6 +257,11 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_direct_options direct_opt = lmb_direct_options_of(cfg);
     if (st == LMB_OK)
         st = lmb_direct_create(s, &direct_opt, &rt, em, sky, &direct, err);
+    /* light groups (not for bake --direct-of: the watch's look at some lights' direct light) */
+    if (st == LMB_OK && !cfg->direct_of_count)
+        st = lmb_light_groups_resolve(s, cfg, sky != NULL, lmb_emitters_count(em) > 0, &groups, err);
+    if (st == LMB_OK && groups.count && !shard)
+        lmb_light_groups_report(&groups, s, log);
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     cache.threads = cfg->threads;
@@ -285,14 +296,21 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_lighting_hooks hooks = {progress, user, cfg->stages_out[0] ? lmb_stages_out_stage : NULL, &so};
     if (st == LMB_OK && dark)
         st = dark_atlases(s, cfg, &l, &cache, stats, err);
-    else if (st == LMB_OK)
+    else if (st == LMB_OK && !groups.count)
         st = lmb_light_atlases(cfg, direct, &cache, steps, &hooks, stats, &records, log, err);
     /* light probes: placed in every process alike, lit as a step from the finished cache (not
      * for bake --direct-of: the watch reads only its lightmaps) */
     if (st == LMB_OK && !cfg->direct_of_count)
         st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
-    if (st == LMB_OK)
+    if (st == LMB_OK && groups.count && !dark) { /* each group's lighting and probes on its own */
+        lmb_lighting_hooks group_hooks = {progress, user, NULL, NULL};
+        lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, sky, &cache, steps, &group_hooks,
+                            validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard,
+                            shard ? NULL : log};
+        st = lmb_group_lighting(&ge, &groups, stats, &records, &group_light, err);
+    } else if (st == LMB_OK) {
         st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, shard ? NULL : log, err);
+    }
     if (st == LMB_OK && validity.entry) {
         if (validity_read)
             lmb_info(log, "gather points: the validity of %llu read back with the layout (their rays not traced again)",
@@ -326,8 +344,16 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (finishes)
         tail_cfg.threads = run->tail_threads;
     cfg = &tail_cfg;
-    if (st == LMB_OK && !dark)
+    if (st == LMB_OK && !dark && !groups.count)
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
+    /* light groups: each group's lightmap through the post stage, then their sum at the scales */
+    for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++) {
+        lmb_group_swap(&group_light, g, &cache);
+        st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
+        lmb_group_swap(&group_light, g, &cache);
+    }
+    if (st == LMB_OK && !dark && groups.count)
+        st = lmb_group_compose(&groups, &group_light, &cache, &probes, err);
     /* The light is done: what only lighting read goes before the images, where OpenImageIO's
      * libraries are loaded (the lights before the ray-tracing scene they point into). */
     lmb_direct_free(direct);
@@ -346,7 +372,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         if (progress)
             progress(user, "images", a, l.atlas_count);
         st = lmb_write_atlas_images(cfg, od.staging, od.stem, a, cache.irradiance[a], cache.state[a], l.width[a],
-                                    l.height[a], &outputs[a], err);
+                                    l.height[a], groups.count > 0 && !dark, &outputs[a], err);
         clamped += outputs[a].rgbm_clamped;
         if (st == LMB_OK && outputs[a].rgbm_clamped)
             lmb_warn(log, "atlas %u: %llu texels brighter than RGBM's range %g were clamped (output.rgbm_range; auto "
@@ -363,6 +389,11 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (progress && st == LMB_OK)
         progress(user, "images", l.atlas_count, l.atlas_count);
     stats->rgbm_clamped = clamped;
+    for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++) /* each group's own files */
+        for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
+            st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g],
+                                        group_light.irradiance[(size_t)g * l.atlas_count + a], l.width[a], l.height[a],
+                                        err);
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
     for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)
@@ -381,7 +412,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_probes_output(&probes, cfg, od.staging, od.stem, log, &out_probes, err);
         if (st == LMB_OK)
             st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
-                                            cache.shadowmask != NULL, &out_probes, err);
+                                            cache.shadowmask != NULL, &out_probes, dark ? NULL : &groups, err);
         lmb_probes_output_free(&out_probes);
     }
     free(outputs);
@@ -394,6 +425,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK)
         snprintf(stats->gltf_path, sizeof stats->gltf_path, "%s/%s.gltf", outdir, od.stem);
 done:
+    lmb_group_light_free(&group_light);
+    lmb_light_groups_free(&groups);
     lmb_point_validity_free(&validity);
     lmb_steps_free(steps);
     lmb_part_identity_free(&id);

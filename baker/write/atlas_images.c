@@ -7,6 +7,7 @@
 #include "atlas_images.h"
 
 #include "image_adapter.h"
+#include "image_native.h"
 #include "ktx2.h"
 #include "rgbm.h"
 #include "post/dilate.h"
@@ -47,7 +48,7 @@ static void tonemap(const float *rgb, const uint8_t *valid, uint32_t w, uint32_t
 }
 
 /* One file to write: float or 8-bit pixels through OpenImageIO, or float pixels as KTX2. */
-typedef enum image_kind { IMAGE_F32, IMAGE_U8, IMAGE_KTX2 } image_kind;
+typedef enum image_kind { IMAGE_F32, IMAGE_U8, IMAGE_KTX2, IMAGE_EXR_FLOAT } image_kind;
 
 typedef struct image_job {
     image_kind kind;
@@ -71,9 +72,10 @@ static lmb_status write_images(const image_job *jobs, int n, uint32_t w, uint32_
     for (int k = 0; k < n; k++) {
         const image_job *j = &jobs[k];
         errs[k] = (lmb_error){LMB_OK, ""};
-        sts[k] = j->kind == IMAGE_F32  ? lmb_image_write_f32(j->path, w, h, j->channels, j->f32, &errs[k])
-                 : j->kind == IMAGE_U8 ? lmb_image_write_u8(j->path, w, h, j->channels, j->u8, &errs[k])
-                                       : lmb_ktx2_write(j->path, w, h, j->f32, &j->ktx2, j->ktx2_report, &errs[k]);
+        sts[k] = j->kind == IMAGE_F32         ? lmb_image_write_f32(j->path, w, h, j->channels, j->f32, &errs[k])
+                 : j->kind == IMAGE_U8        ? lmb_image_write_u8(j->path, w, h, j->channels, j->u8, &errs[k])
+                 : j->kind == IMAGE_EXR_FLOAT ? lmb_image_native_write_exr_float(j->path, w, h, j->f32, &errs[k])
+                                              : lmb_ktx2_write(j->path, w, h, j->f32, &j->ktx2, j->ktx2_report, &errs[k]);
     }
     for (int k = 0; k < n; k++)
         if (sts[k] != LMB_OK) {
@@ -99,7 +101,7 @@ static float *scaled_copy(const lmb_config *cfg, const float *rgb, size_t texels
 }
 
 lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
-                                  const float *irradiance, const uint8_t *valid, uint32_t w, uint32_t h,
+                                  const float *irradiance, const uint8_t *valid, uint32_t w, uint32_t h, int exr_float,
                                   lmb_atlas_output *info, lmb_error *err)
 {
     memset(info, 0, sizeof *info);
@@ -118,7 +120,7 @@ lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const 
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
     int count = 0;
     if (st == LMB_OK && (cfg->output_formats & LMB_OUTPUT_EXR)) {
-        jobs[count] = (image_job){IMAGE_F32, "", 3, rgb, NULL, {0}, NULL};
+        jobs[count] = (image_job){exr_float ? IMAGE_EXR_FLOAT : IMAGE_F32, "", 3, rgb, NULL, {0}, NULL};
         snprintf(jobs[count++].path, sizeof jobs->path, "%s/%s-lightmap-%u.exr", dir, stem, a);
     }
     /* the glTF references the .hdr and .png: written whatever the formats say */
@@ -176,6 +178,20 @@ lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const cha
     image_job job = {IMAGE_F32, "", 3, rgb, NULL, {0}, NULL};
     snprintf(job.path, sizeof job.path, "%s/%s-lightmap-%u.hdr", dir, stem, a);
     lmb_status st = write_images(&job, 1, w, h, image_threads(cfg), err);
+    free(rgb);
+    return st;
+}
+
+lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
+                                  const char *group, const float *irradiance, uint32_t w, uint32_t h, lmb_error *err)
+{
+    float *rgb = scaled_copy(cfg, irradiance, (size_t)w * h);
+    if (!rgb)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
+    image_job jobs[2] = {{IMAGE_EXR_FLOAT, "", 3, rgb, NULL, {0}, NULL}, {IMAGE_F32, "", 3, rgb, NULL, {0}, NULL}};
+    snprintf(jobs[0].path, sizeof jobs[0].path, "%s/%s-lightmap-%u-group-%s.exr", dir, stem, a, group);
+    snprintf(jobs[1].path, sizeof jobs[1].path, "%s/%s-lightmap-%u-group-%s.hdr", dir, stem, a, group);
+    lmb_status st = write_images(jobs, 2, w, h, image_threads(cfg), err);
     free(rgb);
     return st;
 }

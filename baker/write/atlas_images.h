@@ -21,10 +21,11 @@ typedef struct lmb_atlas_output {
     lmb_ktx2_report ktx2;  /* ktx2: texels above the block format's range, clamped */
 } lmb_atlas_output;
 
-/* irradiance: 3 floats per atlas texel (E, lux); valid: LMB_TEXEL_* per texel. Files go into dir. */
+/* irradiance: 3 floats per atlas texel (E, lux); valid: LMB_TEXEL_* per texel. Files go into dir.
+ * exr_float: the .exr in 32-bit float (light groups), else half float where every value fits. */
 lmb_status lmb_write_atlas_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
                                   const float *irradiance, const uint8_t *valid, uint32_t width, uint32_t height,
-                                  lmb_atlas_output *info, lmb_error *err);
+                                  int exr_float, lmb_atlas_output *info, lmb_error *err);
 
 /* The directional atlas (output.directional; docs/artists.md): d holds the
  * light's mean direction D per texel (3 floats, world space, |D| <= 1).
@@ -37,6 +38,13 @@ lmb_status lmb_write_direction_images(const lmb_config *cfg, const char *dir, co
  * lightmap's own .hdr is written (the watch's stages, watch/stages_out.h). */
 lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
                                const float *irradiance, uint32_t width, uint32_t height, lmb_error *err);
+
+/* A light group's lightmap (docs/light-groups.md): <stem>-lightmap-N-group-NAME.exr (32-bit
+ * float) and .hdr, irradiance (3 floats per texel) as output.scale says; a game blends the
+ * groups' files. */
+lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
+                                  const char *group, const float *irradiance, uint32_t width, uint32_t height,
+                                  lmb_error *err);
 
 /* output.shadowmask: <stem>-lightmap-N-shadowmask.png, RGBA8, per channel a light's visibility
  * (4 floats per texel in [0, 1]), linear. */

@@ -282,6 +282,19 @@ extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gl
             k["vkFormat"] = Value((int)f->ktx2_vkformat);
             lm["ktx2"] = Value(k);
         }
+        if (f->groups) {
+            Value::Array groups;
+            for (uint32_t g = 0; g < f->groups; g++) {
+                Value::Object one, gf;
+                gf["exr"] = Value(std::string(f->group_exr[g]));
+                gf["hdr"] = Value(std::string(f->group_hdr[g]));
+                one["name"] = Value(std::string(f->group_name[g]));
+                one["scale"] = Value(f->group_scale[g]);
+                one["files"] = Value(gf);
+                groups.push_back(Value(one));
+            }
+            lm["groups"] = Value(groups);
+        }
         Value::Object extras;
         extras["lightmap"] = Value(lm);
         t.extras = Value(extras);
@@ -367,6 +380,8 @@ void node_lightmap_extras(tinygltf::Model &m, tinygltf::Node &n, int texture, co
     lm["scaleOffset"] = Value(Value::Array{Value(so[0]), Value(so[1]), Value(so[2]), Value(so[3])});
     lm["scale"] = tex.count("scale") ? tex["scale"] : Value(std::string("irradiance"));
     lm["files"] = tex.count("files") ? tex["files"] : Value(Value::Object());
+    if (tex.count("groups"))
+        lm["groups"] = tex["groups"];
     Value::Object extras = n.extras.IsObject() ? n.extras.Get<Value::Object>() : Value::Object();
     extras["lightmap"] = Value(lm);
     n.extras = Value(extras);

@@ -40,11 +40,15 @@ typedef struct lmb_gltf_lightmap_files {
     uint32_t ktx2_vkformat;   /* ktx2: its vkFormat */
     const char *direction_png, *direction_exr, *direction_ktx2; /* output.directional */
     const char *shadowmask;   /* output.shadowmask: the RGBA8 PNG */
+    uint32_t groups;          /* output.light_groups: each group's name, scale and files */
+    const char *group_name[LMB_MAX_LIGHT_GROUPS], *group_exr[LMB_MAX_LIGHT_GROUPS], *group_hdr[LMB_MAX_LIGHT_GROUPS];
+    double group_scale[LMB_MAX_LIGHT_GROUPS];
 } lmb_gltf_lightmap_files;
 
 /* Adds the texture of one atlas: source files->png, MOZ_texture_rgbe files->hdr, and
  * extras.lightmap {atlas, width, height, scale, files {format: uri}, rgbm {range, decode},
- * ktx2 {vkFormat}}, so an engine script finds every file without guessing names. Returns its
+ * ktx2 {vkFormat}, groups [{name, scale, files {exr, hdr}}] (light groups: the texture's files
+ * hold sum_g scale_g x group g's)}, so an engine script finds every file without guessing names. Returns its
  * index, or -1 on failure. */
 int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gltf_lightmap_files *files, lmb_error *err);
 

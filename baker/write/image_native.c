@@ -135,14 +135,14 @@ static exr_result_t exr_write_rgb(exr_context_t ctx, uint32_t w, uint32_t h, con
 }
 
 static lmb_status write_exr(const char *tmp, const char *path, uint32_t w, uint32_t h, uint32_t channels,
-                            const float *pixels, lmb_error *err)
+                            const float *pixels, int full_float, lmb_error *err)
 {
     if (channels != 3)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: the EXR writer takes RGB, not %u channels", path, channels);
     size_t n = (size_t)w * h * 3;
     /* half float holds up to 65504: sunlight (up to ~120,000 lux) would turn to Inf, so an atlas
      * with a larger value is stored in 32-bit float */
-    int fits_half = 1;
+    int fits_half = !full_float;
     for (size_t i = 0; i < n && fits_half; i++)
         fits_half = fabsf(pixels[i]) <= 65504.0f;
     uint16_t *half = NULL;
@@ -188,7 +188,17 @@ lmb_status lmb_image_native_write_f32(const char *path, uint32_t width, uint32_t
     char tmp[4096];
     if (!part_name(path, tmp, sizeof tmp))
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: path too long", path);
-    lmb_status st = strcmp(extension(path), ".exr") == 0 ? write_exr(tmp, path, width, height, channels, pixels, err)
+    lmb_status st = strcmp(extension(path), ".exr") == 0 ? write_exr(tmp, path, width, height, channels, pixels, 0, err)
                                                          : write_hdr(tmp, path, width, height, channels, pixels, err);
+    return st == LMB_OK ? move_into_place(tmp, path, err) : st;
+}
+
+lmb_status lmb_image_native_write_exr_float(const char *path, uint32_t width, uint32_t height, const float *pixels,
+                                            lmb_error *err)
+{
+    char tmp[4096];
+    if (!part_name(path, tmp, sizeof tmp))
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: path too long", path);
+    lmb_status st = write_exr(tmp, path, width, height, 3, pixels, 1, err);
     return st == LMB_OK ? move_into_place(tmp, path, err) : st;
 }

@@ -18,4 +18,9 @@ lmb_status lmb_image_native_write_u8(const char *path, uint32_t width, uint32_t 
 lmb_status lmb_image_native_write_f32(const char *path, uint32_t width, uint32_t height, uint32_t channels,
                                       const float *pixels, lmb_error *err);
 
+/* An RGB .exr in 32-bit float whatever its values (light groups: a game's sum of the groups'
+ * files then matches the bake's sum to float rounding, where half float would hold 11 bits). */
+lmb_status lmb_image_native_write_exr_float(const char *path, uint32_t width, uint32_t height, const float *pixels,
+                                            lmb_error *err);
+
 #endif

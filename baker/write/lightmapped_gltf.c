@@ -98,7 +98,7 @@ typedef struct instance_prims {
 lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                                       const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
                                       int directional, int shadowmask, const lmb_gltf_probes *probes,
-                                      lmb_error *err)
+                                      const lmb_light_groups *groups, lmb_error *err)
 {
     int32_t *tex = malloc(((size_t)l->atlas_count + 1) * 2 * sizeof *tex), *dir_tex = tex + l->atlas_count + 1;
     if (!tex)
@@ -131,6 +131,16 @@ lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const
             .direction_exr = directional ? dexr : NULL,
             .direction_ktx2 = directional && (f & LMB_OUTPUT_KTX2) ? dktx2 : NULL,
             .shadowmask = shadowmask ? mask : NULL};
+        char group_exr[LMB_MAX_LIGHT_GROUPS][512], group_hdr[LMB_MAX_LIGHT_GROUPS][512];
+        for (uint32_t g = 0; groups && g < groups->count; g++) {
+            snprintf(group_exr[g], sizeof group_exr[g], "%s-lightmap-%u-group-%s.exr", stem, a, groups->name[g]);
+            snprintf(group_hdr[g], sizeof group_hdr[g], "%s-lightmap-%u-group-%s.hdr", stem, a, groups->name[g]);
+            files.group_name[g] = groups->name[g];
+            files.group_scale[g] = groups->scale[g];
+            files.group_exr[g] = group_exr[g];
+            files.group_hdr[g] = group_hdr[g];
+        }
+        files.groups = groups ? groups->count : 0;
         tex[a] = lmb_gltf_add_lightmap_texture(s->doc, &files, err);
         dir_tex[a] = directional && tex[a] >= 0 ? lmb_gltf_add_direction_texture(s->doc, dpng, err) : -1;
         if (tex[a] < 0 || (directional && dir_tex[a] < 0))

@@ -9,6 +9,7 @@
 
 #include <lmbake/lmbake.h>
 
+#include "lights/light_groups.h"
 #include "pack/layout.h"
 #include "write/atlas_images.h"
 #include "write/gltf_write.h"
@@ -20,10 +21,11 @@
 void lmb_copy_input_textures(lmb_scene *s, lmb_output_dir *od, const lmb_log *log);
 
 /* DIR/STEM.gltf (+ STEM-lightmap.bin) and, when records->count, the records file. outputs: per
- * atlas what its images hold (RGBM range). probes: NULL or the light probes. */
+ * atlas what its images hold (RGBM range). probes: NULL or the light probes. groups: NULL or the
+ * light groups, whose files (lmb_write_group_images) each lightmap texture names. */
 lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, const char *dir,
                                       const char *stem, const lmb_atlas_output *outputs, const lmb_ic_points *records,
                                       int directional, int shadowmask, const lmb_gltf_probes *probes,
-                                      lmb_error *err);
+                                      const lmb_light_groups *groups, lmb_error *err);
 
 #endif

@@ -189,6 +189,7 @@ typedef struct lmb_light {
     char *node_name;     /* the node that places it: its name or "node N" */
     lmb_light_mode mode;
     int shadowmask_channel; /* output.shadowmask: its visibility's channel (0..3) in the shadowmask, or -1 */
+    char *group;         /* extras.lightmap_group of the light, else of its node ("": none) */
     lmb_light_type type;
     uint32_t gltf_light; /* index into KHR_lights_punctual.lights */
     uint32_t node;       /* node that places it */
@@ -311,6 +312,18 @@ typedef struct lmb_light_mode_rule {
     int mode; /* lmb_light_mode; -1 before it is read */
 } lmb_light_mode_rule;
 
+/* output.light_groups entry (docs/light-groups.md): a set of the level's light sources baked into
+ * a lightmap of its own, which a game scales and tints at run time; the bake's own lightmap is
+ * the sum of the groups' at their scales. */
+#define LMB_MAX_LIGHT_GROUPS 8
+typedef struct lmb_light_group_spec {
+    char name[LMB_PATTERN_LEN];    /* letters, digits, '_' and '-': it names the group's files */
+    char pattern[LMB_PATTERN_LEN]; /* match: the lights whose name or node name matches ("" none) */
+    int sky, emissive;             /* the sky's light, every emissive surface's light */
+    double scale;                  /* its weight in the lightmap the bake writes (1) */
+    uint32_t line;                 /* the config's line that starts it (for messages; not part of its text) */
+} lmb_light_group_spec;
+
 /* probes.volumes entry: a box of probes at the centres of a resolution[0] x [1] x [2] grid of
  * cells (an irradiance volume an artist places) */
 #define LMB_MAX_PROBE_VOLUMES 16
@@ -411,6 +424,8 @@ typedef struct lmb_config {
      * "" = none */
     char stages_out[4096];
     int shadowmask;                /* output.shadowmask: the visibility of up to 4 `indirect` lights per texel */
+    lmb_light_group_spec light_groups[LMB_MAX_LIGHT_GROUPS]; /* output.light_groups */
+    uint32_t light_group_count;
     /* materials the file did not set, or set wrongly for a bake */
     double default_albedo[3];      /* materials.default.albedo: primitives with no material; [0] < 0: none (glTF's metal) */
     lmb_material_override material_overrides[LMB_MAX_PATTERNS];

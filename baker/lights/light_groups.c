@@ -1,0 +1,131 @@
+/* Which group each light source is in (see light_groups.h). */
+#include "light_groups.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int32_t find_group(const lmb_light_groups *g, const char *name)
+{
+    for (uint32_t k = 0; k < g->count; k++)
+        if (!strcmp(g->name[k], name))
+            return (int32_t)k;
+    return -1;
+}
+
+/* The group named `name`, added (scale 1) when there is none yet; -1 when the groups are full. */
+static int32_t group_named(lmb_light_groups *g, const char *name)
+{
+    int32_t k = find_group(g, name);
+    if (k >= 0 || g->count >= LMB_MAX_LIGHT_GROUPS)
+        return k;
+    snprintf(g->name[g->count], sizeof g->name[g->count], "%s", name);
+    g->scale[g->count] = 1.0;
+    return (int32_t)g->count++;
+}
+
+void lmb_light_groups_free(lmb_light_groups *g)
+{
+    free(g->of_light);
+    memset(g, 0, sizeof *g);
+}
+
+lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
+                                    lmb_light_groups *out, lmb_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->sky = out->emissive = -1;
+    int any_extra = 0;
+    for (uint32_t i = 0; i < s->light_count; i++)
+        any_extra |= s->lights[i].group && s->lights[i].group[0] && s->lights[i].mode != LMB_LIGHT_REALTIME;
+    if (!cfg->light_group_count && !any_extra)
+        return LMB_OK;
+    const char *where = cfg->config_path[0] ? cfg->config_path : "the config";
+    if (cfg->shadowmask)
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: output.light_groups and output.shadowmask: a bake holds one or "
+                             "the other (light groups with shadowmasks are not built yet)", where);
+    out->of_light = malloc(((size_t)s->light_count + 1) * sizeof *out->of_light);
+    if (!out->of_light)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    for (uint32_t k = 0; k < cfg->light_group_count; k++) {
+        snprintf(out->name[k], sizeof out->name[k], "%s", cfg->light_groups[k].name);
+        out->scale[k] = cfg->light_groups[k].scale;
+    }
+    out->count = cfg->light_group_count;
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        const lmb_light *l = &s->lights[i];
+        out->of_light[i] = -1;
+        if (l->mode == LMB_LIGHT_REALTIME)
+            continue;
+        int32_t k = -1;
+        if (l->group && l->group[0]) {
+            k = group_named(out, l->group);
+            if (k < 0) {
+                lmb_light_groups_free(out);
+                return lmb_error_set(err, LMB_ERR_INPUT, "%s: light '%s' (node '%s'): extras.lightmap_group '%s' would "
+                                     "make more than %d light groups (output.light_groups holds at most %d)", s->path,
+                                     l->name, l->node_name, l->group, LMB_MAX_LIGHT_GROUPS, LMB_MAX_LIGHT_GROUPS);
+            }
+        }
+        for (uint32_t j = 0; k < 0 && j < cfg->light_group_count; j++) {
+            const char *p = cfg->light_groups[j].pattern;
+            if (p[0] && (lmb_glob_match(p, l->name) || lmb_glob_match(p, l->node_name)))
+                k = (int32_t)j;
+        }
+        out->of_light[i] = k; /* -1: the rest's, below */
+    }
+    for (uint32_t j = 0; j < cfg->light_group_count; j++) {
+        if (has_sky && out->sky < 0 && cfg->light_groups[j].sky)
+            out->sky = (int32_t)j;
+        if (has_emissive && out->emissive < 0 && cfg->light_groups[j].emissive)
+            out->emissive = (int32_t)j;
+    }
+    /* what no group claims: the group "rest" */
+    int unclaimed = (has_sky && out->sky < 0) || (has_emissive && out->emissive < 0);
+    for (uint32_t i = 0; i < s->light_count; i++)
+        unclaimed |= s->lights[i].mode != LMB_LIGHT_REALTIME && out->of_light[i] < 0;
+    int32_t rest = unclaimed ? group_named(out, "rest") : -1;
+    if (unclaimed && rest < 0) {
+        lmb_light_groups_free(out);
+        return lmb_error_set(err, LMB_ERR_INPUT, "%s: %d light groups hold some of the level's light and the rest needs "
+                             "one more (at most %d): name a group for every light, or give one sky: true / emissive: "
+                             "true", where, LMB_MAX_LIGHT_GROUPS, LMB_MAX_LIGHT_GROUPS);
+    }
+    if (has_sky && out->sky < 0)
+        out->sky = rest;
+    if (has_emissive && out->emissive < 0)
+        out->emissive = rest;
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        if (s->lights[i].mode != LMB_LIGHT_REALTIME && out->of_light[i] < 0)
+            out->of_light[i] = rest;
+        if (out->of_light[i] >= 0)
+            out->lights[out->of_light[i]]++;
+    }
+    /* a config group that holds nothing is a mistake (a typo in match, a renamed light) */
+    for (uint32_t j = 0; j < cfg->light_group_count; j++)
+        if (!out->lights[j] && out->sky != (int32_t)j && out->emissive != (int32_t)j) {
+            const lmb_light_group_spec *g = &cfg->light_groups[j];
+            char what[512];
+            snprintf(what, sizeof what, "%s%s%s%s%s", g->pattern[0] ? "no light's name or node name matches '" : "",
+                     g->pattern, g->pattern[0] ? "'" : "no match", g->sky && !has_sky ? ", the level has no sky" : "",
+                     g->emissive && !has_emissive ? ", nothing in it emits" : "");
+            lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: output.light_groups '%s' holds no light: %s, and no light's "
+                          "extras.lightmap_group names it (%s)", where, g->line, g->name, what, s->path);
+            lmb_light_groups_free(out);
+            return LMB_ERR_INPUT;
+        }
+    return LMB_OK;
+}
+
+void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, const lmb_log *log)
+{
+    for (uint32_t k = 0; k < g->count; k++) {
+        char first[160] = "";
+        for (uint32_t i = 0; i < s->light_count && !first[0]; i++)
+            if (g->of_light[i] == (int32_t)k)
+                snprintf(first, sizeof first, " ('%s'%s)", s->lights[i].name, g->lights[k] > 1 ? ", ..." : "");
+        lmb_info(log, "light group '%s': %u light(s)%s%s%s, scale %g", g->name[k], g->lights[k], first,
+                 g->sky == (int32_t)k ? ", the sky" : "", g->emissive == (int32_t)k ? ", the emissive surfaces" : "",
+                 g->scale[k]);
+    }
+}

@@ -1,0 +1,41 @@
+/*
+ * Light groups (output.light_groups, a light's extras.lightmap_group; docs/light-groups.md):
+ * which of the level's light sources each group holds. The bake lights every group on its own
+ * (its lights alone, at their own intensities) and writes a lightmap per group; the lightmap it
+ * writes as the level's is their sum at the groups' scales, the same sum a game computes to
+ * switch or dim the groups at run time. Light is linear in its sources, so each group's
+ * lightmap is what a bake of that group's lights alone gives, and no group's sampling reads
+ * another's light or any group's scale: the sum at other scales is exact.
+ *
+ * Which group a source is in: a light's extras.lightmap_group (its own, else its node's); else
+ * the first config group whose match its name or node name matches; the sky and the emissive
+ * surfaces: the first group with sky: true / emissive: true. What no group claims goes to a
+ * group named "rest" (made when needed). Realtime lights are in no group (they are not baked).
+ */
+#ifndef LMBAKE_LIGHT_GROUPS_H
+#define LMBAKE_LIGHT_GROUPS_H
+
+#include <lmbake/lmbake.h>
+
+typedef struct lmb_light_groups {
+    uint32_t count; /* 0: the level has no groups (one lightmap, as without the key) */
+    char name[LMB_MAX_LIGHT_GROUPS][LMB_PATTERN_LEN];
+    double scale[LMB_MAX_LIGHT_GROUPS];
+    uint32_t lights[LMB_MAX_LIGHT_GROUPS]; /* how many of the level's lights each holds */
+    int32_t *of_light;                     /* per scene light: its group, -1 (realtime: in none) */
+    int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
+} lmb_light_groups;
+
+/* The groups of scene s under cfg (after lmb_scene_set_light_modes). has_sky, has_emissive:
+ * whether the level has a sky and emissive surfaces. Errors (LMB_ERR_INPUT, nothing baked): a
+ * config group that ends up holding no light source (named with its line), a light's group
+ * that would make more than LMB_MAX_LIGHT_GROUPS (the file, light and node named), groups with
+ * output.shadowmask. Free with lmb_light_groups_free. */
+lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
+                                    lmb_light_groups *out, lmb_error *err);
+void lmb_light_groups_free(lmb_light_groups *g);
+
+/* The log's line: each group, what it holds and its scale. */
+void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, const lmb_log *log);
+
+#endif

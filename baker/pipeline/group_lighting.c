@@ -1,0 +1,233 @@
+/* The lighting of each light group on its own, and their sum (see group_lighting.h). */
+#include "group_lighting.h"
+
+#include "util/lmb_math.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void lmb_group_light_free(lmb_group_light *gl)
+{
+    size_t n = (size_t)gl->groups * gl->atlases;
+    for (size_t k = 0; gl->irradiance && k < n; k++)
+        free(gl->irradiance[k]);
+    for (size_t k = 0; gl->direction && k < n; k++)
+        free(gl->direction[k]);
+    for (uint32_t g = 0; gl->sh && g < gl->groups; g++) {
+        free(gl->sh[g]);
+        free(gl->cube[g]);
+    }
+    free(gl->irradiance);
+    free(gl->direction);
+    free(gl->sh);
+    free(gl->cube);
+    memset(gl, 0, sizeof *gl);
+}
+
+static lmb_status light_alloc(lmb_group_light *gl, uint32_t groups, uint32_t atlases, int directional, int probes,
+                              lmb_error *err)
+{
+    memset(gl, 0, sizeof *gl);
+    gl->groups = groups;
+    gl->atlases = atlases;
+    size_t n = (size_t)groups * atlases + 1;
+    gl->irradiance = calloc(n, sizeof *gl->irradiance);
+    gl->direction = directional ? calloc(n, sizeof *gl->direction) : NULL;
+    gl->sh = probes ? calloc((size_t)groups + 1, sizeof *gl->sh) : NULL;
+    gl->cube = probes ? calloc((size_t)groups + 1, sizeof *gl->cube) : NULL;
+    if (!gl->irradiance || (directional && !gl->direction) || (probes && (!gl->sh || !gl->cube))) {
+        lmb_group_light_free(gl);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    }
+    return LMB_OK;
+}
+
+/* Group g's light out of the cache and the probes into gl (the cache's images taken, not copied:
+ * the next group's passes make new ones); a dark group's is 0. */
+static lmb_status keep_group(const lmb_group_env *env, uint32_t g, int dark, lmb_group_light *gl, lmb_error *err)
+{
+    lmb_cache *c = env->cache;
+    for (uint32_t a = 0; a < c->atlas_count; a++) {
+        size_t n = 3 * (size_t)c->layout->width[a] * c->layout->height[a] + 1, k = (size_t)g * c->atlas_count + a;
+        if (dark) {
+            gl->irradiance[k] = calloc(n, sizeof **gl->irradiance);
+        } else {
+            gl->irradiance[k] = c->irradiance[a];
+            c->irradiance[a] = NULL;
+        }
+        if (gl->direction && (dark || !c->direction || !c->direction[a])) {
+            gl->direction[k] = calloc(n, sizeof **gl->direction);
+        } else if (gl->direction) {
+            gl->direction[k] = c->direction[a];
+            c->direction[a] = NULL;
+        }
+        if (!gl->irradiance[k] || (gl->direction && !gl->direction[k]))
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
+    }
+    const lmb_probe_set *p = env->probes;
+    if (gl->sh && p && p->count) {
+        gl->sh[g] = calloc((size_t)p->count * LMB_PROBE_SH + 1, sizeof **gl->sh);
+        gl->cube[g] = calloc((size_t)p->count * LMB_PROBE_CUBE + 1, sizeof **gl->cube);
+        if (!gl->sh[g] || !gl->cube[g])
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for %u probes", p->count);
+        if (!dark) {
+            memcpy(gl->sh[g], p->sh, (size_t)p->count * LMB_PROBE_SH * sizeof *p->sh);
+            memcpy(gl->cube[g], p->cube, (size_t)p->count * LMB_PROBE_CUBE * sizeof *p->cube);
+        }
+    }
+    return LMB_OK;
+}
+
+/* The lights of the level that are not in group g are left out while it is lit (as realtime
+ * lights are); saved: the modes to put back. */
+static void only_group(lmb_scene *s, const lmb_light_groups *groups, uint32_t g, lmb_light_mode *saved)
+{
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        saved[i] = s->lights[i].mode;
+        if (groups->of_light[i] != (int32_t)g)
+            s->lights[i].mode = LMB_LIGHT_REALTIME;
+    }
+}
+
+static void restore_modes(lmb_scene *s, const lmb_light_mode *saved)
+{
+    for (uint32_t i = 0; i < s->light_count; i++)
+        s->lights[i].mode = saved[i];
+}
+
+/* Group g: its lights alone through the lighting passes and the probes. */
+static lmb_status light_group(const lmb_group_env *env, const lmb_light_groups *groups, uint32_t g,
+                              lmb_bake_stats *stats, lmb_ic_points *records, int *dark, lmb_error *err)
+{
+    const lmb_config *cfg = env->cfg;
+    lmb_direct *direct = NULL;
+    lmb_status st = lmb_direct_create(env->scene, env->direct_opt, env->rt,
+                                      groups->emissive == (int32_t)g ? env->emitters : NULL,
+                                      groups->sky == (int32_t)g ? env->sky : NULL, &direct, err);
+    if (st != LMB_OK)
+        return st;
+    if (env->validity)
+        lmb_direct_set_validity(direct, env->validity);
+    *dark = !lmb_direct_any_light(direct);
+    lmb_info(env->log, "light group '%s' (%u of %u): lighting%s", groups->name[g], g + 1, groups->count,
+             *dark ? ": nothing in it emits, its lightmap is black" : "");
+    if (!*dark) {
+        free(records->xyzr); /* the last group's records are the ones written */
+        records->xyzr = NULL;
+        records->count = 0;
+        st = lmb_light_atlases(cfg, direct, env->cache, env->steps, env->hooks, stats, records, env->log, err);
+    }
+    if (st == LMB_OK && env->probes)
+        st = lmb_probes_light(env->probes, cfg, direct, env->cache, env->steps, *dark,
+                              env->hooks ? env->hooks->progress : NULL, env->hooks ? env->hooks->progress_user : NULL,
+                              env->log, err);
+    lmb_direct_set_validity(direct, NULL);
+    lmb_direct_free(direct);
+    return st;
+}
+
+lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *groups, lmb_bake_stats *stats,
+                              lmb_ic_points *records, lmb_group_light *out, lmb_error *err)
+{
+    lmb_scene *s = env->scene;
+    memset(out, 0, sizeof *out);
+    lmb_status st = env->keep ? light_alloc(out, groups->count, env->cache->atlas_count, env->cfg->directional,
+                                            env->probes != NULL, err)
+                              : LMB_OK;
+    lmb_light_mode *saved = malloc(((size_t)s->light_count + 1) * sizeof *saved);
+    if (st == LMB_OK && !saved)
+        st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    for (uint32_t g = 0; g < groups->count && st == LMB_OK; g++) {
+        lmb_bake_stats other;
+        memset(&other, 0, sizeof other);
+        lmb_bake_stats *gs = g ? &other : stats;
+        int dark = 0;
+        only_group(s, groups, g, saved);
+        st = light_group(env, groups, g, gs, records, &dark, err);
+        restore_modes(s, saved);
+        if (g)
+            stats->rays += other.rays;
+        if (st == LMB_OK && env->keep)
+            st = keep_group(env, g, dark, out, err);
+    }
+    free(saved);
+    if (st != LMB_OK)
+        lmb_group_light_free(out);
+    return st;
+}
+
+void lmb_group_swap(lmb_group_light *gl, uint32_t g, lmb_cache *cache)
+{
+    for (uint32_t a = 0; a < cache->atlas_count; a++) {
+        float **k = &gl->irradiance[(size_t)g * gl->atlases + a], *t = *k;
+        *k = cache->irradiance[a];
+        cache->irradiance[a] = t;
+    }
+}
+
+lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_light *gl, lmb_cache *cache,
+                             lmb_probe_set *probes, lmb_error *err)
+{
+    uint32_t G = gl->groups;
+    if (gl->direction && !cache->direction)
+        cache->direction = calloc((size_t)cache->atlas_count + 1, sizeof *cache->direction);
+    if (gl->direction && !cache->direction)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    for (uint32_t a = 0; a < cache->atlas_count; a++) {
+        size_t n = (size_t)cache->layout->width[a] * cache->layout->height[a];
+        float *e = malloc((3 * n + 1) * sizeof *e), *d = gl->direction ? malloc((3 * n + 1) * sizeof *d) : NULL;
+        if (!e || (gl->direction && !d)) {
+            free(e);
+            free(d);
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
+        }
+        for (size_t i = 0; i < n; i++) {
+            double sum[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+            for (uint32_t g = 0; g < G; g++) {
+                const float *eg = gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i;
+                for (int c = 0; c < 3; c++)
+                    sum[c] += groups->scale[g] * (double)eg[c];
+                if (d) {
+                    const float *dg = gl->direction[(size_t)g * gl->atlases + a] + 3 * i;
+                    double w = groups->scale[g] * (0.2126 * eg[0] + 0.7152 * eg[1] + 0.0722 * eg[2]);
+                    for (int c = 0; c < 3; c++)
+                        v[c] += w * (double)dg[c];
+                }
+            }
+            for (int c = 0; c < 3; c++)
+                e[3 * i + c] = (float)sum[c];
+            if (d) {
+                double lum = 0.2126 * sum[0] + 0.7152 * sum[1] + 0.0722 * sum[2], len = 0;
+                for (int c = 0; c < 3; c++) {
+                    v[c] = lum > 0 ? v[c] / lum : 0;
+                    len += v[c] * v[c];
+                }
+                len = sqrt(len);
+                for (int c = 0; c < 3; c++)
+                    d[3 * i + c] = (float)(len > 1 ? v[c] / len : v[c]);
+            }
+        }
+        free(cache->irradiance[a]);
+        cache->irradiance[a] = e;
+        if (d) {
+            free(cache->direction[a]);
+            cache->direction[a] = d;
+        }
+    }
+    for (uint32_t p = 0; gl->sh && probes && p < probes->count; p++) {
+        for (int k = 0; k < LMB_PROBE_SH; k++) {
+            double v = 0;
+            for (uint32_t g = 0; g < G; g++)
+                v += groups->scale[g] * (double)gl->sh[g][(size_t)p * LMB_PROBE_SH + k];
+            probes->sh[(size_t)p * LMB_PROBE_SH + k] = (float)v;
+        }
+        for (int k = 0; k < LMB_PROBE_CUBE; k++) {
+            double v = 0;
+            for (uint32_t g = 0; g < G; g++)
+                v += groups->scale[g] * (double)gl->cube[g][(size_t)p * LMB_PROBE_CUBE + k];
+            probes->cube[(size_t)p * LMB_PROBE_CUBE + k] = (float)v;
+        }
+    }
+    return LMB_OK;
+}

@@ -1,0 +1,230 @@
+#!/usr/bin/env python3
+"""Light groups (docs/light-groups.md): a lightmap per group, the bake's lightmap their sum.
+
+usage: check_light_groups.py LMBAKE WORKDIR [short]   (short, the sanitizer pass: scales (0.3, 2)
+       only, no plain bakes, no --threads 1: the same code, a third of the bakes)
+
+The level: sun-box.gltf (tools/make_scenes.py: a 10 x 10 ground, a closed 1 m cube on it, a sun of
+1000 lux) with two coloured point lamps added (lamp_a 200 cd, lamp_b 100 cd), baked at 6 texels
+per unit with output.light_groups {sun: match sun} and {lamps: match lamp_*}.
+  - engine sum: a game's sum of the two groups' files (32-bit float EXR) of the bake at scales
+    (1, 1), at weights (1, 0), (0, 1) and (0.3, 2), equals the lightmap of a bake whose groups
+    have those scales, within 1e-6 relative at every texel above 1e-6 of the brightest;
+  - the groups' files are the same bytes whatever the scales (no group reads a scale), and the
+    same at 1 and 3 threads and from a farm of 2 shards (every output file byte for byte);
+  - the sum at (1, 1) is the level's light: against a bake without groups, the mean within 1% and
+    the per-texel rms difference within 1.5x that between two seeds of the plain bake (+0.2%);
+  - the glTF names each group's name, scale and files on every lightmap texture and node;
+  - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
+  - bad input exits 2 with nothing written: a group that holds no light (its config line named),
+    a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string.
+"""
+import filecmp
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import OpenImageIO as oiio
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+fails = []
+
+
+def check(ok, what):
+    print("%s %s" % ("ok  " if ok else "FAIL", what))
+    if not ok:
+        fails.append(what)
+
+
+def read_exr(path):
+    i = oiio.ImageInput.open(path)
+    if not i:
+        raise RuntimeError("cannot open %s" % path)
+    a = i.read_image(format="float")
+    i.close()
+    return np.asarray(a, dtype=np.float64)
+
+
+def bake(lmbake, work, scene, name, config, *args):
+    cfg = os.path.join(work, name + ".yaml")
+    with open(cfg, "w") as f:
+        f.write(config)
+    out = os.path.join(work, name)
+    shutil.rmtree(out, ignore_errors=True)
+    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "-q"] + list(args), capture_output=True, text=True)
+    return out, p
+
+
+def make_level(work):
+    scenes = os.path.join(work, "scenes")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
+                   stdout=subprocess.DEVNULL)
+    with open(os.path.join(scenes, "sun-box.gltf")) as f:
+        d = json.load(f)
+    lights = d["extensions"]["KHR_lights_punctual"]["lights"]
+    lights.append({"name": "lamp_a", "type": "point", "intensity": 200.0, "color": [1.0, 0.8, 0.6]})
+    lights.append({"name": "lamp_b", "type": "point", "intensity": 100.0, "color": [0.6, 0.8, 1.0]})
+    d["nodes"].append({"name": "lamp_a", "translation": [2.5, 1.5, 2.0], "extensions": {"KHR_lights_punctual": {"light": 1}}})
+    d["nodes"].append({"name": "lamp_b", "translation": [-2.5, 0.7, -1.5], "extensions": {"KHR_lights_punctual": {"light": 2}}})
+    d["scenes"][0]["nodes"] += [len(d["nodes"]) - 2, len(d["nodes"]) - 1]
+    level = os.path.join(scenes, "sun-lamps.gltf")
+    with open(level, "w") as f:
+        json.dump(d, f)
+    return scenes, level, d
+
+
+BASE = "texel_density: 6\n"
+
+
+def groups_config(sun, lamps):
+    return BASE + "output:\n  light_groups:\n    - {name: sun, match: sun, scale: %r}\n" \
+                  "    - {name: lamps, match: \"lamp_*\", scale: %r}\n" % (sun, lamps)
+
+
+def group_files(out):
+    return sorted(f for f in os.listdir(out) if re.search(r"-lightmap-\d+-group-", f))
+
+
+def engine(lmbake, work, level, short):
+    ref, p = bake(lmbake, work, level, "scales-1-1", groups_config(1.0, 1.0))
+    check(p.returncode == 0, "bake with groups sun and lamps: exit %d %s" % (p.returncode, p.stderr[-400:]))
+    if p.returncode:
+        return
+    files = group_files(ref)
+    check(files == ["sun-lamps-lightmap-0-group-lamps.exr", "sun-lamps-lightmap-0-group-lamps.hdr",
+                    "sun-lamps-lightmap-0-group-sun.exr", "sun-lamps-lightmap-0-group-sun.hdr"],
+          "each group's lightmap written: %s" % files)
+    sun, lamps = (read_exr(os.path.join(ref, "sun-lamps-lightmap-0-group-%s.exr" % g)) for g in ("sun", "lamps"))
+    for ws in ((0.3, 2.0),) if short else ((1.0, 0.0), (0.0, 1.0), (0.3, 2.0)):
+        out, p = bake(lmbake, work, level, "scales-%g-%g" % ws, groups_config(*ws))
+        if p.returncode:
+            check(False, "bake at scales %s: exit %d %s" % (ws, p.returncode, p.stderr[-400:]))
+            continue
+        same = all(filecmp.cmp(os.path.join(ref, f), os.path.join(out, f), shallow=False) for f in files)
+        baked = read_exr(os.path.join(out, "sun-lamps-lightmap-0.exr"))
+        summed = np.float32(ws[0]) * sun.astype(np.float32) + np.float32(ws[1]) * lamps.astype(np.float32)
+        lit = baked > 1e-6 * max(baked.max(), 1e-30)
+        rel = np.abs(summed - baked)[lit] / baked[lit] if lit.any() else np.array([np.inf])
+        check(same and lit.sum() > 1000 and rel.max() <= 1e-6,
+              "scales %s: the engine's sum of the groups' EXRs = the bake's lightmap, worst %.2e relative over %d "
+              "channels (bound 1e-6); the groups' files %s" % (ws, rel.max(), lit.sum(),
+                                                              "the same bytes" if same else "DIFFER"))
+    if not short:
+        plain_against(lmbake, work, level, sun, lamps)
+    gltf_names(ref)
+    threads_and_farm(lmbake, work, level, ref, short)
+
+
+def plain_against(lmbake, work, level, sun, lamps):
+    """The sum at (1, 1) against a bake without groups, and that bake's own noise (two seeds)."""
+    plain, p1 = bake(lmbake, work, level, "plain", BASE)
+    plain2, p2 = bake(lmbake, work, level, "plain-seed2", BASE + "seed: 2\n")
+    if p1.returncode or p2.returncode:
+        check(False, "plain bakes: exit %d, %d" % (p1.returncode, p2.returncode))
+        return
+    a, b = read_exr(os.path.join(plain, "sun-lamps-lightmap-0.exr")), read_exr(os.path.join(plain2, "sun-lamps-lightmap-0.exr"))
+    s = sun + lamps
+    lit = a > 0.01 * a.max()
+    diff = np.sqrt(np.mean(((s - a)[lit] / a[lit]) ** 2))
+    noise = np.sqrt(np.mean(((b - a)[lit] / a[lit]) ** 2))
+    ratio = s[lit].mean() / a[lit].mean()
+    check(abs(ratio - 1) <= 0.01 and diff <= 1.5 * noise + 0.002,
+          "sun + lamps = the bake without groups: mean ratio %.4f, %.2f%% rms per texel (two seeds of the plain bake: "
+          "%.2f%% rms)" % (ratio, 100 * diff, 100 * noise))
+    lamp_share = lamps[lit].mean() / s[lit].mean()
+    check(0.001 < lamp_share < 0.5, "the lamps' group holds their light: %.2f%% of the level's" % (100 * lamp_share))
+
+
+def gltf_names(ref):
+    with open(os.path.join(ref, "sun-lamps.gltf")) as f:
+        doc = json.load(f)
+    named = [t["extras"]["lightmap"].get("groups") for t in doc["textures"]
+             if "lightmap" in t.get("extras", {}) and "files" in t["extras"]["lightmap"]]
+    want = [{"name": "sun", "scale": 1.0, "files": {"exr": "sun-lamps-lightmap-0-group-sun.exr",
+                                                    "hdr": "sun-lamps-lightmap-0-group-sun.hdr"}},
+            {"name": "lamps", "scale": 1.0, "files": {"exr": "sun-lamps-lightmap-0-group-lamps.exr",
+                                                      "hdr": "sun-lamps-lightmap-0-group-lamps.hdr"}}]
+    nodes = [n["extras"]["lightmap"].get("groups") for n in doc["nodes"]
+             if "atlas" in n.get("extras", {}).get("lightmap", {})]
+    check(named == [want] and nodes and all(g == want for g in nodes),
+          "extras.lightmap.groups on the lightmap texture and its %d nodes: %s" % (len(nodes), json.dumps(named)[:300]))
+
+
+def threads_and_farm(lmbake, work, level, ref, short):
+    t3, p = bake(lmbake, work, level, "threads-3", groups_config(1.0, 1.0), "--threads", "3")
+    t1, p1 = bake(lmbake, work, level, "threads-1", groups_config(1.0, 1.0), "--threads", "1") if not short else (None, None)
+    farm_out = os.path.join(work, "farm-out")
+    shutil.rmtree(farm_out, ignore_errors=True)
+    shutil.rmtree(os.path.join(work, "farm"), ignore_errors=True)
+    pf = subprocess.run([lmbake, "farm", "parallel", level, "-c", os.path.join(work, "scales-1-1.yaml"), "--farm",
+                         os.path.join(work, "farm"), "-o", farm_out, "--shards", "2", "--threads", "1", "-q"],
+                        capture_output=True, text=True)
+    runs = [("--threads 3", t3, p.returncode), ("farm parallel, 2 shards", farm_out, pf.returncode)]
+    if not short:
+        runs.append(("--threads 1", t1, p1.returncode))
+    for name, out, rc in runs:
+        listed = sorted(os.listdir(ref))
+        differ = [f for f in listed if rc == 0 and (not os.path.exists(os.path.join(out, f)) or
+                                                   not filecmp.cmp(os.path.join(ref, f), os.path.join(out, f), shallow=False))]
+        check(rc == 0 and not differ and sorted(os.listdir(out)) == listed,
+              "%s: every one of %d files the same bytes%s" % (name, len(listed), " (differ: %s)" % differ if differ else ""))
+
+
+def extras_group(lmbake, work, level, doc):
+    d = json.loads(json.dumps(doc))
+    d["extensions"]["KHR_lights_punctual"]["lights"][1]["extras"] = {"lightmap_group": "torch"}
+    path = os.path.join(os.path.dirname(level), "extras-group.gltf")
+    with open(path, "w") as f:
+        json.dump(d, f)
+    out, p = bake(lmbake, work, path, "extras-group", BASE)
+    files = group_files(out) if p.returncode == 0 else []
+    check(p.returncode == 0 and
+          files == ["extras-group-lightmap-0-group-rest.exr", "extras-group-lightmap-0-group-rest.hdr",
+                    "extras-group-lightmap-0-group-torch.exr", "extras-group-lightmap-0-group-torch.hdr"],
+          "a light's extras.lightmap_group 'torch' and no config: groups torch and rest (%s)" % files)
+    d["extensions"]["KHR_lights_punctual"]["lights"][1]["extras"] = {"lightmap_group": 3}
+    path = os.path.join(os.path.dirname(level), "extras-bad.gltf")
+    with open(path, "w") as f:
+        json.dump(d, f)
+    out, p = bake(lmbake, work, path, "extras-bad", BASE)
+    check(p.returncode == 2 and "extras-bad.gltf: light 'lamp_a'" in p.stderr and
+          "extras.lightmap_group is not a string" in p.stderr and not os.path.exists(out),
+          "extras.lightmap_group 3: exit %d, %s" % (p.returncode, p.stderr.strip()[-200:]))
+
+
+def errors(lmbake, work, level):
+    cases = [
+        ("unused", BASE + "output:\n  light_groups:\n    - {name: sun, match: sun}\n    - {name: torches, match: \"torch*\"}\n",
+         "unused.yaml:5: output.light_groups 'torches' holds no light: no light's name or node name matches 'torch*'"),
+        ("bad-name", BASE + "output:\n  light_groups:\n    - {name: \"a b\", match: sun}\n",
+         "bad-name.yaml:4: key 'output.light_groups': name 'a b': letters, digits, '_' and '-' only"),
+        ("too-many", BASE + "output:\n  light_groups:\n" + "".join("    - {name: g%d, match: sun}\n" % i for i in range(9)),
+         "too-many.yaml:12: key 'output.light_groups': expected at most 8 entries, got 9"),
+        ("twice", BASE + "output:\n  light_groups:\n    - {name: a, match: sun}\n    - {name: a, match: lamp_a}\n",
+         "twice.yaml:5: key 'output.light_groups': name 'a' is given twice (lines 4 and 5)"),
+    ]
+    for name, config, want in cases:
+        out, p = bake(lmbake, work, level, name, config)
+        check(p.returncode == 2 and want in p.stderr and not os.path.exists(out),
+              "%s: exit %d, nothing written, %r" % (name, p.returncode, p.stderr.strip()[-220:]))
+
+
+def main():
+    lmbake, work = sys.argv[1:3]
+    short = len(sys.argv) > 3 and sys.argv[3] == "short"
+    os.makedirs(work, exist_ok=True)
+    scenes, level, doc = make_level(work)
+    engine(lmbake, work, level, short)
+    extras_group(lmbake, work, level, doc)
+    errors(lmbake, work, level)
+    print("%d failed" % len(fails))
+    return 1 if fails else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
