@@ -9,6 +9,8 @@ usage: make_scenes.py OUTDIR
                       point light 5 cm under the ceiling: the defaults' accuracy scene
   point-plane.gltf    10 x 10 plane, point light of I = 100 cd at h = 2 above (0, 0)
   sun-box.gltf        10 x 10 plane, closed 1 m cube on it, directional light of 1000 lux
+  sun-lamps.gltf      sun-box.gltf with two point lamps: lamp_a 200 cd (1, 0.8, 0.6) at (2.5, 1.5, 2),
+                      lamp_b 100 cd (0.6, 0.8, 1) at (-2.5, 0.7, -1.5)
   disk.gltf           plane, emissive disk (64 segments, R = 0.5, L = 10 nits) facing down at h = 1
   sky-plane.gltf      10 x 10 plane and no light: lit by the config's sky (sky.* keys)
   sky-well.gltf       a disk (R = 0.5) at the bottom of a black open cylinder 1 deep: lit by
@@ -156,6 +158,10 @@ def analytic(out):
     q = [axis[0] / ln * math.sin(th / 2), axis[1] / ln * math.sin(th / 2), 0.0, math.cos(th / 2)]
     s.light("sun", "directional", 1000.0, rotation=q)
     s.write(os.path.join(out, "sun-box.gltf"))
+    # the same with two coloured point lamps (light groups: a sun and the lamps)
+    s.light("lamp_a", "point", 200.0, color=(1.0, 0.8, 0.6), translation=(2.5, 1.5, 2.0))
+    s.light("lamp_b", "point", 100.0, color=(0.6, 0.8, 1.0), translation=(-2.5, 0.7, -1.5))
+    s.write(os.path.join(out, "sun-lamps.gltf"))
 
     s = Scene()
     s.mesh("plane", plane(6), s.material("grey", (0.5, 0.5, 0.5)))

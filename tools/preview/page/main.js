@@ -1,6 +1,7 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
 // the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
-// (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, ui, directional=0 to shade without
+// (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, groups=w1,w2,...: light groups'
+// weights (groups.js), ui, directional=0 to shade without
 // directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr, sphere=x,y,z: the probe-lit
 // sphere there, probes=1: the probes as markers) and the page exposes hooks for tests: window.lmbReady, lmbInfo,
 // lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView, lmbSet, lmbCamera;
@@ -15,6 +16,7 @@ import { Fly } from './fly.js';
 import { startView, frontViewPose } from './start-view.js';
 import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
 import { loadProbes, ProbesView, shIrradiance, SPHERE_ALBEDO, probeLitCopies, probeLitMaterial } from './probes-view.js';
+import { loadLightGroups, patchLightGroups } from './groups.js';
 
 const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
 // "none" is three's LinearToneMapping: clamp(colour x 2^EV) (three applies no exposure at all
@@ -32,6 +34,7 @@ const state = {
   lightmap: q.get('lightmap') || 'ktx2', // the lightmap files read: ktx2 (when the glTF names them, else .hdr) or hdr
   sphere: q.get('sphere') ? q.get('sphere').split(',').map(Number) : null, // the probe-lit sphere's centre
   probes: q.get('probes') === '1', // the probes as markers
+  groups: q.get('groups') ? q.get('groups').split(',').map(Number) : null, // light groups' weights (null: the bake's scales)
 };
 const info = (window.lmbInfo = { error: null });
 window.lmbReady = false;
@@ -109,6 +112,18 @@ function rectOf(e, k) {
   return [sx * S, sy * T, ox * S + O, oy * T + P];
 }
 
+// Light groups (groups.js): each group's lightmap, and weights the lit and lightmap views sum them at
+const groups = await loadLightGroups(gltf.parser.json, sceneInfo.gltf, atlases);
+const groupWeights = (w) => {
+  if (!groups) { if (w) throw new Error('this bake has no light groups (output.light_groups)'); return; }
+  const v = w || groups.scales;
+  if (v.length !== groups.names.length || v.some((x) => !Number.isFinite(x) || x < 0)) throw new Error(`groups wants ${groups.names.length} weights >= 0 (${groups.names.join(', ')})`);
+  v.forEach((x, g) => { groups.weights[g].value = x; });
+};
+groupWeights(state.groups);
+const groupPatched = new Set();
+const withGroups = (m, atlas) => { if (groups && !groupPatched.has(m)) { groupPatched.add(m); patchLightGroups(m, groups, atlas); } return m; };
+
 // Each mesh and its materials per mode
 const GREY = new THREE.MeshBasicMaterial({ color: 0x404040, toneMapped: false });
 const entries = [];
@@ -125,8 +140,9 @@ root.traverse((o) => {
   const inst = e.instances ? 'inst' : '';
   if (lm) e.lightmap = cached(`lm:${lm.uuid}:${lit.lightMapIntensity}:${lit.side}:${inst}`, () => {
     const m = Object.assign(lightmapMaterial(lm, lit.lightMapIntensity), { side: lit.side });
-    return e.instances ? patchInstanceRectangles(m) : m;
+    return withGroups(e.instances ? patchInstanceRectangles(m) : m, e.atlas);
   });
+  if (lm) withGroups(lit, e.atlas);
   if (e.atlas >= 0 && o.geometry.attributes.uv1) {
     const a = atlases[e.atlas], so = e.scaleOffset, instanced = !!e.instances;
     e.invalid = cached(`inv:${e.atlas}:${so}:${lit.lightMapIntensity}:${lit.side}:${inst}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity, { scaleOffset: so, instanced }), { side: lit.side }));
@@ -233,6 +249,7 @@ const isInstancePatched = (m) => m.customProgramCacheKey().includes('lmbake-inst
 function updateInfo() {
   Object.assign(info, {
     gltf: sceneInfo.name, mode: state.mode, ev: state.ev, evAuto, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
+    groups: groups ? { names: groups.names, scales: groups.scales, weights: groups.weights.map((w) => w.value) } : null,
     camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
     bounds: { min: box.min.toArray(), max: box.max.toArray() },
     canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
@@ -273,13 +290,23 @@ $('hover').classList.toggle('hidden', !state.ui);
 $('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-6: views' +
   (probesView ? ', P: probe-lit sphere (I/K J/L U/O move it), G: probes' : '');
 $('atlas').innerHTML = atlases.filter(Boolean).map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
+// one slider per light group (groups.js): its weight in the lit and lightmap views
+if (groups) {
+  $('groups').innerHTML = groups.names.map((n, g) => `<label>${n} <input id="group${g}" type="range" min="0" max="${Math.max(4, 2 * groups.scales[g])}" step="0.05"> <span id="groupText${g}"></span></label>`).join('');
+  groups.names.forEach((_, g) => $(`group${g}`).addEventListener('input', (e) => { groups.weights[g].value = Number(e.target.value); sync(); updateInfo(); requestRender(); }));
+}
 const sync = () => {
+  for (let g = 0; groups && g < groups.names.length; g++) {
+    $(`group${g}`).value = groups.weights[g].value;
+    $(`groupText${g}`).textContent = `x ${groups.weights[g].value.toFixed(2)}`;
+  }
   $('mode').value = state.mode; $('ev').value = state.ev; $('evText').textContent = state.ev.toFixed(1);
   $('tonemap').value = state.tonemap; $('atlas').value = state.atlas; $('layer').value = state.layer;
   $('atlasControls').classList.toggle('hidden', state.mode !== 'atlas');
   $('fly').checked = fly.enabled;
   const u = new URL(location.href);
   for (const k of ['mode', 'ev', 'tonemap', 'atlas', 'layer']) u.searchParams.set(k, state[k]);
+  if (groups) u.searchParams.set('groups', groups.weights.map((w) => w.value).join(','));
   history.replaceState(null, '', u);
 };
 const onInput = (id, f) => $(id).addEventListener('input', (e) => { f(e.target.value); sync(); apply(); });
@@ -407,12 +434,13 @@ window.lmbSetView = (cam, ev) => {
   if (ev !== undefined) state.ev = ev;
   apply();
 };
-// The view parameters of the URL (mode, ev, tonemap, view|cam, atlas, layer, zoom, at) without a
+// The view parameters of the URL (mode, ev, tonemap, view|cam, atlas, layer, zoom, at, groups) without a
 // reload, each missing one at its default as in a fresh page; those read at load only (lightmap,
 // directional, sphere, probes, ui) cannot change. A test's shots of one bake share a page this way
 // (a page takes ~2 s to open in SwiftShader, a switch ~0.3 s). Returns lmbInfo after the frame.
 window.lmbSet = (p) => {
-  for (const k of Object.keys(p)) if (!['mode', 'ev', 'tonemap', 'view', 'cam', 'atlas', 'layer', 'zoom', 'at'].includes(k)) throw new Error(`lmbSet: '${k}' is read at load only`);
+  for (const k of Object.keys(p)) if (!['mode', 'ev', 'tonemap', 'view', 'cam', 'atlas', 'layer', 'zoom', 'at', 'groups'].includes(k)) throw new Error(`lmbSet: '${k}' is read at load only`);
+  groupWeights(p.groups !== undefined ? String(p.groups).split(',').map(Number) : null);
   const mode = p.mode ?? 'lit', tonemap = p.tonemap ?? 'agx', layer = p.layer ?? 'lightmap', atlas = Number(p.atlas ?? 0);
   const ev = p.ev === undefined || p.ev === 'auto' ? 'auto' : Number(p.ev);
   if (!MODES.includes(mode)) throw new Error(`unknown mode '${mode}' (one of ${MODES.join(', ')})`);
