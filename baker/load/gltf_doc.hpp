@@ -40,6 +40,12 @@ struct lmb_gltf_doc {
     /* light probes to add at saving, after the pruning that renumbers accessors and views
        (lmb_gltf_set_probes) */
     std::vector<float> probe_positions, probe_sh, probe_cube;
+    struct probe_group {
+        std::string name;
+        double scale;
+        std::vector<float> sh, cube;
+    };
+    std::vector<probe_group> probe_groups; /* light groups: each group's own probes' light */
     std::vector<uint32_t> probe_tetrahedra; /* 4 per tetrahedron */
     double probe_spacing = 0;
     int probe_radiance = 0;

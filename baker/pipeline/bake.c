@@ -410,6 +410,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_copy_input_textures(s, &od, log);
         lmb_gltf_probes out_probes;
         st = lmb_probes_output(&probes, cfg, od.staging, od.stem, log, &out_probes, err);
+        for (uint32_t g = 0; st == LMB_OK && !dark && group_light.sh && g < groups.count; g++)
+            st = lmb_probes_output_group(&out_probes, cfg, g, groups.name[g], groups.scale[g], group_light.sh[g],
+                                         group_light.cube[g], err);
         if (st == LMB_OK)
             st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
                                             cache.shadowmask != NULL, &out_probes, dark ? NULL : &groups, err);

@@ -96,8 +96,37 @@ lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, co
     return write_volumes(set, scale, dir, stem, out, err);
 }
 
+lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, uint32_t g, const char *name,
+                                   double scale, const float *sh_lux, const float *cube_lux, lmb_error *err)
+{
+    if (!out->count || g >= LMB_MAX_LIGHT_GROUPS)
+        return LMB_OK;
+    size_t n = out->count;
+    double k = cfg->output_scale == LMB_SCALE_RADIANCE ? 1.0 / LMB_PI : 1.0;
+    float *sh = malloc(LMB_PROBE_SH * n * sizeof *sh), *cube = malloc(LMB_PROBE_CUBE * n * sizeof *cube);
+    if (!sh || !cube) {
+        free(sh);
+        free(cube);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for light group '%s'", name);
+    }
+    for (size_t i = 0; i < LMB_PROBE_SH * n; i++)
+        sh[i] = sh_lux ? (float)(sh_lux[i] * k) : 0.0f;
+    for (size_t i = 0; i < LMB_PROBE_CUBE * n; i++)
+        cube[i] = cube_lux ? (float)(cube_lux[i] * k) : 0.0f;
+    out->group_name[g] = name;
+    out->group_scale[g] = scale;
+    out->group_sh[g] = sh;
+    out->group_cube[g] = cube;
+    out->groups = g + 1;
+    return LMB_OK;
+}
+
 void lmb_probes_output_free(lmb_gltf_probes *out)
 {
+    for (uint32_t g = 0; g < out->groups; g++) {
+        free((void *)out->group_sh[g]);
+        free((void *)out->group_cube[g]);
+    }
     free((void *)out->positions);
     free((void *)out->sh);
     free((void *)out->cube);

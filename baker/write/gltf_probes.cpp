@@ -79,6 +79,22 @@ void lmb_gltf_add_probes(lmb_gltf_doc *doc)
     m.bufferViews[(size_t)cube].name = "lightmap probes ambient cube";
     probes["sh"] = Value(sh);
     probes["ambientCube"] = Value(cube);
+    if (!doc->probe_groups.empty()) { /* light groups: sh and ambientCube hold their sum at the scales */
+        Value::Array groups;
+        for (const auto &g : doc->probe_groups) {
+            Value::Object one;
+            int gsh = add_view(w, g.sh.data(), sizeof(float) * 27 * (size_t)count, 0);
+            int gcube = add_view(w, g.cube.data(), sizeof(float) * 18 * (size_t)count, 0);
+            m.bufferViews[(size_t)gsh].name = "lightmap probes SH L2, light group " + g.name;
+            m.bufferViews[(size_t)gcube].name = "lightmap probes ambient cube, light group " + g.name;
+            one["name"] = Value(g.name);
+            one["scale"] = Value(g.scale);
+            one["sh"] = Value(gsh);
+            one["ambientCube"] = Value(gcube);
+            groups.push_back(Value(one));
+        }
+        probes["groups"] = Value(groups);
+    }
     if (!doc->probe_tetrahedra.empty()) {
         tinygltf::Accessor a;
         a.bufferView = add_view(w, doc->probe_tetrahedra.data(), sizeof(uint32_t) * doc->probe_tetrahedra.size(), 0);
@@ -122,6 +138,11 @@ extern "C" lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_prob
         doc->probe_positions.assign(p->positions, p->positions + 3 * (size_t)p->count);
         doc->probe_sh.assign(p->sh, p->sh + 27 * (size_t)p->count);
         doc->probe_cube.assign(p->cube, p->cube + 18 * (size_t)p->count);
+        doc->probe_groups.clear();
+        for (uint32_t g = 0; g < p->groups; g++)
+            doc->probe_groups.push_back({p->group_name[g], p->group_scale[g],
+                                         std::vector<float>(p->group_sh[g], p->group_sh[g] + 27 * (size_t)p->count),
+                                         std::vector<float>(p->group_cube[g], p->group_cube[g] + 18 * (size_t)p->count)});
         doc->probe_tetrahedra.assign(p->tetrahedra, p->tetrahedra + 4 * (size_t)p->tetrahedron_count);
         doc->probe_spacing = p->spacing;
         doc->probe_radiance = p->radiance;

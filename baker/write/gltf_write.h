@@ -112,6 +112,10 @@ typedef struct lmb_gltf_probes {
     int radiance;           /* output.scale radiance */
     uint32_t volume_count;  /* the grids as bevy's irradiance volumes (KTX2) */
     const struct lmb_gltf_volume *volumes;
+    uint32_t groups;        /* light groups: each group's own SH and ambient cubes (sh and cube: their sum) */
+    const char *group_name[LMB_MAX_LIGHT_GROUPS];
+    double group_scale[LMB_MAX_LIGHT_GROUPS];
+    const float *group_sh[LMB_MAX_LIGHT_GROUPS], *group_cube[LMB_MAX_LIGHT_GROUPS];
 } lmb_gltf_probes;
 
 typedef struct lmb_gltf_volume {
@@ -127,7 +131,7 @@ typedef struct lmb_gltf_volume {
 /* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes
  * as buffer views of float32, the tetrahedra as a SCALAR uint32 accessor) and names them in
  * asset.extras.lightmap.probes {count, positions, sh, ambientCube, tetrahedra, shBasis, scale,
- * unit, spacing} (docs/probes.md); the asset's other extras
+ * unit, spacing, groups [{name, scale, sh, ambientCube}] (light groups)} (docs/probes.md); the asset's other extras
  * are kept. Per volume a node "lightmap irradiance volume" (or "... K" for probes.volumes entry
  * K) in the default scene whose transform takes a unit cube centred on the origin to the
  * volume's box (bevy's IrradianceVolume), with extras.lightmap.irradianceVolume {uri,

@@ -9,6 +9,8 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - engine sum: a game's sum of the two groups' files (32-bit float EXR) of the bake at scales
     (1, 1), at weights (1, 0), (0, 1) and (0.3, 2), equals the lightmap of a bake whose groups
     have those scales, within 1e-6 relative at every texel above 1e-6 of the brightest;
+  - the light probes likewise: their SH and ambient cubes = sum_g w_g x each group's own (named in
+    asset.extras.lightmap.probes.groups), within 1e-6 relative;
   - the groups' files are the same bytes whatever the scales (no group reads a scale), and the
     same at 1 and 3 threads and from a farm of 2 shards (every output file byte for byte);
   - the sum at (1, 1) is the level's light: against a bake without groups, the mean within 1% and
@@ -23,6 +25,7 @@ import json
 import os
 import re
 import shutil
+import struct
 import subprocess
 import sys
 
@@ -47,6 +50,26 @@ def read_exr(path):
     a = i.read_image(format="float")
     i.close()
     return np.asarray(a, dtype=np.float64)
+
+
+def probe_floats(gltf, view):
+    """A buffer view of float32 (the probes' SH or ambient cubes) as a numpy array."""
+    with open(gltf) as f:
+        doc = json.load(f)
+    v = doc["bufferViews"][view]
+    with open(os.path.join(os.path.dirname(gltf), doc["buffers"][v["buffer"]]["uri"]), "rb") as f:
+        f.seek(v.get("byteOffset", 0))
+        data = f.read(v["byteLength"])
+    return np.array(struct.unpack("<%df" % (len(data) // 4), data), dtype=np.float64)
+
+
+def probes_of(gltf):
+    """asset.extras.lightmap.probes: (sum's sh, sum's cube, {group: (scale, sh, cube)})."""
+    with open(gltf) as f:
+        p = json.load(f)["asset"]["extras"]["lightmap"]["probes"]
+    groups = {g["name"]: (g["scale"], probe_floats(gltf, g["sh"]), probe_floats(gltf, g["ambientCube"]))
+              for g in p.get("groups", [])}
+    return probe_floats(gltf, p["sh"]), probe_floats(gltf, p["ambientCube"]), groups
 
 
 def bake(lmbake, work, scene, name, config, *args):
@@ -104,6 +127,19 @@ def engine(lmbake, work, level, short):
               "scales %s: the engine's sum of the groups' EXRs = the bake's lightmap, worst %.2e relative over %d "
               "channels (bound 1e-6); the groups' files %s" % (ws, rel.max(), lit.sum(),
                                                               "the same bytes" if same else "DIFFER"))
+        # the probes likewise: the sum's SH and ambient cubes = sum_g w_g x the groups' (of the (1, 1) bake)
+        sh, cube, pg = probes_of(os.path.join(out, "sun-lamps.gltf"))
+        sh1, cube1, pg1 = probes_of(os.path.join(ref, "sun-lamps.gltf"))
+        worst, same_groups = 0.0, sorted(pg) == ["lamps", "sun"] and sorted(pg1) == ["lamps", "sun"]
+        for total, k in ((sh, 1), (cube, 2)):
+            summed = ws[0] * pg1["sun"][k] + ws[1] * pg1["lamps"][k] if same_groups else total * 0
+            big = np.abs(total) > 1e-6 * np.abs(total).max()
+            worst = max(worst, (np.abs(summed - total)[big] / np.abs(total)[big]).max())
+            same_groups = same_groups and all(np.array_equal(pg[g][k], pg1[g][k]) for g in pg1)
+        check(same_groups and worst <= 1e-6 and [pg[g][0] for g in ("sun", "lamps")] == list(ws),
+              "scales %s: the probes' SH and ambient cubes = sum_g w_g x the groups' (asset.extras.lightmap.probes."
+              "groups), worst %.2e relative (bound 1e-6); the groups' probes the same at every scale: %s"
+              % (ws, worst, same_groups))
     if not short:
         plain_against(lmbake, work, level, sun, lamps)
     gltf_names(ref)
