@@ -1,11 +1,12 @@
 #!/usr/bin/env node
-// The preview's light-group sliders (tools/preview/page/groups.js; docs/light-groups.md) in
+// The preview's light-group sliders (lmbake-three's loaders/three/lmbake-groups.js; docs/light-groups.md) in
 // headless Chromium, on a bake with two groups (sun-lamps.gltf: the sun, and two lamps): the page
 // finds the groups with the bake's scales as its weights; at weights (1, 0), (0, 1) and (0.3, 2)
 // (lmbSet, what the sliders set) the lightmap view's pixel is sRGB(sum_g w_g E_g / pi x 2^EV), E_g
 // read bilinearly from each group's .hdr at the uv1 the pixel sees, within 2 levels, at a grid of
 // pixels away from edges; and the sum moves with the weights (each set's pixels differ from the
-// others' where the groups differ).
+// others' where the groups differ); in the lit view (the glTF's materials, patched by lmbake-three's
+// lightGroups as a game's are) all weights at 0 leave the lightmapped pixels black.
 //   usage: node tests/preview/preview_groups.mjs BAKE_OUT_GLTF SHOTS_DIR
 import fs from 'node:fs';
 import path from 'node:path';
@@ -76,6 +77,14 @@ try {
   const differ = (a, b) => { let k = 0; for (const p of picks) if (Math.max(...a.at(p.px, p.py).map((x, c) => Math.abs(x - b.at(p.px, p.py)[c]))) > 8) k++; return k; };
   check(differ(shots[0], shots[1]) > 50 && differ(shots[1], shots[2]) > 50,
     `the weights change the picture: (1,0) vs (0,1) at ${differ(shots[0], shots[1])} pixels, (0,1) vs (0.3,2) at ${differ(shots[1], shots[2])} (by > 8 levels)`);
+  // the lit view (the glTF's own materials, patched by lmbake-three's lightGroups as a game's are):
+  // all groups at 0 is black where the lightmap is the only light, the bake's scales are not
+  const lit = async (w) => decodePng(await (await showPreview(v0, { mode: 'lit', tonemap: 'none', cam: CAM, lightmap: 'hdr', ev, groups: w })).page.screenshot());
+  const off = await lit('0,0'), on = await lit(groups.map((x) => x.scale).join(','));
+  const lum = (png, p) => Math.max(...png.at(p.px, p.py));
+  const darkOff = picks.filter((p) => lum(off, p) <= 1).length, brightOn = picks.filter((p) => lum(on, p) > 8).length;
+  check(darkOff === picks.length && brightOn > 0.5 * picks.length,
+    `lit view: every group at 0 leaves ${darkOff} of ${picks.length} lightmapped pixels black; at the bake's scales ${brightOn} are lit`);
   const late = v0.errors.filter((e) => !e.startsWith('note'));
   check(!late.length, `no page errors${late.length ? ': ' + late.join('; ') : ''}`);
   await v0.context.close();

@@ -1,7 +1,7 @@
 // lmbake preview page: loads the bake's glTF with the lightmap plugin and shows it in one of
 // the view modes (lit, lightmap, checker, invalid, atlas, records). The URL query drives everything
 // (mode, ev, tonemap, view (start: the default, start-view.js; front)|cam, atlas, layer, zoom, at, groups=w1,w2,...: light groups'
-// weights (groups.js), ui, directional=0 to shade without
+// weights (lmbake-groups.js), ui, directional=0 to shade without
 // directional lightmaps, lightmap=ktx2 (the default: the KTX2 files the glTF names) or hdr, sphere=x,y,z: the probe-lit
 // sphere there, probes=1: the probes as markers) and the page exposes hooks for tests: window.lmbReady, lmbInfo,
 // lmbProject, lmbPick, lmbTexelToScreen, lmbAtlasData, lmbProbeSphere, lmbMoveProbeSphere, lmbSetView, lmbSet, lmbCamera;
@@ -16,7 +16,7 @@ import { Fly } from './fly.js';
 import { startView, frontViewPose } from './start-view.js';
 import { loadRecords, recordsBaseMaterial, RECORD_RAMP } from './records-view.js';
 import { loadProbes, ProbesView, shIrradiance, SPHERE_ALBEDO, probeLitCopies, probeLitMaterial } from './probes-view.js';
-import { loadLightGroups, patchLightGroups } from './groups.js';
+import { lightGroups, patchLightGroups } from '/loaders/three/lmbake-groups.js';
 
 const MODES = ['lit', 'lightmap', 'checker', 'invalid', 'atlas', 'records'];
 // "none" is three's LinearToneMapping: clamp(colour x 2^EV) (three applies no exposure at all
@@ -112,8 +112,10 @@ function rectOf(e, k) {
   return [sx * S, sy * T, ox * S + O, oy * T + P];
 }
 
-// Light groups (groups.js): each group's lightmap, and weights the lit and lightmap views sum them at
-const groups = await loadLightGroups(gltf.parser.json, sceneInfo.gltf, atlases);
+// Light groups (lmbake-three's lmbake-groups.js): each group's lightmap, and weights the lit and lightmap views sum them at
+// (lightGroups patches the glTF's own materials, the lit view's, as a game's; the lightmap view's
+// materials, made below, get the same patch)
+const groups = await lightGroups(gltf, sceneInfo.gltf, atlases);
 const groupWeights = (w) => {
   if (!groups) { if (w) throw new Error('this bake has no light groups (output.light_groups)'); return; }
   const v = w || groups.scales;
@@ -121,8 +123,7 @@ const groupWeights = (w) => {
   v.forEach((x, g) => { groups.weights[g].value = x; });
 };
 groupWeights(state.groups);
-const groupPatched = new Set();
-const withGroups = (m, atlas) => { if (groups && !groupPatched.has(m)) { groupPatched.add(m); patchLightGroups(m, groups, atlas); } return m; };
+const withGroups = (m, atlas) => (groups ? patchLightGroups(m, groups, atlas) : m);
 
 // Each mesh and its materials per mode
 const GREY = new THREE.MeshBasicMaterial({ color: 0x404040, toneMapped: false });
@@ -142,7 +143,6 @@ root.traverse((o) => {
     const m = Object.assign(lightmapMaterial(lm, lit.lightMapIntensity), { side: lit.side });
     return withGroups(e.instances ? patchInstanceRectangles(m) : m, e.atlas);
   });
-  if (lm) withGroups(lit, e.atlas);
   if (e.atlas >= 0 && o.geometry.attributes.uv1) {
     const a = atlases[e.atlas], so = e.scaleOffset, instanced = !!e.instances;
     e.invalid = cached(`inv:${e.atlas}:${so}:${lit.lightMapIntensity}:${lit.side}:${inst}`, () => Object.assign(invalidMaterial(a, lit.lightMapIntensity, { scaleOffset: so, instanced }), { side: lit.side }));
@@ -290,7 +290,7 @@ $('hover').classList.toggle('hidden', !state.ui);
 $('help').textContent = 'drag: orbit/look, wheel: zoom, F: fly (WASD, Q/E, Shift), R: front view, 1-6: views' +
   (probesView ? ', P: probe-lit sphere (I/K J/L U/O move it), G: probes' : '');
 $('atlas').innerHTML = atlases.filter(Boolean).map((a) => `<option value="${a.index}">${a.index}: ${a.uri} (${a.width}x${a.height})</option>`).join('');
-// one slider per light group (groups.js): its weight in the lit and lightmap views
+// one slider per light group (lmbake-groups.js): its weight in the lit and lightmap views
 if (groups) {
   $('groups').innerHTML = groups.names.map((n, g) => `<label>${n} <input id="group${g}" type="range" min="0" max="${Math.max(4, 2 * groups.scales[g])}" step="0.05"> <span id="groupText${g}"></span></label>`).join('');
   groups.names.forEach((_, g) => $(`group${g}`).addEventListener('input', (e) => { groups.weights[g].value = Number(e.target.value); sync(); updateInfo(); requestRender(); }));

@@ -1,11 +1,12 @@
-// Light groups in the preview (docs/light-groups.md): a bake with output.light_groups writes each
-// group's lightmap beside the level's, which is their sum at the groups' scales. Here each group's
-// .hdr is read per atlas and the lightmapped materials (lit and lightmap views) get a shader patch
-// that reads sum_g w_g x group_g where three's lightMap read the bake's sum; the page's sliders
-// (and lmbSet({groups})) set the w_g, starting at the bake's scales: the sum a game draws.
+// lmbake-three's light groups (docs/light-groups.md): a bake with output.light_groups writes each
+// group's lightmap beside the level's, which is their sum at the groups' scales. lightGroups()
+// reads each group's .hdr per atlas and patches the lightmapped materials so that where three's
+// lightMap read the bake's sum they read sum_g w_g x group_g, with one weight per group that the
+// game sets at run time (day and night, lamps on and off): setWeight(name, w). lmbake's preview
+// draws its sliders with the two steps below it (loadLightGroups, patchLightGroups).
 import * as THREE from 'three';
 import { HDRLoader } from 'three/addons/loaders/HDRLoader.js';
-import { addShaderPatch } from '/loaders/three/lmbake-three.js';
+import { addShaderPatch } from './lmbake-three.js';
 
 // A group's .hdr as the lightmap plugin makes its textures: half floats, bilinear, no mipmaps,
 // clamped, linear, not flipped (glTF UVs have v down, row 0 on top)
@@ -62,4 +63,28 @@ export function patchLightGroups(material, groups, atlas) {
     fs = fs.split('texture2D( lightMap, vLightMapUv )').join('lmbGroupsSample( vLightMapUv )');
     shader.fragmentShader = `${decl}\nvec4 lmbGroupsSample( vec2 uv ) { return vec4( ${sum}, 1.0 ); }\n${fs}`;
   });
+}
+
+// The groups of a bake loaded with lmbakeLightmaps({ atlases }) (gltfUrl: where it was loaded
+// from), every lightmapped material of gltf.scene patched; null when the bake has no groups.
+// weights start at the bake's scales; setWeight(group name or index, w) changes one at once.
+export async function lightGroups(gltf, gltfUrl, atlases) {
+  const groups = await loadLightGroups(gltf.parser.json, gltfUrl, atlases);
+  if (!groups) return null;
+  const done = new Set();
+  gltf.scene.traverse((o) => {
+    if (!o.isMesh) return;
+    for (const m of Array.isArray(o.material) ? o.material : [o.material]) {
+      const atlas = m && m.lightMap && m.lightMap.userData ? m.lightMap.userData.atlas : undefined;
+      if (atlas === undefined || done.has(m)) continue;
+      done.add(m);
+      patchLightGroups(m, groups, atlas);
+    }
+  });
+  groups.setWeight = (g, w) => {
+    const k = typeof g === 'number' ? g : groups.names.indexOf(g);
+    if (!(k >= 0 && k < groups.names.length)) throw new Error(`no light group ${g} (${groups.names.join(', ')})`);
+    groups.weights[k].value = w;
+  };
+  return groups;
 }
