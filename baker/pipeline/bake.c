@@ -16,6 +16,7 @@
 #include "watch/layout_cache.h"
 #include "watch/stages_out.h"
 #include "watch/validity_cache.h"
+#include "pipeline/group_cache.h"
 #include "pipeline/group_lighting.h"
 #include "pipeline/lighting.h"
 #include "pipeline/stage_options.h"
@@ -304,8 +305,10 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
     if (st == LMB_OK && groups.count && !dark) { /* each group's lighting and probes on its own */
         lmb_lighting_hooks group_hooks = {progress, user, NULL, NULL};
+        /* kept between bakes beside the layouts (a local bake with --layout-cache: the watch's) */
+        const char *kept = run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path ? run->layout_cache : NULL;
         lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, sky, &cache, steps, &group_hooks,
-                            validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard,
+                            validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard, kept,
                             shard ? NULL : log};
         st = lmb_group_lighting(&ge, &groups, stats, &records, &group_light, err);
     } else if (st == LMB_OK) {
@@ -346,11 +349,17 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     cfg = &tail_cfg;
     if (st == LMB_OK && !dark && !groups.count)
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
-    /* light groups: each group's lightmap through the post stage, then their sum at the scales */
+    /* light groups: each group's lightmap through the post stage (a group read back from the
+     * cache had it), kept for the next bake, then their sum at the scales */
     for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++) {
+        if (group_light.cached[g])
+            continue;
         lmb_group_swap(&group_light, g, &cache);
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
         lmb_group_swap(&group_light, g, &cache);
+        if (st == LMB_OK && run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path)
+            lmb_group_cache_write(run->layout_cache, group_light.key[g], g, &group_light, &cache, probes.count,
+                                  stats->texels, stats->valid_texels, log);
     }
     if (st == LMB_OK && !dark && groups.count)
         st = lmb_group_compose(&groups, &group_light, &cache, &probes, err);

@@ -1,6 +1,8 @@
 /* The lighting of each light group on its own, and their sum (see group_lighting.h). */
 #include "group_lighting.h"
 
+#include "pipeline/group_cache.h"
+
 #include "util/lmb_math.h"
 
 #include <math.h>
@@ -18,10 +20,15 @@ void lmb_group_light_free(lmb_group_light *gl)
         free(gl->sh[g]);
         free(gl->cube[g]);
     }
+    for (uint32_t g = 0; gl->records && g < gl->groups; g++)
+        free(gl->records[g].xyzr);
     free(gl->irradiance);
     free(gl->direction);
     free(gl->sh);
     free(gl->cube);
+    free(gl->records);
+    free(gl->key);
+    free(gl->cached);
     memset(gl, 0, sizeof *gl);
 }
 
@@ -36,7 +43,11 @@ static lmb_status light_alloc(lmb_group_light *gl, uint32_t groups, uint32_t atl
     gl->direction = directional ? calloc(n, sizeof *gl->direction) : NULL;
     gl->sh = probes ? calloc((size_t)groups + 1, sizeof *gl->sh) : NULL;
     gl->cube = probes ? calloc((size_t)groups + 1, sizeof *gl->cube) : NULL;
-    if (!gl->irradiance || (directional && !gl->direction) || (probes && (!gl->sh || !gl->cube))) {
+    gl->records = calloc((size_t)groups + 1, sizeof *gl->records);
+    gl->key = calloc((size_t)groups + 1, sizeof *gl->key);
+    gl->cached = calloc((size_t)groups + 1, 1);
+    if (!gl->irradiance || (directional && !gl->direction) || (probes && (!gl->sh || !gl->cube)) || !gl->records ||
+        !gl->key || !gl->cached) {
         lmb_group_light_free(gl);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
     }
@@ -45,7 +56,8 @@ static lmb_status light_alloc(lmb_group_light *gl, uint32_t groups, uint32_t atl
 
 /* Group g's light out of the cache and the probes into gl (the cache's images taken, not copied:
  * the next group's passes make new ones); a dark group's is 0. */
-static lmb_status keep_group(const lmb_group_env *env, uint32_t g, int dark, lmb_group_light *gl, lmb_error *err)
+static lmb_status keep_group(const lmb_group_env *env, uint32_t g, int dark, const lmb_ic_points *records,
+                             lmb_group_light *gl, lmb_error *err)
 {
     lmb_cache *c = env->cache;
     for (uint32_t a = 0; a < c->atlas_count; a++) {
@@ -64,6 +76,13 @@ static lmb_status keep_group(const lmb_group_env *env, uint32_t g, int dark, lmb
         }
         if (!gl->irradiance[k] || (gl->direction && !gl->direction[k]))
             return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
+    }
+    if (!dark && records->count) {
+        gl->records[g].xyzr = malloc(4 * (size_t)records->count * sizeof *records->xyzr + 1);
+        if (!gl->records[g].xyzr)
+            return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for records");
+        memcpy(gl->records[g].xyzr, records->xyzr, 4 * (size_t)records->count * sizeof *records->xyzr);
+        gl->records[g].count = records->count;
     }
     const lmb_probe_set *p = env->probes;
     if (gl->sh && p && p->count) {
@@ -138,20 +157,46 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
     lmb_light_mode *saved = malloc(((size_t)s->light_count + 1) * sizeof *saved);
     if (st == LMB_OK && !saved)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    uint32_t probes = env->probes ? env->probes->count : 0;
+    if (st == LMB_OK && env->keep && env->cache_dir)
+        st = lmb_group_cache_keys(s, env->cfg, groups, out->key, err);
     for (uint32_t g = 0; g < groups->count && st == LMB_OK; g++) {
         lmb_bake_stats other;
         memset(&other, 0, sizeof other);
         lmb_bake_stats *gs = g ? &other : stats;
         int dark = 0;
+        if (env->keep && env->cache_dir) { /* kept by an earlier bake with the same key: read back */
+            uint64_t texels = 0, valid = 0;
+            if (lmb_group_cache_read(env->cache_dir, out->key[g], g, out, env->cache, probes, &texels,
+                                                     &valid, env->log)) {
+                out->cached[g] = 1;
+                gs->texels = texels;
+                gs->valid_texels = valid;
+                lmb_info(env->log, "light group '%s' (%u of %u): read back from the cache (its lights, the level and "
+                         "the config but the groups' scales are an earlier bake's)", groups->name[g], g + 1,
+                         groups->count);
+                continue;
+            }
+        }
         only_group(s, groups, g, saved);
-        st = light_group(env, groups, g, gs, records, &dark, err);
+        if (st == LMB_OK)
+            st = light_group(env, groups, g, gs, records, &dark, err);
         restore_modes(s, saved);
         if (g)
             stats->rays += other.rays;
         if (st == LMB_OK && env->keep)
-            st = keep_group(env, g, dark, out, err);
+            st = keep_group(env, g, dark, records, out, err);
     }
     free(saved);
+    /* the records written: the last group's (lit or read back) */
+    if (st == LMB_OK && env->keep && groups->count) {
+        const lmb_ic_points *last = &out->records[groups->count - 1];
+        free(records->xyzr);
+        records->xyzr = last->count ? malloc(4 * (size_t)last->count * sizeof *records->xyzr + 1) : NULL;
+        records->count = records->xyzr ? last->count : 0;
+        if (records->xyzr)
+            memcpy(records->xyzr, last->xyzr, 4 * (size_t)last->count * sizeof *records->xyzr);
+    }
     if (st != LMB_OK)
         lmb_group_light_free(out);
     return st;

@@ -24,7 +24,10 @@ typedef struct lmb_group_light {
     uint32_t groups, atlases;
     float **irradiance;
     float **direction;
-    float **sh, **cube; /* [g]: the probe set's arrays for that group (NULL without probes) */
+    float **sh, **cube;     /* [g]: the probe set's arrays for that group (NULL without probes) */
+    lmb_ic_points *records; /* [g]: the group's final-gather records (owned) */
+    uint8_t (*key)[32];     /* [g]: its key in the cache between bakes (group_cache.h), when kept */
+    uint8_t *cached;        /* [g]: 1 when read back from that cache (its post stage done) */
 } lmb_group_light;
 
 /* What a group's lighting needs (the bake driver's, borrowed). */
@@ -41,11 +44,14 @@ typedef struct lmb_group_env {
     lmb_point_validity *validity;    /* the gather points' validity memo, or NULL */
     lmb_probe_set *probes;           /* placed, or NULL (no probes lit) */
     int keep;                        /* this process writes the output: each group's light is kept */
+    const char *cache_dir;           /* with keep: the groups' light kept between bakes here
+                                        (group_cache.h; the layout cache's folder), or NULL */
     const lmb_log *log;
 } lmb_group_env;
 
 /* Every group's lighting in turn (stats: the first group's figures, the rays of all; records: the
- * last group's final-gather records); with env->keep, each group's light into *out. */
+ * last group's final-gather records); with env->keep, each group's light into *out, and with
+ * env->cache_dir a group whose key is there read back instead of lit (out->cached). */
 lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *groups, lmb_bake_stats *stats,
                               lmb_ic_points *records, lmb_group_light *out, lmb_error *err);
 

@@ -16,6 +16,8 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - the sum at (1, 1) is the level's light: against a bake without groups, the mean within 1% and
     the per-texel rms difference within 1.5x that between two seeds of the plain bake (+0.2%);
   - the glTF names each group's name, scale and files on every lightmap texture and node;
+  - kept between bakes (--layout-cache, the watch's): a bake at new scales reads every group back and
+    writes the bytes of a bake without the cache; an edit of a light in the glTF lights them again;
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
     a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string.
@@ -73,12 +75,15 @@ def probes_of(gltf):
 
 
 def bake(lmbake, work, scene, name, config, *args):
+    """lmbake bake, quiet unless args say --log (then its log lines: no progress, every info line)."""
     cfg = os.path.join(work, name + ".yaml")
     with open(cfg, "w") as f:
         f.write(config)
     out = os.path.join(work, name)
     shutil.rmtree(out, ignore_errors=True)
-    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out, "-q"] + list(args), capture_output=True, text=True)
+    quiet = [] if "--log" in args else ["-q"]
+    args = [a for a in args if a != "--log"]
+    p = subprocess.run([lmbake, "bake", scene, "-c", cfg, "-o", out] + quiet + args, capture_output=True, text=True)
     return out, p
 
 
@@ -201,6 +206,35 @@ def threads_and_farm(lmbake, work, level, ref, short):
               "%s: every one of %d files the same bytes%s" % (name, len(listed), " (differ: %s)" % differ if differ else ""))
 
 
+def kept_between_bakes(lmbake, work, level, doc):
+    """--layout-cache (the watch's): a scale edit reads every group back, the files those of a bake
+    without the cache; an edit of the glTF lights them again."""
+    cache = os.path.join(work, "kept")
+    shutil.rmtree(cache, ignore_errors=True)
+    first, p1 = bake(lmbake, work, level, "kept-1-1", groups_config(1.0, 1.0), "--layout-cache", cache, "--log")
+    again, p2 = bake(lmbake, work, level, "kept-0.3-2", groups_config(0.3, 2.0), "--layout-cache", cache, "--log")
+    fresh = os.path.join(work, "scales-0.3-2")
+    listed = sorted(os.listdir(fresh)) if os.path.isdir(fresh) else []
+    differ = [f for f in listed if p2.returncode == 0 and (not os.path.exists(os.path.join(again, f)) or
+                                                          not filecmp.cmp(os.path.join(fresh, f), os.path.join(again, f),
+                                                                          shallow=False))]
+    log = p2.stdout + p2.stderr
+    read_back = log.count("read back from the cache")
+    check(p1.returncode == 0 and p2.returncode == 0 and read_back == 2 and "): lighting" not in log and listed
+          and not differ and sorted(os.listdir(again)) == listed,
+          "scales (1, 1) then (0.3, 2) with --layout-cache: %d of 2 groups read back, none lit; every one of %d files "
+          "the bytes of a bake without the cache%s" % (read_back, len(listed), " (differ: %s)" % differ if differ else ""))
+    d = json.loads(json.dumps(doc))
+    d["extensions"]["KHR_lights_punctual"]["lights"][1]["intensity"] = 150.0
+    edited = os.path.join(os.path.dirname(level), "sun-lamps-edited.gltf")
+    with open(edited, "w") as f:
+        json.dump(d, f)
+    out, p3 = bake(lmbake, work, edited, "kept-edited", groups_config(0.3, 2.0), "--layout-cache", cache, "--log")
+    log = p3.stdout + p3.stderr
+    check(p3.returncode == 0 and log.count("): lighting") == 2 and "read back from the cache" not in log,
+          "lamp_a 200 -> 150 cd in the glTF: both groups lit again (%d), none read back" % log.count("): lighting"))
+
+
 def extras_group(lmbake, work, level, doc):
     d = json.loads(json.dumps(doc))
     d["extensions"]["KHR_lights_punctual"]["lights"][1]["extras"] = {"lightmap_group": "torch"}
@@ -246,6 +280,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     scenes, level, doc = make_level(work)
     engine(lmbake, work, level, short)
+    kept_between_bakes(lmbake, work, level, doc)
     extras_group(lmbake, work, level, doc)
     errors(lmbake, work, level)
     print("%d failed" % len(fails))

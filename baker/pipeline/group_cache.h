@@ -1,0 +1,35 @@
+/*
+ * Light groups' light kept between bakes (docs/light-groups.md#kept-between-bakes): with
+ * `--layout-cache DIR` (what `lmbake preview --watch` passes), each light group's finished light
+ * (its dilated, post-processed images, directions, probes' light, irradiance-cache records and
+ * the texels' states) is written to DIR, under a key of everything that decides it: lmbake's
+ * version, the glTF file with every buffer and image it reads (lmb_part_identity_make), the sky
+ * image when the group holds the sky, the config's text with every group's scale set to 1 and
+ * threads to 0, and the group's place and name. A later bake whose group has the same key reads
+ * it back instead of lighting it: a change of the groups' scales relights at once, and the files
+ * are those a bake without the cache writes, byte for byte (the same composition runs on the
+ * same floats). A change of the glTF (a light moved or dimmed) or of any other config key lights
+ * every group again.
+ */
+#ifndef LMBAKE_GROUP_CACHE_H
+#define LMBAKE_GROUP_CACHE_H
+
+#include "pipeline/group_lighting.h"
+
+/* Every group's key into keys[g] (the level's files hashed once for all). */
+lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, const lmb_light_groups *groups,
+                                uint8_t (*keys)[32], lmb_error *err);
+
+/* Group g's light from DIR into gl (its images, directions, probes' light and records) and the
+ * cache's texel states, texels and valid_texels: 1 when the file was there and whole, 0 when not
+ * (a damaged one is said on the log). */
+int lmb_group_cache_read(const char *dir, const uint8_t key[32], uint32_t g, lmb_group_light *gl, lmb_cache *cache,
+                         uint32_t probes, uint64_t *texels, uint64_t *valid_texels, const lmb_log *log);
+
+/* Group g's light (gl, after the post stage) and the cache's texel states into DIR; a file that
+ * cannot be written is said on the log (the bake goes on). */
+void lmb_group_cache_write(const char *dir, const uint8_t key[32], uint32_t g, const lmb_group_light *gl,
+                           const lmb_cache *cache, uint32_t probes, uint64_t texels, uint64_t valid_texels,
+                           const lmb_log *log);
+
+#endif
