@@ -208,6 +208,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     memset(&groups, 0, sizeof groups);
     lmb_group_light group_light;
     memset(&group_light, 0, sizeof group_light);
+    /* the groups' light kept between bakes beside the layouts (a local bake with --layout-cache:
+     * the watch's), or NULL */
+    const char *groups_kept = run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path ? run->layout_cache : NULL;
     lmb_point_validity validity; /* with a layout cache: the gather points' validity kept between bakes */
     memset(&validity, 0, sizeof validity);
     uint64_t validity_read = 0;
@@ -305,11 +308,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
     if (st == LMB_OK && groups.count && !dark) { /* each group's lighting and probes on its own */
         lmb_lighting_hooks group_hooks = {progress, user, NULL, NULL};
-        /* kept between bakes beside the layouts (a local bake with --layout-cache: the watch's) */
-        const char *kept = run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path ? run->layout_cache : NULL;
         lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, sky, &cache, steps, &group_hooks,
-                            validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard, kept,
-                            shard ? NULL : log};
+                            validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard,
+                            groups_kept, shard ? NULL : log};
         st = lmb_group_lighting(&ge, &groups, stats, &records, &group_light, err);
     } else if (st == LMB_OK) {
         st = lmb_probes_light(&probes, cfg, direct, &cache, steps, dark, progress, user, shard ? NULL : log, err);
@@ -357,8 +358,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_group_swap(&group_light, g, &cache);
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
         lmb_group_swap(&group_light, g, &cache);
-        if (st == LMB_OK && run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path)
-            lmb_group_cache_write(run->layout_cache, group_light.key[g], g, &group_light, &cache, probes.count,
+        if (st == LMB_OK && groups_kept)
+            lmb_group_cache_write(groups_kept, group_light.key[g], g, &group_light, &cache, probes.count,
                                   stats->texels, stats->valid_texels, log);
     }
     if (st == LMB_OK && !dark && groups.count)
