@@ -7,10 +7,13 @@
 #include "util/file.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <nettle/sha2.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 static const char magic[8] = {'L', 'M', 'B', 'A', 'K', 'E', 1, '\n'};
@@ -254,46 +257,35 @@ static lmb_status refuse(const char *path, lmb_error *err, const char *what)
     return lmb_error_set(err, LMB_ERR_INPUT, "'%s': %s", path, what);
 }
 
-lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
-                         lmb_part_place *got, void **body, size_t *body_length, lmb_error *err)
+/* Checks a whole file's bytes (checksum, identity, place: lmb_part_read's order) and finds its
+ * body: *body_offset and *body_length into h. */
+static lmb_status check_part(const char *path, const uint8_t *h, size_t size, const lmb_part_identity *expect,
+                             const lmb_part_place *want, lmb_part_place *got, size_t *body_offset,
+                             size_t *body_length, lmb_error *err)
 {
-    *body = NULL;
-    *body_length = 0;
-    char *file;
-    size_t size;
-    lmb_status st = lmb_read_file(path, "part", &file, &size, err);
-    if (st != LMB_OK)
-        return st;
-    const uint8_t *h = (const uint8_t *)file;
     char why[600];
     if (size < HEADER_BYTES + 32 || memcmp(h, magic, 8)) {
         int ours = size >= 8 && !memcmp(h, magic, 8);
-        free(file);
         return refuse(path, err, ours ? "truncated (shorter than its header)" : "not an lmbake plan or part file");
     }
     uint32_t format = get_u32(h + 8);
     uint64_t config_length = get_u64(h + 8 + 20 + 32 + 96), length = get_u64(h + 8 + 20 + 32 + 96 + 8);
     if (format != LMB_PART_FORMAT) {
         snprintf(why, sizeof why, "file format %u; this lmbake reads format %u", format, LMB_PART_FORMAT);
-        free(file);
         return refuse(path, err, why);
     }
-    if (config_length > size || length > size || HEADER_BYTES + config_length + length + 32 != size) {
-        free(file);
+    if (config_length > size || length > size || HEADER_BYTES + config_length + length + 32 != size)
         return refuse(path, err, "truncated or padded: its length is not what its header says");
-    }
     uint8_t sum[32];
     struct sha256_ctx c;
     sha256_init(&c);
     sha256_update(&c, size - 32, h);
     sha256_digest(&c, 32, sum);
-    if (memcmp(sum, h + size - 32, 32)) {
-        free(file);
+    if (memcmp(sum, h + size - 32, 32))
         return refuse(path, err, "damaged: its SHA-256 does not match its contents");
-    }
     lmb_part_place place = {get_u32(h + 12), get_u32(h + 16), get_u32(h + 20), get_u32(h + 24)};
     const uint8_t *version = h + 28, *input = h + 60, *config = h + 92, *plan = h + 124;
-    const char *config_text = file + HEADER_BYTES;
+    const char *config_text = (const char *)h + HEADER_BYTES;
     char a[17], b[17];
     why[0] = '\0';
     if (strncmp((const char *)version, expect->version, 32))
@@ -319,13 +311,77 @@ lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, cons
     else if (want->shards && (place.shard != want->shard || place.shards != want->shards))
         snprintf(why, sizeof why, "is shard %u/%u, not %u/%u", place.shard + 1, place.shards, want->shard + 1,
                  want->shards);
-    if (why[0]) {
-        free(file);
+    if (why[0])
         return refuse(path, err, why);
-    }
     *got = place;
+    *body_offset = HEADER_BYTES + (size_t)config_length;
     *body_length = (size_t)length;
-    memmove(file, file + HEADER_BYTES + config_length, (size_t)length);
+    return LMB_OK;
+}
+
+lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
+                         lmb_part_place *got, void **body, size_t *body_length, lmb_error *err)
+{
+    *body = NULL;
+    *body_length = 0;
+    char *file;
+    size_t size, offset, length;
+    lmb_status st = lmb_read_file(path, "part", &file, &size, err);
+    if (st != LMB_OK)
+        return st;
+    st = check_part(path, (const uint8_t *)file, size, expect, want, got, &offset, &length, err);
+    if (st != LMB_OK) {
+        free(file);
+        return st;
+    }
+    *body_length = length;
+    memmove(file, file + offset, length);
     *body = file;
     return LMB_OK;
+}
+
+lmb_status lmb_part_map(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
+                        lmb_part_place *got, lmb_part_view *view, lmb_error *err)
+{
+    memset(view, 0, sizeof *view);
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return lmb_error_set(err, LMB_ERR_INPUT, "cannot open part '%s': %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fd, &sb) != 0) {
+        lmb_status st = lmb_error_set(err, LMB_ERR_INPUT, "cannot read part '%s': %s", path, strerror(errno));
+        close(fd);
+        return st;
+    }
+    size_t size = (size_t)sb.st_size;
+    if (size < HEADER_BYTES + 32) { /* (mmap refuses a length of 0) */
+        uint8_t head[8] = {0};
+        ssize_t n = size ? read(fd, head, size < 8 ? size : 8) : 0;
+        close(fd);
+        int ours = n == 8 && !memcmp(head, magic, 8);
+        return refuse(path, err, ours ? "truncated (shorter than its header)" : "not an lmbake plan or part file");
+    }
+    /* MAP_POPULATE: the page cache's pages mapped in one call, not a fault per page */
+    void *map = mmap(NULL, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    close(fd);
+    if (map == MAP_FAILED)
+        return lmb_error_set(err, LMB_ERR_INPUT, "cannot map part '%s': %s", path, strerror(errno));
+    size_t offset, length;
+    lmb_status st = check_part(path, map, size, expect, want, got, &offset, &length, err);
+    if (st != LMB_OK) {
+        munmap(map, size);
+        return st;
+    }
+    view->map = map;
+    view->map_length = size;
+    view->body = (const uint8_t *)map + offset;
+    view->body_length = length;
+    return LMB_OK;
+}
+
+void lmb_part_unmap(lmb_part_view *view)
+{
+    if (view->map)
+        munmap(view->map, view->map_length);
+    memset(view, 0, sizeof *view);
 }

@@ -72,6 +72,21 @@ lmb_status lmb_part_write_pieces(const char *path, const lmb_part_identity *id, 
 lmb_status lmb_part_read(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
                          lmb_part_place *got, void **body, size_t *body_length, lmb_error *err);
 
+/* A part file mapped read-only (lmb_part_map): the body lies in the page cache's own pages, with
+ * no copy into a buffer of this process. */
+typedef struct lmb_part_view {
+    void *map;
+    size_t map_length;
+    const uint8_t *body;
+    size_t body_length;
+} lmb_part_view;
+
+/* lmb_part_read's checks, on the file mapped instead of read: what a merge reads megabytes of
+ * and copies once, into the merged state. *view unmapped with lmb_part_unmap. */
+lmb_status lmb_part_map(const char *path, const lmb_part_identity *expect, const lmb_part_place *want,
+                        lmb_part_place *got, lmb_part_view *view, lmb_error *err);
+void lmb_part_unmap(lmb_part_view *view);
+
 /* SHA-256 of n bytes. */
 void lmb_sha256(const void *data, size_t n, uint8_t out[32]);
 

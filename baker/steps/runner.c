@@ -188,7 +188,8 @@ static lmb_status run_shard(lmb_steps *s, const lmb_step_desc *d, uint32_t step,
     return st;
 }
 
-/* Step `step`'s merged state into out and counters, checked against d. */
+/* Step `step`'s merged state into out and counters, checked against d: the parts its state
+ * lists, merged again. */
 static lmb_status read_state(lmb_steps *s, const lmb_step_desc *d, uint32_t step, lmb_buf *out,
                              uint64_t counters[LMB_STEP_COUNTERS], lmb_error *err)
 {
@@ -200,23 +201,17 @@ static lmb_status read_state(lmb_steps *s, const lmb_step_desc *d, uint32_t step
     if (stat(path, &sb) != 0)
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: step %u (%s) has not been merged: run its shards and "
                              "'lmbake merge' first", path, step, d->name);
-    lmb_part_place want = {LMB_PART_STATE, step, 0, 1}, got;
-    void *raw = NULL;
-    size_t size = 0;
-    lmb_status st = lmb_part_read(path, &s->id, &want, &got, &raw, &size, err);
-    step_body b;
+    uint32_t shards = 0;
+    uint8_t *sums = NULL;
+    lmb_merge_report report;
+    lmb_status st = lmb_step_state_read(s->dir, &s->id, step, &shards, &sums, err);
     if (st == LMB_OK)
-        st = lmb_step_body_decode(path, raw, size, &b, err);
-    if (st == LMB_OK && (b.end || b.items != d->items || strcmp(b.name, d->name) != 0))
+        st = lmb_step_merge_parts(s->dir, &s->id, step, shards, 0, sums, out, counters, &report, err);
+    free(sums);
+    if (st == LMB_OK && (report.end || report.noop || report.items != d->items || strcmp(report.name, d->name)))
         st = lmb_error_set(err, LMB_ERR_INPUT, "%s: holds '%s' (%llu items%s), but this bake's step %u is '%s' "
-                           "(%llu items)", path, b.name, (unsigned long long)b.items, b.end ? ", the end" : "", step,
-                           d->name, (unsigned long long)d->items);
-    if (st == LMB_OK) {
-        memcpy(counters, b.counters, sizeof b.counters);
-        st = lmb_buf_append(out, b.bytes, b.size, err);
-    }
-    free(b.chunks);
-    free(raw);
+                           "(%llu items)", path, report.name, (unsigned long long)report.items,
+                           report.end || report.noop ? ", the end" : "", step, d->name, (unsigned long long)d->items);
     return st;
 }
 
@@ -249,7 +244,7 @@ static lmb_status work_step(lmb_steps *s, const lmb_step_desc *d, uint32_t step,
             continue;
         }
         lmb_step_state_path(s->dir, step, path, sizeof path);
-        if (exists(path)) { /* merged already (its parts may be cleaned up) */
+        if (exists(path)) { /* merged already (by a worker started before this one) */
             s->waited_s += seconds_now() - start;
             return LMB_OK;
         }
@@ -270,7 +265,7 @@ static lmb_status work_step(lmb_steps *s, const lmb_step_desc *d, uint32_t step,
     double waited = seconds_now();
     s->waited_s += waited - start;
     if (st == LMB_OK)
-        st = lmb_step_merge_parts(s->dir, &s->id, step, s->shards, s->worker == 0, out, counters, &report, err);
+        st = lmb_step_merge_parts(s->dir, &s->id, step, s->shards, s->worker == 0, NULL, out, counters, &report, err);
     if (st == LMB_OK && (report.end || report.noop || report.items != d->items || strcmp(report.name, d->name)))
         st = lmb_error_set(err, LMB_ERR_INPUT, "%s/parts: step %u's parts hold '%s' (%llu items%s), but this bake's "
                            "step %u is '%s' (%llu items): a farm folder with parts of another run?", s->dir, step,

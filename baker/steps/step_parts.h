@@ -8,11 +8,12 @@
 
 #include "runner.h"
 
-/* The body of a part or a state:
+/* The body of a part:
  *   u32 end, u32 name_length, u64 items, u64 chunks, counters[LMB_STEP_COUNTERS], u64 bytes,
  *   name, chunks x (u64 first, u64 last, u64 size), bytes     (little-endian hosts only, as
  * part_file.h). A part holds its shard's chunks of items (in item order, their bytes one after
- * the other); a state holds one chunk, every item. */
+ * the other). A step's state lists its parts by the SHA-256 that ends each part file: u32
+ * shards, u32 0, shards x 32 bytes; reading a state merges the parts it lists. */
 #define BODY_HEADER (2 * 4 + (3 + LMB_STEP_COUNTERS) * 8)
 
 typedef struct step_chunk {
@@ -37,7 +38,7 @@ typedef struct step_body {
  * chunk costs a call and 24 bytes in the part. */
 #define LMB_STEP_CHUNKS_PER_SHARD 32
 
-/* Writes b as the body of a part or state file at path: its head (everything before the
+/* Writes b as the body of a part file at path: its head (everything before the
  * results) and b->bytes as they lie, not joined into one copy first. */
 lmb_status lmb_step_body_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
                                const step_body *b, lmb_error *err);
@@ -48,7 +49,10 @@ void lmb_step_state_path(const char *dir, uint32_t step, char *out, size_t n);
 uint64_t *lmb_step_chunk_cuts(const lmb_step_desc *d, uint32_t shards, uint64_t *count);
 lmb_status lmb_step_write_end_marker(const char *dir, uint32_t step, lmb_error *err);
 lmb_status lmb_step_merge_parts(const char *dir, const lmb_part_identity *id, uint32_t step, uint32_t shards,
-                                int write_state, lmb_buf *out, uint64_t *counters, lmb_merge_report *report,
-                                lmb_error *err);
+                                int write_state, const uint8_t *sums, lmb_buf *out, uint64_t *counters,
+                                lmb_merge_report *report, lmb_error *err);
+/* Step `step`'s state: its shard count and the parts' SHA-256s (*sums: malloc'd, shards x 32). */
+lmb_status lmb_step_state_read(const char *dir, const lmb_part_identity *id, uint32_t step, uint32_t *shards,
+                               uint8_t **sums, lmb_error *err);
 
 #endif

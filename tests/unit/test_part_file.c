@@ -32,14 +32,22 @@ static lmb_scene *load(const char *rel)
     return s;
 }
 
-/* Reads path against expect/want; returns the status and leaves the message in msg. */
+/* Reads path against expect/want, read into memory and mapped (the merge's way): both must give
+ * the same status, message and body. Returns the status and leaves the message in msg. */
 static lmb_status read_as(const char *path, const lmb_part_identity *expect, const lmb_part_place *want, char *msg)
 {
-    lmb_part_place got;
+    lmb_part_place got, got_mapped;
     void *body = NULL;
-    size_t n;
-    lmb_error err = {LMB_OK, ""};
+    size_t n = 0;
+    lmb_error err = {LMB_OK, ""}, err_mapped = {LMB_OK, ""};
     lmb_status st = lmb_part_read(path, expect, want, &got, &body, &n, &err);
+    lmb_part_view view;
+    lmb_status st_mapped = lmb_part_map(path, expect, want, &got_mapped, &view, &err_mapped);
+    CHECK_INT(st_mapped, st);
+    CHECK(!strcmp(err.message, err_mapped.message));
+    if (st == LMB_OK && st_mapped == LMB_OK)
+        CHECK(view.body_length == n && !memcmp(view.body, body, n) && !memcmp(&got, &got_mapped, sizeof got));
+    lmb_part_unmap(&view);
     snprintf(msg, 512, "%s", err.message);
     free(body);
     return st;
@@ -97,6 +105,7 @@ int main(int argc, char **argv)
     void *back = NULL;
     size_t n = 0;
     CHECK_INT(lmb_part_read(path, &id_threads, &place, &got, &back, &n, &err), LMB_OK);
+    CHECK_INT(read_as(path, &id_threads, &place, msg), LMB_OK); /* mapped: the same body */
     CHECK_INT(n, sizeof body);
     CHECK(back && !memcmp(back, body, sizeof body));
     CHECK(got.kind == LMB_PART_SHARD && got.step == 3 && got.shard == 1 && got.shards == 4);
@@ -160,6 +169,15 @@ int main(int argc, char **argv)
     fclose(f);
     CHECK_INT(read_as(path2, &id, &place, msg), LMB_ERR_INPUT);
     CHECK(contains(msg, "not an lmbake plan or part file"));
+    f = fopen(path2, "wb"); /* empty (a file mmap cannot map) */
+    fclose(f);
+    CHECK_INT(read_as(path2, &id, &place, msg), LMB_ERR_INPUT);
+    CHECK(contains(msg, "not an lmbake plan or part file"));
+    f = fopen(path2, "wb"); /* its magic and no more */
+    fwrite(a, 1, 20, f);
+    fclose(f);
+    CHECK_INT(read_as(path2, &id, &place, msg), LMB_ERR_INPUT);
+    CHECK(contains(msg, "truncated (shorter than its header)"));
     free(a);
 
     char hex[65];

@@ -3,7 +3,8 @@
  * grows with the index (item i costs i + 1): each of 4 shards computes LMB_STEP_CHUNKS_PER_SHARD (32) chunks spread over
  * the step (chunk c to shard c mod 4), the shards' chunks tile [0, 1000) exactly once, and each
  * shard's cost is within 1.5% of a quarter of the total (chunks cut by cost, not by count); the merged
- * state reads back (finish mode) as the items in order with the counters summed; a shard run
+ * state reads back (finish mode) as the items in order with the counters summed, and is refused,
+ * naming the part, when a part it lists was written again with other results or is gone; a shard run
  * twice writes the same bytes; a step under min_rays runs in every process and is no farm step;
  * a merge over a missing part or a part of another config is refused, naming it; a worker
  * whose step 0 is another step than the farm folder's refuses, naming both. Streamed
@@ -31,6 +32,7 @@ typedef struct fake {
     double cost;
     const double *costs;
     int *hits; /* per item: how many times computed */
+    uint32_t offset; /* item i's bytes are i + offset (another run's results) */
 } fake;
 
 /* Item i's bytes: its index (u32); counter 0 counts items, counter 1 sums the indices. */
@@ -47,7 +49,7 @@ static lmb_status compute(void *user, uint64_t first, uint64_t last, lmb_buf *ou
         f->hits[i]++;
     }
     for (uint64_t i = first; i < last; i++) {
-        uint32_t v = (uint32_t)i;
+        uint32_t v = (uint32_t)i + f->offset;
         lmb_status st = lmb_buf_append(out, &v, 4, err);
         if (st != LMB_OK)
             return st;
@@ -78,7 +80,7 @@ static void test_streamed(void)
     lmb_error err;
     lmb_steps *s;
     CHECK_INT(lmb_steps_create(LMB_STEPS_LOCAL, NULL, NULL, 0, 0, 1, 100.0, NULL, &s, &err), LMB_OK);
-    fake f = {0, 0, 0, 0, 0, NULL, NULL};
+    fake f = {0, 0, 0, 0, 0, NULL, NULL, 0};
     lmb_step_desc d = {"streamed", ITEMS, NULL, 1e9, compute, &f};
     collected c = {{0}, 0};
     uint64_t counters[LMB_STEP_COUNTERS];
@@ -186,7 +188,7 @@ int main(int argc, char **argv)
     for (int k = 0; k < SHARDS; k++) {
         lmb_steps *s;
         CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, farm, &id, 0, (uint32_t)k, SHARDS, 100.0, NULL, &s, &err), LMB_OK);
-        fake f = {0, 0, 0, 0, 0, cost, hits}, fs = {0, 0, 0, 0, 0, NULL, NULL};
+        fake f = {0, 0, 0, 0, 0, cost, hits, 0}, fs = {0, 0, 0, 0, 0, NULL, NULL, 0};
         lmb_buf out = {0};
         uint64_t counters[LMB_STEP_COUNTERS];
         /* under min_rays: computed here, whole, and not counted as a step */
@@ -214,7 +216,7 @@ int main(int argc, char **argv)
     {
         lmb_steps *s;
         CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, farm, &id, 0, 1, SHARDS, 100.0, NULL, &s, &err), LMB_OK);
-        fake f = {0, 0, 0, 0, 0, NULL, NULL};
+        fake f = {0, 0, 0, 0, 0, NULL, NULL, 0};
         lmb_buf out = {0};
         uint64_t counters[LMB_STEP_COUNTERS];
         lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
@@ -231,7 +233,7 @@ int main(int argc, char **argv)
     {
         lmb_steps *s;
         CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, other, &id_other, 0, 2, SHARDS, 100.0, NULL, &s, &err), LMB_OK);
-        fake f = {0, 0, 0, 0, 0, NULL, NULL};
+        fake f = {0, 0, 0, 0, 0, NULL, NULL, 0};
         lmb_buf out = {0};
         uint64_t counters[LMB_STEP_COUNTERS];
         lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
@@ -273,7 +275,7 @@ int main(int argc, char **argv)
     {
         lmb_steps *s;
         CHECK_INT(lmb_steps_create(LMB_STEPS_FINISH, farm, &id, 0, 0, 1, 100.0, NULL, &s, &err), LMB_OK);
-        fake f = {0, 0, 0, 0, 0, NULL, NULL};
+        fake f = {0, 0, 0, 0, 0, NULL, NULL, 0};
         lmb_buf out = {0};
         uint64_t counters[LMB_STEP_COUNTERS];
         lmb_step_desc d = {"skewed", ITEMS, cost, 1e9, compute, &f};
@@ -298,6 +300,40 @@ int main(int argc, char **argv)
         CHECK_INT(c.calls, 1);
         CHECK(c.all.size == out.size && memcmp(c.all.data, out.data, out.size) == 0);
         lmb_buf_free(&c.all);
+        /* the state lists its parts by their SHA-256: part 2 written again with other results
+         * after the merge, or part 3 gone, and the step is refused, the part named */
+        lmb_steps *shard2;
+        CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, farm, &id, 0, 1, SHARDS, 100.0, NULL, &shard2, &err), LMB_OK);
+        fake other = {0, 0, 0, 0, 0, NULL, NULL, 7};
+        lmb_step_desc d_other = {"skewed", ITEMS, cost, 1e9, compute, &other};
+        lmb_buf scratch = {0};
+        CHECK_INT(lmb_steps_run(shard2, &d_other, &scratch, counters, &err), LMB_STEP_STOPPED);
+        lmb_steps_free(shard2);
+        lmb_steps *again;
+        CHECK_INT(lmb_steps_create(LMB_STEPS_FINISH, farm, &id, 0, 0, 1, 100.0, NULL, &again, &err), LMB_OK);
+        CHECK_INT(lmb_steps_run(again, &d, &scratch, counters, &err), LMB_ERR_INPUT);
+        printf("refused: %s\n", err.message);
+        CHECK(strstr(err.message, "0000.2-of-4.part") && strstr(err.message, "state lists"));
+        lmb_steps_free(again);
+        CHECK_INT(lmb_steps_create(LMB_STEPS_SHARD, farm, &id, 0, 1, SHARDS, 100.0, NULL, &shard2, &err), LMB_OK);
+        fake same = {0, 0, 0, 0, 0, NULL, NULL, 0};
+        lmb_step_desc d_same = {"skewed", ITEMS, cost, 1e9, compute, &same};
+        CHECK_INT(lmb_steps_run(shard2, &d_same, &scratch, counters, &err), LMB_STEP_STOPPED); /* the same bytes */
+        lmb_steps_free(shard2);
+        snprintf(path, sizeof path, "%s/parts/0000.3-of-4.part", farm);
+        snprintf(path2, sizeof path2, "%s/parts/saved", farm);
+        CHECK(rename(path, path2) == 0);
+        CHECK_INT(lmb_steps_create(LMB_STEPS_FINISH, farm, &id, 0, 0, 1, 100.0, NULL, &again, &err), LMB_OK);
+        CHECK_INT(lmb_steps_run(again, &d, &scratch, counters, &err), LMB_ERR_INPUT);
+        printf("refused: %s\n", err.message);
+        CHECK(strstr(err.message, "--shard 3/4") != NULL);
+        lmb_steps_free(again);
+        CHECK(rename(path2, path) == 0);
+        CHECK_INT(lmb_steps_create(LMB_STEPS_FINISH, farm, &id, 0, 0, 1, 100.0, NULL, &again, &err), LMB_OK);
+        CHECK_INT(lmb_steps_run(again, &d, &scratch, counters, &err), LMB_OK);
+        CHECK(scratch.size == out.size && memcmp(scratch.data, out.data, out.size) == 0);
+        lmb_steps_free(again);
+        lmb_buf_free(&scratch);
         /* the next step is not merged: refused, named */
         lmb_step_desc d2 = {"next", 5, NULL, 1e9, compute, &f};
         CHECK_INT(lmb_steps_run(s, &d2, &out, counters, &err), LMB_ERR_INPUT);
