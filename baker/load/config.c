@@ -255,7 +255,7 @@ void lmb_config_default(lmb_config *cfg)
     cfg->ktx2_zstd = 1;
     cfg->default_albedo[0] = cfg->default_albedo[1] = cfg->default_albedo[2] = -1; /* none: glTF's metal */
     cfg->ic_ray_scale = 4;
-    cfg->farm_min_step_rays = 1000000; /* ~0.1 s of one core: a step costs a process start per shard */
+    cfg->farm_min_step_rays = 250000; /* under 0.1 s of one core: below, a step's wait and merge cost more */
     cfg->ic_records = LMB_IC_RECORDS_SHARED; /* docs/irradiance-cache.md: as accurate, 1.0-1.4x faster */
     cfg->seed = 1;
     cfg->threads = 0;
