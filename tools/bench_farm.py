@@ -11,7 +11,10 @@
    shard of every step one after the other and logs each shard's time; then
       critical path = plan + (worker wall - all shard times) + sum over steps of the slowest shard
    i.e. what does not split (start, between-step work, merges, the tail that writes the bake)
-   once, plus each step's slowest shard. Against `lmbake bake --threads 1`. The worker's
+   once, plus each step's slowest shard. A shard's time is its computing and the write of its
+   part (each machine writes its own); with a binary whose log does not say the write, all N
+   parts' writes fall in what does not split. Both are reported for the same run
+   (farm_s_writes_serial: every part's write on the path). Against `lmbake bake --threads 1`. The worker's
    output at N shards is compared with that bake's, byte for byte. What does not split is
    reported: start (load, plan, ray-tracing scene, before the first step), between steps
    (the code between steps, merges), and the tail after the last step.
@@ -53,18 +56,20 @@ def identical(a, b):
         filecmp.cmp(os.path.join(a, n), os.path.join(b, n), shallow=False) for n in names)
 
 
-SHARD_LINE = re.compile(r"step (\d+) \(.*\): shard (\d+) of (\d+) computed in ([0-9.]+) s")
+SHARD_LINE = re.compile(r"step (\d+) \(.*\): shard (\d+) of (\d+) computed in ([0-9.]+) s.*?(?:wrote \S+ in ([0-9.]+) s)?$")
 
 
 def timed_worker(args):
-    """Runs a worker, stamping each line of its log: (wall, [(t, step, shard, seconds)])."""
+    """Runs a worker, stamping each line of its log: (wall, [(t, step, shard, seconds, written)]): a
+    shard's seconds computing and writing its part (a binary that does not say the write: 0)."""
     t0 = time.time()
     p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     shards = []
     for line in p.stdout:
         m = SHARD_LINE.search(line)
         if m:
-            shards.append((time.time() - t0, int(m.group(1)), int(m.group(2)), float(m.group(4))))
+            written = float(m.group(5)) if m.group(5) else 0.0
+            shards.append((time.time() - t0, int(m.group(1)), int(m.group(2)), float(m.group(4)) + written, written))
     if p.wait() != 0:
         sys.exit("bench_farm: %s failed" % " ".join(args))
     return time.time() - t0, shards
@@ -117,13 +122,18 @@ def critical_path(lmbake, tag, scene, name, work, n, bake_run, rows):
     same = identical(ref, out)
     if not same:
         sys.exit("bench_farm: the worker's output at %d shards differs from lmbake bake" % n)
-    steps = sorted({s for _, s, _, _ in shards})
-    slowest = {s: max(t for _, st, _, t in shards if st == s) for s in steps}
-    total = sum(t for _, _, _, t in shards)
+    steps = sorted({s for _, s, _, _, _ in shards})
+    slowest = {s: max(t for _, st, _, t, _ in shards if st == s) for s in steps}
+    total = sum(t for _, _, _, t, _ in shards)
+    written = sum(w for _, _, _, _, w in shards)
+    # the same run with every part's write charged to the critical path, as the model did before
+    # shards said their writes (each machine writes its own part, so the slowest shard's is enough)
+    slowest_computed = {s: max(t - w for _, st, _, t, w in shards if st == s) for s in steps}
     start = shards[0][0] - shards[0][3] if shards else wall
     tail = wall - shards[-1][0] if shards else 0.0
     between = wall - total - start - tail
     critical = plan + (wall - total) + sum(slowest.values())
+    writes_serial = plan + (wall - total + written) + sum(slowest_computed.values())
     mean = total / n
     rows.append(dict(measure="critical path", binary=tag, scene=name, round=1, shards=n, bake_s=round(bake, 2),
                      farm_s=round(critical, 2), ratio=round(critical / bake, 4), identical=same,
@@ -131,12 +141,16 @@ def critical_path(lmbake, tag, scene, name, work, n, bake_run, rows):
                      steps=len(steps), plan_s=round(plan, 2), start_s=round(start, 2),
                      between_s=round(between, 2), tail_s=round(tail, 2),
                      shard_work_s=round(total, 2), slowest_sum_s=round(sum(slowest.values()), 2),
-                     slowest_over_mean=round(sum(slowest.values()) / mean, 3) if mean else 1.0))
+                     slowest_over_mean=round(sum(slowest.values()) / mean, 3) if mean else 1.0,
+                     part_writes_s=round(written, 2), farm_s_writes_serial=round(writes_serial, 2),
+                     ratio_same_run_writes_serial=round(writes_serial / (plan + wall), 4)))
     print("%s %s, %d shards: %d steps; critical path %.1f s = plan %.1f + start %.1f + between steps %.1f + tail "
           "%.1f + slowest shards %.1f (all shards' work %.1f s, slowest/mean %.2f): %.3fx the bake, %.3fx this "
-          "run's one machine (%.1f s), identical: %s" %
+          "run's one machine (%.1f s), identical: %s; the parts' writes %.2f s (all %d charged to the path: %.3fx "
+          "the one machine)" %
           (tag, name, n, len(steps), critical, plan, start, between, tail, sum(slowest.values()), total,
-           rows[-1]["slowest_over_mean"], critical / bake, critical / (plan + wall), plan + wall, same), flush=True)
+           rows[-1]["slowest_over_mean"], critical / bake, critical / (plan + wall), plan + wall, same, written, n,
+           writes_serial / (plan + wall)), flush=True)
 
 
 def main():

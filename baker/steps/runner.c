@@ -178,13 +178,15 @@ static lmb_status run_shard(lmb_steps *s, const lmb_step_desc *d, uint32_t step,
     snprintf(b.name, sizeof b.name, "%s", d->name);
     lmb_step_part_path(s->dir, step, shard, s->shards, path, sizeof path);
     lmb_part_place place = {LMB_PART_SHARD, step, shard, s->shards};
+    double t1 = seconds_now();
     if (st == LMB_OK)
         st = lmb_step_body_write(path, &s->id, &place, &b, err);
+    double wrote = seconds_now() - t1;
     free(chunks);
-    if (st == LMB_OK) /* the farm benchmark reads this line's time */
-        lmb_info(s->log, "step %u (%s): shard %u of %u computed in %.4f s (%llu of %llu items in %llu chunks), wrote %s",
-                 step, d->name, shard + 1, s->shards, took, (unsigned long long)items, (unsigned long long)d->items,
-                 (unsigned long long)mine, path);
+    if (st == LMB_OK) /* the farm benchmark reads this line's times */
+        lmb_info(s->log, "step %u (%s): shard %u of %u computed in %.4f s (%llu of %llu items in %llu chunks), wrote %s "
+                 "in %.4f s", step, d->name, shard + 1, s->shards, took, (unsigned long long)items,
+                 (unsigned long long)d->items, (unsigned long long)mine, path, wrote);
     return st;
 }
 
