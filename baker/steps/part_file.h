@@ -25,7 +25,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define LMB_PART_FORMAT 1
+/* 2: a step's state lists its parts by SHA-256 (format 1 copied their bytes) */
+#define LMB_PART_FORMAT 2
 
 typedef enum lmb_part_kind { LMB_PART_PLAN = 1, LMB_PART_SHARD = 2, LMB_PART_STATE = 3 } lmb_part_kind;
 
