@@ -125,8 +125,9 @@ static const char step_help[] =
 static const char merge_help[] =
     "usage: lmbake merge SCENE [-c CONFIG] --farm DIR --step S --shards N\n"
     "\n"
-    "Merges the N parts of step S in DIR into DIR/steps/SSSS.state, which later steps and\n"
-    "'lmbake finish' read. Refuses a part made from another plan, input, config or lmbake\n"
+    "Checks and merges the N parts of step S in DIR and writes DIR/steps/SSSS.state, which\n"
+    "lists them by SHA-256: later steps and 'lmbake finish' merge the parts it lists (keep the\n"
+    "parts until the bake is done). Refuses a part made from another plan, input, config or lmbake\n"
     "version, naming the part and what differs, and a missing part, naming the shard to rerun.\n"
     "When the bake has no step S, writes DIR/end: the drivers stop there.\n"
     "\n"
