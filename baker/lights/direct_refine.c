@@ -30,6 +30,8 @@ typedef struct refine_ctx {
     lmb_instance_rows instance_rows; /* which instances a band visits */
     lmb_progress_fn progress;
     void *progress_user;
+    uint64_t bands;          /* the atlas's: progress is told over all of them, so a farm shard's
+                                chunks do not each report a stage done */
 } refine_ctx;
 
 /* The rounds texel i needs: its standard error after R rounds is sqrt(variance / R); R is the
@@ -241,7 +243,7 @@ static lmb_status refine_bands(void *user, uint64_t first, uint64_t last, lmb_bu
             band_refined_free(&r[b - b0]);
         }
         if (st == LMB_OK && c->progress)
-            c->progress(c->progress_user, "direct refinement", b1 - first, last - first);
+            c->progress(c->progress_user, "direct refinement", b1, c->bands);
         b0 = b1;
     }
     free(r);
@@ -349,7 +351,7 @@ lmb_status lmb_direct_refine_step(lmb_steps *steps, const lmb_direct *direct,
     lmb_status st = LMB_OK;
     if (noise->refined) {
         refine_ctx c = {opt, direct, scene, layout, a, width, height, rows, da, rounds, first, {0},
-                        progress, progress_user};
+                        progress, progress_user, bands};
         st = lmb_instance_rows_make(scene, layout, a, rows, &c.instance_rows, err);
         char name[64];
         snprintf(name, sizeof name, "direct, atlas %u: more samples", a);
