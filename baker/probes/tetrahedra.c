@@ -9,8 +9,8 @@
  * 1.4e-5 of level-single-10's extent of 235, so no 5 points are cospherical) takes 0.1-0.2 s; it
  * splits each such cell into tetrahedra plus slivers whose volume from the probes' own positions
  * is 0. Those are dropped (counted), as are the flat ones Qt left between two cells triangulated
- * differently; the volumes and orientations below read the probes' own positions. Each tetrahedron is written
- * with a positive volume: (p1 - p0) x (p2 - p0) . (p3 - p0) > 0.
+ * differently; the volumes and orientations below read the probes' own positions. Each
+ * tetrahedron is written with a positive volume: (p1 - p0) x (p2 - p0) . (p3 - p0) > 0.
  * Deterministic: one thread, facets in qhull's own order for the same points, and QJ's random
  * joggle drawn from qhull's fixed default seed (no QR option: QR-1 would seed it by the time).
  */

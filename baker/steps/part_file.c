@@ -354,12 +354,12 @@ lmb_status lmb_part_map(const char *path, const lmb_part_identity *expect, const
         return st;
     }
     size_t size = (size_t)sb.st_size;
-    if (size < HEADER_BYTES + 32) { /* (mmap refuses a length of 0) */
-        uint8_t head[8] = {0};
-        ssize_t n = size ? read(fd, head, size < 8 ? size : 8) : 0;
+    if (size < HEADER_BYTES + 32) { /* too short to be a part (and mmap refuses a length of 0): read, refused */
+        uint8_t small[HEADER_BYTES + 32];
+        ssize_t n = size ? read(fd, small, size) : 0;
         close(fd);
-        int ours = n == 8 && !memcmp(head, magic, 8);
-        return refuse(path, err, ours ? "truncated (shorter than its header)" : "not an lmbake plan or part file");
+        size_t offset, length;
+        return check_part(path, small, n > 0 ? (size_t)n : 0, expect, want, got, &offset, &length, err);
     }
     /* MAP_POPULATE: the page cache's pages mapped in one call, not a fault per page */
     void *map = mmap(NULL, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
@@ -376,6 +376,7 @@ lmb_status lmb_part_map(const char *path, const lmb_part_identity *expect, const
     view->map_length = size;
     view->body = (const uint8_t *)map + offset;
     view->body_length = length;
+    view->sum = (const uint8_t *)map + size - 32;
     return LMB_OK;
 }
 

@@ -80,6 +80,7 @@ typedef struct lmb_part_view {
     size_t map_length;
     const uint8_t *body;
     size_t body_length;
+    const uint8_t *sum; /* the 32-byte SHA-256 that ends the file (a state lists its parts by it) */
 } lmb_part_view;
 
 /* lmb_part_read's checks, on the file mapped instead of read: what a merge reads megabytes of
