@@ -1,10 +1,10 @@
 /*
  * The bake's own image formats written without OpenImageIO (image_native.h): .exr through
- * OpenEXR's C library (OpenEXRCore), .png through libpng's simplified API, .hdr through stb's
+ * OpenEXR's C library (OpenEXRCore), .png through libpng, .hdr through stb's
  * image writer. Loading the OpenImageIO module makes the dynamic loader bind Debian's build of
  * it with its 261 shared libraries (FFmpeg, GStreamer, OpenCV, ...): about 0.38 s of a bake
  * that only writes its lightmaps (docs/testing.md); these three libraries load in milliseconds.
- * The files are what the module wrote: .exr as half float with ZIP compression (32-bit float
+ * The files hold what the module wrote: .exr as half float with ZIP compression (32-bit float
  * when a value is beyond half's range), channels R, G, B; no time stamp anywhere (the same bake
  * gives byte-identical files). Each file is written to a temporary name beside the target
  * (NAME.part.EXT) and renamed into place: a failed write never leaves a partial file.
@@ -18,9 +18,14 @@
 
 #include <errno.h>
 #include <math.h>
+#include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* zlib's level for the .exr (ZIP) and .png files: 4 rather than zlib's default 6, half the
+ * time for a few per cent of bytes (docs/output.md, "Files": the figures). */
+#define LMB_ZIP_LEVEL 4
 
 static const char *extension(const char *path)
 {
@@ -53,21 +58,61 @@ static lmb_status move_into_place(const char *tmp, const char *path, lmb_error *
     return LMB_OK;
 }
 
+/* libpng's error handler: the message kept, then back to write_png's setjmp. */
+static void png_failed(png_structp png, png_const_charp message)
+{
+    char *keep = png_get_error_ptr(png);
+    snprintf(keep, 256, "%s", message);
+    png_longjmp(png, 1);
+}
+
+static void png_warned(png_structp png, png_const_charp message)
+{
+    (void)png;
+    (void)message;
+}
+
+/* The file written through libpng's full API rather than its simplified one, whose zlib level
+ * cannot be set: LMB_ZIP_LEVEL, with libpng's adaptive row filters. */
 static lmb_status write_png(const char *tmp, const char *path, uint32_t w, uint32_t h, uint32_t channels,
                             const uint8_t *pixels, lmb_error *err)
 {
-    static const png_uint_32 formats[] = {0, PNG_FORMAT_GRAY, PNG_FORMAT_GA, PNG_FORMAT_RGB, PNG_FORMAT_RGBA};
+    static const int types[] = {0, PNG_COLOR_TYPE_GRAY, PNG_COLOR_TYPE_GRAY_ALPHA, PNG_COLOR_TYPE_RGB,
+                                PNG_COLOR_TYPE_RGBA};
     if (channels < 1 || channels > 4)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: %u channels cannot be a PNG", path, channels);
-    png_image image;
-    memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    image.width = w;
-    image.height = h;
-    image.format = formats[channels]; /* RGBM's 4th channel is data: stored as given, not premultiplied */
-    if (!png_image_write_to_file(&image, tmp, 0, pixels, (png_int_32)(w * channels), NULL)) {
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write image: %s", path, strerror(errno));
+    char message[256] = "";
+    png_bytep *rows = malloc(((size_t)h + 1) * sizeof *rows);
+    png_structp png = rows ? png_create_write_struct(PNG_LIBPNG_VER_STRING, message, png_failed, png_warned) : NULL;
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    int ok = info != NULL;
+    if (!ok)
+        snprintf(message, sizeof message, "out of memory");
+    else if (setjmp(png_jmpbuf(png)))
+        ok = 0;
+    else {
+        for (uint32_t y = 0; y < h; y++) /* RGBM's 4th channel is data: stored as given */
+            rows[y] = (png_bytep)(pixels + (size_t)y * w * channels);
+        png_init_io(png, f);
+        png_set_compression_level(png, LMB_ZIP_LEVEL);
+        png_set_IHDR(png, info, w, h, 8, types[channels], PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                     PNG_FILTER_TYPE_DEFAULT);
+        png_write_info(png, info);
+        png_write_image(png, rows);
+        png_write_end(png, NULL);
+    }
+    png_destroy_write_struct(png ? &png : NULL, info ? &info : NULL);
+    free(rows);
+    if (fclose(f) != 0 && ok) {
+        ok = 0;
+        snprintf(message, sizeof message, "%s", strerror(errno));
+    }
+    if (!ok) {
         remove(tmp);
-        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write image: %s", path, image.message);
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "%s: cannot write image: %s", path, message);
     }
     return LMB_OK;
 }
@@ -154,7 +199,7 @@ static lmb_status write_exr(const char *tmp, const char *path, uint32_t w, uint3
             half[i] = imath_float_to_half(pixels[i]);
     }
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.zip_level = 6; /* zlib's default level, deterministic */
+    init.zip_level = LMB_ZIP_LEVEL;
     exr_context_t ctx = NULL;
     exr_result_t rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv == EXR_ERR_SUCCESS)
