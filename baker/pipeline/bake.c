@@ -15,6 +15,7 @@
 #include "steps/runner.h"
 #include "watch/layout_cache.h"
 #include "watch/stages_out.h"
+#include "watch/probe_cache.h"
 #include "watch/validity_cache.h"
 #include "pipeline/group_cache.h"
 #include "pipeline/group_lighting.h"
@@ -304,8 +305,14 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_light_atlases(cfg, direct, &cache, steps, &hooks, stats, &records, log, err);
     /* light probes: placed in every process alike, lit as a step from the finished cache (not
      * for bake --direct-of: the watch reads only its lightmaps) */
-    if (st == LMB_OK && !cfg->direct_of_count)
-        st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
+    /* with a layout cache, the placement (rays, qhull) is read back with the layout when a bake
+     * left it (watch/probe_cache.h); MASK cut-outs decide it too, as they do the validity */
+    int probes_kept = run->layout_cache && run->mode == LMB_FARM_LOCAL && !plan_path && !rt.cut_geoms, probes_read = 0;
+    if (st == LMB_OK && !cfg->direct_of_count) {
+        probes_read = probes_kept && lmb_probe_cache_read(s, cfg, run->layout_cache, &probes, log);
+        if (!probes_read)
+            st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
+    }
     if (st == LMB_OK && groups.count && !dark) { /* each group's lighting and probes on its own */
         lmb_lighting_hooks group_hooks = {progress, user, NULL, NULL};
         lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, sky, &cache, steps, &group_hooks,
@@ -433,6 +440,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_output_dir_commit(&od, err);
     else
         lmb_output_dir_abort(&od);
+    if (st == LMB_OK && probes_kept && !probes_read)
+        lmb_probe_cache_write(s, cfg, run->layout_cache, &probes, log);
     if (st == LMB_OK && progress)
         progress(user, "glTF", 1, 1);
     if (st == LMB_OK)

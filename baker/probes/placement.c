@@ -596,5 +596,6 @@ void lmb_probe_set_free(lmb_probe_set *set)
     free(set->cell);
     free(set->sh);
     free(set->cube);
+    lmb_probe_tetrahedra_free(&set->tets);
     memset(set, 0, sizeof *set);
 }

@@ -52,7 +52,7 @@ static lmb_status write_volumes(const lmb_probe_set *set, double scale, const ch
     return st;
 }
 
-lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
+lmb_status lmb_probes_output(lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
                              const lmb_log *log, lmb_gltf_probes *out, lmb_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -81,11 +81,16 @@ lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, co
     out->cube = cube;
     out->spacing = set->spacing;
     out->radiance = radiance;
-    lmb_probe_tetrahedra_out tets;
-    lmb_status st = lmb_probe_tetrahedra(set, &tets, err);
+    lmb_status st = lmb_probe_set_tetrahedra(set, err);
     if (st != LMB_OK)
         return st;
-    out->tetrahedra = tets.tetrahedra; /* owned by out now */
+    const lmb_probe_tetrahedra_out tets = set->tets;
+    uint32_t *copy = malloc(4 * (size_t)tets.count * sizeof *copy + 1);
+    if (!copy)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory for %u tetrahedra", tets.count);
+    if (tets.count)
+        memcpy(copy, tets.tetrahedra, 4 * (size_t)tets.count * sizeof *copy);
+    out->tetrahedra = copy; /* owned by out */
     out->tetrahedron_count = tets.count;
     if (tets.count)
         lmb_info(log, "probes: %u tetrahedra (Delaunay, qhull)%s", tets.count,

@@ -48,6 +48,16 @@ typedef struct lmb_probe_grid {
     const char *node_name;
 } lmb_probe_grid;
 
+/* The Delaunay tetrahedra of a set of probe positions (tetrahedra.c, qhull): 4 probe indices
+ * each, positive volume, flat ones dropped. Fewer than 4 probes, or all in a plane: none, and
+ * `why` says what qhull said. */
+typedef struct lmb_probe_tetrahedra_out {
+    uint32_t *tetrahedra; /* 4 per tetrahedron */
+    uint32_t count;
+    uint32_t flat;        /* flat tetrahedra dropped */
+    char why[256];
+} lmb_probe_tetrahedra_out;
+
 typedef struct lmb_probe_set {
     uint32_t count;
     double *position;  /* 3 per probe, world */
@@ -61,6 +71,8 @@ typedef struct lmb_probe_set {
     uint32_t rays;     /* rays per probe (probes.rays) */
     uint32_t *cell;    /* per probe: its voxel among all grids' (lmb_probe_grid.first_voxel + x fastest) */
     lmb_probe_grid *grids;
+    lmb_probe_tetrahedra_out tets; /* the placed set's tetrahedra once made (lmb_probe_set_tetrahedra) */
+    int tets_made;
     uint32_t grid_count; /* the auto grid (probes.auto) first, then each probes.volumes entry, then
                             each node's extras.lightmap_probes */
 } lmb_probe_set;
@@ -114,21 +126,16 @@ lmb_status lmb_probes_line_walls(lmb_probe_set *set, const lmb_layout *layout, c
                                  double offset, double spacing, uint32_t limit, int threads,
                                  int (*inside)(const lmb_rt *rt, const double p[3]), lmb_error *err);
 
-/* The Delaunay tetrahedra of the probe positions (tetrahedra.c, qhull): 4 probe indices each,
- * positive volume, flat ones dropped. Fewer than 4 probes, or all in a plane: none, and `why`
- * says what qhull said. */
-typedef struct lmb_probe_tetrahedra_out {
-    uint32_t *tetrahedra; /* 4 per tetrahedron */
-    uint32_t count;
-    uint32_t flat;        /* flat tetrahedra dropped */
-    char why[256];
-} lmb_probe_tetrahedra_out;
+/* The Delaunay tetrahedra of the probe positions (lmb_probe_tetrahedra). */
 lmb_status lmb_probe_tetrahedra(const lmb_probe_set *set, lmb_probe_tetrahedra_out *out, lmb_error *err);
 void lmb_probe_tetrahedra_free(lmb_probe_tetrahedra_out *out);
+/* The placed set's tetrahedra into set->tets, unless made already (or read back with the set
+ * from a layout cache, watch/probe_cache.h): made once, for the output. */
+lmb_status lmb_probe_set_tetrahedra(lmb_probe_set *set, lmb_error *err);
 /* The set as the output holds it (probe_output.c): owned arrays, free with lmb_probes_output_free
- * (also after an error); its grid as DIR/STEM-irradiance-volume.ktx2 (bevy's layout). Empty, no
+ * (also after an error), the tetrahedra the set's (made here when not yet); its grid as DIR/STEM-irradiance-volume.ktx2 (bevy's layout). Empty, no
  * file, when the set is. */
-lmb_status lmb_probes_output(const lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
+lmb_status lmb_probes_output(lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
                              const lmb_log *log, lmb_gltf_probes *out, lmb_error *err);
 /* Light groups: group g's own probes' light (sh_lux, cube_lux: LMB_PROBE_SH and LMB_PROBE_CUBE per
  * probe, lux, as lmb_probe_set holds them) into out, in the output's scale; out->groups = g + 1. */

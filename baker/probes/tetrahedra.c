@@ -121,6 +121,15 @@ lmb_status lmb_probe_tetrahedra(const lmb_probe_set *set, lmb_probe_tetrahedra_o
     return st;
 }
 
+lmb_status lmb_probe_set_tetrahedra(lmb_probe_set *set, lmb_error *err)
+{
+    if (set->tets_made)
+        return LMB_OK;
+    lmb_status st = lmb_probe_tetrahedra(set, &set->tets, err);
+    set->tets_made = st == LMB_OK;
+    return st;
+}
+
 void lmb_probe_tetrahedra_free(lmb_probe_tetrahedra_out *out)
 {
     free(out->tetrahedra);

@@ -5,7 +5,7 @@ cornell-point.gltf at a small density:
 1. the first bake builds the layout and keeps it in DIR ("layout: built ... kept");
 2. a lighting-only change (the lamp 3x brighter in the file, and a config sampling key) reads it
    back ("layout: read back") with the gather points' validity the first bake tested (none of
-   their rays traced again: fewer rays), and the files equal a plain `lmbake bake` of the
+   their rays traced again: fewer rays) and the probes it placed, and the files equal a plain `lmbake bake` of the
    changed level and config, byte for byte;
 3. a layout change (a mesh node moved; then atlas.padding) builds it again;
 4. damaged cache files (the layout, the validity) are said in a warning, the layout is built and
@@ -88,6 +88,12 @@ def main():
     ok &= check(m is not None and int(m.group(1)) > 1000 and rays(log) < rays_first,
                 "and the gather points' validity: %s points, %s rays against %s in the first bake"
                 % (m.group(1) if m else None, rays(log), rays_first))
+    m = re.search(r"probes: (\d+) read back with the layout", log)
+    probe_files = [f for f in os.listdir(cache) if f.endswith("-probes.lmbq")]
+    ok &= check(m is not None and int(m.group(1)) > 8 and "auto grid" not in log and len(probe_files) == 1 and
+                probe_files[0].startswith(kept[0][:-5] if kept else "?"),
+                "and the probes' placement and tetrahedra, kept beside it (%s): %s probes" %
+                (probe_files, m.group(1) if m else None))
     code, _ = bake("plain", lighting)
     diff = differing(os.path.join(work, "cached"), os.path.join(work, "plain"))
     ok &= check(code == 0 and not diff, "files from the layout read back equal a plain bake's, byte for byte%s"
@@ -108,8 +114,8 @@ def main():
         open(path, "wb").write(data)
     code, log = bake("damaged", lighting, "--layout-cache", cache)
     ok &= check(code == 0 and "layout cache:" in log and "layout: built" in log and "is damaged" in log and
-                "validity of" not in log, "damaged cache files: warned, layout built, points tested again (exit %d)"
-                % code)
+                "validity of" not in log and "read back with the layout" not in log,
+                "damaged cache files: warned, layout built, points tested and probes placed again (exit %d)" % code)
     code, _ = bake("plain2", lighting)
     diff = differing(os.path.join(work, "damaged"), os.path.join(work, "plain2"))
     ok &= check(not diff, "and the files equal a plain bake's%s" % (": differ " + ", ".join(diff) if diff else ""))
