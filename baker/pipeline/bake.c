@@ -406,11 +406,22 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (progress && st == LMB_OK)
         progress(user, "images", l.atlas_count, l.atlas_count);
     stats->rgbm_clamped = clamped;
-    for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++) /* each group's own files */
-        for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++)
+    /* each group's own files: the same bytes at any scales, so a group read back from the cache
+     * copies the files it kept instead of encoding them again */
+    for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++)
+        for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
+            char paths[2][LMB_GROUP_IMAGE_PATH];
+            const char *const names[2] = {paths[0], paths[1]};
+            lmb_group_image_paths(od.staging, od.stem, a, groups.name[g], paths);
+            if (group_light.cached[g] && groups_kept &&
+                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, names, log))
+                continue;
             st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g],
                                         group_light.irradiance[(size_t)g * l.atlas_count + a], l.width[a], l.height[a],
                                         err);
+            if (st == LMB_OK && groups_kept)
+                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, log);
+        }
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
     for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)

@@ -46,6 +46,15 @@ static void cache_path(const char *dir, const uint8_t key[32], char *path, size_
     snprintf(path, size, "%s/group-%s.lmbg", dir, hex);
 }
 
+/* The group's own files of atlas a: DIR/group-KEY-aA.lmbf beside its light. */
+static void files_path(const char *dir, const uint8_t key[32], uint32_t a, char *path, size_t size)
+{
+    char hex[33];
+    for (int i = 0; i < 16; i++)
+        snprintf(hex + 2 * i, 3, "%02x", key[i]);
+    snprintf(path, size, "%s/group-%s-a%u.lmbf", dir, hex, a);
+}
+
 /* The identity the files carry: their key (the part file's checks then name a mismatch). */
 static void cache_identity(const uint8_t key[32], lmb_part_identity *id)
 {
@@ -115,11 +124,14 @@ int lmb_group_cache_read(const char *dir, const uint8_t key[32], uint32_t g, lmb
     lmb_part_identity id;
     cache_identity(key, &id);
     lmb_part_place want = {LMB_PART_STATE, 0, 0, 1}, got;
-    void *body = NULL;
+    lmb_part_view view; /* mapped: the arrays are copied once, out of the page cache */
     size_t size = 0, at = sizeof(body_header);
     lmb_error e = {LMB_OK, ""};
     uint32_t n = cache->atlas_count;
-    int ok = lmb_part_read(path, &id, &want, &got, &body, &size, &e) == LMB_OK && size >= sizeof(body_header);
+    int mapped = lmb_part_map(path, &id, &want, &got, &view, &e) == LMB_OK;
+    const void *body = mapped ? view.body : NULL;
+    size = mapped ? view.body_length : 0;
+    int ok = mapped && size >= sizeof(body_header);
     body_header h;
     if (ok) {
         memcpy(&h, body, sizeof h);
@@ -168,7 +180,8 @@ int lmb_group_cache_read(const char *dir, const uint8_t key[32], uint32_t g, lmb
         if (ok)
             memcpy(gl->records[g].xyzr, b + at, 4 * (size_t)h.records * sizeof(float));
     }
-    free(body);
+    if (mapped)
+        lmb_part_unmap(&view);
     if (!ok) { /* nothing half read stays: the group is lit instead */
         for (uint32_t a = 0; a < n; a++) {
             size_t k = (size_t)g * n + a;
@@ -195,5 +208,88 @@ int lmb_group_cache_read(const char *dir, const uint8_t key[32], uint32_t g, lmb
     *texels = h.texels;
     *valid_texels = h.valid_texels;
     utime(path, NULL); /* the watch keeps what was used last */
+    return 1;
+}
+
+/* The whole of a file (owned, free()); NULL when it cannot be read. */
+static uint8_t *slurp(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    uint8_t *data = NULL;
+    long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (n >= 0 && fseek(f, 0, SEEK_SET) == 0)
+        data = malloc((size_t)n + 1);
+    if (data && fread(data, 1, (size_t)n, f) != (size_t)n) {
+        free(data);
+        data = NULL;
+    }
+    fclose(f);
+    *size = data ? (size_t)n : 0;
+    return data;
+}
+
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
+                                const lmb_log *log)
+{
+    char path[4200];
+    files_path(dir, key, a, path, sizeof path);
+    size_t sizes[2] = {0, 0};
+    uint8_t *data[2] = {slurp(paths[0], &sizes[0]), slurp(paths[1], &sizes[1])};
+    uint64_t head[2] = {sizes[0], sizes[1]};
+    lmb_part_piece pieces[3] = {{head, sizeof head}, {data[0], sizes[0]}, {data[1], sizes[1]}};
+    lmb_part_identity id;
+    cache_identity(key, &id);
+    lmb_part_place place = {LMB_PART_STATE, a, 0, 1};
+    lmb_error e = {LMB_OK, ""};
+    lmb_status st = data[0] && data[1] ? lmb_part_write_pieces(path, &id, &place, pieces, 3, &e)
+                                       : lmb_error_set(&e, LMB_ERR_INTERNAL, "%s: cannot read the group's files", path);
+    if (st != LMB_OK)
+        lmb_warn(log, "light group cache: %s (the next bake encodes this group's files again)", e.message);
+    free(data[0]);
+    free(data[1]);
+}
+
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
+                               const lmb_log *log)
+{
+    char path[4200];
+    files_path(dir, key, a, path, sizeof path);
+    FILE *exists = fopen(path, "rb");
+    if (!exists)
+        return 0;
+    fclose(exists);
+    lmb_part_identity id;
+    cache_identity(key, &id);
+    lmb_part_place want = {LMB_PART_STATE, a, 0, 1}, got;
+    lmb_part_view view;
+    lmb_error e = {LMB_OK, ""};
+    uint64_t head[2] = {0, 0};
+    int ok = lmb_part_map(path, &id, &want, &got, &view, &e) == LMB_OK;
+    if (ok) {
+        ok = view.body_length >= sizeof head;
+        if (ok)
+            memcpy(head, view.body, sizeof head);
+        ok = ok && head[0] <= view.body_length && head[1] == view.body_length - sizeof head - head[0];
+        if (!ok)
+            snprintf(e.message, sizeof e.message, "%.900s: not a group's files", path);
+        const uint8_t *at = view.body + sizeof head;
+        for (int k = 0; k < 2 && ok; k++) {
+            FILE *f = fopen(paths[k], "wb");
+            ok = f && fwrite(at, 1, head[k], f) == head[k];
+            if (f && fclose(f) != 0)
+                ok = 0;
+            if (!ok)
+                snprintf(e.message, sizeof e.message, "cannot write %.900s", paths[k]);
+            at += head[k];
+        }
+        lmb_part_unmap(&view);
+    }
+    if (!ok) {
+        lmb_warn(log, "light group cache: %s; encoding the group's files instead", e.message);
+        return 0;
+    }
+    utime(path, NULL);
     return 1;
 }

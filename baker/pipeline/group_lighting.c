@@ -6,6 +6,7 @@
 #include "util/lmb_math.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -227,7 +228,9 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
             free(d);
             return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
         }
-        for (size_t i = 0; i < n; i++) {
+        int threads = cache->threads > 0 ? (int)cache->threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(threads) schedule(static)
+        for (size_t i = 0; i < n; i++) { /* each texel on its own: the same floats at any thread count */
             double sum[3] = {0, 0, 0}, v[3] = {0, 0, 0};
             for (uint32_t g = 0; g < G; g++) {
                 const float *eg = gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i;

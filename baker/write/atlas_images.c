@@ -182,6 +182,13 @@ lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const cha
     return st;
 }
 
+void lmb_group_image_paths(const char *dir, const char *stem, uint32_t a, const char *group,
+                           char paths[2][LMB_GROUP_IMAGE_PATH])
+{
+    snprintf(paths[0], LMB_GROUP_IMAGE_PATH, "%s/%s-lightmap-%u-group-%s.exr", dir, stem, a, group);
+    snprintf(paths[1], LMB_GROUP_IMAGE_PATH, "%s/%s-lightmap-%u-group-%s.hdr", dir, stem, a, group);
+}
+
 lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
                                   const char *group, const float *irradiance, uint32_t w, uint32_t h, lmb_error *err)
 {
@@ -189,8 +196,10 @@ lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const 
     if (!rgb)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
     image_job jobs[2] = {{IMAGE_EXR_FLOAT, "", 3, rgb, NULL, {0}, NULL}, {IMAGE_F32, "", 3, rgb, NULL, {0}, NULL}};
-    snprintf(jobs[0].path, sizeof jobs[0].path, "%s/%s-lightmap-%u-group-%s.exr", dir, stem, a, group);
-    snprintf(jobs[1].path, sizeof jobs[1].path, "%s/%s-lightmap-%u-group-%s.hdr", dir, stem, a, group);
+    char paths[2][LMB_GROUP_IMAGE_PATH];
+    lmb_group_image_paths(dir, stem, a, group, paths);
+    for (int k = 0; k < 2; k++)
+        snprintf(jobs[k].path, sizeof jobs[k].path, "%s", paths[k]);
     lmb_status st = write_images(jobs, 2, w, h, image_threads(cfg), err);
     free(rgb);
     return st;

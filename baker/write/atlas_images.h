@@ -46,6 +46,11 @@ lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const 
                                   const char *group, const float *irradiance, uint32_t width, uint32_t height,
                                   lmb_error *err);
 
+/* Those two files' paths in dir: paths[0] the .exr, paths[1] the .hdr. */
+#define LMB_GROUP_IMAGE_PATH 8600
+void lmb_group_image_paths(const char *dir, const char *stem, uint32_t atlas, const char *group,
+                           char paths[2][LMB_GROUP_IMAGE_PATH]);
+
 /* output.shadowmask: <stem>-lightmap-N-shadowmask.png, RGBA8, per channel a light's visibility
  * (4 floats per texel in [0, 1]), linear. */
 lmb_status lmb_write_shadowmask_image(const char *dir, const char *stem, uint32_t atlas, const float *v, uint32_t width,

@@ -224,6 +224,22 @@ def kept_between_bakes(lmbake, work, level, doc):
           and not differ and sorted(os.listdir(again)) == listed,
           "scales (1, 1) then (0.3, 2) with --layout-cache: %d of 2 groups read back, none lit; every one of %d files "
           "the bytes of a bake without the cache%s" % (read_back, len(listed), " (differ: %s)" % differ if differ else ""))
+    # each group's own files kept too (copied, not encoded again); a damaged one is encoded again
+    kept_files = sorted(f for f in os.listdir(cache) if f.endswith("-a0.lmbf")) if os.path.isdir(cache) else []
+    check(len(kept_files) == 2, "each group's own files kept beside its light: %s" % kept_files)
+    for f in kept_files:
+        path = os.path.join(cache, f)
+        data = bytearray(open(path, "rb").read())
+        data[len(data) // 2] ^= 0xFF
+        open(path, "wb").write(data)
+    damaged, p4 = bake(lmbake, work, level, "kept-damaged", groups_config(0.3, 2.0), "--layout-cache", cache, "--log")
+    log = p4.stdout + p4.stderr
+    differ = [f for f in listed if p4.returncode == 0 and (not os.path.exists(os.path.join(damaged, f)) or
+                                                          not filecmp.cmp(os.path.join(fresh, f), os.path.join(damaged, f),
+                                                                          shallow=False))]
+    check(p4.returncode == 0 and log.count("encoding the group's files instead") == 2 and listed and not differ,
+          "the kept files damaged: said, encoded again, every file still the bytes of a bake without the cache%s"
+          % (" (differ: %s)" % differ if differ else ""))
     d = json.loads(json.dumps(doc))
     d["extensions"]["KHR_lights_punctual"]["lights"][1]["intensity"] = 150.0
     edited = os.path.join(os.path.dirname(level), "sun-lamps-edited.gltf")

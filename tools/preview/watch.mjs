@@ -276,7 +276,7 @@ function tidyQuickDirs() {
 
 // Layouts: the four used last (a quick and a final one, before and after a change of layout);
 // lmbake touches a layout it reads back. The gather points' validity kept with a layout
-// (layout-KEY-seedN.lmbv) goes with it.
+// (layout-KEY-seedN.lmbv) and the probes placed with it (layout-KEY-probes.lmbq) go with it.
 function tidyLayouts() {
   let names = [];
   try { names = fs.readdirSync(layoutRoot); } catch { return; }
