@@ -7,6 +7,10 @@
  * lightmap is what a bake of that group's lights alone gives, and no group's sampling reads
  * another's light or any group's scale: the sum at other scales is exact.
  *
+ * A group that holds one light is lit with it at unit intensity and white, then weighed by its
+ * intensity and colour: the light of a single light is linear in both, so an edit of either is a
+ * new weight, and the bake of the edited level composes the same floats.
+ *
  * Which group a source is in: a light's extras.lightmap_group (its own, else its node's); else
  * the first config group whose match its name or node name matches; the sky and the emissive
  * surfaces: the first group with sky: true / emissive: true. What no group claims goes to a
@@ -24,6 +28,11 @@ typedef struct lmb_light_groups {
     uint32_t lights[LMB_MAX_LIGHT_GROUPS]; /* how many of the level's lights each holds */
     int32_t *of_light;                     /* per scene light: its group, -1 (realtime: in none) */
     int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
+    /* A group of one light (neither the sky nor the emissive surfaces) is lit with that light at
+     * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel):
+     * an edit of those is a new weight, not a new lighting. Other groups: weight 1 1 1. */
+    int unit[LMB_MAX_LIGHT_GROUPS];
+    double weight[LMB_MAX_LIGHT_GROUPS][3];
 } lmb_light_groups;
 
 /* The groups of scene s under cfg (after lmb_scene_set_light_modes). has_sky, has_emissive:

@@ -414,13 +414,20 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
             const char *const names[2] = {paths[0], paths[1]};
             lmb_group_image_paths(od.staging, od.stem, a, groups.name[g], paths);
             if (group_light.cached[g] && groups_kept &&
-                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, names, log))
+                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, groups.weight[g], names, log))
                 continue;
-            st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g],
-                                        group_light.irradiance[(size_t)g * l.atlas_count + a], l.width[a], l.height[a],
-                                        err);
+            size_t n = 3 * (size_t)l.width[a] * l.height[a];
+            float *weighed = malloc((n + 1) * sizeof *weighed);
+            if (!weighed)
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
+            if (st == LMB_OK) {
+                lmb_group_weighed(&groups, g, group_light.irradiance[(size_t)g * l.atlas_count + a], n, weighed);
+                st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g], weighed, l.width[a],
+                                            l.height[a], err);
+            }
+            free(weighed);
             if (st == LMB_OK && groups_kept)
-                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, log);
+                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, groups.weight[g], names, log);
         }
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
@@ -438,9 +445,21 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_copy_input_textures(s, &od, log);
         lmb_gltf_probes out_probes;
         st = lmb_probes_output(&probes, cfg, od.staging, od.stem, log, &out_probes, err);
-        for (uint32_t g = 0; st == LMB_OK && !dark && group_light.sh && g < groups.count; g++)
-            st = lmb_probes_output_group(&out_probes, cfg, g, groups.name[g], groups.scale[g], group_light.sh[g],
-                                         group_light.cube[g], err);
+        for (uint32_t g = 0; st == LMB_OK && !dark && group_light.sh && g < groups.count; g++) {
+            size_t n = probes.count;
+            float *sh = group_light.sh[g] ? malloc((n * LMB_PROBE_SH + 1) * sizeof *sh) : NULL;
+            float *cube = group_light.cube[g] ? malloc((n * LMB_PROBE_CUBE + 1) * sizeof *cube) : NULL;
+            if ((group_light.sh[g] && !sh) || (group_light.cube[g] && !cube))
+                st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for %zu probes", n);
+            if (st == LMB_OK && sh) /* the group's probes as its lightmap: weighed */
+                lmb_group_weighed(&groups, g, group_light.sh[g], n * LMB_PROBE_SH, sh);
+            if (st == LMB_OK && cube)
+                lmb_group_weighed(&groups, g, group_light.cube[g], n * LMB_PROBE_CUBE, cube);
+            if (st == LMB_OK)
+                st = lmb_probes_output_group(&out_probes, cfg, g, groups.name[g], groups.scale[g], sh, cube, err);
+            free(sh);
+            free(cube);
+        }
         if (st == LMB_OK)
             st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
                                             cache.shadowmask != NULL, &out_probes, dark ? NULL : &groups, err);

@@ -12,32 +12,6 @@
 
 #define GROUP_CACHE_FORMAT 1u
 
-lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, const lmb_light_groups *groups,
-                                uint8_t (*keys)[32], lmb_error *err)
-{
-    lmb_config bare = *cfg; /* the scales only weigh the groups' sum: no group's light reads them */
-    for (uint32_t k = 0; k < bare.light_group_count; k++)
-        bare.light_groups[k].scale = 1;
-    lmb_part_identity id;
-    lmb_status st = lmb_part_identity_make(scene, &bare, &id, err);
-    if (st != LMB_OK)
-        return st;
-    for (uint32_t g = 0; g < groups->count; g++) {
-        uint8_t all[32 + 64 + 32 + 32 + 4 + LMB_PATTERN_LEN];
-        memset(all, 0, sizeof all);
-        memcpy(all, id.version, sizeof id.version);
-        memcpy(all + 32, id.input, 32);
-        memcpy(all + 64, id.config, 32);
-        uint32_t format = GROUP_CACHE_FORMAT;
-        memcpy(all + 128, &format, 4);
-        memcpy(all + 132, &g, 4);
-        memcpy(all + 136, groups->name[g], strnlen(groups->name[g], LMB_PATTERN_LEN - 1));
-        lmb_sha256(all, sizeof all, keys[g]);
-    }
-    lmb_part_identity_free(&id);
-    return LMB_OK;
-}
-
 static void cache_path(const char *dir, const uint8_t key[32], char *path, size_t size)
 {
     char hex[33];
@@ -230,15 +204,21 @@ static uint8_t *slurp(const char *path, size_t *size)
     return data;
 }
 
-void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                                const lmb_log *log)
+/* The body: the files' weight and sizes, then the two files. */
+typedef struct files_header {
+    double weight[3];
+    uint64_t size[2];
+} files_header;
+
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
+                                const char *const paths[2], const lmb_log *log)
 {
     char path[4200];
     files_path(dir, key, a, path, sizeof path);
     size_t sizes[2] = {0, 0};
     uint8_t *data[2] = {slurp(paths[0], &sizes[0]), slurp(paths[1], &sizes[1])};
-    uint64_t head[2] = {sizes[0], sizes[1]};
-    lmb_part_piece pieces[3] = {{head, sizeof head}, {data[0], sizes[0]}, {data[1], sizes[1]}};
+    files_header head = {{weight[0], weight[1], weight[2]}, {sizes[0], sizes[1]}};
+    lmb_part_piece pieces[3] = {{&head, sizeof head}, {data[0], sizes[0]}, {data[1], sizes[1]}};
     lmb_part_identity id;
     cache_identity(key, &id);
     lmb_part_place place = {LMB_PART_STATE, a, 0, 1};
@@ -251,8 +231,8 @@ void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t
     free(data[1]);
 }
 
-int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                               const lmb_log *log)
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
+                               const char *const paths[2], const lmb_log *log)
 {
     char path[4200];
     files_path(dir, key, a, path, sizeof path);
@@ -265,27 +245,32 @@ int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t 
     lmb_part_place want = {LMB_PART_STATE, a, 0, 1}, got;
     lmb_part_view view;
     lmb_error e = {LMB_OK, ""};
-    uint64_t head[2] = {0, 0};
-    int ok = lmb_part_map(path, &id, &want, &got, &view, &e) == LMB_OK;
+    files_header head;
+    memset(&head, 0, sizeof head);
+    int ok = lmb_part_map(path, &id, &want, &got, &view, &e) == LMB_OK, other_weight = 0;
     if (ok) {
         ok = view.body_length >= sizeof head;
         if (ok)
-            memcpy(head, view.body, sizeof head);
-        ok = ok && head[0] <= view.body_length && head[1] == view.body_length - sizeof head - head[0];
+            memcpy(&head, view.body, sizeof head);
+        ok = ok && head.size[0] <= view.body_length - sizeof head &&
+             head.size[1] == view.body_length - sizeof head - head.size[0];
         if (!ok)
             snprintf(e.message, sizeof e.message, "%.900s: not a group's files", path);
+        other_weight = ok && memcmp(head.weight, weight, sizeof head.weight) != 0;
         const uint8_t *at = view.body + sizeof head;
-        for (int k = 0; k < 2 && ok; k++) {
+        for (int k = 0; k < 2 && ok && !other_weight; k++) {
             FILE *f = fopen(paths[k], "wb");
-            ok = f && fwrite(at, 1, head[k], f) == head[k];
+            ok = f && fwrite(at, 1, head.size[k], f) == head.size[k];
             if (f && fclose(f) != 0)
                 ok = 0;
             if (!ok)
                 snprintf(e.message, sizeof e.message, "cannot write %.900s", paths[k]);
-            at += head[k];
+            at += head.size[k];
         }
         lmb_part_unmap(&view);
     }
+    if (other_weight) /* the light's intensity or colour edited: the files are the group's light weighed anew */
+        return 0;
     if (!ok) {
         lmb_warn(log, "light group cache: %s; encoding the group's files instead", e.message);
         return 0;

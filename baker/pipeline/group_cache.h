@@ -8,8 +8,10 @@
  * threads to 0, and the group's place and name. A later bake whose group has the same key reads
  * it back instead of lighting it: a change of the groups' scales relights at once, and the files
  * are those a bake without the cache writes, byte for byte (the same composition runs on the
- * same floats). A change of the glTF (a light moved or dimmed) or of any other config key lights
- * every group again.
+ * same floats). The key holds of the glTF everything but the punctual lights the group does not
+ * hold (group_key.c): another group's light edited or moved, or the intensity or colour of the
+ * light a unit group holds, keeps it; any other change of the glTF or of a config key lights the
+ * group again.
  */
 #ifndef LMBAKE_GROUP_CACHE_H
 #define LMBAKE_GROUP_CACHE_H
@@ -36,12 +38,13 @@ void lmb_group_cache_write(const char *dir, const uint8_t key[32], uint32_t g, c
  * lmb_write_group_images wrote them into the output's staging folder) kept in DIR beside its
  * light: they are the same bytes at any scales, and a later bake that reads the group back copies
  * them instead of encoding them again. A file that cannot be kept is said on the log. */
-void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                                const lmb_log *log);
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
+                                const char *const paths[2], const lmb_log *log);
 
-/* The files kept for that group and atlas written to paths: 1 when they were kept whole, 0 when
- * not (then they are to be encoded; a damaged file is said on the log). */
-int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                               const lmb_log *log);
+/* The files kept for that group and atlas written to paths: 1 when they were kept whole at this
+ * weight (lmb_light_groups.weight: a unit group's files hold its light's intensity x colour), 0
+ * when not (then they are to be encoded; a damaged file is said on the log). */
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
+                               const char *const paths[2], const lmb_log *log);
 
 #endif

@@ -99,21 +99,36 @@ static lmb_status keep_group(const lmb_group_env *env, uint32_t g, int dark, con
     return LMB_OK;
 }
 
+/* What group g's lighting changes of a light, to put back. */
+typedef struct saved_light {
+    lmb_light_mode mode;
+    float intensity, color[3];
+} saved_light;
+
 /* The lights of the level that are not in group g are left out while it is lit (as realtime
- * lights are); saved: the modes to put back. */
-static void only_group(lmb_scene *s, const lmb_light_groups *groups, uint32_t g, lmb_light_mode *saved)
+ * lights are); a unit group's light shines at intensity 1 and white (lmb_light_groups.unit: its
+ * intensity and colour are the group's weight). saved: what to put back. */
+static void only_group(lmb_scene *s, const lmb_light_groups *groups, uint32_t g, saved_light *saved)
 {
     for (uint32_t i = 0; i < s->light_count; i++) {
-        saved[i] = s->lights[i].mode;
+        lmb_light *l = &s->lights[i];
+        saved[i] = (saved_light){l->mode, l->intensity, {l->color[0], l->color[1], l->color[2]}};
         if (groups->of_light[i] != (int32_t)g)
-            s->lights[i].mode = LMB_LIGHT_REALTIME;
+            l->mode = LMB_LIGHT_REALTIME;
+        else if (groups->unit[g]) {
+            l->intensity = 1.0f;
+            l->color[0] = l->color[1] = l->color[2] = 1.0f;
+        }
     }
 }
 
-static void restore_modes(lmb_scene *s, const lmb_light_mode *saved)
+static void restore_lights(lmb_scene *s, const saved_light *saved)
 {
-    for (uint32_t i = 0; i < s->light_count; i++)
-        s->lights[i].mode = saved[i];
+    for (uint32_t i = 0; i < s->light_count; i++) {
+        s->lights[i].mode = saved[i].mode;
+        s->lights[i].intensity = saved[i].intensity;
+        memcpy(s->lights[i].color, saved[i].color, sizeof saved[i].color);
+    }
 }
 
 /* Group g: its lights alone through the lighting passes and the probes. */
@@ -155,7 +170,7 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
     lmb_status st = env->keep ? light_alloc(out, groups->count, env->cache->atlas_count, env->cfg->directional,
                                             env->probes != NULL, err)
                               : LMB_OK;
-    lmb_light_mode *saved = malloc(((size_t)s->light_count + 1) * sizeof *saved);
+    saved_light *saved = malloc(((size_t)s->light_count + 1) * sizeof *saved);
     if (st == LMB_OK && !saved)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
     uint32_t probes = env->probes ? env->probes->count : 0;
@@ -182,7 +197,7 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
         only_group(s, groups, g, saved);
         if (st == LMB_OK)
             st = light_group(env, groups, g, gs, records, &dark, err);
-        restore_modes(s, saved);
+        restore_lights(s, saved);
         if (g)
             stats->rays += other.rays;
         if (st == LMB_OK && env->keep)
@@ -233,7 +248,8 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
         for (size_t i = 0; i < n; i++) { /* each texel on its own: the same floats at any thread count */
             double sum[3] = {0, 0, 0}, v[3] = {0, 0, 0};
             for (uint32_t g = 0; g < G; g++) {
-                const float *eg = gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i;
+                float eg[3]; /* the group's light as its own files hold it (lmb_group_weighed) */
+                lmb_group_weighed(groups, g, gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i, 3, eg);
                 for (int c = 0; c < 3; c++)
                     sum[c] += groups->scale[g] * (double)eg[c];
                 if (d) {
@@ -264,18 +280,26 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
         }
     }
     for (uint32_t p = 0; gl->sh && probes && p < probes->count; p++) {
-        for (int k = 0; k < LMB_PROBE_SH; k++) {
-            double v = 0;
-            for (uint32_t g = 0; g < G; g++)
-                v += groups->scale[g] * (double)gl->sh[g][(size_t)p * LMB_PROBE_SH + k];
-            probes->sh[(size_t)p * LMB_PROBE_SH + k] = (float)v;
+        double sh[LMB_PROBE_SH] = {0}, cube[LMB_PROBE_CUBE] = {0};
+        for (uint32_t g = 0; g < G; g++) {
+            float gs[LMB_PROBE_SH], gc[LMB_PROBE_CUBE];
+            lmb_group_weighed(groups, g, gl->sh[g] + (size_t)p * LMB_PROBE_SH, LMB_PROBE_SH, gs);
+            lmb_group_weighed(groups, g, gl->cube[g] + (size_t)p * LMB_PROBE_CUBE, LMB_PROBE_CUBE, gc);
+            for (int k = 0; k < LMB_PROBE_SH; k++)
+                sh[k] += groups->scale[g] * (double)gs[k];
+            for (int k = 0; k < LMB_PROBE_CUBE; k++)
+                cube[k] += groups->scale[g] * (double)gc[k];
         }
-        for (int k = 0; k < LMB_PROBE_CUBE; k++) {
-            double v = 0;
-            for (uint32_t g = 0; g < G; g++)
-                v += groups->scale[g] * (double)gl->cube[g][(size_t)p * LMB_PROBE_CUBE + k];
-            probes->cube[(size_t)p * LMB_PROBE_CUBE + k] = (float)v;
-        }
+        for (int k = 0; k < LMB_PROBE_SH; k++)
+            probes->sh[(size_t)p * LMB_PROBE_SH + k] = (float)sh[k];
+        for (int k = 0; k < LMB_PROBE_CUBE; k++)
+            probes->cube[(size_t)p * LMB_PROBE_CUBE + k] = (float)cube[k];
     }
     return LMB_OK;
+}
+
+void lmb_group_weighed(const lmb_light_groups *groups, uint32_t g, const float *rgb, size_t n, float *out)
+{
+    for (size_t k = 0; k < n; k++)
+        out[k] = (float)(groups->weight[g][k % 3] * (double)rgb[k]);
 }

@@ -90,6 +90,23 @@ static void hash_sky_image(const lmb_config *cfg, struct sha256_ctx *c)
     hash_file(folder, cfg->sky_image, c);
 }
 
+void lmb_part_input_hash(const lmb_scene *scene, const lmb_config *cfg, const void *file, size_t size, uint8_t out[32])
+{
+    struct sha256_ctx c;
+    sha256_init(&c);
+    sha256_update(&c, size, (const uint8_t *)file);
+    const lmb_gltf_view *v = lmb_gltf_get_view(scene->doc);
+    for (uint32_t b = 0; b < v->buffer_count; b++) { /* as loaded: external files and data URIs */
+        uint64_t n = v->buffers[b].size;
+        sha256_update(&c, sizeof n, (const uint8_t *)&n);
+        if (n)
+            sha256_update(&c, n, v->buffers[b].data);
+    }
+    hash_image_files(scene, &c);
+    hash_sky_image(cfg, &c);
+    sha256_digest(&c, 32, out);
+}
+
 lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg, lmb_part_identity *id,
                                   lmb_error *err)
 {
@@ -100,20 +117,9 @@ lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg,
     lmb_status st = lmb_read_file(scene->path, "input", &file, &size, err);
     if (st != LMB_OK)
         return st;
-    struct sha256_ctx c;
-    sha256_init(&c);
-    sha256_update(&c, size, (const uint8_t *)file);
+    lmb_part_input_hash(scene, cfg, file, size, id->input);
     free(file);
-    const lmb_gltf_view *v = lmb_gltf_get_view(scene->doc);
-    for (uint32_t b = 0; b < v->buffer_count; b++) { /* as loaded: external files and data URIs */
-        uint64_t n = v->buffers[b].size;
-        sha256_update(&c, sizeof n, (const uint8_t *)&n);
-        if (n)
-            sha256_update(&c, n, v->buffers[b].data);
-    }
-    hash_image_files(scene, &c);
-    hash_sky_image(cfg, &c);
-    sha256_digest(&c, 32, id->input);
+    struct sha256_ctx c;
     lmb_config bare = *cfg;
     bare.threads = 0;
     size_t n = lmb_config_write(&bare, NULL, 0);

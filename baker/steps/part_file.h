@@ -51,6 +51,11 @@ lmb_status lmb_part_identity_make(const lmb_scene *scene, const lmb_config *cfg,
                                   lmb_error *err);
 void lmb_part_identity_free(lmb_part_identity *id);
 
+/* The identity's input hash with the glTF file's bytes given instead of read from scene->path
+ * (then every buffer as loaded, every image file the glTF references, the config's sky image):
+ * a light group's key hashes the file with the lights it does not hold taken out. */
+void lmb_part_input_hash(const lmb_scene *scene, const lmb_config *cfg, const void *file, size_t size, uint8_t out[32]);
+
 /* Writes path (via path.tmp-HOST-PID and rename). */
 lmb_status lmb_part_write(const char *path, const lmb_part_identity *id, const lmb_part_place *place,
                           const void *body, size_t body_length, lmb_error *err);

@@ -17,7 +17,9 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
     the per-texel rms difference within 1.5x that between two seeds of the plain bake (+0.2%);
   - the glTF names each group's name, scale and files on every lightmap texture and node;
   - kept between bakes (--layout-cache, the watch's): a bake at new scales reads every group back and
-    writes the bytes of a bake without the cache; an edit of a light in the glTF lights them again;
+    writes the bytes of a bake without the cache; so does an edit of the sun's intensity and colour
+    (alone in its group: its weight) and the sun switched off; an edit or a move of a lamp lights
+    the lamps' group again and reads the sun's back; every time the bytes of a bake without it;
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
     a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string.
@@ -240,15 +242,49 @@ def kept_between_bakes(lmbake, work, level, doc):
     check(p4.returncode == 0 and log.count("encoding the group's files instead") == 2 and listed and not differ,
           "the kept files damaged: said, encoded again, every file still the bytes of a bake without the cache%s"
           % (" (differ: %s)" % differ if differ else ""))
-    d = json.loads(json.dumps(doc))
-    d["extensions"]["KHR_lights_punctual"]["lights"][1]["intensity"] = 150.0
-    edited = os.path.join(os.path.dirname(level), "sun-lamps-edited.gltf")
-    with open(edited, "w") as f:
-        json.dump(d, f)
-    out, p3 = bake(lmbake, work, edited, "kept-edited", groups_config(0.3, 2.0), "--layout-cache", cache, "--log")
-    log = p3.stdout + p3.stderr
-    check(p3.returncode == 0 and log.count("): lighting") == 2 and "read back from the cache" not in log,
-          "lamp_a 200 -> 150 cd in the glTF: both groups lit again (%d), none read back" % log.count("): lighting"))
+    # edits of the glTF's lights: the sun is alone in its group (lit at unit intensity and white,
+    # weighed by its intensity x colour), the lamps share theirs
+    lights = doc["extensions"]["KHR_lights_punctual"]["lights"]
+    sun = next(i for i, l in enumerate(lights) if l["name"] == "sun")
+    lamp_a = next(i for i, l in enumerate(lights) if l["name"] == "lamp_a")
+
+    def edited_bake(name, what, edit, lit, read):
+        d = json.loads(json.dumps(doc))
+        edit(d)
+        edited = os.path.join(os.path.dirname(level), "sun-lamps-%s.gltf" % name)
+        with open(edited, "w") as f:
+            json.dump(d, f)
+        out, p = bake(lmbake, work, edited, "kept-" + name, groups_config(0.3, 2.0), "--layout-cache", cache, "--log")
+        plain, pp = bake(lmbake, work, edited, "plain-" + name, groups_config(0.3, 2.0))
+        log = p.stdout + p.stderr
+        names = sorted(os.listdir(plain)) if pp.returncode == 0 else []
+        differ = [f for f in names if p.returncode != 0 or not os.path.exists(os.path.join(out, f)) or
+                  not filecmp.cmp(os.path.join(plain, f), os.path.join(out, f), shallow=False)]
+        check(p.returncode == 0 and log.count("): lighting") == lit and log.count("read back from the cache") == read
+              and names and not differ,
+              "%s: %d group(s) lit again, %d read back (want %d, %d); every one of %d files the bytes of a bake "
+              "without the cache%s" % (what, log.count("): lighting"), log.count("read back from the cache"), lit, read,
+                                       len(names), " (differ: %s)" % differ if differ else ""))
+
+    def brighter_warmer_sun(d):
+        d["extensions"]["KHR_lights_punctual"]["lights"][sun]["intensity"] *= 2.5
+        d["extensions"]["KHR_lights_punctual"]["lights"][sun]["color"] = [1.0, 0.85, 0.7]
+    edited_bake("sun-tinted", "the sun x 2.5 and tinted in the glTF (alone in its group)", brighter_warmer_sun, 0, 2)
+
+    def sun_off(d):
+        d["extensions"]["KHR_lights_punctual"]["lights"][sun]["intensity"] = 0.0
+    edited_bake("sun-off", "the sun switched off (intensity 0)", sun_off, 0, 2)
+
+    def dim_lamp_a(d):
+        d["extensions"]["KHR_lights_punctual"]["lights"][lamp_a]["intensity"] = 150.0
+    edited_bake("lamp-a-150", "lamp_a 200 -> 150 cd (its group holds lamp_b too)", dim_lamp_a, 1, 1)
+
+    def move_lamp_b(d):
+        lamp_b = next(i for i, l in enumerate(lights) if l["name"] == "lamp_b")
+        node = next(n for n in d["nodes"] if n.get("extensions", {}).get("KHR_lights_punctual", {}).get("light") == lamp_b)
+        node["translation"] = [t + 0.5 for t in node.get("translation", [0, 0, 0])]
+        node["name"] = "lamp_b moved"
+    edited_bake("lamp-b-moved", "lamp_b moved 0.5 m on each axis", move_lamp_b, 1, 1)
 
 
 def extras_group(lmbake, work, level, doc):
