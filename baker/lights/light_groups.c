@@ -114,10 +114,14 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
             lmb_light_groups_free(out);
             return LMB_ERR_INPUT;
         }
+    /* unit groups: one light alone; or the config's sky alone (sky.intensity its weight: a
+     * sky from the file's image-based light is lit as it is) */
     for (uint32_t k = 0; k < out->count; k++) {
-        out->unit[k] = out->lights[k] == 1 && out->sky != (int32_t)k && out->emissive != (int32_t)k;
+        int sky_alone = out->sky == (int32_t)k && !out->lights[k] && out->emissive != (int32_t)k &&
+                        cfg->sky_intensity > 0;
+        out->unit[k] = sky_alone || (out->lights[k] == 1 && out->sky != (int32_t)k && out->emissive != (int32_t)k);
         for (int c = 0; c < 3; c++)
-            out->weight[k][c] = 1.0;
+            out->weight[k][c] = sky_alone ? cfg->sky_intensity : 1.0;
         for (uint32_t i = 0; out->unit[k] && i < s->light_count; i++)
             if (out->of_light[i] == (int32_t)k)
                 for (int c = 0; c < 3; c++)
@@ -135,6 +139,7 @@ void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, cons
                 snprintf(first, sizeof first, " ('%s'%s)", s->lights[i].name, g->lights[k] > 1 ? ", ..." : "");
         lmb_info(log, "light group '%s': %u light(s)%s%s%s, scale %g%s", g->name[k], g->lights[k], first,
                  g->sky == (int32_t)k ? ", the sky" : "", g->emissive == (int32_t)k ? ", the emissive surfaces" : "",
-                 g->scale[k], g->unit[k] ? " (lit at unit intensity, weighed by the light's intensity x colour)" : "");
+                 g->scale[k], !g->unit[k] ? "" : g->sky == (int32_t)k ? " (lit at unit intensity, weighed by sky.intensity)"
+                                                 : " (lit at unit intensity, weighed by the light's intensity x colour)");
     }
 }

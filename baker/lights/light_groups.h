@@ -29,8 +29,9 @@ typedef struct lmb_light_groups {
     int32_t *of_light;                     /* per scene light: its group, -1 (realtime: in none) */
     int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
     /* A group of one light (neither the sky nor the emissive surfaces) is lit with that light at
-     * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel):
-     * an edit of those is a new weight, not a new lighting. Other groups: weight 1 1 1. */
+     * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel);
+     * a group of the config's sky alone is lit at sky.intensity 1 and weighed by it: an edit of
+     * those is a new weight, not a new lighting. Other groups: weight 1 1 1. */
     int unit[LMB_MAX_LIGHT_GROUPS];
     double weight[LMB_MAX_LIGHT_GROUPS][3];
 } lmb_light_groups;

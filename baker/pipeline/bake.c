@@ -200,6 +200,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_emitters *em = NULL;
     lmb_direct *direct = NULL;
     lmb_sky *sky = NULL;
+    lmb_sky *unit_sky = NULL; /* the sky of a unit light group: sky.intensity 1 (its weight, after) */
     lmb_textures tx;
     lmb_cache cache;
     lmb_ic_points records = {NULL, 0};
@@ -313,9 +314,14 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         if (!probes_read)
             st = lmb_probes_place(s, &l, cfg, &rt, shard ? NULL : log, &probes, err);
     }
+    if (st == LMB_OK && groups.count && !dark && groups.sky >= 0 && groups.unit[groups.sky]) {
+        lmb_sky_options unit_opt = lmb_sky_options_of(cfg);
+        unit_opt.intensity = 1;
+        st = lmb_sky_create(&unit_opt, s, NULL, &unit_sky, err);
+    }
     if (st == LMB_OK && groups.count && !dark) { /* each group's lighting and probes on its own */
         lmb_lighting_hooks group_hooks = {progress, user, NULL, NULL};
-        lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, sky, &cache, steps, &group_hooks,
+        lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, unit_sky ? unit_sky : sky, &cache, steps, &group_hooks,
                             validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard,
                             groups_kept, shard ? NULL : log};
         st = lmb_group_lighting(&ge, &groups, stats, &records, &group_light, err);
@@ -377,6 +383,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     direct = NULL;
     lmb_sky_free(sky);
     sky = NULL;
+    lmb_sky_free(unit_sky);
+    unit_sky = NULL;
     lmb_emitters_free(em);
     em = NULL;
     lmb_textures_free(&tx);
@@ -487,6 +495,7 @@ done:
     lmb_probe_set_free(&probes);
     lmb_direct_free(direct);
     lmb_sky_free(sky);
+    lmb_sky_free(unit_sky);
     lmb_emitters_free(em);
     lmb_textures_free(&tx);
     lmb_rt_free(&rt);

@@ -1,16 +1,21 @@
 /*
  * A light group's cache key (group_cache.h, lmb_group_cache_keys): a SHA-256 of what decides the
  * group's light and of nothing else, so that a bake reads back every group an edit leaves as it
- * was. It holds lmbake's version; the glTF's JSON with every punctual light taken out (the
- * lights' definitions, each node's reference to one, and the name, transform and extras of a
- * node that held nothing but a light); the buffers, image files and sky image as the bake reads
- * them (lmb_part_input_hash); the config's text with every group's scale 1; the group's place
- * and name; and the lights the group holds as the bake reads them: type, mode, world position
- * and direction, range, cones, and intensity and colour unless the group is lit at unit
- * intensity (lmb_light_groups.unit: they are its weight, applied after). Another group's light
- * edited, moved or switched off, or a unit group's light dimmed or tinted, keeps the key. A JSON
- * cJSON cannot parse (it parsed for the loader) is hashed as it is: no group is read back
- * wrongly, only lit again.
+ * was. It holds:
+ *   - lmbake's version;
+ *   - the glTF's JSON with every punctual light taken out (the lights' definitions, each node's
+ *     reference to one, and the name, transform and extras of a node that held nothing but a
+ *     light), its buffers and image files as the bake reads them, and the sky image for the
+ *     group that holds the sky (lmb_part_input_hash);
+ *   - the config's text with every group's scale 1; the sky's keys only for the group that holds
+ *     the sky, its sky.intensity 1 when that group is a unit group (then it is its weight);
+ *   - the group's place and name, whether it holds the sky and the emissive surfaces;
+ *   - the lights it holds as the bake reads them: type, mode, world position and direction,
+ *     range, cones, and intensity and colour unless the group is a unit group
+ *     (lmb_light_groups.unit: they are its weight, applied after).
+ * So another group's light or sky edited, a unit group's light dimmed, tinted or switched off,
+ * or a unit group's sky dimmed, keeps the key. A JSON cJSON cannot parse (it parsed for the
+ * loader) is hashed as it is: no group is read back wrongly, only lit again.
  */
 #include "group_cache.h"
 
@@ -104,45 +109,70 @@ static void hash_group_lights(const lmb_scene *s, const lmb_light_groups *groups
     }
 }
 
+/* The config as group g's light reads it: every group's scale 1 (the scales only weigh the sum);
+ * the sky's keys as a level without a sky has them unless g holds the sky, and sky.intensity 1
+ * when g is the sky's unit group (it is g's weight). */
+static void group_config(const lmb_config *cfg, const lmb_light_groups *groups, uint32_t g, lmb_config *out)
+{
+    *out = *cfg;
+    for (uint32_t k = 0; k < out->light_group_count; k++)
+        out->light_groups[k].scale = 1;
+    if (groups->sky != (int32_t)g) {
+        lmb_config d;
+        lmb_config_default(&d);
+        out->sky_intensity = d.sky_intensity;
+        out->sky_rotation = d.sky_rotation;
+        out->sky_cosine_only = d.sky_cosine_only;
+        memcpy(out->sky_color, d.sky_color, sizeof d.sky_color);
+        memcpy(out->sky_ground, d.sky_ground, sizeof d.sky_ground);
+        memcpy(out->sky_up, d.sky_up, sizeof d.sky_up);
+        memcpy(out->sky_image, d.sky_image, sizeof d.sky_image);
+    } else if (groups->unit[g]) {
+        out->sky_intensity = 1;
+    }
+}
+
 lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, const lmb_light_groups *groups,
                                 uint8_t (*keys)[32], lmb_error *err)
 {
-    lmb_config bare = *cfg; /* the scales only weigh the groups' sum: no group's light reads them */
-    for (uint32_t k = 0; k < bare.light_group_count; k++)
-        bare.light_groups[k].scale = 1;
-    lmb_part_identity id;
-    lmb_status st = lmb_part_identity_make(scene, &bare, &id, err);
-    char *file = NULL;
-    size_t size = 0;
-    if (st == LMB_OK)
-        st = lmb_read_file(scene->path, "input", &file, &size, err);
-    if (st != LMB_OK) {
-        lmb_part_identity_free(&id);
-        return st;
+    char *file = NULL, *bare_json = NULL;
+    size_t size = 0, len = 0;
+    const char *json = NULL;
+    lmb_status st = lmb_read_file(scene->path, "input", &file, &size, err);
+    if (st == LMB_OK) {
+        json_of(file, size, &json, &len);
+        bare_json = without_lights(json, len);
+        if (bare_json) { /* else the file as it is (the JSON parsed for the loader, not for cJSON) */
+            json = bare_json;
+            len = strlen(bare_json);
+        }
     }
-    const char *json;
-    size_t len;
-    json_of(file, size, &json, &len);
-    char *bare_json = without_lights(json, len);
-    uint8_t input[32];
-    if (bare_json)
-        lmb_part_input_hash(scene, &bare, bare_json, strlen(bare_json), input);
-    else
-        memcpy(input, id.input, sizeof input);
-    free(bare_json);
-    free(file);
-    for (uint32_t g = 0; g < groups->count; g++) {
+    for (uint32_t g = 0; g < groups->count && st == LMB_OK; g++) {
+        lmb_config gc;
+        group_config(cfg, groups, g, &gc);
+        gc.threads = 0; /* as lmb_part_identity_make: the thread count never changes a result */
+        size_t n = lmb_config_write(&gc, NULL, 0);
+        char *text = malloc(n + 1);
+        if (!text) {
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+            break;
+        }
+        lmb_config_write(&gc, text, n + 1);
+        uint8_t input[32];
+        lmb_part_input_hash(scene, &gc, json, len, input); /* the sky image's file: only the sky's group */
         struct sha256_ctx c;
-        uint32_t head[2] = {GROUP_KEY_FORMAT, g};
+        uint32_t head[4] = {GROUP_KEY_FORMAT, g, groups->sky == (int32_t)g, groups->emissive == (int32_t)g};
         sha256_init(&c);
-        sha256_update(&c, sizeof id.version, (const uint8_t *)id.version);
+        sha256_update(&c, sizeof LMB_VERSION_STRING, (const uint8_t *)LMB_VERSION_STRING);
         sha256_update(&c, sizeof input, input);
-        sha256_update(&c, sizeof id.config, id.config);
+        sha256_update(&c, n, (const uint8_t *)text);
         sha256_update(&c, sizeof head, (const uint8_t *)head);
         sha256_update(&c, strlen(groups->name[g]) + 1, (const uint8_t *)groups->name[g]);
         hash_group_lights(scene, groups, g, &c);
         sha256_digest(&c, 32, keys[g]);
+        free(text);
     }
-    lmb_part_identity_free(&id);
-    return LMB_OK;
+    free(bare_json);
+    free(file);
+    return st;
 }

@@ -18,8 +18,9 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - the glTF names each group's name, scale and files on every lightmap texture and node;
   - kept between bakes (--layout-cache, the watch's): a bake at new scales reads every group back and
     writes the bytes of a bake without the cache; so does an edit of the sun's intensity and colour
-    (alone in its group: its weight) and the sun switched off; an edit or a move of a lamp lights
-    the lamps' group again and reads the sun's back; every time the bytes of a bake without it;
+    (alone in its group: its weight), the sun switched off, and sky.intensity with the sky alone
+    in its group; an edit or a move of a lamp lights the lamps' group again and reads the sun's
+    back; every time the bytes of a bake without it;
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
     a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string.
@@ -285,6 +286,24 @@ def kept_between_bakes(lmbake, work, level, doc):
         node["translation"] = [t + 0.5 for t in node.get("translation", [0, 0, 0])]
         node["name"] = "lamp_b moved"
     edited_bake("lamp-b-moved", "lamp_b moved 0.5 m on each axis", move_lamp_b, 1, 1)
+
+    # the config's sky alone in its group: a unit group too, sky.intensity its weight
+    def sky_groups(intensity):
+        return BASE + "sky: {intensity: %r}\noutput:\n  light_groups:\n    - {name: sky, sky: true}\n" \
+                      "    - {name: lights, match: \"*\"}\n" % intensity
+    sky_cache = os.path.join(work, "kept-sky")
+    shutil.rmtree(sky_cache, ignore_errors=True)
+    _, s1 = bake(lmbake, work, level, "sky-400-kept", sky_groups(400.0), "--layout-cache", sky_cache, "--log")
+    kept_out, s2 = bake(lmbake, work, level, "sky-150-kept", sky_groups(150.0), "--layout-cache", sky_cache, "--log")
+    fresh_out, s3 = bake(lmbake, work, level, "sky-150", sky_groups(150.0))
+    log1, log2 = s1.stdout + s1.stderr, s2.stdout + s2.stderr
+    names = sorted(os.listdir(fresh_out)) if s3.returncode == 0 else []
+    differ = [f for f in names if s2.returncode != 0 or not os.path.exists(os.path.join(kept_out, f)) or
+              not filecmp.cmp(os.path.join(fresh_out, f), os.path.join(kept_out, f), shallow=False)]
+    check(s1.returncode == 0 and "weighed by sky.intensity" in log1 and s2.returncode == 0 and
+          log2.count("read back from the cache") == 2 and "): lighting" not in log2 and names and not differ,
+          "sky.intensity 400 -> 150 (the sky alone in its group): both groups read back; every one of %d files the "
+          "bytes of a bake without the cache%s" % (len(names), " (differ: %s)" % differ if differ else ""))
 
 
 def extras_group(lmbake, work, level, doc):

@@ -118,11 +118,19 @@ function bake(kind, generation, onStage = null) {
     p.on('close', (code) => {
       if (p.cancelled) return resolve({ cancelled: true });
       if (child === p) { child = null; status.baking = null; }
-      if (code === 0) return resolve({ ok: true, dir: out, layoutKept: /^layout: read back/m.test(stdout) });
+      if (code === 0) return resolve({ ok: true, dir: out, layoutKept: /^layout: read back/m.test(stdout), groups: groupsOf(stdout) });
       const errors = stderr.split('\n').filter((l) => /error:/.test(l));
       resolve({ ok: false, error: (errors.length ? errors.join('\n') : stderr.trim().split('\n').slice(-3).join('\n')) || `lmbake exited ${code}` });
     });
   });
+}
+
+// What a bake with light groups did with each group (docs/light-groups.md): read back from the
+// layout cache (a scale, or a unit group's weight: the sum only) or lit; null without groups.
+function groupsOf(log) {
+  const read = (log.match(/^light group '[^']*' \(\d+ of \d+\): read back/gm) || []).length;
+  const lit = (log.match(/^light group '[^']*' \(\d+ of \d+\): lighting/gm) || []).length;
+  return read + lit ? { read, lit } : null;
 }
 
 // The newest state of the files, baked: fingerprint, quick bake, final bake; any step may
@@ -169,7 +177,7 @@ async function bakeNewest() {
     // A quick look is shown at once, composed on the last final where it can be.
     composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
     quickLayoutKept = r.layoutKept;
-    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, refined: null });
+    showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, refined: null, groups: r.groups });
   }
   const quick = opts.quick ? path.join(quickRoot, String(generation)) : null;
   const stagesOf = (kind) => ({ direct: stageDir(generation, kind, 'direct'), bounces: stageDir(generation, kind, 'bounces') });
@@ -182,13 +190,14 @@ async function bakeNewest() {
 }
 
 // A bake (or a revision of one) on screen: /status, the history, the log line, the tidying.
-function showBake({ generation, kind, revision, seen, change, layoutKept, composed, refined }) {
+function showBake({ generation, kind, revision, seen, change, layoutKept, composed, refined, groups = null }) {
   const seconds = (Date.now() - seen) / 1000;
-  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, placesKept: change.placesKept, layoutKept, composedOn: composed, refined };
+  status.shown = { generation, kind, revision, readyAt: Date.now(), seconds, changed: change.what, layout: change.layout, placesKept: change.placesKept, layoutKept, composedOn: composed, refined, groups };
   status.history.push({ generation, kind, revision, seconds, changed: change.what });
   if (status.history.length > 50) status.history.shift();
   status.error = null;
-  const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}`;
+  const relit = groups && groups.read ? `; light groups: ${groups.read} read back${groups.lit ? `, ${groups.lit} lit` : ', none lit'}` : '';
+  const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}${relit}`;
   if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (${refined === 'direct' ? 'the direct light' : 'the bounced light'} at the final's resolution, from final bake ${generation}'s ${refined === 'direct' ? 'direct stage' : 'bounce passes'})`);
   else say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${what}${composed !== null ? `; composed on final bake ${composed}` : ''})`);
   tidyQuickDirs();
