@@ -10,8 +10,8 @@ level-single-10 (11 lights) in three groups: the sun, Lamp 0 alone, the other te
 (each of the first bake's level, not one after the other): Lamp 0 x 2, Lamp 0 tinted, Lamp 0
 off, the sun x 0.5 (each alone in its group: a new weight), the lamps' group scale x 0.5 (the
 config), Lamp 0 moved 2 m (its group lit again). bevy's Cornell box with its emissive ceiling in a
-group: the group's scale x 3, and the ceiling's emissive strength x 3 in the glTF (the group lit
-again). Then the same level under `lmbake preview --watch` (no browser): Lamp 0 x 2 and Lamp 0
+group: the group's scale x 3, and the ceiling's emissive strength x 3 and its colour tinted in the
+glTF (alone in their group: a new weight). Then the same level under `lmbake preview --watch` (no browser): Lamp 0 x 2 and Lamp 0
 moved 2 m saved over the watched file, each timed from the save to the final files on the watch's
 /status, its lightmaps compared with the fresh bake of that edit. About 20 minutes on 2 cores.
 """
@@ -101,6 +101,14 @@ def move_light(name, d):
     return edit
 
 
+def emissive_tint(color):
+    def edit(doc):
+        for m in doc.get("materials", []):
+            if any(m.get("emissiveFactor", [0, 0, 0])):
+                m["emissiveFactor"] = color
+    return edit
+
+
 def emissive_x(k):
     def edit(doc):
         for m in doc.get("materials", []):
@@ -186,7 +194,8 @@ LEVELS = [
       ("Lamp 0 moved 2 m", move_light("Lamp 0", [2.0, 0.0, 0.0]), None)]),
     ("assets/scenes/cornell-box-bevy/CornellBox.glb", ["name: ceiling, emissive: true"],
      [("ceiling's group scale x 3", None, "name: ceiling, emissive: true, scale: 3"),
-      ("emissive strength x 3", emissive_x(3.0), None)]),
+      ("emissive strength x 3", emissive_x(3.0), None),
+      ("emissive colour tinted", emissive_tint([1.0, 0.7, 0.4]), None)]),
 ]
 
 

@@ -19,10 +19,13 @@ typedef struct lmb_emitters lmb_emitters; /* opaque: emissive triangles and thei
 
 /* What the emitters take of the config: emission_sides (lights.emission_sides: front only, or
  * both where the material is double-sided) and scale (lights.emissive_scale, an intensity:
- * multiplies every emissive material's emission; 0: nothing emits). */
+ * multiplies every emissive material's emission; 0: nothing emits). unit: every emissive
+ * triangle emits 1 (times its texture) instead of its material's emission x scale: the
+ * emitters of a unit light group (light_groups.h), whose emission is its weight. */
 typedef struct lmb_emitter_options {
     lmb_emission_sides emission_sides;
     double scale;
+    int unit;
 } lmb_emitter_options;
 
 /* Emissive triangles of every instance; `textures` (may be NULL) holds decoded emissive

@@ -88,7 +88,7 @@ lmb_status lmb_emitters_build(const lmb_scene *s, const lmb_emitter_options *opt
                     x.n[k] = (in->flips_winding ? -c[k] : c[k]) / len;
                 x.area = 0.5 * len;
                 for (int k = 0; k < 3; k++)
-                    x.le[k] = (float)(mat->emissive[k] * opt->scale);
+                    x.le[k] = opt->unit ? 1.0f : (float)(mat->emissive[k] * opt->scale);
                 x.two_sided = opt->emission_sides == LMB_EMIT_MATERIAL && mat->double_sided;
                 x.tex = emitter_texture(tx, mat, pr, f, x.uv);
                 x.instance = i;

@@ -30,6 +30,36 @@ void lmb_light_groups_free(lmb_light_groups *g)
     memset(g, 0, sizeof *g);
 }
 
+/* Whether every emissive surface the bake places emits one radiance le (emissiveFactor x strength
+ * x lights.emissive_scale, as lmb_emitters_build computes it), and their textures cannot tell a
+ * tint from a new power: no emissive texture, or one emissive material alone. Then the emitters'
+ * power CDF is the same at any le, and an emission lit at 1 and weighed by le is exact. */
+static int shared_emission(const lmb_scene *s, double scale, float le[3])
+{
+    int32_t first = -1, textured = 0, same = 1;
+    for (uint32_t i = 0; i < s->instance_count; i++) {
+        const lmb_mesh *m = &s->meshes[s->instances[i].mesh];
+        for (uint32_t p = 0; p < m->primitive_count; p++) {
+            int32_t k = s->primitives[m->first_primitive + p].material;
+            if (k < 0 || !lmb_material_is_emissive(&s->materials[k]))
+                continue;
+            const lmb_material *mat = &s->materials[k];
+            float e[3];
+            for (int c = 0; c < 3; c++)
+                e[c] = (float)(mat->emissive[c] * scale);
+            textured |= mat->emissive_texture.texture >= 0;
+            if (first < 0) {
+                first = k;
+                memcpy(le, e, sizeof e);
+            } else if (k != first) {
+                same &= !memcmp(le, e, sizeof e);
+                same &= !textured;
+            }
+        }
+    }
+    return first >= 0 && same;
+}
+
 lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
                                     lmb_light_groups *out, lmb_error *err)
 {
@@ -114,14 +144,19 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
             lmb_light_groups_free(out);
             return LMB_ERR_INPUT;
         }
-    /* unit groups: one light alone; or the config's sky alone (sky.intensity its weight: a
-     * sky from the file's image-based light is lit as it is) */
+    /* unit groups: one light alone; the config's sky alone (sky.intensity its weight: a sky
+     * from the file's image-based light is lit as it is); the emissive surfaces alone, when
+     * they share one emission (its weight, per channel) */
+    float le[3] = {1, 1, 1};
+    int one_emission = has_emissive && shared_emission(s, cfg->emissive_scale, le);
     for (uint32_t k = 0; k < out->count; k++) {
         int sky_alone = out->sky == (int32_t)k && !out->lights[k] && out->emissive != (int32_t)k &&
                         cfg->sky_intensity > 0;
-        out->unit[k] = sky_alone || (out->lights[k] == 1 && out->sky != (int32_t)k && out->emissive != (int32_t)k);
+        int emission_alone = out->emissive == (int32_t)k && !out->lights[k] && out->sky != (int32_t)k && one_emission;
+        out->unit[k] = sky_alone || emission_alone ||
+                       (out->lights[k] == 1 && out->sky != (int32_t)k && out->emissive != (int32_t)k);
         for (int c = 0; c < 3; c++)
-            out->weight[k][c] = sky_alone ? cfg->sky_intensity : 1.0;
+            out->weight[k][c] = sky_alone ? cfg->sky_intensity : emission_alone ? (double)le[c] : 1.0;
         for (uint32_t i = 0; out->unit[k] && i < s->light_count; i++)
             if (out->of_light[i] == (int32_t)k)
                 for (int c = 0; c < 3; c++)
@@ -139,7 +174,11 @@ void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, cons
                 snprintf(first, sizeof first, " ('%s'%s)", s->lights[i].name, g->lights[k] > 1 ? ", ..." : "");
         lmb_info(log, "light group '%s': %u light(s)%s%s%s, scale %g%s", g->name[k], g->lights[k], first,
                  g->sky == (int32_t)k ? ", the sky" : "", g->emissive == (int32_t)k ? ", the emissive surfaces" : "",
-                 g->scale[k], !g->unit[k] ? "" : g->sky == (int32_t)k ? " (lit at unit intensity, weighed by sky.intensity)"
-                                                 : " (lit at unit intensity, weighed by the light's intensity x colour)");
+                 g->scale[k], !g->unit[k]                ? ""
+                              : g->sky == (int32_t)k      ? " (lit at unit intensity, weighed by sky.intensity)"
+                              : g->emissive == (int32_t)k ? " (lit at unit emission, weighed by the surfaces' emissive "
+                                                            "colour x strength)"
+                                                          : " (lit at unit intensity, weighed by the light's intensity "
+                                                            "x colour)");
     }
 }

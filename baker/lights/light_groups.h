@@ -9,7 +9,8 @@
  *
  * A group that holds one light is lit with it at unit intensity and white, then weighed by its
  * intensity and colour: the light of a single light is linear in both, so an edit of either is a
- * new weight, and the bake of the edited level composes the same floats.
+ * new weight, and the bake of the edited level composes the same floats. So is the config's sky
+ * alone in a group (sky.intensity), and the emissive surfaces alone when they share one emission.
  *
  * Which group a source is in: a light's extras.lightmap_group (its own, else its node's); else
  * the first config group whose match its name or node name matches; the sky and the emissive
@@ -30,8 +31,10 @@ typedef struct lmb_light_groups {
     int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
     /* A group of one light (neither the sky nor the emissive surfaces) is lit with that light at
      * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel);
-     * a group of the config's sky alone is lit at sky.intensity 1 and weighed by it: an edit of
-     * those is a new weight, not a new lighting. Other groups: weight 1 1 1. */
+     * a group of the config's sky alone is lit at sky.intensity 1 and weighed by it; a group of
+     * the emissive surfaces alone, when they share one emission (factor x strength x
+     * lights.emissive_scale; textures only on one material), is lit at emission 1 and weighed by
+     * it: an edit of those is a new weight, not a new lighting. Other groups: weight 1 1 1. */
     int unit[LMB_MAX_LIGHT_GROUPS];
     double weight[LMB_MAX_LIGHT_GROUPS][3];
 } lmb_light_groups;

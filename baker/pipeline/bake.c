@@ -201,6 +201,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     lmb_direct *direct = NULL;
     lmb_sky *sky = NULL;
     lmb_sky *unit_sky = NULL; /* the sky of a unit light group: sky.intensity 1 (its weight, after) */
+    lmb_emitters *unit_em = NULL; /* the emitters of a unit light group: emission 1 (its weight, after) */
     lmb_textures tx;
     lmb_cache cache;
     lmb_ic_points records = {NULL, 0};
@@ -319,9 +320,14 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         unit_opt.intensity = 1;
         st = lmb_sky_create(&unit_opt, s, NULL, &unit_sky, err);
     }
+    if (st == LMB_OK && groups.count && !dark && groups.emissive >= 0 && groups.unit[groups.emissive]) {
+        lmb_emitter_options unit_opt = emitter_opt;
+        unit_opt.unit = 1;
+        st = lmb_emitters_build(s, &unit_opt, &tx, &unit_em, err);
+    }
     if (st == LMB_OK && groups.count && !dark) { /* each group's lighting and probes on its own */
         lmb_lighting_hooks group_hooks = {progress, user, NULL, NULL};
-        lmb_group_env ge = {s, cfg, &direct_opt, &rt, em, unit_sky ? unit_sky : sky, &cache, steps, &group_hooks,
+        lmb_group_env ge = {s, cfg, &direct_opt, &rt, unit_em ? unit_em : em, unit_sky ? unit_sky : sky, &cache, steps, &group_hooks,
                             validity.entry ? &validity : NULL, cfg->direct_of_count ? NULL : &probes, !shard,
                             groups_kept, shard ? NULL : log};
         st = lmb_group_lighting(&ge, &groups, stats, &records, &group_light, err);
@@ -385,6 +391,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     sky = NULL;
     lmb_sky_free(unit_sky);
     unit_sky = NULL;
+    lmb_emitters_free(unit_em);
+    unit_em = NULL;
     lmb_emitters_free(em);
     em = NULL;
     lmb_textures_free(&tx);
@@ -496,6 +504,7 @@ done:
     lmb_direct_free(direct);
     lmb_sky_free(sky);
     lmb_sky_free(unit_sky);
+    lmb_emitters_free(unit_em);
     lmb_emitters_free(em);
     lmb_textures_free(&tx);
     lmb_rt_free(&rt);

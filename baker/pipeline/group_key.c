@@ -6,9 +6,13 @@
  *   - the glTF's JSON with every punctual light taken out (the lights' definitions, each node's
  *     reference to one, and the name, transform and extras of a node that held nothing but a
  *     light), its buffers and image files as the bake reads them, and the sky image for the
- *     group that holds the sky (lmb_part_input_hash);
+ *     group that holds the sky (lmb_part_input_hash); the materials' emission only for a group
+ *     that holds the emissive surfaces and is not a unit group (for the others each emissive
+ *     factor reads [1, 1, 1] and the strength is left out; a unit group hashes which materials
+ *     emit: their emission is its weight);
  *   - the config's text with every group's scale 1; the sky's keys only for the group that holds
  *     the sky, its sky.intensity 1 when that group is a unit group (then it is its weight);
+ *     lights.emissive_scale only for the group of the emissive surfaces, 1 in a unit group;
  *   - the group's place and name, whether it holds the sky and the emissive surfaces;
  *   - the lights it holds as the bake reads them: type, mode, world position and direction,
  *     range, cones, and intensity and colour unless the group is a unit group
@@ -27,7 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GROUP_KEY_FORMAT 2u /* 2: the JSON without punctual lights, the group's own lights */
+#define GROUP_KEY_FORMAT 3u /* 2: the JSON without punctual lights, the group's own lights; 3: emission */
 
 static uint32_t le32(const uint8_t *p)
 {
@@ -59,12 +63,36 @@ static int only_keys(const cJSON *obj, const char *const *names, int count)
     return 1;
 }
 
-/* The JSON text without its punctual lights (owned, free()); NULL when cJSON cannot parse it. */
-static char *without_lights(const char *json, size_t len)
+/* Each material's emission as [1, 1, 1] where it emits (its factor not black), without its
+ * strength: what is left of it when the emission is a weight or not read at all. */
+static void emission_left_out(cJSON *root)
+{
+    const cJSON *materials = cJSON_GetObjectItemCaseSensitive(root, "materials");
+    for (cJSON *m = cJSON_IsArray(materials) ? materials->child : NULL; m; m = m->next) {
+        cJSON *ext = cJSON_GetObjectItemCaseSensitive(m, "extensions");
+        cJSON_DeleteItemFromObjectCaseSensitive(ext, "KHR_materials_emissive_strength");
+        if (ext && !ext->child)
+            cJSON_DeleteItemFromObjectCaseSensitive(m, "extensions");
+        const cJSON *factor = cJSON_GetObjectItemCaseSensitive(m, "emissiveFactor");
+        int emits = 0;
+        for (const cJSON *v = cJSON_IsArray(factor) ? factor->child : NULL; v; v = v->next)
+            emits |= cJSON_IsNumber(v) && v->valuedouble != 0;
+        if (emits) {
+            const double one[3] = {1, 1, 1};
+            cJSON_ReplaceItemInObjectCaseSensitive(m, "emissiveFactor", cJSON_CreateDoubleArray(one, 3));
+        }
+    }
+}
+
+/* The JSON text without its punctual lights, and with emission_left_out when asked (owned,
+ * free()); NULL when cJSON cannot parse it. */
+static char *without_lights(const char *json, size_t len, int no_emission)
 {
     cJSON *root = cJSON_ParseWithLength(json, len);
     if (!root)
         return NULL;
+    if (no_emission)
+        emission_left_out(root);
     cJSON *ext = cJSON_GetObjectItemCaseSensitive(root, "extensions");
     cJSON_DeleteItemFromObjectCaseSensitive(ext, "KHR_lights_punctual");
     const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
@@ -130,24 +158,32 @@ static void group_config(const lmb_config *cfg, const lmb_light_groups *groups, 
     } else if (groups->unit[g]) {
         out->sky_intensity = 1;
     }
+    if (groups->emissive != (int32_t)g) {
+        lmb_config d;
+        lmb_config_default(&d);
+        out->emissive_scale = d.emissive_scale;
+    } else if (groups->unit[g]) {
+        out->emissive_scale = 1;
+    }
 }
 
 lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, const lmb_light_groups *groups,
                                 uint8_t (*keys)[32], lmb_error *err)
 {
-    char *file = NULL, *bare_json = NULL;
-    size_t size = 0, len = 0;
-    const char *json = NULL;
+    char *file = NULL, *bare[2] = {NULL, NULL};
+    size_t size = 0, len[2] = {0, 0};
+    const char *json[2] = {NULL, NULL}; /* [0] the materials' emission as it is, [1] left out */
     lmb_status st = lmb_read_file(scene->path, "input", &file, &size, err);
-    if (st == LMB_OK) {
-        json_of(file, size, &json, &len);
-        bare_json = without_lights(json, len);
-        if (bare_json) { /* else the file as it is (the JSON parsed for the loader, not for cJSON) */
-            json = bare_json;
-            len = strlen(bare_json);
+    for (int k = 0; k < 2 && st == LMB_OK; k++) {
+        json_of(file, size, &json[k], &len[k]);
+        bare[k] = without_lights(json[k], len[k], k);
+        if (bare[k]) { /* else the file as it is (the JSON parsed for the loader, not for cJSON) */
+            json[k] = bare[k];
+            len[k] = strlen(bare[k]);
         }
     }
     for (uint32_t g = 0; g < groups->count && st == LMB_OK; g++) {
+        int emission = groups->emissive == (int32_t)g && !groups->unit[g];
         lmb_config gc;
         group_config(cfg, groups, g, &gc);
         gc.threads = 0; /* as lmb_part_identity_make: the thread count never changes a result */
@@ -159,7 +195,7 @@ lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, c
         }
         lmb_config_write(&gc, text, n + 1);
         uint8_t input[32];
-        lmb_part_input_hash(scene, &gc, json, len, input); /* the sky image's file: only the sky's group */
+        lmb_part_input_hash(scene, &gc, json[!emission], len[!emission], input); /* the sky image: its group's */
         struct sha256_ctx c;
         uint32_t head[4] = {GROUP_KEY_FORMAT, g, groups->sky == (int32_t)g, groups->emissive == (int32_t)g};
         sha256_init(&c);
@@ -169,10 +205,15 @@ lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, c
         sha256_update(&c, sizeof head, (const uint8_t *)head);
         sha256_update(&c, strlen(groups->name[g]) + 1, (const uint8_t *)groups->name[g]);
         hash_group_lights(scene, groups, g, &c);
+        for (uint32_t m = 0; groups->emissive == (int32_t)g && groups->unit[g] && m < scene->material_count; m++) {
+            uint8_t emits = (uint8_t)lmb_material_is_emissive(&scene->materials[m]);
+            sha256_update(&c, 1, &emits);
+        }
         sha256_digest(&c, 32, keys[g]);
         free(text);
     }
-    free(bare_json);
+    free(bare[0]);
+    free(bare[1]);
     free(file);
     return st;
 }

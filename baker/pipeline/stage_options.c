@@ -36,6 +36,6 @@ lmb_sky_options lmb_sky_options_of(const lmb_config *cfg)
 
 lmb_emitter_options lmb_emitter_options_of(const lmb_config *cfg)
 {
-    lmb_emitter_options o = {cfg->emission_sides, cfg->emissive_scale};
+    lmb_emitter_options o = {cfg->emission_sides, cfg->emissive_scale, 0};
     return o;
 }

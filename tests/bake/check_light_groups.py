@@ -18,8 +18,9 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - the glTF names each group's name, scale and files on every lightmap texture and node;
   - kept between bakes (--layout-cache, the watch's): a bake at new scales reads every group back and
     writes the bytes of a bake without the cache; so does an edit of the sun's intensity and colour
-    (alone in its group: its weight), the sun switched off, and sky.intensity with the sky alone
-    in its group; an edit or a move of a lamp lights the lamps' group again and reads the sun's
+    (alone in its group: its weight), the sun switched off, sky.intensity with the sky alone in
+    its group, and an emissive material's strength and colour with the emissive surfaces alone in
+    theirs; an edit or a move of a lamp lights the lamps' group again and reads the sun's
     back; every time the bytes of a bake without it;
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
@@ -304,6 +305,51 @@ def kept_between_bakes(lmbake, work, level, doc):
           log2.count("read back from the cache") == 2 and "): lighting" not in log2 and names and not differ,
           "sky.intensity 400 -> 150 (the sky alone in its group): both groups read back; every one of %d files the "
           "bytes of a bake without the cache%s" % (len(names), " (differ: %s)" % differ if differ else ""))
+
+    # the emissive surfaces alone in their group (one emissive material: its emission the weight)
+    def glowing(factor, strength):
+        d = json.loads(json.dumps(doc))
+        d["materials"].append({"name": "glow", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0]},
+                               "emissiveFactor": factor,
+                               "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": strength}}})
+        d.setdefault("extensionsUsed", []).append("KHR_materials_emissive_strength")
+        cube = next(n["mesh"] for n in d["nodes"] if n.get("name") == "cube")
+        for prim in d["meshes"][cube]["primitives"]:
+            prim["material"] = len(d["materials"]) - 1
+        path = os.path.join(os.path.dirname(level), "sun-lamps-glow-%g.gltf" % strength)
+        with open(path, "w") as f:
+            json.dump(d, f)
+        return path
+    glow_cfg = BASE + "output:\n  light_groups:\n    - {name: glow, emissive: true}\n    - {name: lights, match: \"*\"}\n"
+    glow_cache = os.path.join(work, "kept-glow")
+    shutil.rmtree(glow_cache, ignore_errors=True)
+    first_level, edited_level = glowing([1.0, 0.9, 0.8], 4.0), glowing([0.6, 0.8, 1.0], 12.0)
+    _, e1 = bake(lmbake, work, first_level, "glow-kept", glow_cfg, "--layout-cache", glow_cache, "--log")
+    kept_out, e2 = bake(lmbake, work, edited_level, "glow-tinted-kept", glow_cfg, "--layout-cache", glow_cache, "--log")
+    fresh_out, e3 = bake(lmbake, work, edited_level, "glow-tinted", glow_cfg)
+    log1, log2 = e1.stdout + e1.stderr, e2.stdout + e2.stderr
+    names = sorted(os.listdir(fresh_out)) if e3.returncode == 0 else []
+    differ = [f for f in names if e2.returncode != 0 or not os.path.exists(os.path.join(kept_out, f)) or
+              not filecmp.cmp(os.path.join(fresh_out, f), os.path.join(kept_out, f), shallow=False)]
+    glow_exr = [f for f in names if f.endswith("-group-glow.exr")]
+    bright = glow_exr and read_exr(os.path.join(fresh_out, glow_exr[0])).max() > 0
+    check(e1.returncode == 0 and "weighed by the surfaces' emissive colour x strength" in log1 and e2.returncode == 0
+          and log2.count("read back from the cache") == 2 and "): lighting" not in log2 and names and not differ
+          and bright,
+          "an emissive cube's strength 4 -> 12 and tinted (alone in its group): both groups read back; every one of "
+          "%d files the bytes of a bake without the cache%s" % (len(names), " (differ: %s)" % differ if differ else ""))
+    # lit at emission 1 and weighed: the light of a bake of the emission alone (the lights off)
+    only_out, e4 = bake(lmbake, work, edited_level, "glow-only", BASE + "lights: {intensity_scale: 0}\n")
+    only_exr = [f for f in os.listdir(only_out) if f.endswith("-lightmap-0.exr")] if e4.returncode == 0 else []
+    if glow_exr and only_exr:
+        weighed = read_exr(os.path.join(fresh_out, glow_exr[0]))[..., :3].sum(axis=(0, 1))
+        alone = read_exr(os.path.join(only_out, only_exr[0]))[..., :3].sum(axis=(0, 1))
+        ratio = weighed / np.maximum(alone, 1e-30)
+    else:
+        ratio = np.zeros(3)
+    check(np.all(np.abs(ratio - 1) < 0.01),
+          "the emissive group weighed by its emission = a bake of the emission alone: per-channel sums' ratio %s "
+          "(bound 1%%)" % np.round(ratio, 5).tolist())
 
 
 def extras_group(lmbake, work, level, doc):
