@@ -63,6 +63,8 @@ int bake_args_parse(int argc, char **argv, bake_args *a, const char *help)
             a->preview = 1;
         } else if (cli_is_flag(argv[i], "--quick", NULL)) {
             a->quick = 1;
+        } else if (cli_is_flag(argv[i], "--relight-only", NULL)) {
+            a->relight_only = 1;
         } else if ((r = cli_opt_value(argc, argv, &i, "--direct-of", NULL, &v)) != 0) {
             if (r < 0 || !*v)
                 return cli_usage_error("bake", "--direct-of needs a light's name");
@@ -155,6 +157,8 @@ int bake_args_check_stage(stage_kind stage, bake_args *a, char *plan_path, size_
                                "'lmbake bake' options");
     if (a->plan && a->layout_cache)
         return cli_usage_error(name, "--plan and --layout-cache both give the layout: one or the other");
+    if (a->relight_only && (!a->layout_cache || stage != STAGE_BAKE))
+        return cli_usage_error(name, "--relight-only needs --layout-cache DIR (where the light groups are kept)");
     if (stage != STAGE_BAKE && stage != STAGE_FINISH && a->preview)
         return cli_usage_error(name, "--preview is an option of 'lmbake bake' and 'lmbake finish'");
     if (farm_stage && !a->farm)

@@ -17,6 +17,7 @@ typedef struct bake_args {
     int timings;
     long long threads, seed, rays, method; /* -1: from the config */
     int quiet, reference, preview, print_config, quick;
+    int relight_only; /* --relight-only */
     const char *direct_of[LMB_MAX_DIRECT_OF + 1]; /* --direct-of LIGHT, repeatable */
     uint32_t direct_of_count;
     long long step;               /* -1: not given */

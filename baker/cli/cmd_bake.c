@@ -53,6 +53,10 @@ static const char help[] =
     "                      keep the layout (unwrap, pack) in DIR and read it back when only\n"
     "                      lights, materials, sky or sampling changed (what preview --watch\n"
     "                      does between bakes): the same files, byte for byte\n"
+    "      --relight-only  with --layout-cache and light groups: bake only when the layout\n"
+    "                      and every group's light are kept in DIR (an edit of scales or of\n"
+    "                      a unit group's weight: the sum and the files); else exit 4 before\n"
+    "                      any work, nothing written (preview --watch tries it first)\n"
     "      --print-config  print the effective config (every key, after -c and the options\n"
     "                      above) as YAML that -c reads back, and exit; SCENE may be left out\n"
     "      --timings[=CSV] at the end, per stage: wall time, CPU time over all threads and the\n"
@@ -67,7 +71,8 @@ static const char help[] =
     "Outdoor levels: sky.intensity (nits) or sky.image (an HDR map) gives them a sky, and\n"
     "materials.default.albedo an albedo where the file has no material (docs/sky.md).\n"
     "\n"
-    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error\n";
+    "exit codes: 0 ok, 1 usage error, 2 bad input, 3 internal error, 4 --relight-only and\n"
+    "not every light group kept\n";
 
 /* "bounces: auto, 7 passes + final gather; each pass added 31.2% 18.1% ... of the direct light;
  * ratio 0.79, estimated tail 9.8% of the total added" */
@@ -343,7 +348,7 @@ static int run(int argc, char **argv, stage_kind stage)
                        a.farm, (uint32_t)(a.step > 0 ? a.step : 0), (uint32_t)(a.shard ? a.shard - 1 : 0),
                        (uint32_t)(a.shards ? a.shards : 1), 0, 0,
                        (uint32_t)(a.worker ? a.worker - 1 : 0), (uint32_t)(a.workers ? a.workers : 1),
-                       (double)a.wait_timeout, a.layout_cache, 0, (uint32_t)a.tail_threads};
+                       (double)a.wait_timeout, a.layout_cache, 0, (uint32_t)a.tail_threads, a.relight_only};
     int writes_bake = stage != STAGE_STEP && (stage != STAGE_WORKER || (a.outdir_given && a.worker == 1));
     lmb_bake_stats bs;
     double ts = cli_now();

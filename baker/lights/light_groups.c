@@ -165,20 +165,24 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
     return LMB_OK;
 }
 
+/* One line per group: what it holds, its scale, and a unit group's weight (the watch reads the
+ * lines to say which group an edit relit, and by how much: tools/preview/watch.mjs). */
 void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, const lmb_log *log)
 {
     for (uint32_t k = 0; k < g->count; k++) {
-        char first[160] = "";
+        char first[160] = "", weight[160] = "";
         for (uint32_t i = 0; i < s->light_count && !first[0]; i++)
             if (g->of_light[i] == (int32_t)k)
                 snprintf(first, sizeof first, " ('%s'%s)", s->lights[i].name, g->lights[k] > 1 ? ", ..." : "");
+        if (g->unit[k])
+            snprintf(weight, sizeof weight, " (lit at unit %s, weighed by %s: [%g, %g, %g])",
+                     g->emissive == (int32_t)k ? "emission" : "intensity",
+                     g->sky == (int32_t)k        ? "sky.intensity"
+                     : g->emissive == (int32_t)k ? "the surfaces' emissive colour x strength"
+                                                 : "the light's intensity x colour",
+                     g->weight[k][0], g->weight[k][1], g->weight[k][2]);
         lmb_info(log, "light group '%s': %u light(s)%s%s%s, scale %g%s", g->name[k], g->lights[k], first,
                  g->sky == (int32_t)k ? ", the sky" : "", g->emissive == (int32_t)k ? ", the emissive surfaces" : "",
-                 g->scale[k], !g->unit[k]                ? ""
-                              : g->sky == (int32_t)k      ? " (lit at unit intensity, weighed by sky.intensity)"
-                              : g->emissive == (int32_t)k ? " (lit at unit emission, weighed by the surfaces' emissive "
-                                                            "colour x strength)"
-                                                          : " (lit at unit intensity, weighed by the light's intensity "
-                                                            "x colour)");
+                 g->scale[k], weight);
     }
 }

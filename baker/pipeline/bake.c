@@ -71,6 +71,27 @@ static lmb_status texels_fit_memory(const lmb_config *cfg, uint64_t texels, lmb_
  * none runs (no gather points, no rays, no seams). Each atlas's texels are those the layout
  * lists (coverage.h), marked valid for the mask and the dilation; no texel is tested for lying
  * inside geometry. Directional maps, when asked for, point nowhere (D = 0). */
+/* lmb_farm_run.relight_only: LMB_OK when the layout was read back and every light group is kept
+ * in the layout cache (the bake only sums and writes), else LMB_NOT_KEPT saying what is not. */
+static lmb_status relight_only(const lmb_scene *s, const lmb_config *cfg, const lmb_farm_run *run,
+                               const lmb_light_groups *groups, lmb_error *err)
+{
+    if (!groups->count)
+        return lmb_error_set(err, LMB_NOT_KEPT, "--relight-only: %s has no light groups (output.light_groups)", s->path);
+    if (!run->layout_reused)
+        return lmb_error_set(err, LMB_NOT_KEPT, "--relight-only: the layout is not kept in %s", run->layout_cache);
+    uint8_t(*keys)[32] = malloc((size_t)groups->count * sizeof *keys);
+    if (!keys)
+        return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    lmb_status st = lmb_group_cache_keys(s, cfg, groups, keys, err);
+    for (uint32_t g = 0; g < groups->count && st == LMB_OK; g++)
+        if (!lmb_group_cache_has(run->layout_cache, keys[g]))
+            st = lmb_error_set(err, LMB_NOT_KEPT, "--relight-only: light group '%s' is to be lit (its light is not "
+                               "kept in %s)", groups->name[g], run->layout_cache);
+    free(keys);
+    return st;
+}
+
 static lmb_status dark_atlases(const lmb_scene *s, const lmb_config *cfg, const lmb_layout *l, lmb_cache *cache,
                                lmb_bake_stats *stats, lmb_error *err)
 {
@@ -165,7 +186,7 @@ lmb_status lmb_bake_planned(lmb_scene *s, const lmb_config *cfg, const char *pla
                             lmb_progress_fn progress, void *user, lmb_bake_stats *stats, const lmb_log *log,
                             lmb_error *err)
 {
-    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, NULL, 0, 0};
+    lmb_farm_run run = {LMB_FARM_LOCAL, NULL, 0, 0, 1, 0, 0, 0, 1, 0, NULL, 0, 0, 0};
     return lmb_bake_farm(s, cfg, plan_path, &run, outdir, progress, user, stats, log, err);
 }
 
@@ -269,6 +290,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_light_groups_resolve(s, cfg, sky != NULL, lmb_emitters_count(em) > 0, &groups, err);
     if (st == LMB_OK && groups.count && !shard)
         lmb_light_groups_report(&groups, s, log);
+    if (st == LMB_OK && run->relight_only)
+        st = relight_only(s, cfg, run, &groups, err);
     if (st == LMB_OK)
         st = lmb_cache_init(&cache, s, &l, &rt, &tx, err);
     cache.threads = cfg->threads;

@@ -86,6 +86,16 @@ void lmb_group_cache_write(const char *dir, const uint8_t key[32], uint32_t g, c
     free(pieces);
 }
 
+int lmb_group_cache_has(const char *dir, const uint8_t key[32])
+{
+    char path[4200];
+    cache_path(dir, key, path, sizeof path);
+    FILE *f = fopen(path, "rb");
+    if (f)
+        fclose(f);
+    return f != NULL;
+}
+
 int lmb_group_cache_read(const char *dir, const uint8_t key[32], uint32_t g, lmb_group_light *gl, lmb_cache *cache,
                          uint32_t probes, uint64_t *texels, uint64_t *valid_texels, const lmb_log *log)
 {

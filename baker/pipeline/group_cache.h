@@ -22,6 +22,9 @@
 lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, const lmb_light_groups *groups,
                                 uint8_t (*keys)[32], lmb_error *err);
 
+/* Whether DIR holds a group's light under key (not read: lmb_group_cache_read checks it whole). */
+int lmb_group_cache_has(const char *dir, const uint8_t key[32]);
+
 /* Group g's light from DIR into gl (its images, directions, probes' light and records) and the
  * cache's texel states, texels and valid_texels: 1 when the file was there and whole, 0 when not
  * (a damaged one is said on the log). */

@@ -174,6 +174,15 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
     if (st == LMB_OK && !saved)
         st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
     uint32_t probes = env->probes ? env->probes->count : 0;
+    if (st == LMB_OK && env->keep) { /* what the groups cost beyond a bake without them */
+        uint64_t texels = 0;
+        for (uint32_t a = 0; a < env->cache->atlas_count; a++)
+            texels += (uint64_t)env->cache->layout->width[a] * env->cache->layout->height[a];
+        unsigned per = env->cfg->directional ? 24u : 12u;
+        lmb_info(env->log, "light groups: each group's light kept until the files are written: %u group(s) x %u bytes "
+                 "x %llu texels = %.1f MB", groups->count, per, (unsigned long long)texels,
+                 (double)groups->count * per * (double)texels / 1048576.0);
+    }
     if (st == LMB_OK && env->keep && env->cache_dir)
         st = lmb_group_cache_keys(s, env->cfg, groups, out->key, err);
     for (uint32_t g = 0; g < groups->count && st == LMB_OK; g++) {

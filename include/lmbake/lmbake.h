@@ -28,7 +28,8 @@ typedef enum lmb_status {
     LMB_OK = 0,
     LMB_ERR_USAGE = 1,    /* bad command line */
     LMB_ERR_INPUT = 2,    /* bad scene, config or other input file */
-    LMB_ERR_INTERNAL = 3  /* out of memory, I/O failure, a bug */
+    LMB_ERR_INTERNAL = 3, /* out of memory, I/O failure, a bug */
+    LMB_NOT_KEPT = 4      /* lmb_farm_run.relight_only: the bake would light, not relight (nothing written) */
 } lmb_status;
 
 typedef struct lmb_error {
@@ -616,6 +617,9 @@ typedef struct lmb_farm_run {
     uint32_t tail_threads;    /* LMB_FARM_WORKER, the worker that writes the output: threads for what
                                  runs after the last step, when the other workers have stopped
                                  (post-processing, images, glTF); 0: every core of its machine */
+    int relight_only;         /* with layout_cache: bake only when the layout and every light group
+                                 are kept there (a relight: the sum and the files); else stop before
+                                 any work with LMB_NOT_KEPT, nothing written (preview --watch) */
 } lmb_farm_run;
 
 /* lmb_bake_planned through the farm: plan_path is required unless mode is LMB_FARM_LOCAL.

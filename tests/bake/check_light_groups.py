@@ -20,7 +20,7 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
     writes the bytes of a bake without the cache; so does an edit of the sun's intensity and colour
     (alone in its group: its weight), the sun switched off, sky.intensity with the sky alone in
     its group, and an emissive material's strength and colour with the emissive surfaces alone in
-    theirs; an edit or a move of a lamp lights the lamps' group again and reads the sun's
+    theirs; random intensities and colours of every light, each alone in its group; an edit or a move of a lamp lights the lamps' group again and reads the sun's
     back; every time the bytes of a bake without it;
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
@@ -231,6 +231,21 @@ def kept_between_bakes(lmbake, work, level, doc):
     # each group's own files kept too (copied, not encoded again); a damaged one is encoded again
     kept_files = sorted(f for f in os.listdir(cache) if f.endswith("-a0.lmbf")) if os.path.isdir(cache) else []
     check(len(kept_files) == 2, "each group's own files kept beside its light: %s" % kept_files)
+    # --relight-only: with everything kept the bake of other scales runs; with a group not kept it
+    # stops (exit 4) and writes nothing
+    relit, pr = bake(lmbake, work, level, "relight-only", groups_config(0.5, 1.5), "--layout-cache", cache,
+                     "--relight-only")
+    d = json.loads(json.dumps(doc))
+    d["extensions"]["KHR_lights_punctual"]["lights"][1]["intensity"] *= 0.5
+    dimmed = os.path.join(os.path.dirname(level), "sun-lamps-relight-only.gltf")
+    with open(dimmed, "w") as f:
+        json.dump(d, f)
+    refused, pn = bake(lmbake, work, dimmed, "relight-refused", groups_config(0.5, 1.5), "--layout-cache", cache,
+                       "--relight-only")
+    check(pr.returncode == 0 and os.path.isdir(relit) and pn.returncode == 4 and not os.path.exists(refused)
+          and "light group 'lamps' is to be lit" in pn.stderr,
+          "--relight-only: other scales bake (exit %d); a lamp dimmed in a shared group: exit %d, nothing written, %r"
+          % (pr.returncode, pn.returncode, pn.stderr.strip()[-120:]))
     for f in kept_files:
         path = os.path.join(cache, f)
         data = bytearray(open(path, "rb").read())
@@ -352,6 +367,40 @@ def kept_between_bakes(lmbake, work, level, doc):
           "(bound 1%%)" % np.round(ratio, 5).tolist())
 
 
+def random_lights(lmbake, work, level, doc):
+    """Every light alone in its group (a unit group each): for random intensities and colours of
+    every light, a bake that reads the groups back writes the bytes of a bake of the level with
+    those values."""
+    import random
+    rng = random.Random(62)
+    cfg = BASE + "output:\n  light_groups:\n" + "".join(
+        "    - {name: %s, match: %s}\n" % (l["name"], l["name"]) for l in doc["extensions"]["KHR_lights_punctual"]["lights"])
+    cache = os.path.join(work, "kept-random")
+    shutil.rmtree(cache, ignore_errors=True)
+    _, p0 = bake(lmbake, work, level, "random-kept", cfg, "--layout-cache", cache)
+    ok = p0.returncode == 0
+    tried = []
+    for k in range(2):
+        d = json.loads(json.dumps(doc))
+        for l in d["extensions"]["KHR_lights_punctual"]["lights"]:
+            l["intensity"] = l["intensity"] * rng.uniform(0.0, 3.0)
+            l["color"] = [round(rng.uniform(0.0, 1.0), 4) for _ in range(3)]
+        edited = os.path.join(os.path.dirname(level), "sun-lamps-random-%d.gltf" % k)
+        with open(edited, "w") as f:
+            json.dump(d, f)
+        out, p = bake(lmbake, work, edited, "random-%d-kept" % k, cfg, "--layout-cache", cache, "--log")
+        plain, pp = bake(lmbake, work, edited, "random-%d" % k, cfg)
+        log = p.stdout + p.stderr
+        names = sorted(os.listdir(plain)) if pp.returncode == 0 else []
+        differ = [f for f in names if p.returncode != 0 or not os.path.exists(os.path.join(out, f)) or
+                  not filecmp.cmp(os.path.join(plain, f), os.path.join(out, f), shallow=False)]
+        ok &= p.returncode == 0 and log.count("read back from the cache") == 3 and "): lighting" not in log and \
+            bool(names) and not differ
+        tried.append("%d files%s" % (len(names), " (differ: %s)" % differ if differ else ""))
+    check(ok, "every light alone in its group, random intensities and colours twice: all 3 groups read back, the "
+          "bytes of a bake of the edited level (%s)" % "; ".join(tried))
+
+
 def extras_group(lmbake, work, level, doc):
     d = json.loads(json.dumps(doc))
     d["extensions"]["KHR_lights_punctual"]["lights"][1]["extras"] = {"lightmap_group": "torch"}
@@ -398,6 +447,7 @@ def main():
     scenes, level, doc = make_level(work)
     engine(lmbake, work, level, short)
     kept_between_bakes(lmbake, work, level, doc)
+    random_lights(lmbake, work, level, doc)
     extras_group(lmbake, work, level, doc)
     errors(lmbake, work, level)
     print("%d failed" % len(fails))

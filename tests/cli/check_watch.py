@@ -15,6 +15,13 @@
                put back: baked. OUTDIR inside the level's folder: its bakes never trigger another.
 3. cancel      a save during a bake stops it (the log says "stopped") and only the newest state is
                baked: no final bake of the stopped generation (the time to the stop is printed).
+4. groups      light groups under the watch (docs/light-groups.md): make_scenes.py's sun-lamps.gltf
+               with the sun alone in its group and the lamps in another; the sun x 2 in the file:
+               both groups read back (/status shown.groups {read 2, lit 0}), the terminal line says
+               "relit: sun x 2", no quick look before it (`--relight-only` first), the final
+               files those of `lmbake bake` of the changed level byte for byte; a lamp dimmed:
+               a quick look then the final, "lit again: lamps", one read back; the sun tinted:
+               "sun tinted".
 
 usage: check_watch.py LMBAKE WORKDIR CHECK
 """
@@ -243,10 +250,72 @@ def cancel(lmbake, work):
     return ok
 
 
+def groups(lmbake, work):
+    scenes = os.path.join(work, "scenes")
+    subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), scenes], check=True,
+                   stdout=subprocess.DEVNULL)
+    level_dir = os.path.join(work, "level")
+    shutil.rmtree(level_dir, ignore_errors=True)
+    os.makedirs(level_dir)
+    level, cfg = os.path.join(level_dir, "sun-lamps.gltf"), os.path.join(level_dir, "bake.yaml")
+    doc = json.load(open(os.path.join(scenes, "sun-lamps.gltf")))
+    save_json(level, doc)
+    save_text(cfg, "texel_density: 6\noutput:\n  light_groups:\n    - {name: sun, match: sun}\n"
+                   "    - {name: lamps, match: \"lamp_*\"}\n")
+    lights = doc["extensions"]["KHR_lights_punctual"]["lights"]
+    sun = next(l for l in lights if l["name"] == "sun")
+    out = os.path.join(work, "out")
+    shutil.rmtree(out, ignore_errors=True)
+    w = Watch(lmbake, level, cfg, out)
+    ok = True
+
+    def line(generation):
+        for _ in range(50):
+            found = [l for l in w.log() if l.startswith("watch: final bake %d ready" % generation)]
+            if found:
+                return found[0]
+            time.sleep(0.1)
+        return ""
+    try:
+        w.shown(1, "final")
+        sun["intensity"] *= 2
+        save_json(level, doc)
+        s = w.shown(2, "final")
+        said = line(2)
+        ok &= check(s["shown"].get("groups", {}).get("read") == 2 and s["shown"]["groups"]["lit"] == 0
+                    and "relit: sun x 2;" in said and "light groups: 2 read back, none lit" in said,
+                    "the sun x 2: both groups read back (%s); %r" % (s["shown"].get("groups", {}).get("relit"), said))
+        plain = os.path.join(work, "plain")
+        shutil.rmtree(plain, ignore_errors=True)
+        subprocess.run([lmbake, "bake", level, "-c", cfg, "-o", plain, "-q"], check=True)
+        diff = same_tree(out, plain)
+        ok &= check(not diff, "the sun x 2: the final files equal `lmbake bake` of the changed level, byte for byte (%d "
+                    "files)%s" % (len(os.listdir(plain)), ": differ " + ", ".join(diff) if diff else ""))
+        kinds = [h["kind"] for h in s["history"] if h["generation"] == 2]
+        ok &= check(kinds == ["final"], "the sun x 2: relit first (--relight-only), no quick look before it: %s" % kinds)
+        next(l for l in lights if l["name"] == "lamp_a")["intensity"] *= 0.5
+        save_json(level, doc)
+        s = w.shown(3, "final")
+        said = line(3)
+        kinds = [h["kind"] for h in s["history"] if h["generation"] == 3]
+        ok &= check(kinds == ["quick", "final"], "lamp_a dimmed: not a relight (--relight-only exit 4): a quick look, "
+                    "then the final: %s" % kinds)
+        ok &= check("relit: lit again: lamps;" in said and "light groups: 1 read back, 1 lit" in said,
+                    "lamp_a dimmed: its group lit again, the sun's read back: %r" % said)
+        sun["color"] = [1.0, 0.8, 0.6]
+        save_json(level, doc)
+        w.shown(4, "final")
+        said = line(4)
+        ok &= check("relit: sun tinted;" in said, "the sun tinted: %r" % said)
+    finally:
+        w.stop()
+    return ok
+
+
 def main():
     lmbake, work, name = sys.argv[1], sys.argv[2], sys.argv[3]
     os.makedirs(work, exist_ok=True)
-    ok = {"identical": identical, "errors": errors, "cancel": cancel}[name](lmbake, work)
+    ok = {"identical": identical, "errors": errors, "cancel": cancel, "groups": groups}[name](lmbake, work)
     sys.exit(0 if ok else 1)
 
 

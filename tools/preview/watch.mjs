@@ -65,6 +65,7 @@ const status = {
 };
 
 let files = [], lastSnapshot = null, movedAt = 0, dirty = true, child = null, goodPrint = null;
+let lastGroups = { quick: null, final: null }; // each kind's last bake's light groups (groupsOf)
 let dying = 0; // stopped bakes not yet gone: the next one waits for them (one writer of OUTDIR at a time)
 
 function stopChild(why) {
@@ -84,11 +85,11 @@ function stopChild(why) {
 // called once the bake says a stage's files are whole: direct, bounces). Resolves to {ok,
 // seconds} or {ok: false, error}; a cancelled bake resolves {cancelled: true}.
 const stageDir = (generation, kind, stage) => path.join(quickRoot, `${generation}-stages-${kind}`, stage);
-function bake(kind, generation, onStage = null) {
+function bake(kind, generation, onStage = null, extra = []) {
   const out = kind === 'quick' ? path.join(quickRoot, String(generation)) : opts.outdir;
   const stages = path.dirname(stageDir(generation, kind, 'direct'));
   fs.rmSync(stages, { recursive: true, force: true });
-  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, '--stages-out', stages, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : [])];
+  const args = ['bake', opts.level, '-o', out, '--layout-cache', layoutRoot, '--stages-out', stages, ...(opts.config ? ['-c', opts.config] : []), ...(kind === 'quick' ? ['--quick'] : []), ...extra];
   return new Promise((resolve) => {
     const p = spawn(opts.lmbake, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     child = p;
@@ -120,17 +121,44 @@ function bake(kind, generation, onStage = null) {
       if (child === p) { child = null; status.baking = null; }
       if (code === 0) return resolve({ ok: true, dir: out, layoutKept: /^layout: read back/m.test(stdout), groups: groupsOf(stdout) });
       const errors = stderr.split('\n').filter((l) => /error:/.test(l));
-      resolve({ ok: false, error: (errors.length ? errors.join('\n') : stderr.trim().split('\n').slice(-3).join('\n')) || `lmbake exited ${code}` });
+      resolve({ ok: false, code, error: (errors.length ? errors.join('\n') : stderr.trim().split('\n').slice(-3).join('\n')) || `lmbake exited ${code}` });
     });
   });
 }
 
 // What a bake with light groups did with each group (docs/light-groups.md): read back from the
-// layout cache (a scale, or a unit group's weight: the sum only) or lit; null without groups.
+// layout cache (a scale, or a unit group's weight: the sum only) or lit, and what each group
+// weighs in the sum (its scale x a unit group's weight, per channel; `light` names a group's
+// one light); null without groups.
 function groupsOf(log) {
   const read = (log.match(/^light group '[^']*' \(\d+ of \d+\): read back/gm) || []).length;
-  const lit = (log.match(/^light group '[^']*' \(\d+ of \d+\): lighting/gm) || []).length;
-  return read + lit ? { read, lit } : null;
+  const litNames = [...log.matchAll(/^light group '([^']*)' \(\d+ of \d+\): lighting/gm)].map((m) => m[1]);
+  const weights = {};
+  for (const m of log.matchAll(/^light group '([^']*)': (\d+) light\(s\)(?: \('(.*?)'(, \.\.\.)?\))?(?:, the sky)?(?:, the emissive surfaces)?, scale ([^ ,()\n]+)(.*)$/gm)) {
+    const unit = /: \[([^\]]*)\]\)$/.exec(m[6]);
+    const w = unit ? unit[1].split(',').map(Number) : [1, 1, 1];
+    weights[m[1]] = { light: m[2] === '1' && !m[4] ? m[3] : null, w: w.map((x) => x * Number(m[5])) };
+  }
+  return read + litNames.length ? { read, lit: litNames.length, litNames, weights } : null;
+}
+
+// What changed in the light groups from one bake to the next, in words: 'Lamp 0 x 2', 'group
+// lamps x 0.5', 'sun tinted', 'Lamp 3 off', 'lit again: lamps'.
+function relitOf(before, after) {
+  if (!before || !after) return [];
+  const said = [];
+  for (const [name, g] of Object.entries(after.weights)) {
+    const was = before.weights[name];
+    if (!was || g.w.every((x, c) => x === was.w[c]) || after.litNames.includes(name)) continue;
+    const label = g.light || `group ${name}`;
+    const ratios = g.w.map((x, c) => (was.w[c] ? x / was.w[c] : NaN));
+    if (g.w.every((x) => x === 0)) said.push(`${label} off`);
+    else if (was.w.every((x) => x === 0)) said.push(`${label} on`);
+    else if (ratios.every((r) => Math.abs(r - ratios[0]) <= 1e-4 * Math.abs(ratios[0]))) said.push(`${label} x ${Number(ratios[0].toPrecision(3))}`);
+    else said.push(`${label} tinted`);
+  }
+  if (after.litNames.length) said.push(`lit again: ${after.litNames.join(', ')}`);
+  return said;
 }
 
 // The newest state of the files, baked: fingerprint, quick bake, final bake; any step may
@@ -156,6 +184,21 @@ async function bakeNewest() {
   say(`bake ${generation}: ${change.what.join('; ')} (${change.layout ? 'layout and lighting' : 'lighting only'})`);
   const seen = movedAt || Date.now(), started = lastSnapshot;
   const base = status.lastGood;
+  // With light groups, a change that keeps the layout may only weigh the kept groups anew (a
+  // scale, a lamp's intensity or colour): then the final bake is about a second and comes
+  // first, with no quick look (`--relight-only` stops at once, exit 4, when a group is to be lit).
+  if (opts.quick && !change.layout && lastGroups.final && base) {
+    const r = await bake('final', generation, null, ['--relight-only']);
+    if (r.cancelled || dirty) return;
+    if (!r.ok && r.code !== 4 && snapshot(files) !== started) return superseded('final', generation);
+    if (!r.ok && r.code !== 4) return failed(r.error);
+    if (r.ok) {
+      r.groups.relit = relitOf(lastGroups.final, r.groups);
+      lastGroups = { quick: null, final: r.groups };
+      showBake({ generation, kind: 'final', revision: 0, seen, change, layoutKept: r.layoutKept, composed: null, refined: null, groups: r.groups });
+      return finished(fp, print, generation, null);
+    }
+  }
   let composed = null, quickLayoutKept = false;
   for (const kind of opts.quick ? ['quick', 'final'] : ['final']) {
     // A composed quick picture is refined while the final bake runs: once it has its direct light
@@ -177,9 +220,16 @@ async function bakeNewest() {
     // A quick look is shown at once, composed on the last final where it can be.
     composed = kind === 'quick' ? composeQuick(generation, change, null) : null;
     quickLayoutKept = r.layoutKept;
+    if (r.groups) r.groups.relit = relitOf(lastGroups[kind], r.groups);
+    lastGroups[kind] = r.groups;
     showBake({ generation, kind, revision: 0, seen, change, layoutKept: r.layoutKept, composed, refined: null, groups: r.groups });
   }
-  const quick = opts.quick ? path.join(quickRoot, String(generation)) : null;
+  finished(fp, print, generation, opts.quick ? path.join(quickRoot, String(generation)) : null);
+}
+
+// Generation N's final bake is in OUTDIR: the last good state (with its quick look's folder, or
+// null when it had none), what the next change composes on.
+function finished(fp, print, generation, quick) {
   const stagesOf = (kind) => ({ direct: stageDir(generation, kind, 'direct'), bounces: stageDir(generation, kind, 'bounces') });
   status.lastGood = { fp, generation, outdir: outdirStamp(), quick, stages: quick ? { quick: stagesOf('quick'), final: stagesOf('final') } : null };
   goodPrint = print;
@@ -196,7 +246,7 @@ function showBake({ generation, kind, revision, seen, change, layoutKept, compos
   status.history.push({ generation, kind, revision, seconds, changed: change.what });
   if (status.history.length > 50) status.history.shift();
   status.error = null;
-  const relit = groups && groups.read ? `; light groups: ${groups.read} read back${groups.lit ? `, ${groups.lit} lit` : ', none lit'}` : '';
+  const relit = !groups || !groups.read ? '' : `${groups.relit.length ? `; relit: ${groups.relit.join(', ')}` : ''}; light groups: ${groups.read} read back${groups.lit ? `, ${groups.lit} lit` : ', none lit'}`;
   const what = `${change.what.join('; ')}${generation === 1 ? '' : ' changed'}${layoutKept ? '; layout kept' : ''}${relit}`;
   if (revision) say(`quick bake ${generation} refined in ${seconds.toFixed(1)} s (${refined === 'direct' ? 'the direct light' : 'the bounced light'} at the final's resolution, from final bake ${generation}'s ${refined === 'direct' ? 'direct stage' : 'bounce passes'})`);
   else say(`${kind} bake ${generation} ready in ${seconds.toFixed(1)} s (${what}${composed !== null ? `; composed on final bake ${composed}` : ''})`);
