@@ -2,6 +2,7 @@
  * lmbake: command-line entry point. Dispatches to a subcommand; every subcommand has
  * --help. Exit codes: 0 ok, 1 usage, 2 bad input, 3 internal error.
  */
+#define _DEFAULT_SOURCE /* readlink, setenv */
 #include "commands.h"
 
 #include <lmbake/lmbake.h>
@@ -10,6 +11,8 @@
 #include <string.h>
 #ifdef __GLIBC__
 #include <malloc.h>
+#include <stdlib.h>
+#include <unistd.h>
 #endif
 
 static const char usage[] =
@@ -38,9 +41,39 @@ static const char usage[] =
     "\n"
     "exit codes: 0 ok, 1 usage error, 2 bad input (scene, config), 3 internal error\n";
 
+#ifdef __GLIBC__
+/* Large buffers on transparent huge pages: each is mapped on its own (below), and a first touch
+ * of a fresh 4 KB page is a page fault, a fifth of the CPU time of a bake that reads its light
+ * groups back and writes its files (docs/threads.md, "Huge pages"). glibc's malloc advises
+ * huge pages for its mappings when its tunable glibc.malloc.hugetlb is 1, and reads tunables
+ * only as a process starts: so lmbake starts itself again once with it set, unless
+ * GLIBC_TUNABLES already names it (glibc.malloc.hugetlb=0 keeps 4 KB pages) or the running
+ * file is not lmbake itself (a loader running it). Nothing a bake computes depends on it. */
+static void on_huge_pages(char **argv)
+{
+    const char *tunables = getenv("GLIBC_TUNABLES");
+    if (tunables && strstr(tunables, "glibc.malloc.hugetlb"))
+        return;
+    char exe[4096];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return;
+    exe[n] = 0;
+    const char *base = strrchr(exe, '/');
+    if (strncmp(base ? base + 1 : exe, "lmbake", 6))
+        return;
+    char value[8192];
+    snprintf(value, sizeof value, "%s%sglibc.malloc.hugetlb=1", tunables ? tunables : "",
+             tunables && *tunables ? ":" : "");
+    if (setenv("GLIBC_TUNABLES", value, 1) == 0)
+        execv(exe, argv); /* returns only when it failed: go on with 4 KB pages */
+}
+#endif
+
 int main(int argc, char **argv)
 {
 #ifdef __GLIBC__
+    on_huge_pages(argv);
     /* Buffers of 128 KB and more are mapped and unmapped on their own. Left to itself, glibc
      * raises this threshold after the first large free, so later large transients (a band, a
      * chunk of a step, a filter's rows) come from the heap, where freeing them does not give
