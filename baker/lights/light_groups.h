@@ -9,7 +9,8 @@
  *
  * A group that holds one light is lit with it at unit intensity and white, then weighed by its
  * intensity and colour: the light of a single light is linear in both, so an edit of either is a
- * new weight, and the bake of the edited level composes the same floats. So is the config's sky
+ * new weight, and the bake of the edited level composes the same floats. Its own files hold the
+ * light at 1; the glTF names the weight (`intensity`) for the game to multiply. So is the config's sky
  * alone in a group (sky.intensity), and the emissive surfaces alone when they share one emission.
  *
  * Which group a source is in: a light's extras.lightmap_group (its own, else its node's); else

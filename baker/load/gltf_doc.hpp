@@ -42,7 +42,7 @@ struct lmb_gltf_doc {
     std::vector<float> probe_positions, probe_sh, probe_cube;
     struct probe_group {
         std::string name;
-        double scale;
+        double scale, intensity[3]; /* what the group's own probes are multiplied by, with scale */
         std::vector<float> sh, cube;
     };
     std::vector<probe_group> probe_groups; /* light groups: each group's own probes' light */

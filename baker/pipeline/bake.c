@@ -445,28 +445,22 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (progress && st == LMB_OK)
         progress(user, "images", l.atlas_count, l.atlas_count);
     stats->rgbm_clamped = clamped;
-    /* each group's own files: the same bytes at any scales, so a group read back from the cache
-     * copies the files it kept instead of encoding them again */
+    /* each group's own files: its light as lit (a group of one source at intensity 1; the glTF
+     * names the intensity a game multiplies it by), the same bytes at any scale and intensity,
+     * so a group read back from the cache copies the files it kept instead of encoding them */
     for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++)
         for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
             char paths[2][LMB_GROUP_IMAGE_PATH];
             const char *const names[2] = {paths[0], paths[1]};
             lmb_group_image_paths(od.staging, od.stem, a, groups.name[g], paths);
             if (group_light.cached[g] && groups_kept &&
-                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, groups.weight[g], names, log))
+                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, names, log))
                 continue;
-            size_t n = 3 * (size_t)l.width[a] * l.height[a];
-            float *weighed = malloc((n + 1) * sizeof *weighed);
-            if (!weighed)
-                st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
-            if (st == LMB_OK) {
-                lmb_group_weighed(&groups, g, group_light.irradiance[(size_t)g * l.atlas_count + a], n, weighed);
-                st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g], weighed, l.width[a],
-                                            l.height[a], err);
-            }
-            free(weighed);
+            st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g],
+                                        group_light.irradiance[(size_t)g * l.atlas_count + a], l.width[a], l.height[a],
+                                        err);
             if (st == LMB_OK && groups_kept)
-                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, groups.weight[g], names, log);
+                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, log);
         }
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
@@ -484,21 +478,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_copy_input_textures(s, &od, log);
         lmb_gltf_probes out_probes;
         st = lmb_probes_output(&probes, cfg, od.staging, od.stem, log, &out_probes, err);
-        for (uint32_t g = 0; st == LMB_OK && !dark && group_light.sh && g < groups.count; g++) {
-            size_t n = probes.count;
-            float *sh = group_light.sh[g] ? malloc((n * LMB_PROBE_SH + 1) * sizeof *sh) : NULL;
-            float *cube = group_light.cube[g] ? malloc((n * LMB_PROBE_CUBE + 1) * sizeof *cube) : NULL;
-            if ((group_light.sh[g] && !sh) || (group_light.cube[g] && !cube))
-                st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for %zu probes", n);
-            if (st == LMB_OK && sh) /* the group's probes as its lightmap: weighed */
-                lmb_group_weighed(&groups, g, group_light.sh[g], n * LMB_PROBE_SH, sh);
-            if (st == LMB_OK && cube)
-                lmb_group_weighed(&groups, g, group_light.cube[g], n * LMB_PROBE_CUBE, cube);
-            if (st == LMB_OK)
-                st = lmb_probes_output_group(&out_probes, cfg, g, groups.name[g], groups.scale[g], sh, cube, err);
-            free(sh);
-            free(cube);
-        }
+        for (uint32_t g = 0; st == LMB_OK && !dark && group_light.sh && g < groups.count; g++) /* as its files */
+            st = lmb_probes_output_group(&out_probes, cfg, g, groups.name[g], groups.scale[g], groups.weight[g],
+                                         group_light.sh[g], group_light.cube[g], err);
         if (st == LMB_OK)
             st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,
                                             cache.shadowmask != NULL, &out_probes, dark ? NULL : &groups, err);

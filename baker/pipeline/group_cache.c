@@ -214,20 +214,19 @@ static uint8_t *slurp(const char *path, size_t *size)
     return data;
 }
 
-/* The body: the files' weight and sizes, then the two files. */
+/* The body: the files' sizes, then the two files. */
 typedef struct files_header {
-    double weight[3];
     uint64_t size[2];
 } files_header;
 
-void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
-                                const char *const paths[2], const lmb_log *log)
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
+                                const lmb_log *log)
 {
     char path[4200];
     files_path(dir, key, a, path, sizeof path);
     size_t sizes[2] = {0, 0};
     uint8_t *data[2] = {slurp(paths[0], &sizes[0]), slurp(paths[1], &sizes[1])};
-    files_header head = {{weight[0], weight[1], weight[2]}, {sizes[0], sizes[1]}};
+    files_header head = {{sizes[0], sizes[1]}};
     lmb_part_piece pieces[3] = {{&head, sizeof head}, {data[0], sizes[0]}, {data[1], sizes[1]}};
     lmb_part_identity id;
     cache_identity(key, &id);
@@ -241,8 +240,8 @@ void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t
     free(data[1]);
 }
 
-int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
-                               const char *const paths[2], const lmb_log *log)
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
+                               const lmb_log *log)
 {
     char path[4200];
     files_path(dir, key, a, path, sizeof path);
@@ -257,7 +256,7 @@ int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t 
     lmb_error e = {LMB_OK, ""};
     files_header head;
     memset(&head, 0, sizeof head);
-    int ok = lmb_part_map(path, &id, &want, &got, &view, &e) == LMB_OK, other_weight = 0;
+    int ok = lmb_part_map(path, &id, &want, &got, &view, &e) == LMB_OK;
     if (ok) {
         ok = view.body_length >= sizeof head;
         if (ok)
@@ -266,9 +265,8 @@ int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t 
              head.size[1] == view.body_length - sizeof head - head.size[0];
         if (!ok)
             snprintf(e.message, sizeof e.message, "%.900s: not a group's files", path);
-        other_weight = ok && memcmp(head.weight, weight, sizeof head.weight) != 0;
         const uint8_t *at = view.body + sizeof head;
-        for (int k = 0; k < 2 && ok && !other_weight; k++) {
+        for (int k = 0; k < 2 && ok; k++) {
             FILE *f = fopen(paths[k], "wb");
             ok = f && fwrite(at, 1, head.size[k], f) == head.size[k];
             if (f && fclose(f) != 0)
@@ -279,8 +277,6 @@ int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t 
         }
         lmb_part_unmap(&view);
     }
-    if (other_weight) /* the light's intensity or colour edited: the files are the group's light weighed anew */
-        return 0;
     if (!ok) {
         lmb_warn(log, "light group cache: %s; encoding the group's files instead", e.message);
         return 0;

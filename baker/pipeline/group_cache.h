@@ -39,15 +39,15 @@ void lmb_group_cache_write(const char *dir, const uint8_t key[32], uint32_t g, c
 
 /* Group g's own files of atlas a (paths[0] its .exr, paths[1] its .hdr, as
  * lmb_write_group_images wrote them into the output's staging folder) kept in DIR beside its
- * light: they are the same bytes at any scales, and a later bake that reads the group back copies
+ * light: they are the same bytes at any scales and, for a group of one source, at any intensity
+ * and colour of it (they hold its light at 1), and a later bake that reads the group back copies
  * them instead of encoding them again. A file that cannot be kept is said on the log. */
-void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
-                                const char *const paths[2], const lmb_log *log);
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
+                                const lmb_log *log);
 
-/* The files kept for that group and atlas written to paths: 1 when they were kept whole at this
- * weight (lmb_light_groups.weight: a unit group's files hold its light's intensity x colour), 0
- * when not (then they are to be encoded; a damaged file is said on the log). */
-int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const double weight[3],
-                               const char *const paths[2], const lmb_log *log);
+/* The files kept for that group and atlas written to paths: 1 when they were kept whole, 0 when
+ * not (then they are to be encoded; a damaged file is said on the log). */
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
+                               const lmb_log *log);
 
 #endif

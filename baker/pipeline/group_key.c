@@ -31,7 +31,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GROUP_KEY_FORMAT 3u /* 2: the JSON without punctual lights, the group's own lights; 3: emission */
+#define GROUP_KEY_FORMAT 4u /* 2: the JSON without punctual lights, the group's own lights; 3: emission;
+                                  4: a unit group's kept files hold its light at intensity 1 */
 
 static uint32_t le32(const uint8_t *p)
 {

@@ -257,13 +257,15 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
         for (size_t i = 0; i < n; i++) { /* each texel on its own: the same floats at any thread count */
             double sum[3] = {0, 0, 0}, v[3] = {0, 0, 0};
             for (uint32_t g = 0; g < G; g++) {
-                float eg[3]; /* the group's light as its own files hold it (lmb_group_weighed) */
-                lmb_group_weighed(groups, g, gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i, 3, eg);
-                for (int c = 0; c < 3; c++)
-                    sum[c] += groups->scale[g] * (double)eg[c];
+                const float *eg = gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i; /* as its files hold it */
+                double part[3];
+                for (int c = 0; c < 3; c++) {
+                    part[c] = groups->scale[g] * groups->weight[g][c] * (double)eg[c];
+                    sum[c] += part[c];
+                }
                 if (d) {
                     const float *dg = gl->direction[(size_t)g * gl->atlases + a] + 3 * i;
-                    double w = groups->scale[g] * (0.2126 * eg[0] + 0.7152 * eg[1] + 0.0722 * eg[2]);
+                    double w = 0.2126 * part[0] + 0.7152 * part[1] + 0.0722 * part[2];
                     for (int c = 0; c < 3; c++)
                         v[c] += w * (double)dg[c];
                 }
@@ -290,14 +292,12 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
     }
     for (uint32_t p = 0; gl->sh && probes && p < probes->count; p++) {
         double sh[LMB_PROBE_SH] = {0}, cube[LMB_PROBE_CUBE] = {0};
-        for (uint32_t g = 0; g < G; g++) {
-            float gs[LMB_PROBE_SH], gc[LMB_PROBE_CUBE];
-            lmb_group_weighed(groups, g, gl->sh[g] + (size_t)p * LMB_PROBE_SH, LMB_PROBE_SH, gs);
-            lmb_group_weighed(groups, g, gl->cube[g] + (size_t)p * LMB_PROBE_CUBE, LMB_PROBE_CUBE, gc);
+        for (uint32_t g = 0; g < G; g++) { /* channel k % 3 of each */
+            const float *gs = gl->sh[g] + (size_t)p * LMB_PROBE_SH, *gc = gl->cube[g] + (size_t)p * LMB_PROBE_CUBE;
             for (int k = 0; k < LMB_PROBE_SH; k++)
-                sh[k] += groups->scale[g] * (double)gs[k];
+                sh[k] += groups->scale[g] * groups->weight[g][k % 3] * (double)gs[k];
             for (int k = 0; k < LMB_PROBE_CUBE; k++)
-                cube[k] += groups->scale[g] * (double)gc[k];
+                cube[k] += groups->scale[g] * groups->weight[g][k % 3] * (double)gc[k];
         }
         for (int k = 0; k < LMB_PROBE_SH; k++)
             probes->sh[(size_t)p * LMB_PROBE_SH + k] = (float)sh[k];
@@ -305,10 +305,4 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
             probes->cube[(size_t)p * LMB_PROBE_CUBE + k] = (float)cube[k];
     }
     return LMB_OK;
-}
-
-void lmb_group_weighed(const lmb_light_groups *groups, uint32_t g, const float *rgb, size_t n, float *out)
-{
-    for (size_t k = 0; k < n; k++)
-        out[k] = (float)(groups->weight[g][k % 3] * (double)rgb[k]);
 }

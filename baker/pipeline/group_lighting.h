@@ -61,17 +61,13 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
 void lmb_group_swap(lmb_group_light *gl, uint32_t g, lmb_cache *cache);
 
 /* The cache's images and directions and the probes' light := the groups' sum at their scales:
- * E = sum_g s_g E_g per texel (in double, in group order; E_g the group's light weighed,
- * lmb_group_weighed); the direction D = sum_g s_g |E_g|
+ * E = sum_g s_g w_g E_g per texel (in double, in group order; E_g the group's light as lit and as
+ * its own files hold it, w_g its weight: lmb_light_groups.weight, per channel, the intensity the
+ * glTF names); the direction D = sum_g s_g |w_g E_g|
  * D_g / |E| (|.|: luminance; each group's D weighted by its light, as lighting.c makes D from
  * the light's parts), at most unit length. */
 lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_light *gl, lmb_cache *cache,
                              lmb_probe_set *probes, lmb_error *err);
-
-/* Group g's light as it stands in the level and in the group's own files: what the group was
- * lit with (RGB triples, or SH and ambient-cube floats: channel k % 3) times its weight
- * (lmb_light_groups.weight: a unit group's light's intensity x colour), rounded to float. */
-void lmb_group_weighed(const lmb_light_groups *groups, uint32_t g, const float *rgb, size_t n, float *out);
 
 void lmb_group_light_free(lmb_group_light *gl);
 

@@ -102,7 +102,8 @@ lmb_status lmb_probes_output(lmb_probe_set *set, const lmb_config *cfg, const ch
 }
 
 lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, uint32_t g, const char *name,
-                                   double scale, const float *sh_lux, const float *cube_lux, lmb_error *err)
+                                   double scale, const double intensity[3], const float *sh_lux, const float *cube_lux,
+                                   lmb_error *err)
 {
     if (!out->count || g >= LMB_MAX_LIGHT_GROUPS)
         return LMB_OK;
@@ -120,6 +121,8 @@ lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, 
         cube[i] = cube_lux ? (float)(cube_lux[i] * k) : 0.0f;
     out->group_name[g] = name;
     out->group_scale[g] = scale;
+    for (int c = 0; c < 3; c++)
+        out->group_intensity[g][c] = intensity[c];
     out->group_sh[g] = sh;
     out->group_cube[g] = cube;
     out->groups = g + 1;

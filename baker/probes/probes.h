@@ -138,9 +138,12 @@ lmb_status lmb_probe_set_tetrahedra(lmb_probe_set *set, lmb_error *err);
 lmb_status lmb_probes_output(lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
                              const lmb_log *log, lmb_gltf_probes *out, lmb_error *err);
 /* Light groups: group g's own probes' light (sh_lux, cube_lux: LMB_PROBE_SH and LMB_PROBE_CUBE per
- * probe, lux, as lmb_probe_set holds them) into out, in the output's scale; out->groups = g + 1. */
+ * probe, lux, as lmb_probe_set holds them; a group of one source at intensity 1) into out, in the
+ * output's scale, with its scale and intensity (RGB, what the game multiplies it by); out->groups
+ * = g + 1. */
 lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, uint32_t g, const char *name,
-                                   double scale, const float *sh_lux, const float *cube_lux, lmb_error *err);
+                                   double scale, const double intensity[3], const float *sh_lux, const float *cube_lux,
+                                   lmb_error *err);
 void lmb_probes_output_free(lmb_gltf_probes *out);
 
 #endif

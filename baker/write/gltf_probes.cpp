@@ -79,7 +79,7 @@ void lmb_gltf_add_probes(lmb_gltf_doc *doc)
     m.bufferViews[(size_t)cube].name = "lightmap probes ambient cube";
     probes["sh"] = Value(sh);
     probes["ambientCube"] = Value(cube);
-    if (!doc->probe_groups.empty()) { /* light groups: sh and ambientCube hold their sum at the scales */
+    if (!doc->probe_groups.empty()) { /* light groups: sh and ambientCube hold sum_g scale_g x intensity_g x group g's */
         Value::Array groups;
         for (const auto &g : doc->probe_groups) {
             Value::Object one;
@@ -89,6 +89,7 @@ void lmb_gltf_add_probes(lmb_gltf_doc *doc)
             m.bufferViews[(size_t)gcube].name = "lightmap probes ambient cube, light group " + g.name;
             one["name"] = Value(g.name);
             one["scale"] = Value(g.scale);
+            one["intensity"] = Value(Value::Array{Value(g.intensity[0]), Value(g.intensity[1]), Value(g.intensity[2])});
             one["sh"] = Value(gsh);
             one["ambientCube"] = Value(gcube);
             groups.push_back(Value(one));
@@ -141,6 +142,7 @@ extern "C" lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_prob
         doc->probe_groups.clear();
         for (uint32_t g = 0; g < p->groups; g++)
             doc->probe_groups.push_back({p->group_name[g], p->group_scale[g],
+                                         {p->group_intensity[g][0], p->group_intensity[g][1], p->group_intensity[g][2]},
                                          std::vector<float>(p->group_sh[g], p->group_sh[g] + 27 * (size_t)p->count),
                                          std::vector<float>(p->group_cube[g], p->group_cube[g] + 18 * (size_t)p->count)});
         doc->probe_tetrahedra.assign(p->tetrahedra, p->tetrahedra + 4 * (size_t)p->tetrahedron_count);

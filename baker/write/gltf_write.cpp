@@ -290,6 +290,8 @@ extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gl
                 gf["hdr"] = Value(std::string(f->group_hdr[g]));
                 one["name"] = Value(std::string(f->group_name[g]));
                 one["scale"] = Value(f->group_scale[g]);
+                one["intensity"] = Value(Value::Array{Value(f->group_intensity[g][0]), Value(f->group_intensity[g][1]),
+                                                      Value(f->group_intensity[g][2])});
                 one["files"] = Value(gf);
                 groups.push_back(Value(one));
             }

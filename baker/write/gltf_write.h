@@ -40,15 +40,17 @@ typedef struct lmb_gltf_lightmap_files {
     uint32_t ktx2_vkformat;   /* ktx2: its vkFormat */
     const char *direction_png, *direction_exr, *direction_ktx2; /* output.directional */
     const char *shadowmask;   /* output.shadowmask: the RGBA8 PNG */
-    uint32_t groups;          /* output.light_groups: each group's name, scale and files */
+    uint32_t groups;          /* output.light_groups: each group's name, scale, intensity and files */
     const char *group_name[LMB_MAX_LIGHT_GROUPS], *group_exr[LMB_MAX_LIGHT_GROUPS], *group_hdr[LMB_MAX_LIGHT_GROUPS];
     double group_scale[LMB_MAX_LIGHT_GROUPS];
+    double group_intensity[LMB_MAX_LIGHT_GROUPS][3]; /* RGB: a group of one source's intensity x colour (its
+                                                        files hold it at 1), else 1 1 1 */
 } lmb_gltf_lightmap_files;
 
 /* Adds the texture of one atlas: source files->png, MOZ_texture_rgbe files->hdr, and
  * extras.lightmap {atlas, width, height, scale, files {format: uri}, rgbm {range, decode},
- * ktx2 {vkFormat}, groups [{name, scale, files {exr, hdr}}] (light groups: the texture's files
- * hold sum_g scale_g x group g's)}, so an engine script finds every file without guessing names. Returns its
+ * ktx2 {vkFormat}, groups [{name, scale, intensity [r, g, b], files {exr, hdr}}] (light groups:
+ * the texture's files hold sum_g scale_g x intensity_g x group g's)}, so an engine script finds every file without guessing names. Returns its
  * index, or -1 on failure. */
 int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gltf_lightmap_files *files, lmb_error *err);
 
@@ -114,7 +116,7 @@ typedef struct lmb_gltf_probes {
     const struct lmb_gltf_volume *volumes;
     uint32_t groups;        /* light groups: each group's own SH and ambient cubes (sh and cube: their sum) */
     const char *group_name[LMB_MAX_LIGHT_GROUPS];
-    double group_scale[LMB_MAX_LIGHT_GROUPS];
+    double group_scale[LMB_MAX_LIGHT_GROUPS], group_intensity[LMB_MAX_LIGHT_GROUPS][3];
     const float *group_sh[LMB_MAX_LIGHT_GROUPS], *group_cube[LMB_MAX_LIGHT_GROUPS];
 } lmb_gltf_probes;
 
@@ -131,7 +133,7 @@ typedef struct lmb_gltf_volume {
 /* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes
  * as buffer views of float32, the tetrahedra as a SCALAR uint32 accessor) and names them in
  * asset.extras.lightmap.probes {count, positions, sh, ambientCube, tetrahedra, shBasis, scale,
- * unit, spacing, groups [{name, scale, sh, ambientCube}] (light groups)} (docs/probes.md); the asset's other extras
+ * unit, spacing, groups [{name, scale, intensity, sh, ambientCube}] (light groups)} (docs/probes.md); the asset's other extras
  * are kept. Per volume a node "lightmap irradiance volume" (or "... K" for probes.volumes entry
  * K) in the default scene whose transform takes a unit cube centred on the origin to the
  * volume's box (bevy's IrradianceVolume), with extras.lightmap.irradianceVolume {uri,

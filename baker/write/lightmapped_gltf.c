@@ -137,6 +137,8 @@ lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const
             snprintf(group_hdr[g], sizeof group_hdr[g], "%s-lightmap-%u-group-%s.hdr", stem, a, groups->name[g]);
             files.group_name[g] = groups->name[g];
             files.group_scale[g] = groups->scale[g];
+            for (int c = 0; c < 3; c++)
+                files.group_intensity[g][c] = groups->weight[g][c];
             files.group_exr[g] = group_exr[g];
             files.group_hdr[g] = group_hdr[g];
         }

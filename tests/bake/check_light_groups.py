@@ -7,15 +7,17 @@ usage: check_light_groups.py LMBAKE WORKDIR [short]   (short, the sanitizer pass
 The level: sun-lamps.gltf (tools/make_scenes.py: a 10 x 10 ground, a closed 1 m cube on it, a sun
 of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6 texels per unit with output.light_groups {sun: match sun} and {lamps: match lamp_*}.
   - engine sum: a game's sum of the two groups' files (32-bit float EXR) of the bake at scales
-    (1, 1), at weights (1, 0), (0, 1) and (0.3, 2), equals the lightmap of a bake whose groups
-    have those scales, within 1e-6 relative at every texel above 1e-6 of the brightest;
-  - the light probes likewise: their SH and ambient cubes = sum_g w_g x each group's own (named in
-    asset.extras.lightmap.probes.groups), within 1e-6 relative;
+    (1, 1), at weights (1, 0), (0, 1) and (0.3, 2), each times the group's intensity (RGB, named
+    in the glTF: the sun's, alone in its group, is its intensity x colour and its files hold it at
+    1; the lamps' 1 1 1), equals the lightmap of a bake whose groups have those scales, within
+    1e-6 relative at every texel above 1e-6 of the brightest;
+  - the light probes likewise: their SH and ambient cubes = sum_g w_g x intensity_g x each group's
+    own (named in asset.extras.lightmap.probes.groups), within 1e-6 relative;
   - the groups' files are the same bytes whatever the scales (no group reads a scale), and the
     same at 1 and 3 threads and from a farm of 2 shards (every output file byte for byte);
   - the sum at (1, 1) is the level's light: against a bake without groups, the mean within 1% and
     the per-texel rms difference within 1.5x that between two seeds of the plain bake (+0.2%);
-  - the glTF names each group's name, scale and files on every lightmap texture and node;
+  - the glTF names each group's name, scale, intensity and files on every lightmap texture and node;
   - kept between bakes (--layout-cache, the watch's): a bake at new scales reads every group back and
     writes the bytes of a bake without the cache; so does an edit of the sun's intensity and colour
     (alone in its group: its weight), the sun switched off, sky.intensity with the sky alone in
@@ -70,12 +72,30 @@ def probe_floats(gltf, view):
 
 
 def probes_of(gltf):
-    """asset.extras.lightmap.probes: (sum's sh, sum's cube, {group: (scale, sh, cube)})."""
+    """asset.extras.lightmap.probes: (sum's sh, sum's cube, {group: (scale, sh, cube)}), each group's
+    sh and cube times its intensity (RGB, channel k % 3), as a game reads them."""
     with open(gltf) as f:
         p = json.load(f)["asset"]["extras"]["lightmap"]["probes"]
-    groups = {g["name"]: (g["scale"], probe_floats(gltf, g["sh"]), probe_floats(gltf, g["ambientCube"]))
-              for g in p.get("groups", [])}
+
+    def lit(g, key):
+        v = probe_floats(gltf, g[key])
+        return v * np.tile(np.array(g["intensity"], dtype=np.float64), len(v) // 3)
+    groups = {g["name"]: (g["scale"], lit(g, "sh"), lit(g, "ambientCube")) for g in p.get("groups", [])}
     return probe_floats(gltf, p["sh"]), probe_floats(gltf, p["ambientCube"]), groups
+
+
+def group_intensities(gltf):
+    """{group: its intensity (RGB) as the lightmap texture's extras.lightmap.groups name it}."""
+    with open(gltf) as f:
+        doc = json.load(f)
+    tex = next(t for t in doc["textures"] if t.get("extras", {}).get("lightmap", {}).get("groups"))
+    return {g["name"]: np.array(g["intensity"], dtype=np.float64) for g in tex["extras"]["lightmap"]["groups"]}
+
+
+def group_light(out, stem, group):
+    """A group's light as a game reads it: its EXR times its intensity."""
+    return read_exr(os.path.join(out, "%s-lightmap-0-group-%s.exr" % (stem, group)))[..., :3] * \
+        group_intensities(os.path.join(out, stem + ".gltf"))[group]
 
 
 def bake(lmbake, work, scene, name, config, *args):
@@ -121,15 +141,15 @@ def engine(lmbake, work, level, short):
     check(files == ["sun-lamps-lightmap-0-group-lamps.exr", "sun-lamps-lightmap-0-group-lamps.hdr",
                     "sun-lamps-lightmap-0-group-sun.exr", "sun-lamps-lightmap-0-group-sun.hdr"],
           "each group's lightmap written: %s" % files)
-    sun, lamps = (read_exr(os.path.join(ref, "sun-lamps-lightmap-0-group-%s.exr" % g)) for g in ("sun", "lamps"))
+    sun, lamps = (group_light(ref, "sun-lamps", g) for g in ("sun", "lamps"))
     for ws in ((0.3, 2.0),) if short else ((1.0, 0.0), (0.0, 1.0), (0.3, 2.0)):
         out, p = bake(lmbake, work, level, "scales-%g-%g" % ws, groups_config(*ws))
         if p.returncode:
             check(False, "bake at scales %s: exit %d %s" % (ws, p.returncode, p.stderr[-400:]))
             continue
         same = all(filecmp.cmp(os.path.join(ref, f), os.path.join(out, f), shallow=False) for f in files)
-        baked = read_exr(os.path.join(out, "sun-lamps-lightmap-0.exr"))
-        summed = np.float32(ws[0]) * sun.astype(np.float32) + np.float32(ws[1]) * lamps.astype(np.float32)
+        baked = read_exr(os.path.join(out, "sun-lamps-lightmap-0.exr"))[..., :3]
+        summed = ws[0] * sun + ws[1] * lamps
         lit = baked > 1e-6 * max(baked.max(), 1e-30)
         rel = np.abs(summed - baked)[lit] / baked[lit] if lit.any() else np.array([np.inf])
         check(same and lit.sum() > 1000 and rel.max() <= 1e-6,
@@ -151,7 +171,7 @@ def engine(lmbake, work, level, short):
               % (ws, worst, same_groups))
     if not short:
         plain_against(lmbake, work, level, sun, lamps)
-    gltf_names(ref)
+    gltf_names(ref, level)
     threads_and_farm(lmbake, work, level, ref, short)
 
 
@@ -162,7 +182,7 @@ def plain_against(lmbake, work, level, sun, lamps):
     if p1.returncode or p2.returncode:
         check(False, "plain bakes: exit %d, %d" % (p1.returncode, p2.returncode))
         return
-    a, b = read_exr(os.path.join(plain, "sun-lamps-lightmap-0.exr")), read_exr(os.path.join(plain2, "sun-lamps-lightmap-0.exr"))
+    a, b = (read_exr(os.path.join(d, "sun-lamps-lightmap-0.exr"))[..., :3] for d in (plain, plain2))
     s = sun + lamps
     lit = a > 0.01 * a.max()
     diff = np.sqrt(np.mean(((s - a)[lit] / a[lit]) ** 2))
@@ -175,15 +195,18 @@ def plain_against(lmbake, work, level, sun, lamps):
     check(0.001 < lamp_share < 0.5, "the lamps' group holds their light: %.2f%% of the level's" % (100 * lamp_share))
 
 
-def gltf_names(ref):
+def gltf_names(ref, level):
     with open(os.path.join(ref, "sun-lamps.gltf")) as f:
         doc = json.load(f)
+    with open(level) as f:
+        sun = next(l for l in json.load(f)["extensions"]["KHR_lights_punctual"]["lights"] if l["name"] == "sun")
     named = [t["extras"]["lightmap"].get("groups") for t in doc["textures"]
              if "lightmap" in t.get("extras", {}) and "files" in t["extras"]["lightmap"]]
-    want = [{"name": "sun", "scale": 1.0, "files": {"exr": "sun-lamps-lightmap-0-group-sun.exr",
-                                                    "hdr": "sun-lamps-lightmap-0-group-sun.hdr"}},
-            {"name": "lamps", "scale": 1.0, "files": {"exr": "sun-lamps-lightmap-0-group-lamps.exr",
-                                                      "hdr": "sun-lamps-lightmap-0-group-lamps.hdr"}}]
+    # the sun alone in its group: its files hold it at intensity 1, the glTF names its intensity x colour
+    want = [{"name": "sun", "scale": 1.0, "intensity": [sun["intensity"] * c for c in sun.get("color", [1, 1, 1])],
+             "files": {"exr": "sun-lamps-lightmap-0-group-sun.exr", "hdr": "sun-lamps-lightmap-0-group-sun.hdr"}},
+            {"name": "lamps", "scale": 1.0, "intensity": [1.0, 1.0, 1.0],
+             "files": {"exr": "sun-lamps-lightmap-0-group-lamps.exr", "hdr": "sun-lamps-lightmap-0-group-lamps.hdr"}}]
     nodes = [n["extras"]["lightmap"].get("groups") for n in doc["nodes"]
              if "atlas" in n.get("extras", {}).get("lightmap", {})]
     check(named == [want] and nodes and all(g == want for g in nodes),
@@ -282,11 +305,22 @@ def kept_between_bakes(lmbake, work, level, doc):
               "%s: %d group(s) lit again, %d read back (want %d, %d); every one of %d files the bytes of a bake "
               "without the cache%s" % (what, log.count("): lighting"), log.count("read back from the cache"), lit, read,
                                        len(names), " (differ: %s)" % differ if differ else ""))
+        return out
 
     def brighter_warmer_sun(d):
         d["extensions"]["KHR_lights_punctual"]["lights"][sun]["intensity"] *= 2.5
         d["extensions"]["KHR_lights_punctual"]["lights"][sun]["color"] = [1.0, 0.85, 0.7]
-    edited_bake("sun-tinted", "the sun x 2.5 and tinted in the glTF (alone in its group)", brighter_warmer_sun, 0, 2)
+    tinted = edited_bake("sun-tinted", "the sun x 2.5 and tinted in the glTF (alone in its group)", brighter_warmer_sun, 0, 2)
+    # the sun's own files hold its light at intensity 1: the same bytes before and after the edit,
+    # the glTF's intensity the new one
+    same = all(filecmp.cmp(os.path.join(first, "sun-lamps-lightmap-0-group-sun.%s" % e),
+                           os.path.join(tinted, "sun-lamps-sun-tinted-lightmap-0-group-sun.%s" % e), shallow=False)
+               for e in ("exr", "hdr")) if os.path.isdir(tinted) else False
+    got = group_intensities(os.path.join(tinted, "sun-lamps-sun-tinted.gltf"))["sun"].tolist() if same else None
+    want = [lights[sun]["intensity"] * 2.5 * c for c in (1.0, 0.85, 0.7)]
+    check(same and np.allclose(got, want, rtol=1e-6),  # the colour as a float
+          "the sun's own EXR and HDR the same bytes after its edit; the glTF names its new intensity %s (want %s)"
+          % (got, want))
 
     def sun_off(d):
         d["extensions"]["KHR_lights_punctual"]["lights"][sun]["intensity"] = 0.0
@@ -357,7 +391,7 @@ def kept_between_bakes(lmbake, work, level, doc):
     only_out, e4 = bake(lmbake, work, edited_level, "glow-only", BASE + "lights: {intensity_scale: 0}\n")
     only_exr = [f for f in os.listdir(only_out) if f.endswith("-lightmap-0.exr")] if e4.returncode == 0 else []
     if glow_exr and only_exr:
-        weighed = read_exr(os.path.join(fresh_out, glow_exr[0]))[..., :3].sum(axis=(0, 1))
+        weighed = group_light(fresh_out, glow_exr[0][:-len("-lightmap-0-group-glow.exr")], "glow").sum(axis=(0, 1))
         alone = read_exr(os.path.join(only_out, only_exr[0]))[..., :3].sum(axis=(0, 1))
         ratio = weighed / np.maximum(alone, 1e-30)
     else:

@@ -26,7 +26,14 @@ const doc = JSON.parse(fs.readFileSync(gltfPath, 'utf8')), dir = path.dirname(gl
 const tex = doc.textures.find((t) => t.extras && t.extras.lightmap && t.extras.lightmap.groups);
 if (!tex) { console.log('FAIL the bake names no light groups'); process.exit(1); }
 const groups = tex.extras.lightmap.groups, atlas = tex.extras.lightmap.atlas;
-const images = groups.map((g) => readHdr(path.join(dir, decodeURIComponent(g.files.hdr))));
+// each group's light as a game reads it: its .hdr times its intensity (RGB: a group of one light
+// holds it at 1 and names the light's intensity x colour)
+const images = groups.map((g) => {
+  const img = readHdr(path.join(dir, decodeURIComponent(g.files.hdr)));
+  const k = Array.isArray(g.intensity) ? g.intensity : [1, 1, 1];
+  for (let i = 0; i < img.data.length; i++) img.data[i] *= k[i % 3];
+  return img;
+});
 const W = images[0].width, H = images[0].height;
 // E of group g at atlas uv, bilinear over texel centres (three: LinearFilter, clamped, no mipmaps)
 const at = (img, x, y, c) => img.data[3 * (Math.min(H - 1, Math.max(0, y)) * W + Math.min(W - 1, Math.max(0, x))) + c];

@@ -15,12 +15,12 @@ import os from 'node:os';
 import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { projectRoot, resolveFile, TYPES } from './server.mjs';
-import { watchedFiles, snapshot, configKeys, fingerprint, compare } from './watch-inputs.mjs';
+import { watchedFiles, snapshot, configReader, fingerprint, compare } from './watch-inputs.mjs';
 import { createComposer } from './compose.mjs';
 
 const usage = 'usage: lmbake preview --watch LEVEL.gltf|glb [-c CONFIG] [-o OUTDIR] [--port N] [--lightmap ktx2|hdr]';
 const POLL_MS = 100; // how often the files' sizes and times are looked at (and on every inotify event)
-const SETTLE_MS = 100; // a change is baked once the files have stood still this long (a bake that read a save half-way is stopped and baked again)
+const SETTLE_MS = 30; // a change is baked once the files have stood still this long (a bake that read a save half-way is stopped and baked again)
 
 function parseArgs(args) {
   const o = { level: null, config: null, outdir: 'lmbake-out', port: 0, lightmap: null, lmbake: process.env.LMBAKE || path.join(projectRoot, 'build', 'lmbake'), quick: true };
@@ -54,6 +54,7 @@ const say = (line) => console.log(`watch: ${line}`);
 // The composed quick picture's maker: it keeps the last final bake's map to the quick layout
 // (built while idle after each final bake) and the last few lightmaps it read.
 const composer = createComposer();
+const readConfig = configReader(); // the config's keys, kept while its bytes stand
 
 // What the page and /status see.
 const status = {
@@ -169,7 +170,7 @@ async function bakeNewest() {
   if (opts.config && !fs.existsSync(opts.config)) { status.state = 'waiting'; status.error = `${opts.config}: missing; waiting for it`; say(status.error); return; }
   let print, fp;
   try {
-    print = configKeys(opts.lmbake, opts.config);
+    print = readConfig(opts.lmbake, opts.config);
     files = watchedFiles(opts.level, opts.config, print);
     lastSnapshot = snapshot(files);
     fp = fingerprint(opts.level, files, print);
