@@ -15,6 +15,10 @@
 // and a material plugin multiplies the lightmap by the surface's diffuse albedo.
 // Light probes (asset.extras.lightmap.probes): read with the level, kept on the root mesh's
 // metadata (lmbakeProbes(result.meshes[0])); lmbake-babylon-probes.js lights meshes by them.
+// Light groups (extras.lightmap.groups on a lightmap texture; docs/light-groups.md): each group's
+// .hdr is read too, and a material plugin makes the lightmap sum_g w_g x intensity_g x group_g
+// (intensity_g: RGB, from the glTF), with one weight per group the game sets at run time:
+// lmbakeLightGroups(result.meshes[0]).setWeight('lamps', 0).
 // Per-copy rectangles: a node with EXT_mesh_gpu_instancing whose attributes hold _LIGHTMAP_SCALE
 // and _LIGHTMAP_OFFSET (VEC2, one per copy; docs/output.md) has its copies (Babylon's thin
 // instances) read the atlas at TEXCOORD_1 x scale_k + offset_k: a thin-instance buffer
@@ -47,6 +51,68 @@ class LightmapTimesAlbedo extends MaterialPluginBase {
     if (shaderType !== 'fragment') return null;
     return { CUSTOM_FRAGMENT_BEFORE_FINALCOLORCOMPOSITION: '#if defined(LIGHTMAP) && defined(LMBAKE_LIGHTMAP)\nlightmapColor.rgb *= surfaceAlbedo;\n#endif\n' };
   }
+}
+
+// Light groups: where the material read its lightmap it reads sum_g gain_g x group_g, gain_g =
+// w_g x intensity_g (RGB), the groups' .hdr textures of its atlas sampled at the lightmap's own
+// coordinates (the atlas is the same; a material's rectangle is in vLightmapUV). Runs before
+// LightmapTimesAlbedo (priority 190 < 200), so the sum is what the albedo multiplies.
+// lmbGroupsSum(uv) is the sum before the texture's level (tests read it).
+class LightGroupsSum extends MaterialPluginBase {
+  constructor(material, groups, textures) {
+    super(material, 'LmbakeLightGroups', 190, { LMBAKE_GROUPS: 0 }, false); // added below: its code needs the textures
+    this._groups = groups;
+    this._textures = textures;
+    this._pluginManager._addPlugin(this);
+    this._enable(true);
+  }
+
+  prepareDefines(defines) { defines.LMBAKE_GROUPS = this._textures.length; }
+
+  getClassName() { return 'LmbakeLightGroups'; }
+
+  getSamplers(samplers) { this._textures.forEach((_, g) => samplers.push(`lmbGroup${g}`)); }
+
+  getUniforms() {
+    const n = this._textures.length;
+    return {
+      ubo: Array.from({ length: n }, (_, g) => ({ name: `lmbGroupGain${g}`, size: 3, type: 'vec3' })),
+      fragment: Array.from({ length: n }, (_, g) => `uniform vec3 lmbGroupGain${g};`).join('\n'),
+    };
+  }
+
+  bindForSubMesh(uniformBuffer) { // every frame: the weights change at run time
+    this._textures.forEach((t, g) => {
+      const w = this._groups.weights[g], k = this._groups.intensities[g];
+      uniformBuffer.updateFloat3(`lmbGroupGain${g}`, w * k[0], w * k[1], w * k[2]);
+      uniformBuffer.setTexture(`lmbGroup${g}`, t);
+    });
+  }
+
+  hasTexture(texture) { return this._textures.includes(texture); }
+
+  getActiveTextures(active) { active.push(...this._textures); }
+
+  getCustomCode(shaderType) {
+    if (shaderType !== 'fragment') return null;
+    const n = this._textures.length;
+    const sum = Array.from({ length: n }, (_, g) => `lmbGroupGain${g} * texture2D(lmbGroup${g}, uv).rgb`).join(' + ');
+    return {
+      CUSTOM_FRAGMENT_DEFINITIONS: `#if defined(LMBAKE_GROUPS) && LMBAKE_GROUPS > 0
+${Array.from({ length: n }, (_, g) => `uniform sampler2D lmbGroup${g};`).join('\n')}
+vec3 lmbGroupsSum(vec2 uv) { return ${sum}; }
+#endif
+`,
+      CUSTOM_FRAGMENT_BEFORE_FINALCOLORCOMPOSITION: '#if defined(LIGHTMAP) && defined(LMBAKE_GROUPS) && LMBAKE_GROUPS > 0\nlightmapColor.rgb = lmbGroupsSum(vLightmapUV) * vLightmapInfos.y;\n#endif\n',
+    };
+  }
+}
+
+// The light groups of a bake loaded with registerLmbakeLightmaps (root: the load's first mesh), or
+// null: {names, scales, intensities, weights, setWeight(group name or index, w)}; the weights
+// start at the bake's scales and are read by every patched material at its next frame.
+export function lmbakeLightGroups(root) {
+  return (root && root.metadata && root.metadata.lmbake && root.metadata.lmbake.groups) || null;
 }
 
 // The per-copy rectangle attribute: (scale u, scale v, offset u, offset v) per thin instance.
@@ -118,6 +184,8 @@ class MozLightmap {
     this._options = options;
     this.enabled = loader.isExtensionUsed(NAME);
     this._textures = new Map(); // texture index -> Promise<{texture, source}>
+    this._groupTextures = new Map(); // texture index -> Promise<[group textures]> (light groups)
+    this._groups = null; // {names, scales, intensities, weights, setWeight}: the first atlas's groups
   }
 
   dispose() { this._loader = null; }
@@ -143,6 +211,8 @@ class MozLightmap {
       tex.level = (ext.intensity ?? 1) / Math.PI;
       babylonMaterial.lightmapTexture = tex;
       babylonMaterial.useLightmapAsShadowmap = false;
+      const groupTextures = await this._lightGroups(extContext, ext.index);
+      if (groupTextures && !(babylonMaterial.pluginManager && babylonMaterial.pluginManager.getPlugin('LmbakeLightGroups'))) new LightGroupsSum(babylonMaterial, this._groups, groupTextures);
       if (!babylonMaterial.pluginManager || !babylonMaterial.pluginManager.getPlugin('LmbakeLightmapTimesAlbedo')) new LightmapTimesAlbedo(babylonMaterial);
     });
   }
@@ -154,8 +224,12 @@ class MozLightmap {
     const json = this._loader.gltf, root = this._loader.rootBabylonMesh;
     const probes = await loadProbes(this._loader);
     if (probes && root) {
-      root.metadata = { ...(root.metadata || {}), lmbake: { probes } };
+      root.metadata = { ...(root.metadata || {}), lmbake: { ...((root.metadata || {}).lmbake || {}), probes } };
       console.log(`lmbake-babylon: ${probes.count} light probes (lmbakeProbes(root))`);
+    }
+    if (this._groups && root) {
+      root.metadata = { ...(root.metadata || {}), lmbake: { ...((root.metadata || {}).lmbake || {}), groups: this._groups } };
+      console.log(`lmbake-babylon: light groups ${this._groups.names.join(', ')} (lmbakeLightGroups(root))`);
     }
     for (const node of json.nodes || []) {
       const ext = node.extensions && node.extensions.EXT_mesh_gpu_instancing, attrs = ext && ext.attributes;
@@ -179,6 +253,56 @@ class MozLightmap {
       }
       console.log(`lmbake-babylon: node ${node.index}: ${count} copies at their own lightmap rectangles`);
     }
+  }
+
+  // The light groups a lightmap texture names (extras.lightmap.groups): each group's .hdr as a
+  // texture (as the level's .hdr is read), in the groups' order; null without groups. Every atlas
+  // must name the same groups (the first one's are the weights' groups).
+  _lightGroups(context, index) {
+    if (!this._groupTextures.has(index)) this._groupTextures.set(index, this._loadLightGroups(context, index));
+    return this._groupTextures.get(index);
+  }
+
+  async _loadLightGroups(context, index) {
+    const def = this._loader.gltf.textures[index];
+    const groups = def && def.extras && def.extras.lightmap && def.extras.lightmap.groups;
+    if (!Array.isArray(groups) || !groups.length) return null;
+    const names = groups.map((g) => String(g.name));
+    if (!this._groups) {
+      const state = {
+        names,
+        scales: groups.map((g) => Number(g.scale)),
+        intensities: groups.map((g) => (Array.isArray(g.intensity) && g.intensity.length === 3 ? g.intensity.map(Number) : [1, 1, 1])),
+      };
+      state.weights = state.scales.slice();
+      state.setWeight = (g, w) => {
+        const k = typeof g === 'number' ? g : state.names.indexOf(g);
+        if (!(k >= 0 && k < state.names.length)) throw new Error(`no light group ${g} (${state.names.join(', ')})`);
+        state.weights[k] = Number(w);
+      };
+      this._groups = state;
+    } else if (names.join('\n') !== this._groups.names.join('\n')) {
+      throw new Error(`${context}: texture ${index} names light groups ${names} where another names ${this._groups.names}`);
+    }
+    return Promise.all(groups.map(async (g) => {
+      const texture = this._hdrTexture(new Uint8Array(await this._fetch(context, def, g.files.hdr)), g.files.hdr);
+      texture.wrapU = texture.wrapV = Texture.CLAMP_ADDRESSMODE;
+      texture.anisotropicFilteringLevel = 1;
+      return texture;
+    }));
+  }
+
+  // A Radiance .hdr as a half-float RGBA texture (Babylon's own RGBE reader)
+  _hdrTexture(bytes, name) {
+    const info = RGBE_ReadHeader(bytes), rgb = RGBE_ReadPixels(bytes, info), n = info.width * info.height;
+    const half = new Uint16Array(4 * n);
+    for (let i = 0; i < n; i++) {
+      for (let c = 0; c < 3; c++) half[4 * i + c] = toHalf(rgb[3 * i + c]);
+      half[4 * i + 3] = 0x3c00;
+    }
+    const texture = new RawTexture(half, info.width, info.height, TEXTUREFORMAT_RGBA, this._loader.babylonScene, false, false, BILINEAR, TEXTURETYPE_HALF_FLOAT);
+    texture.name = name;
+    return texture;
   }
 
   _lightmap(context, index) {
@@ -221,15 +345,7 @@ class MozLightmap {
     }
     if (!texture && rgbe) {
       const img = json.images[rgbe.source];
-      const bytes = new Uint8Array(await this._fetch(context, img, img.uri));
-      const info = RGBE_ReadHeader(bytes), rgb = RGBE_ReadPixels(bytes, info), n = info.width * info.height;
-      const half = new Uint16Array(4 * n);
-      for (let i = 0; i < n; i++) {
-        for (let c = 0; c < 3; c++) half[4 * i + c] = toHalf(rgb[3 * i + c]);
-        half[4 * i + 3] = 0x3c00;
-      }
-      texture = new RawTexture(half, info.width, info.height, TEXTUREFORMAT_RGBA, scene, false, false, BILINEAR, TEXTURETYPE_HALF_FLOAT);
-      texture.name = img.uri;
+      texture = this._hdrTexture(new Uint8Array(await this._fetch(context, img, img.uri)), img.uri);
       console.log(`lmbake-babylon: atlas from ${img.uri} (RGBE as half floats)`);
     }
     if (!texture) throw new Error(`${context}: lightmap texture ${index} has neither a BC6H KTX2 this GPU reads nor a .hdr`);

@@ -20,7 +20,10 @@ fixed point); against the EXR, the file's own precision on top
 Then level-single-10 and 16 copies of a prop through EXT_mesh_gpu_instancing (per-copy
 rectangles), BC6H: each page against its files, and the two pages against each other (the same
 view: the same lightmap coordinates at every pixel, cross_check()); and Babylon's probe-lit
-sphere (probe_light()). Every page runs in one browser.
+sphere (probe_light()); and Babylon's light groups (light_groups(): make_scenes.py's sun-lamps
+with the sun and the lamps in two groups, at weights (0.3, 2): each pixel against the sum of the
+groups' .hdr files at its coordinates, each times its weight and the intensity the glTF names).
+Every page runs in one browser.
 """
 import json
 import os
@@ -176,6 +179,38 @@ def probe_light(work):
     return ok
 
 
+GROUP_WEIGHTS = (0.3, 2.0)
+
+
+def light_groups(work, out):
+    """Babylon's page at GROUP_WEIGHTS against sum_g w_g x intensity_g x group g's .hdr (bilinear at
+    each pixel's coordinates); the bake's own lightmap (the sum at scales 1, 1) is not that sum,
+    so a page that ignored the groups fails."""
+    p = json.load(open(page_file(work, "babylon", "groups")))
+    value = np.array(p["value"], dtype=np.float64).reshape(-1, 4)
+    uv = np.array(p["uv"], dtype=np.float64).reshape(-1, 4)
+    lit = (uv[:, 3] > 0.5) & (value[:, 3] > 0.5)
+    with open(os.path.join(out, "sun-lamps.gltf")) as f:
+        doc = json.load(f)
+    groups = next(t["extras"]["lightmap"]["groups"] for t in doc["textures"]
+                  if t.get("extras", {}).get("lightmap", {}).get("groups"))
+    want, plain = np.zeros((lit.sum(), 3)), bilinear(read_image(os.path.join(out, "sun-lamps-lightmap-0.hdr")),
+                                                    uv[lit, 0], uv[lit, 1])
+    for w, g in zip(GROUP_WEIGHTS, groups):
+        want += w * np.array(g["intensity"]) * bilinear(read_image(os.path.join(out, g["files"]["hdr"])), uv[lit, 0],
+                                                        uv[lit, 1])
+    rel, off_plain = relative(value[lit, :3], want), relative(plain, want)
+    said = any("at weights %s" % ", ".join("%g" % w for w in GROUP_WEIGHTS) in l for l in p["logs"])
+    good = (lit.sum() > 500 and said and rel.size and rel.mean() <= 0.005 and np.percentile(rel, 99) <= 0.01
+            and off_plain.mean() > 0.05)
+    print("babylon light groups %s at weights %s: %d pixels against sum_g w_g x intensity_g x group g's .hdr: mean "
+          "%.4f%% p99 %.3f%% (bounds 0.5%%, 1%%; the bake's own lightmap is %.1f%% off that sum); the page said the "
+          "weights: %s: %s" % ([g["name"] for g in groups], GROUP_WEIGHTS, lit.sum(), 100 * rel.mean(),
+                               100 * np.percentile(rel, 99) if rel.size else -1, 100 * off_plain.mean(), said,
+                               "ok" if good else "FAIL"), flush=True)
+    return good
+
+
 def main():
     lmbake, work, loaders = sys.argv[1], sys.argv[2], sys.argv[3].split(",")
     os.makedirs(work, exist_ok=True)
@@ -209,6 +244,15 @@ def main():
         for loader in loaders:
             jobs.append(page_job(work, os.path.join(out, name + ".gltf"), loader, name))
             checks.append((out, name, loader, "bc6h", name, min_pixels))
+    groups_out = os.path.join(work, "out-groups")
+    if "babylon" in loaders:
+        subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
+                       check=True, stdout=subprocess.DEVNULL)
+        bake(lmbake, os.path.join(work, "scenes", "sun-lamps.gltf"), groups_out, os.path.join(work, "groups.yaml"),
+             CHEAP + "probes: {auto: false}\noutput:\n  directional: false\n  light_groups:\n"
+             "    - {name: sun, match: sun}\n    - {name: lamps, match: \"lamp_*\"}\n")
+        jobs.append(dict(page_job(work, os.path.join(groups_out, "sun-lamps.gltf"), "babylon", "groups"), source="hdr",
+                         groups=",".join("%g" % w for w in GROUP_WEIGHTS)))
     run_pages(work, jobs)
     ok, uvs = True, {}
     for out, stem, loader, fmt, tag, min_pixels in checks:
@@ -217,6 +261,7 @@ def main():
         uvs[(stem, loader)] = (uv, lit)
     if "babylon" in loaders:
         ok &= probe_light(work)
+        ok &= light_groups(work, groups_out)
     for name, _ in levels:
         if len(loaders) == 2:
             ok &= cross_check(work, os.path.join(work, "out-" + name), name, loaders,

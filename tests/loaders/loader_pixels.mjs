@@ -22,14 +22,14 @@ function jobsFromArgs(argv) {
 }
 
 // One page: the example of `loader` on the bake at gltf (served under the server's /bake/ root).
-async function runJob(context, srv, root, { loader, gltf, out, source = 'ktx2', probeLight = false }) {
+async function runJob(context, srv, root, { loader, gltf, out, source = 'ktx2', probeLight = false, groups = null }) {
   const page = await context.newPage();
   try {
     const errors = [], logs = [];
     page.on('pageerror', (e) => errors.push(e.message));
     page.on('console', (m) => (m.type() === 'error' ? errors : logs).push(m.text()));
     const rel = path.relative(root, path.resolve(gltf)).split(path.sep).map(encodeURIComponent).join('/');
-    const url = `${srv.url}loaders/${loader}/example/index.html?` + new URLSearchParams({ gltf: '/bake/' + rel, source, probe: '1' });
+    const url = `${srv.url}loaders/${loader}/example/index.html?` + new URLSearchParams({ gltf: '/bake/' + rel, source, probe: '1', ...(groups ? { groups } : {}) });
     await page.goto(url);
     await page.waitForFunction(() => window.lmbReady === true, null, { timeout: 60000, polling: 100 }).catch(() => errors.push('not ready after 60 s'));
     if (errors.length) throw new Error(`${url}: ${errors.join('; ')}`);

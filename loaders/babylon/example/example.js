@@ -13,7 +13,7 @@ import '@babylonjs/core/Materials/PBR/pbrMaterial.js';
 import '@babylonjs/loaders/glTF/2.0/index.js';
 import { CreateSphere } from '@babylonjs/core/Meshes/Builders/sphereBuilder.js';
 import { PBRMaterial } from '@babylonjs/core/Materials/PBR/pbrMaterial.js';
-import { registerLmbakeLightmaps, lmbakeProbes, applyProbeLight } from 'lmbake-babylon';
+import { registerLmbakeLightmaps, lmbakeProbes, applyProbeLight, lmbakeLightGroups } from 'lmbake-babylon';
 import { interpolateSH, shIrradiance } from 'lmbake-probes';
 
 const params = new URLSearchParams(location.search);
@@ -27,6 +27,13 @@ registerLmbakeLightmaps({ source: params.get('source') || 'ktx2' });
 const gltfUrl = params.get('gltf');
 const result = await ImportMeshAsync(gltfUrl, scene);
 // --
+// ?groups=w1,w2,...: the light groups' weights (a bake with output.light_groups)
+if (params.get('groups')) {
+  const groups = lmbakeLightGroups(result.meshes[0]);
+  if (!groups) throw new Error('groups= given, but the bake has no light groups');
+  params.get('groups').split(',').map(Number).forEach((w, g) => groups.setWeight(g, w));
+  console.log(`light groups ${groups.names.join(', ')} at weights ${groups.weights.join(', ')}`);
+}
 
 // a camera looking at the level's bounds from the front (glTF's +z side), a little above: the
 // view of lmbake-three's example (Babylon's glTF root maps glTF's (x, y, z) to (-x, y, z), and
@@ -48,7 +55,7 @@ if (!params.get('probe')) {
 }
 
 // The loaders' test: each pixel's lightmap value (E in lux: the lightmap texel x its level x pi,
-// the level being intensity / pi) and its lightmap coordinates (u, v, atlas 0) from the same
+// the level being intensity / pi; with light groups, their sum at the weights) and its lightmap coordinates (u, v, atlas 0) from the same
 // camera into a float target, as lmbake-babylon set the materials up.
 class Probe extends MaterialPluginBase {
   constructor(material) {
@@ -78,7 +85,9 @@ class Probe extends MaterialPluginBase {
     if (shaderType !== 'fragment') return null;
     return {
       CUSTOM_FRAGMENT_BEFORE_FRAGCOLOR: `
-#if defined(LIGHTMAP) && defined(LMBAKE_PROBE_VALUE)
+#if defined(LIGHTMAP) && defined(LMBAKE_PROBE_VALUE) && defined(LMBAKE_GROUPS) && LMBAKE_GROUPS > 0
+finalColor = vec4(lmbGroupsSum(vLightmapUV) * vLightmapInfos.y * PI, 1.0);
+#elif defined(LIGHTMAP) && defined(LMBAKE_PROBE_VALUE)
 finalColor = vec4(texture2D(lightmapSampler, vLightmapUV).rgb * vLightmapInfos.y * PI, 1.0);
 #endif
 #if defined(LIGHTMAP) && defined(LMBAKE_PROBE_UV)
