@@ -11,9 +11,12 @@ level-single-10 (11 lights) in three groups: the sun, Lamp 0 alone, the other te
 off, the sun x 0.5 (each alone in its group: a new weight), the lamps' group scale x 0.5 (the
 config), Lamp 0 moved 2 m (its group lit again). bevy's Cornell box with its emissive ceiling in a
 group: the group's scale x 3, and the ceiling's emissive strength x 3 and its colour tinted in the
-glTF (alone in their group: a new weight). Then the same level under `lmbake preview --watch` (no browser): Lamp 0 x 2 and Lamp 0
-moved 2 m saved over the watched file, each timed from the save to the final files on the watch's
-/status, its lightmaps compared with the fresh bake of that edit. About 20 minutes on 2 cores.
+glTF (alone in their group: a new weight). tools/make_scenes.py's sun-lamps (a ground and a cube
+under a sky of 400 lux, a sun and two lamps; 30 texels per unit) with the sky alone in its group: sky.intensity x 0.5
+(the config; a new weight). Then each level under `lmbake preview --watch` (no browser): every
+edit saved over the watched file (the level, or the config for a config edit) in turn, each timed
+from the save to the final files on the watch's /status, its lightmaps compared with the fresh
+bake of that edit. About 25 minutes on 2 cores.
 """
 import csv
 import filecmp
@@ -68,9 +71,18 @@ def write_glb(path, doc, binary):
         f.write(struct.pack("<4sII", b"glTF", 2, 12 + len(chunks)) + chunks)
 
 
-def config(groups):
+def config(groups, base=""):
+    """The config: base's keys, then output.light_groups."""
     lines = ["output:", "  light_groups:"] + ["    - {%s}" % g for g in groups]
-    return "\n".join(lines) + "\n"
+    return base + "\n".join(lines) + "\n"
+
+
+def edited_config(groups, base, change):
+    """The config after an edit: change None (the glTF's edit), a group's line in place of the
+    group of that name, or {"base": text} in place of the base keys."""
+    if isinstance(change, dict):
+        return config(groups, change["base"])
+    return config([change if change and g.split(",")[0] == change.split(",")[0] else g for g in groups], base)
 
 
 def light_index(doc, name):
@@ -127,12 +139,14 @@ def same_images(a, b, prefix_a, prefix_b):
 
 
 def watch_edits(lmbake, level, doc, binary, cfg_text, work, edits, fresh_dirs):
-    """`lmbake preview --watch` of a copy of level; each edit of the first level saved over it in
-    turn; rows of seconds from the save to the final bake on /status."""
-    wdir = os.path.join(work, "watch")
+    """`lmbake preview --watch` of a copy of level; each edit (what, the glTF's edit or None, the
+    config's text after it) of the first level and config saved over them in turn; rows of seconds
+    from the save to the final bake on /status."""
+    wdir = os.path.join(work, "watch-" + os.path.splitext(os.path.basename(level))[0])
     os.makedirs(wdir, exist_ok=True)
     name = os.path.splitext(os.path.basename(level))[0]
-    watched, cfg, out = os.path.join(wdir, name + ".glb"), os.path.join(wdir, "level.yaml"), os.path.join(wdir, "out")
+    ext = os.path.splitext(level)[1]  # .gltf: one with its buffers embedded (make_scenes.py's)
+    watched, cfg, out = os.path.join(wdir, name + ext), os.path.join(wdir, "level.yaml"), os.path.join(wdir, "out")
     shutil.copy(level, watched)
     with open(cfg, "w") as f:
         f.write(cfg_text)
@@ -156,13 +170,26 @@ def watch_edits(lmbake, level, doc, binary, cfg_text, work, edits, fresh_dirs):
                 time.sleep(0.05)
             sys.exit("the watch's final bake %d did not come" % generation)
         final(1)
-        for k, (what, edit) in enumerate(edits):
+        glb_now, cfg_now = None, cfg_text
+        for k, (what, edit, cfg_after) in enumerate(edits):
             d = json.loads(json.dumps(doc))
-            edit(d)
+            if edit:
+                edit(d)
+            glb_after = json.dumps(d)
             time.sleep(1.5)  # the file's time stamp moves on
             saved = time.time()
-            write_glb(watched + ".tmp", d, binary)
-            os.replace(watched + ".tmp", watched)
+            if glb_after != glb_now:  # the level saved (the first edit always: the watched copy is the level's file)
+                if ext == ".gltf":
+                    with open(watched + ".tmp", "w") as f:
+                        json.dump(d, f)
+                else:
+                    write_glb(watched + ".tmp", d, binary)
+                os.replace(watched + ".tmp", watched)
+            if cfg_after != cfg_now:
+                with open(cfg + ".tmp", "w") as f:
+                    f.write(cfg_after)
+                os.replace(cfg + ".tmp", cfg)
+            glb_now, cfg_now = glb_after, cfg_after
             s = final(k + 2)
             secs = s["shown"]["readyAt"] / 1000.0 - saved
             same = same_images(out, fresh_dirs[what][0], name, fresh_dirs[what][1])
@@ -181,9 +208,7 @@ def watch_edits(lmbake, level, doc, binary, cfg_text, work, edits, fresh_dirs):
     return rows
 
 
-WATCHED = ["Lamp 0 x 2", "Lamp 0 moved 2 m"]
-
-LEVELS = [
+LEVELS = [  # (level, its groups, its edits (what, the glTF's edit, the config's), the config's other keys)
     ("bench/levels/level-single-10.glb",
      ["name: sun, match: Sun", 'name: lamp0, match: "Lamp 0"', 'name: lamps, match: "Lamp *"'],
      [("Lamp 0 x 2", scale_light("Lamp 0", 2.0), None),
@@ -196,6 +221,9 @@ LEVELS = [
      [("ceiling's group scale x 3", None, "name: ceiling, emissive: true, scale: 3"),
       ("emissive strength x 3", emissive_x(3.0), None),
       ("emissive colour tinted", emissive_tint([1.0, 0.7, 0.4]), None)]),
+    ("sun-lamps", ["name: sky, sky: true", 'name: lights, match: "*"'],
+     [("sky.intensity x 0.5", None, {"base": "texel_density: 30\nsky: {intensity: 200}\n"})],
+     "texel_density: 30\nsky: {intensity: 400}\n"),
 ]
 
 
@@ -204,7 +232,12 @@ def main():
     os.makedirs(outdir, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as work:
-        for level, groups, edits in LEVELS:
+        for level, groups, edits, *rest in LEVELS:
+            base = rest[0] if rest else ""
+            if level == "sun-lamps":
+                subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
+                               check=True, stdout=subprocess.DEVNULL)
+                level = os.path.join(work, "scenes", "sun-lamps.gltf")
             level = os.path.join(ROOT, level)
             if not os.path.exists(level):
                 print("skipping %s: missing (tools/make_levels.py bench/levels single:10 makes it)" % level)
@@ -213,7 +246,7 @@ def main():
             cache = os.path.join(work, name + "-cache")
             doc, binary = read_gltf(level)
             fresh_dirs = {}
-            first = run(lmbake, level, config(groups), os.path.join(work, "first"), work, name + "-first",
+            first = run(lmbake, level, config(groups, base), os.path.join(work, "first"), work, name + "-first",
                         "--layout-cache", cache, "-q")
             rows.append({"level": name, "edit": "first bake, groups kept", "run": "kept", "seconds": "%.2f" % first[0],
                          "peak_mb": "%.0f" % first[1], "groups_lit": len(groups), "groups_read_back": 0,
@@ -226,7 +259,7 @@ def main():
                     edit(d)
                     edited = os.path.join(work, "%s-edit%d.glb" % (name, k))
                     write_glb(edited, d, binary)
-                cfg = config([group if group and g.split(",")[0] == group.split(",")[0] else g for g in groups])
+                cfg = edited_config(groups, base, group)
                 relit = run(lmbake, edited, cfg, os.path.join(work, "relit"), work, "%s-relit%d" % (name, k),
                             "--layout-cache", cache)
                 fresh = run(lmbake, edited, cfg, os.path.join(work, "fresh"), work, "%s-fresh%d" % (name, k), "-q")
@@ -241,13 +274,11 @@ def main():
                                  "identical": ("yes" if same else "NO") if run_name == "relit" else ""})
                 print("%s, %s: relit %.2f s (%d group(s) lit, %d read back), fresh bake %.1f s, identical: %s" %
                       (name, what, relit[0], lit, read, fresh[0], same), flush=True)
-                if what in WATCHED:
-                    kept = os.path.join(work, "fresh-%s-%d" % (name, k))
-                    shutil.copytree(b, kept)
-                    fresh_dirs[what] = (kept, "%s-edit%d" % (name, k))
-            watched = [(w, e) for w, e, g in edits if w in fresh_dirs and e]
-            if watched:
-                rows += watch_edits(lmbake, level, doc, binary, config(groups), work, watched, fresh_dirs)
+                kept = os.path.join(work, "fresh-%s-%d" % (name, k))
+                shutil.copytree(b, kept)
+                fresh_dirs[what] = (kept, "%s-edit%d" % (name, k) if edit else name)
+            watched = [(w, e, edited_config(groups, base, g)) for w, e, g in edits]
+            rows += watch_edits(lmbake, level, doc, binary, config(groups, base), work, watched, fresh_dirs)
     with open(os.path.join(outdir, "relight.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
