@@ -153,16 +153,25 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
         int sky_alone = out->sky == (int32_t)k && !out->lights[k] && out->emissive != (int32_t)k &&
                         cfg->sky_intensity > 0;
         int emission_alone = out->emissive == (int32_t)k && !out->lights[k] && out->sky != (int32_t)k && one_emission;
+        if (sky_alone)
+            out->sky_color_weight = lmb_sky_color_is_weight(cfg);
         out->unit[k] = sky_alone || emission_alone ||
                        (out->lights[k] == 1 && out->sky != (int32_t)k && out->emissive != (int32_t)k);
         for (int c = 0; c < 3; c++)
-            out->weight[k][c] = sky_alone ? cfg->sky_intensity : emission_alone ? (double)le[c] : 1.0;
+            out->weight[k][c] = sky_alone      ? cfg->sky_intensity * (out->sky_color_weight ? cfg->sky_color[c] : 1.0)
+                                : emission_alone ? (double)le[c]
+                                                 : 1.0;
         for (uint32_t i = 0; out->unit[k] && i < s->light_count; i++)
             if (out->of_light[i] == (int32_t)k)
                 for (int c = 0; c < 3; c++)
                     out->weight[k][c] = (double)s->lights[i].intensity * (double)s->lights[i].color[c];
     }
     return LMB_OK;
+}
+
+int lmb_sky_color_is_weight(const lmb_config *cfg)
+{
+    return !(cfg->sky_ground[0] >= 0);
 }
 
 /* One line per group: what it holds, its scale, and a unit group's weight (the watch reads the
@@ -177,7 +186,7 @@ void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, cons
         if (g->unit[k])
             snprintf(weight, sizeof weight, " (lit at unit %s, weighed by %s: [%g, %g, %g])",
                      g->emissive == (int32_t)k ? "emission" : "intensity",
-                     g->sky == (int32_t)k        ? "sky.intensity"
+                     g->sky == (int32_t)k        ? (g->sky_color_weight ? "sky.intensity x sky.color" : "sky.intensity")
                      : g->emissive == (int32_t)k ? "the surfaces' emissive colour x strength"
                                                  : "the light's intensity x colour",
                      g->weight[k][0], g->weight[k][1], g->weight[k][2]);

@@ -11,7 +11,9 @@
  * intensity and colour: the light of a single light is linear in both, so an edit of either is a
  * new weight, and the bake of the edited level composes the same floats. Its own files hold the
  * light at 1; the glTF names the weight (`intensity`) for the game to multiply. So is the config's sky
- * alone in a group (sky.intensity), and the emissive surfaces alone when they share one emission.
+ * alone in a group (sky.intensity, and sky.color when no ground colour is set: the sky's radiance
+ * is then the colour times one map or one constant, and its samples follow the map alone), and the
+ * emissive surfaces alone when they share one emission.
  *
  * Which group a source is in: a light's extras.lightmap_group (its own, else its node's); else
  * the first config group whose match its name or node name matches; the sky and the emissive
@@ -32,11 +34,13 @@ typedef struct lmb_light_groups {
     int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
     /* A group of one light (neither the sky nor the emissive surfaces) is lit with that light at
      * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel);
-     * a group of the config's sky alone is lit at sky.intensity 1 and weighed by it; a group of
+     * a group of the config's sky alone is lit at sky.intensity 1 and weighed by it (and at
+     * sky.color white, weighed by it, when lmb_sky_color_is_weight); a group of
      * the emissive surfaces alone, when they share one emission (factor x strength x
      * lights.emissive_scale; textures only on one material), is lit at emission 1 and weighed by
      * it: an edit of those is a new weight, not a new lighting. Other groups: weight 1 1 1. */
     int unit[LMB_MAX_LIGHT_GROUPS];
+    int sky_color_weight; /* the sky's unit group is lit at sky.color white too (lmb_sky_color_is_weight) */
     double weight[LMB_MAX_LIGHT_GROUPS][3];
 } lmb_light_groups;
 
@@ -48,6 +52,12 @@ typedef struct lmb_light_groups {
 lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
                                     lmb_light_groups *out, lmb_error *err);
 void lmb_light_groups_free(lmb_light_groups *g);
+
+/* Whether a unit sky group's colour is a weight too: the config sets no ground colour, so the
+ * sky's radiance is sky.color x intensity x (its image or 1) everywhere and a sky lit at white
+ * draws its samples by the image's luminance alone, whatever the colour. With a ground colour the
+ * ground is not tinted by sky.color, and the two colours' ratio decides where samples go. */
+int lmb_sky_color_is_weight(const lmb_config *cfg);
 
 /* The log's line: each group, what it holds and its scale. */
 void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, const lmb_log *log);

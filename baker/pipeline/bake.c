@@ -341,6 +341,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     if (st == LMB_OK && groups.count && !dark && groups.sky >= 0 && groups.unit[groups.sky]) {
         lmb_sky_options unit_opt = lmb_sky_options_of(cfg);
         unit_opt.intensity = 1;
+        for (int c = 0; c < 3 && groups.sky_color_weight; c++)
+            unit_opt.color[c] = 1; /* sky.color is the group's weight too */
         st = lmb_sky_create(&unit_opt, s, NULL, &unit_sky, err);
     }
     if (st == LMB_OK && groups.count && !dark && groups.emissive >= 0 && groups.unit[groups.emissive]) {

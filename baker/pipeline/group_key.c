@@ -18,7 +18,7 @@
  *     range, cones, and intensity and colour unless the group is a unit group
  *     (lmb_light_groups.unit: they are its weight, applied after).
  * So another group's light or sky edited, a unit group's light dimmed, tinted or switched off,
- * or a unit group's sky dimmed, keeps the key. A JSON cJSON cannot parse (it parsed for the
+ * or a unit group's sky dimmed (or tinted, without a ground colour), keeps the key. A JSON cJSON cannot parse (it parsed for the
  * loader) is hashed as it is: no group is read back wrongly, only lit again.
  */
 #include "group_cache.h"
@@ -31,8 +31,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GROUP_KEY_FORMAT 4u /* 2: the JSON without punctual lights, the group's own lights; 3: emission;
-                                  4: a unit group's kept files hold its light at intensity 1 */
+#define GROUP_KEY_FORMAT 5u /* 2: the JSON without punctual lights, the group's own lights; 3: emission;
+                                  4: a unit group's kept files hold its light at intensity 1;
+                                  5: a unit sky group's at sky.color white */
 
 static uint32_t le32(const uint8_t *p)
 {
@@ -140,7 +141,7 @@ static void hash_group_lights(const lmb_scene *s, const lmb_light_groups *groups
 
 /* The config as group g's light reads it: every group's scale 1 (the scales only weigh the sum);
  * the sky's keys as a level without a sky has them unless g holds the sky, and sky.intensity 1
- * when g is the sky's unit group (it is g's weight). */
+ * (and sky.color white, lmb_sky_color_is_weight) when g is the sky's unit group (they are g's weight). */
 static void group_config(const lmb_config *cfg, const lmb_light_groups *groups, uint32_t g, lmb_config *out)
 {
     *out = *cfg;
@@ -158,6 +159,8 @@ static void group_config(const lmb_config *cfg, const lmb_light_groups *groups, 
         memcpy(out->sky_image, d.sky_image, sizeof d.sky_image);
     } else if (groups->unit[g]) {
         out->sky_intensity = 1;
+        for (int c = 0; c < 3 && groups->sky_color_weight; c++)
+            out->sky_color[c] = 1;
     }
     if (groups->emissive != (int32_t)g) {
         lmb_config d;

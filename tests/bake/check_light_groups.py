@@ -337,23 +337,37 @@ def kept_between_bakes(lmbake, work, level, doc):
         node["name"] = "lamp_b moved"
     edited_bake("lamp-b-moved", "lamp_b moved 0.5 m on each axis", move_lamp_b, 1, 1)
 
-    # the config's sky alone in its group: a unit group too, sky.intensity its weight
-    def sky_groups(intensity):
-        return BASE + "sky: {intensity: %r}\noutput:\n  light_groups:\n    - {name: sky, sky: true}\n" \
-                      "    - {name: lights, match: \"*\"}\n" % intensity
+    # the config's sky alone in its group: a unit group too, sky.intensity x sky.color its weight
+    # (no ground colour: the sky is lit at 1 and white)
+    def sky_groups(intensity, color):
+        return BASE + "sky: {intensity: %r, color: %r}\noutput:\n  light_groups:\n    - {name: sky, sky: true}\n" \
+                      "    - {name: lights, match: \"*\"}\n" % (intensity, color)
     sky_cache = os.path.join(work, "kept-sky")
     shutil.rmtree(sky_cache, ignore_errors=True)
-    _, s1 = bake(lmbake, work, level, "sky-400-kept", sky_groups(400.0), "--layout-cache", sky_cache, "--log")
-    kept_out, s2 = bake(lmbake, work, level, "sky-150-kept", sky_groups(150.0), "--layout-cache", sky_cache, "--log")
-    fresh_out, s3 = bake(lmbake, work, level, "sky-150", sky_groups(150.0))
+    first_out, s1 = bake(lmbake, work, level, "sky-400-kept", sky_groups(400.0, [1.0, 1.0, 1.0]), "--layout-cache",
+                         sky_cache, "--log")
+    tint = [1.0, 0.8, 0.6]
+    kept_out, s2 = bake(lmbake, work, level, "sky-150-kept", sky_groups(150.0, tint), "--layout-cache", sky_cache,
+                        "--log")
+    fresh_out, s3 = bake(lmbake, work, level, "sky-150", sky_groups(150.0, tint))
     log1, log2 = s1.stdout + s1.stderr, s2.stdout + s2.stderr
     names = sorted(os.listdir(fresh_out)) if s3.returncode == 0 else []
     differ = [f for f in names if s2.returncode != 0 or not os.path.exists(os.path.join(kept_out, f)) or
               not filecmp.cmp(os.path.join(fresh_out, f), os.path.join(kept_out, f), shallow=False)]
-    check(s1.returncode == 0 and "weighed by sky.intensity" in log1 and s2.returncode == 0 and
-          log2.count("read back from the cache") == 2 and "): lighting" not in log2 and names and not differ,
-          "sky.intensity 400 -> 150 (the sky alone in its group): both groups read back; every one of %d files the "
-          "bytes of a bake without the cache%s" % (len(names), " (differ: %s)" % differ if differ else ""))
+    own = [f for f in names if "-group-sky." in f]
+    moved = [f for f in own if s1.returncode != 0 or
+             not filecmp.cmp(os.path.join(first_out, f), os.path.join(fresh_out, f), shallow=False)]
+    named = [list(group_intensities(os.path.join(fresh_out, "sun-lamps.gltf"))["sky"])] if s3.returncode == 0 else []
+    want = [150.0 * c for c in tint]
+    check(s1.returncode == 0 and "weighed by sky.intensity x sky.color: [400, 400, 400]" in log1 and
+          s2.returncode == 0 and log2.count("read back from the cache") == 2 and "): lighting" not in log2 and
+          names and not differ and own and not moved and len(named) == 1 and
+          all(abs(a - b) <= 1e-6 * b for a, b in zip(named[0], want)),
+          "sky.intensity 400 -> 150 and sky.color white -> %s (the sky alone in its group): both groups read back; "
+          "every one of %d files the bytes of a bake without the cache%s; the sky's own files (%d) the bytes of the "
+          "first bake's%s; the glTF names its intensity %s (want %s)"
+          % (tint, len(names), " (differ: %s)" % differ if differ else "", len(own),
+             " (differ: %s)" % moved if moved else "", named, want))
 
     # the emissive surfaces alone in their group (one emissive material: its emission the weight)
     def glowing(factor, strength):
