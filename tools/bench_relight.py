@@ -4,7 +4,8 @@ one run: each edit baked with the watch's --layout-cache (what `lmbake preview -
 final bake) after a first bake kept the groups, then the same edited level baked without the cache
 (what the files must equal, byte for byte), each under /usr/bin/time -v.
 
-usage: bench_relight.py LMBAKE OUTDIR        (writes OUTDIR/relight.csv and OUTDIR/relight.png)
+usage: bench_relight.py LMBAKE OUTDIR [LEVEL ...]   (writes OUTDIR/relight.csv and OUTDIR/relight.png;
+       LEVEL: a stem of the levels below, e.g. sun-lamps, to run only those: OUTDIR/relight-sun-lamps.csv)
 
 level-single-10 (11 lights) in three groups: the sun, Lamp 0 alone, the other ten lamps. Edits
 (each of the first bake's level, not one after the other): Lamp 0 x 2, Lamp 0 tinted, Lamp 0
@@ -12,8 +13,8 @@ off, the sun x 0.5 (each alone in its group: a new weight), the lamps' group sca
 config), Lamp 0 moved 2 m (its group lit again). bevy's Cornell box with its emissive ceiling in a
 group: the group's scale x 3, and the ceiling's emissive strength x 3 and its colour tinted in the
 glTF (alone in their group: a new weight). tools/make_scenes.py's sun-lamps (a ground and a cube
-under a sky of 400 lux, a sun and two lamps; 30 texels per unit) with the sky alone in its group: sky.intensity x 0.5
-(the config; a new weight). Then each level under `lmbake preview --watch` (no browser): every
+under a sky of 400 lux, a sun and two lamps; 30 texels per unit) with the sky alone in its group: sky.intensity x 0.5,
+and that sky tinted (the config; each a new weight). Then each level under `lmbake preview --watch` (no browser): every
 edit saved over the watched file (the level, or the config for a config edit) in turn, each timed
 from the save to the final files on the watch's /status, its lightmaps compared with the fresh
 bake of that edit. About 25 minutes on 2 cores.
@@ -222,17 +223,21 @@ LEVELS = [  # (level, its groups, its edits (what, the glTF's edit, the config's
       ("emissive strength x 3", emissive_x(3.0), None),
       ("emissive colour tinted", emissive_tint([1.0, 0.7, 0.4]), None)]),
     ("sun-lamps", ["name: sky, sky: true", 'name: lights, match: "*"'],
-     [("sky.intensity x 0.5", None, {"base": "texel_density: 30\nsky: {intensity: 200}\n"})],
+     [("sky.intensity x 0.5", None, {"base": "texel_density: 30\nsky: {intensity: 200}\n"}),
+      ("sky tinted", None, {"base": "texel_density: 30\nsky: {intensity: 200, color: [1.0, 0.8, 0.6]}\n"})],
      "texel_density: 30\nsky: {intensity: 400}\n"),
 ]
 
 
 def main():
-    lmbake, outdir = sys.argv[1], sys.argv[2]
+    lmbake, outdir, only = sys.argv[1], sys.argv[2], sys.argv[3:]
     os.makedirs(outdir, exist_ok=True)
+    stem = "relight" + "".join("-" + o for o in only)
     rows = []
     with tempfile.TemporaryDirectory() as work:
         for level, groups, edits, *rest in LEVELS:
+            if only and os.path.splitext(os.path.basename(level))[0] not in only:
+                continue
             base = rest[0] if rest else ""
             if level == "sun-lamps":
                 subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
@@ -279,7 +284,7 @@ def main():
                 fresh_dirs[what] = (kept, "%s-edit%d" % (name, k) if edit else name)
             watched = [(w, e, edited_config(groups, base, g)) for w, e, g in edits]
             rows += watch_edits(lmbake, level, doc, binary, config(groups, base), work, watched, fresh_dirs)
-    with open(os.path.join(outdir, "relight.csv"), "w", newline="") as f:
+    with open(os.path.join(outdir, stem + ".csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         w.writeheader()
         w.writerows(rows)
@@ -299,14 +304,15 @@ def main():
               for e in edits]
         ax.barh([i + 0.28 * k for i in range(len(edits))], ys, height=0.28, label=labels[run_name])
     ax.set_yticks([i + 0.28 for i in range(len(edits))])
-    ax.set_yticklabels(["%s: %s" % (("single-10" if "single" in l else "Cornell"), e) for l, e in edits], fontsize=8)
+    short = {"level-single-10": "single-10", "CornellBox": "Cornell", "sun-lamps": "sun-lamps"}
+    ax.set_yticklabels(["%s: %s" % (short.get(l, l), e) for l, e in edits], fontsize=8)
     ax.set_xscale("log")
     ax.set_xlabel("seconds after the edit to the final files (2 cores, log scale)")
     ax.set_title("relighting a level with light groups")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(outdir, "relight.png"), dpi=100)
-    print("bench_relight: wrote %s/relight.csv and relight.png" % outdir)
+    fig.savefig(os.path.join(outdir, stem + ".png"), dpi=100)
+    print("bench_relight: wrote %s/%s.csv and %s.png" % (outdir, stem, stem))
     return 0
 
 
