@@ -452,17 +452,22 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
      * so a group read back from the cache copies the files it kept instead of encoding them */
     for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++)
         for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
-            char paths[2][LMB_GROUP_IMAGE_PATH];
-            const char *const names[2] = {paths[0], paths[1]};
-            lmb_group_image_paths(od.staging, od.stem, a, groups.name[g], paths);
+            char paths[LMB_GROUP_FILES][LMB_GROUP_IMAGE_PATH];
+            const char *const names[LMB_GROUP_FILES] = {paths[0], paths[1], paths[2]};
+            uint32_t files = lmb_group_image_paths(cfg, od.staging, od.stem, a, groups.name[g], paths);
             if (group_light.cached[g] && groups_kept &&
-                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, names, log))
+                lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, names, files, log))
                 continue;
+            lmb_ktx2_report ktx2 = {0};
             st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g],
-                                        group_light.irradiance[(size_t)g * l.atlas_count + a], l.width[a], l.height[a],
-                                        err);
+                                        group_light.irradiance[(size_t)g * l.atlas_count + a], cache.state[a],
+                                        l.width[a], l.height[a], &ktx2, err);
+            if (st == LMB_OK && ktx2.clamped)
+                lmb_warn(log, "atlas %u, light group '%s': %llu texels brighter than %s's range (65504) were clamped in "
+                         "its .ktx2", a, groups.name[g], (unsigned long long)ktx2.clamped,
+                         cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR");
             if (st == LMB_OK && groups_kept)
-                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, log);
+                lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, files, log);
         }
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);

@@ -214,34 +214,42 @@ static uint8_t *slurp(const char *path, size_t *size)
     return data;
 }
 
-/* The body: the files' sizes, then the two files. */
+/* The body: the files' count and sizes, then the files. */
 typedef struct files_header {
-    uint64_t size[2];
+    uint64_t count;
+    uint64_t size[LMB_GROUP_FILES];
 } files_header;
 
-void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                                const lmb_log *log)
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const *paths,
+                                uint32_t count, const lmb_log *log)
 {
     char path[4200];
     files_path(dir, key, a, path, sizeof path);
-    size_t sizes[2] = {0, 0};
-    uint8_t *data[2] = {slurp(paths[0], &sizes[0]), slurp(paths[1], &sizes[1])};
-    files_header head = {{sizes[0], sizes[1]}};
-    lmb_part_piece pieces[3] = {{&head, sizeof head}, {data[0], sizes[0]}, {data[1], sizes[1]}};
+    files_header head = {count, {0}};
+    uint8_t *data[LMB_GROUP_FILES] = {NULL};
+    lmb_part_piece pieces[1 + LMB_GROUP_FILES] = {{&head, sizeof head}};
+    int read = count <= LMB_GROUP_FILES;
+    for (uint32_t k = 0; read && k < count; k++) {
+        size_t size = 0;
+        data[k] = slurp(paths[k], &size);
+        head.size[k] = size;
+        pieces[1 + k] = (lmb_part_piece){data[k], size};
+        read = data[k] != NULL;
+    }
     lmb_part_identity id;
     cache_identity(key, &id);
     lmb_part_place place = {LMB_PART_STATE, a, 0, 1};
     lmb_error e = {LMB_OK, ""};
-    lmb_status st = data[0] && data[1] ? lmb_part_write_pieces(path, &id, &place, pieces, 3, &e)
-                                       : lmb_error_set(&e, LMB_ERR_INTERNAL, "%s: cannot read the group's files", path);
+    lmb_status st = read ? lmb_part_write_pieces(path, &id, &place, pieces, 1 + count, &e)
+                         : lmb_error_set(&e, LMB_ERR_INTERNAL, "%s: cannot read the group's files", path);
     if (st != LMB_OK)
         lmb_warn(log, "light group cache: %s (the next bake encodes this group's files again)", e.message);
-    free(data[0]);
-    free(data[1]);
+    for (uint32_t k = 0; k < LMB_GROUP_FILES; k++)
+        free(data[k]);
 }
 
-int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                               const lmb_log *log)
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const *paths,
+                               uint32_t count, const lmb_log *log)
 {
     char path[4200];
     files_path(dir, key, a, path, sizeof path);
@@ -261,12 +269,17 @@ int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t 
         ok = view.body_length >= sizeof head;
         if (ok)
             memcpy(&head, view.body, sizeof head);
-        ok = ok && head.size[0] <= view.body_length - sizeof head &&
-             head.size[1] == view.body_length - sizeof head - head.size[0];
+        uint64_t total = 0;
+        ok = ok && head.count == count;
+        for (uint32_t k = 0; ok && k < count; k++) {
+            ok = head.size[k] <= view.body_length - sizeof head - total;
+            total += ok ? head.size[k] : 0;
+        }
+        ok = ok && total == view.body_length - sizeof head;
         if (!ok)
             snprintf(e.message, sizeof e.message, "%.900s: not a group's files", path);
         const uint8_t *at = view.body + sizeof head;
-        for (int k = 0; k < 2 && ok; k++) {
+        for (uint32_t k = 0; k < count && ok; k++) {
             FILE *f = fopen(paths[k], "wb");
             ok = f && fwrite(at, 1, head.size[k], f) == head.size[k];
             if (f && fclose(f) != 0)

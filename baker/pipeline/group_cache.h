@@ -17,6 +17,7 @@
 #define LMBAKE_GROUP_CACHE_H
 
 #include "pipeline/group_lighting.h"
+#include "write/atlas_images.h"
 
 /* Every group's key into keys[g] (the level's files hashed once for all). */
 lmb_status lmb_group_cache_keys(const lmb_scene *scene, const lmb_config *cfg, const lmb_light_groups *groups,
@@ -37,17 +38,18 @@ void lmb_group_cache_write(const char *dir, const uint8_t key[32], uint32_t g, c
                            const lmb_cache *cache, uint32_t probes, uint64_t texels, uint64_t valid_texels,
                            const lmb_log *log);
 
-/* Group g's own files of atlas a (paths[0] its .exr, paths[1] its .hdr, as
- * lmb_write_group_images wrote them into the output's staging folder) kept in DIR beside its
+/* Group g's own files of atlas a (paths[0..count): its .exr, .hdr and .ktx2 as
+ * lmb_group_image_paths names them and lmb_write_group_images wrote them into the output's
+ * staging folder) kept in DIR beside its
  * light: they are the same bytes at any scales and, for a group of one source, at any intensity
  * and colour of it (they hold its light at 1), and a later bake that reads the group back copies
  * them instead of encoding them again. A file that cannot be kept is said on the log. */
-void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                                const lmb_log *log);
+void lmb_group_cache_keep_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const *paths,
+                                uint32_t count, const lmb_log *log);
 
 /* The files kept for that group and atlas written to paths: 1 when they were kept whole, 0 when
  * not (then they are to be encoded; a damaged file is said on the log). */
-int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const paths[2],
-                               const lmb_log *log);
+int lmb_group_cache_copy_files(const char *dir, const uint8_t key[32], uint32_t a, const char *const *paths,
+                               uint32_t count, const lmb_log *log);
 
 #endif

@@ -182,26 +182,52 @@ lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const cha
     return st;
 }
 
-void lmb_group_image_paths(const char *dir, const char *stem, uint32_t a, const char *group,
-                           char paths[2][LMB_GROUP_IMAGE_PATH])
+uint32_t lmb_group_image_paths(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
+                               const char *group, char paths[LMB_GROUP_FILES][LMB_GROUP_IMAGE_PATH])
 {
     snprintf(paths[0], LMB_GROUP_IMAGE_PATH, "%s/%s-lightmap-%u-group-%s.exr", dir, stem, a, group);
     snprintf(paths[1], LMB_GROUP_IMAGE_PATH, "%s/%s-lightmap-%u-group-%s.hdr", dir, stem, a, group);
+    snprintf(paths[2], LMB_GROUP_IMAGE_PATH, "%s/%s-lightmap-%u-group-%s.ktx2", dir, stem, a, group);
+    return cfg->output_formats & LMB_OUTPUT_KTX2 ? 3 : 2;
 }
 
 lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t a,
-                                  const char *group, const float *irradiance, uint32_t w, uint32_t h, lmb_error *err)
+                                  const char *group, const float *irradiance, const uint8_t *valid, uint32_t w,
+                                  uint32_t h, lmb_ktx2_report *ktx2, lmb_error *err)
 {
+    int threads = image_threads(cfg);
+    char paths[LMB_GROUP_FILES][LMB_GROUP_IMAGE_PATH];
+    uint32_t count = lmb_group_image_paths(cfg, dir, stem, a, group, paths);
     float *rgb = scaled_copy(cfg, irradiance, (size_t)w * h);
-    if (!rgb)
+    uint8_t *care = count > 2 ? lmb_ktx2_lookup_texels(valid, w, h) : NULL;
+    if (!rgb || (count > 2 && !care)) {
+        free(rgb);
+        free(care);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "lightmap images: out of memory");
-    image_job jobs[2] = {{IMAGE_EXR_FLOAT, "", 3, rgb, NULL, {0}, NULL}, {IMAGE_F32, "", 3, rgb, NULL, {0}, NULL}};
-    char paths[2][LMB_GROUP_IMAGE_PATH];
-    lmb_group_image_paths(dir, stem, a, group, paths);
-    for (int k = 0; k < 2; k++)
-        snprintf(jobs[k].path, sizeof jobs[k].path, "%s", paths[k]);
-    lmb_status st = write_images(jobs, 2, w, h, image_threads(cfg), err);
+    }
+    image_job jobs[LMB_GROUP_FILES] = {{IMAGE_EXR_FLOAT, "", 3, rgb, NULL, {0}, NULL},
+                                       {IMAGE_F32, "", 3, rgb, NULL, {0}, NULL}};
+    for (uint32_t k = 0; k < count; k++)
+        snprintf(jobs[k].path, sizeof jobs[k].path, "%.8599s", paths[k]);
+    lmb_status st = LMB_OK;
+    if (count > 2) { /* as the level's own KTX2: a block encoder runs first, alone, on every thread */
+        lmb_ktx2_format f = (lmb_ktx2_format)cfg->ktx2_format;
+        lmb_ktx2_options o = {f, cfg->ktx2_zstd ? LMB_KTX2_ZSTD_LEVEL : 0, cfg->ktx2_mipmaps,
+                              lmb_ktx2_is_block(f) ? threads : 1, care};
+        jobs[2].kind = IMAGE_KTX2;
+        jobs[2].channels = 3;
+        jobs[2].f32 = rgb;
+        jobs[2].ktx2 = o;
+        jobs[2].ktx2_report = ktx2;
+        if (lmb_ktx2_is_block(f)) {
+            st = write_images(&jobs[2], 1, w, h, 1, err);
+            count = 2;
+        }
+    }
+    if (st == LMB_OK)
+        st = write_images(jobs, (int)count, w, h, threads, err);
     free(rgb);
+    free(care);
     return st;
 }
 

@@ -40,16 +40,20 @@ lmb_status lmb_write_hdr_image(const lmb_config *cfg, const char *dir, const cha
                                const float *irradiance, uint32_t width, uint32_t height, lmb_error *err);
 
 /* A light group's lightmap (docs/light-groups.md): <stem>-lightmap-N-group-NAME.exr (32-bit
- * float) and .hdr, irradiance (3 floats per texel) as output.scale says; a game blends the
- * groups' files. */
+ * float) and .hdr, and with output.formats' ktx2 a .ktx2 in output.ktx2's format (its blocks
+ * chosen for the texels a lookup reads, valid: LMB_TEXEL_* per texel, as the level's own);
+ * irradiance (3 floats per texel) as output.scale says; a game blends the groups' files.
+ * ktx2 (may be NULL) receives the KTX2's clamped texels. */
 lmb_status lmb_write_group_images(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
-                                  const char *group, const float *irradiance, uint32_t width, uint32_t height,
-                                  lmb_error *err);
+                                  const char *group, const float *irradiance, const uint8_t *valid, uint32_t width,
+                                  uint32_t height, lmb_ktx2_report *ktx2, lmb_error *err);
 
-/* Those two files' paths in dir: paths[0] the .exr, paths[1] the .hdr. */
+/* Those files' paths in dir: paths[0] the .exr, paths[1] the .hdr, paths[2] the .ktx2 when
+ * output.formats asks for KTX2. Returns how many (2 or 3). */
 #define LMB_GROUP_IMAGE_PATH 8600
-void lmb_group_image_paths(const char *dir, const char *stem, uint32_t atlas, const char *group,
-                           char paths[2][LMB_GROUP_IMAGE_PATH]);
+#define LMB_GROUP_FILES 3
+uint32_t lmb_group_image_paths(const lmb_config *cfg, const char *dir, const char *stem, uint32_t atlas,
+                               const char *group, char paths[LMB_GROUP_FILES][LMB_GROUP_IMAGE_PATH]);
 
 /* output.shadowmask: <stem>-lightmap-N-shadowmask.png, RGBA8, per channel a light's visibility
  * (4 floats per texel in [0, 1]), linear. */

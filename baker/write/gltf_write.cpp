@@ -288,6 +288,8 @@ extern "C" int32_t lmb_gltf_add_lightmap_texture(lmb_gltf_doc *doc, const lmb_gl
                 Value::Object one, gf;
                 gf["exr"] = Value(std::string(f->group_exr[g]));
                 gf["hdr"] = Value(std::string(f->group_hdr[g]));
+                if (f->group_ktx2[g])
+                    gf["ktx2"] = Value(std::string(f->group_ktx2[g]));
                 one["name"] = Value(std::string(f->group_name[g]));
                 one["scale"] = Value(f->group_scale[g]);
                 one["intensity"] = Value(Value::Array{Value(f->group_intensity[g][0]), Value(f->group_intensity[g][1]),

@@ -41,7 +41,8 @@ typedef struct lmb_gltf_lightmap_files {
     const char *direction_png, *direction_exr, *direction_ktx2; /* output.directional */
     const char *shadowmask;   /* output.shadowmask: the RGBA8 PNG */
     uint32_t groups;          /* output.light_groups: each group's name, scale, intensity and files */
-    const char *group_name[LMB_MAX_LIGHT_GROUPS], *group_exr[LMB_MAX_LIGHT_GROUPS], *group_hdr[LMB_MAX_LIGHT_GROUPS];
+    const char *group_name[LMB_MAX_LIGHT_GROUPS], *group_exr[LMB_MAX_LIGHT_GROUPS], *group_hdr[LMB_MAX_LIGHT_GROUPS],
+        *group_ktx2[LMB_MAX_LIGHT_GROUPS]; /* group_ktx2[g] NULL: no KTX2 (output.formats) */
     double group_scale[LMB_MAX_LIGHT_GROUPS];
     double group_intensity[LMB_MAX_LIGHT_GROUPS][3]; /* RGB: a group of one source's intensity x colour (its
                                                         files hold it at 1), else 1 1 1 */

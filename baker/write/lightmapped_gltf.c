@@ -131,10 +131,13 @@ lmb_status lmb_write_lightmapped_gltf(lmb_scene *s, const lmb_config *cfg, const
             .direction_exr = directional ? dexr : NULL,
             .direction_ktx2 = directional && (f & LMB_OUTPUT_KTX2) ? dktx2 : NULL,
             .shadowmask = shadowmask ? mask : NULL};
-        char group_exr[LMB_MAX_LIGHT_GROUPS][512], group_hdr[LMB_MAX_LIGHT_GROUPS][512];
+        char group_exr[LMB_MAX_LIGHT_GROUPS][512], group_hdr[LMB_MAX_LIGHT_GROUPS][512],
+            group_ktx2[LMB_MAX_LIGHT_GROUPS][512];
         for (uint32_t g = 0; groups && g < groups->count; g++) {
             snprintf(group_exr[g], sizeof group_exr[g], "%s-lightmap-%u-group-%s.exr", stem, a, groups->name[g]);
             snprintf(group_hdr[g], sizeof group_hdr[g], "%s-lightmap-%u-group-%s.hdr", stem, a, groups->name[g]);
+            snprintf(group_ktx2[g], sizeof group_ktx2[g], "%s-lightmap-%u-group-%s.ktx2", stem, a, groups->name[g]);
+            files.group_ktx2[g] = f & LMB_OUTPUT_KTX2 ? group_ktx2[g] : NULL;
             files.group_name[g] = groups->name[g];
             files.group_scale[g] = groups->scale[g];
             for (int c = 0; c < 3; c++)

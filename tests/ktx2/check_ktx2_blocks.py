@@ -12,6 +12,13 @@ usage: check_ktx2_blocks.py LMBAKE WORKDIR
            162, 4x4 blocks of 16 bytes, one 128-bit sample: BC6H unsigned float [0, 1], ASTC
            signed float [-1, 1]); texels: mean relative error per chart texel at most 2%, and at
            most 0.5% on 9 x 9 averages
+  groups   sun-lamps with two light groups (the sun, the lamps; scales 0.5 and 3) in BC6H: each
+           group's .ktx2 (named in extras.lightmap.groups[].files) decoded against its EXR over
+           its texels brighter than a thousandth of its median (the sun's group has ~250 texels
+           in deep shadow at 1e-6 of its light, where a block's error of a few 1e-5 of that light
+           is many times theirs), and the engine's sum of the decoded groups x scale x intensity
+           against the level's EXR over every chart texel, with the Cornell bounds (mean 2%,
+           9 x 9 averages 0.5%)
   range    the Cornell box with its light 10^6 times brighter: BC6H's texels past 65504 are
            clamped, counted and warned about ("... were clamped in the .ktx2"), exit 0
   seams    the sphere, cube and tiles of the seams scene (tests/bake/check_artists.py), each
@@ -138,12 +145,56 @@ def over_range(lmbake, work):
     return good
 
 
+def groups(lmbake, work):
+    """Light groups' own KTX2 (BC6H): each decodes to its group's EXR within the Cornell bounds, and
+    the engine's sum of the decoded groups, sum_g scale_g x intensity_g x group_g, to the level's."""
+    out = bake(lmbake, work, "sun-lamps", "groups-bc6h",
+               "texel_density: 24\nbounces: 1\nsamples: {gather: 32, adaptive: false}\nprobes: {auto: false}\n"
+               "output:\n  formats: [exr, ktx2, mask]\n  directional: false\n  ktx2_format: bc6h\n"
+               "  light_groups:\n    - {name: sun, match: sun, scale: 0.5}\n    - {name: lamps, match: \"lamp*\", scale: 3}\n")
+    with open(os.path.join(out, "sun-lamps.gltf")) as f:
+        doc = json.load(f)
+    lm = next(t["extras"]["lightmap"] for t in doc["textures"] if t.get("extras", {}).get("lightmap"))
+    stem = os.path.join(out, "sun-lamps-lightmap-0")
+    read = lambda path: np.asarray(oiio.ImageBuf(path).get_pixels(oiio.FLOAT), dtype=np.float64)[..., :3]
+    mask = np.asarray(oiio.ImageBuf(stem + "-mask.png").get_pixels(oiio.FLOAT))[..., 0] > 0.99
+    ok, total = True, None
+    for g in lm["groups"]:
+        ktx2 = g["files"].get("ktx2")
+        if not ktx2:
+            print("groups   bc6h: group %s names no .ktx2: FAIL" % g["name"])
+            return False
+        info, got = kb.decode(os.path.join(out, ktx2), work)
+        ref = read(os.path.join(out, g["files"]["exr"]))
+        # texels a thousandth of the group's median light and darker are left out of the per-texel
+        # bound: a 4 x 4 block's endpoints are fitted to its brightest texels, and one that falls
+        # from the sun's light into a shadow keeps a few 1e-5 of that light at texels of 1e-6
+        lum = ref.sum(axis=-1)
+        visible = mask & (lum >= 1e-3 * np.median(lum[mask & (lum > 0)]))
+        mean, p99, mean9, p99_9, n, n9 = kb.errors(ref, got, visible)
+        good = info["vkFormat"] == kb.BC6H and mean <= 0.02 and mean9 <= 0.005 and n > 10000
+        ok &= good
+        print("groups   bc6h: group %s's .ktx2 against its EXR: relative error per texel mean %.3f%% (p99 %.2f%%, "
+              "%d texels, %d darker than 1e-3 of its median left out; bound 2%%), 9x9 averages mean %.4f%% (bound "
+              "0.5%%): %s" % (g["name"], 100 * mean, 100 * p99, n, int((mask & ~visible).sum()), 100 * mean9,
+                              "ok" if good else "FAIL"))
+        term = got * g["scale"] * np.array(g["intensity"], dtype=np.float64)
+        total = term if total is None else total + term
+    mean, p99, mean9, p99_9, n, n9 = kb.errors(read(stem + ".exr"), total, mask)
+    good = mean <= 0.02 and mean9 <= 0.005 and n > 10000
+    print("groups   bc6h: the sum of the groups' decoded .ktx2 x scale x intensity against the level's EXR: mean "
+          "%.3f%% (p99 %.2f%%), 9x9 averages mean %.4f%% (bounds 2%%, 0.5%%): %s"
+          % (100 * mean, 100 * p99, 100 * mean9, "ok" if good else "FAIL"))
+    return ok and good
+
+
 def main():
     lmbake, work = sys.argv[1], sys.argv[2]
     os.makedirs(work, exist_ok=True)
     subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
                    check=True, stdout=subprocess.DEVNULL)
     ok = over_range(lmbake, work)
+    ok &= groups(lmbake, work)
     for fmt in FORMATS:
         ok &= cornell(lmbake, work, fmt)
         ok &= seams(lmbake, work, fmt)
