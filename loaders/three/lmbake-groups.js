@@ -1,7 +1,9 @@
 // lmbake-three's light groups (docs/light-groups.md): a bake with output.light_groups writes each
 // group's lightmap beside the level's, which is their sum at the groups' scales times their
 // intensities (RGB: a group of one light holds its light at intensity 1 and names the light's
-// intensity x colour; other groups 1 1 1). lightGroups() reads each group's .hdr per atlas and
+// intensity x colour; other groups 1 1 1). lightGroups() reads each group's lightmap per atlas
+// (its .ktx2 where the atlas itself came from its KTX2 and the glTF names one, on the GPU as the
+// file holds it: BC6H 1 byte per texel; else its .hdr as half floats, 8 bytes per texel) and
 // patches the lightmapped materials so that where three's lightMap read the bake's sum they read
 // sum_g w_g x intensity_g x group_g, with one weight per group that the game sets at run time
 // (day and night, lamps on and off, a flickering torch): setWeight(name, w). lmbake's preview
@@ -10,27 +12,43 @@ import * as THREE from 'three';
 import { HDRLoader } from 'three/addons/loaders/HDRLoader.js';
 import { addShaderPatch } from './lmbake-three.js';
 
-// A group's .hdr as the lightmap plugin makes its textures: half floats, bilinear, no mipmaps,
-// clamped, linear, not flipped (glTF UVs have v down, row 0 on top)
-async function groupTexture(url) {
+// Sampled as the lightmap plugin samples its textures: bilinear, no mipmaps, clamped, linear, not
+// flipped (glTF UVs have v down, row 0 on top)
+function asLightmap(tex, name) {
+  Object.assign(tex, { colorSpace: THREE.LinearSRGBColorSpace, flipY: false, magFilter: THREE.LinearFilter,
+    minFilter: THREE.LinearFilter, generateMipmaps: false, wrapS: THREE.ClampToEdgeWrapping, wrapT: THREE.ClampToEdgeWrapping, name });
+  tex.needsUpdate = true;
+  return tex;
+}
+
+// A group's .hdr as half floats
+async function hdrTexture(url) {
   const res = await fetch(url);
   if (!res.ok) throw new Error(`light group lightmap ${url}: HTTP ${res.status}`);
   const { width, height, data } = new HDRLoader().setDataType(THREE.FloatType).parse(await res.arrayBuffer());
   const half = new Uint16Array(data.length);
   for (let i = 0; i < data.length; i++) half[i] = THREE.DataUtils.toHalfFloat(data[i]);
-  const tex = new THREE.DataTexture(half, width, height, THREE.RGBAFormat, THREE.HalfFloatType);
-  Object.assign(tex, { colorSpace: THREE.LinearSRGBColorSpace, flipY: false, magFilter: THREE.LinearFilter,
-    minFilter: THREE.LinearFilter, generateMipmaps: false, wrapS: THREE.ClampToEdgeWrapping, wrapT: THREE.ClampToEdgeWrapping });
-  tex.needsUpdate = true;
-  return tex;
+  return asLightmap(new THREE.DataTexture(half, width, height, THREE.RGBAFormat, THREE.HalfFloatType), url.pathname);
+}
+
+// Group g's lightmap of atlas a: its .ktx2 when the atlas was read from its own KTX2 (the
+// format the GPU was found to sample) and the glTF names one, else its .hdr. Returns
+// {texture, source: 'ktx2' | 'hdr', format}.
+async function groupTexture(a, g, base) {
+  if (a.source === 'ktx2' && a.readKtx2 && g.files.ktx2) {
+    const d = await a.readKtx2(g.files.ktx2);
+    return { texture: asLightmap(d.texture, g.files.ktx2), source: 'ktx2', format: d.format };
+  }
+  return { texture: await hdrTexture(new URL(g.files.hdr, base)), source: 'hdr', format: 'RGBE (HDRLoader)' };
 }
 
 // The groups every atlas's texture names in extras.lightmap.groups, or null (no groups): names,
 // the bake's scales, weights (one uniform each, shared by every patched material), intensities
-// (one vec3 uniform each) and per atlas the groups' textures.
+// (one vec3 uniform each), per atlas the groups' textures and where each came from
+// (sources[atlas][g]: 'ktx2' or 'hdr').
 export async function loadLightGroups(json, gltfUrl, atlases) {
   let names = null, scales = null, intensities = null;
-  const perAtlas = [];
+  const perAtlas = [], sources = [];
   for (const a of atlases) {
     if (!a) continue;
     const lm = json.textures && json.textures[a.textureIndex] && json.textures[a.textureIndex].extras
@@ -44,10 +62,12 @@ export async function loadLightGroups(json, gltfUrl, atlases) {
       intensities = groups.map((g) => new THREE.Vector3(...(Array.isArray(g.intensity) && g.intensity.length === 3 ? g.intensity.map(Number) : [1, 1, 1])));
     }
     else if (these.join('\n') !== names.join('\n')) throw new Error(`atlas ${a.index} names light groups ${these} where atlas 0 names ${names}`);
-    perAtlas[a.index] = await Promise.all(groups.map((g) => groupTexture(new URL(g.files.hdr, new URL(gltfUrl, location.href)))));
+    const read = await Promise.all(groups.map((g) => groupTexture(a, g, new URL(gltfUrl, location.href))));
+    perAtlas[a.index] = read.map((r) => r.texture);
+    sources[a.index] = read.map((r) => r.source);
   }
   if (!names) return null;
-  return { names, scales, weights: scales.map((s) => ({ value: s })), intensities: intensities.map((v) => ({ value: v })), perAtlas };
+  return { names, scales, weights: scales.map((s) => ({ value: s })), intensities: intensities.map((v) => ({ value: v })), perAtlas, sources };
 }
 
 // The material reads its lightMap as sum_g w_g x intensity_g x group_g of its atlas (three's MeshStandardMaterial

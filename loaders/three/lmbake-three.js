@@ -309,6 +309,9 @@ class LightmapPlugin {
       // radiance: the files hold E/pi (MOZ_lightmap.intensity is pi); toLux makes a texel E
       scale: extras.scale || 'irradiance', toLux: extras.scale === 'radiance' ? Math.PI : 1,
       width, height, data, texture: tex, maskTexture: maskTex, zeroTexels: zero,
+      // a light group's KTX2 (extras.lightmap.groups[].files.ktx2) read as this atlas's was
+      // (lmbake-groups.js): {texture, gpu, format}; throws where this atlas's could not be read
+      readKtx2: (groupUri) => this.readKtx2(groupUri),
     };
     this.atlases[atlas.index] = atlas;
     tex.userData.atlas = atlas.index;

@@ -7,17 +7,22 @@
 // pixels away from edges; and the sum moves with the weights (each set's pixels differ from the
 // others' where the groups differ); in the lit view (the glTF's materials, patched by lmbake-three's
 // lightGroups as a game's are) all weights at 0 leave the lightmapped pixels black.
-//   usage: node tests/preview/preview_groups.mjs BAKE_OUT_GLTF SHOTS_DIR
+// With SOURCE ktx2 the page reads the lightmaps from their KTX2 files (the bake's formats list
+// ktx2; output.ktx2_format e5b9g9r9): every group's texture must come from its own .ktx2 and the
+// pixels match the .hdr's sums within 3 levels (the shared exponent's 9-bit mantissas).
+//   usage: node tests/preview/preview_groups.mjs BAKE_OUT_GLTF SHOTS_DIR [hdr|ktx2]
 import fs from 'node:fs';
 import path from 'node:path';
 import { decodePng, readHdr } from './lib.mjs';
 import { startServer } from '../../tools/preview/server.mjs';
 import { launchBrowser, openPreview, showPreview } from '../../tools/preview/browser.mjs';
 
-const [gltfPath, shotsDir] = process.argv.slice(2);
+const [gltfPath, shotsDir, source = 'hdr'] = process.argv.slice(2);
 if (!shotsDir) { console.error('usage: node tests/preview/preview_groups.mjs BAKE_OUT_GLTF SHOTS_DIR'); process.exit(1); }
 const CAM = '0,8,7,0,0,0'; // above the ground, looking down at the cube: most of the picture is lightmapped
-const TOL = 2; // 8-bit rounding, half-float textures, bilinear weights at finite precision (as preview_e2e.mjs)
+// 8-bit rounding, half-float textures, bilinear weights at finite precision (as preview_e2e.mjs);
+// E5B9G9R9 texels: a channel within 2^-9 of the texel's largest
+const TOL = source === 'ktx2' ? 3 : 2;
 let failures = 0;
 const check = (ok, text) => { failures += !ok; console.log(`${ok ? 'PASS' : 'FAIL'} ${text}`); };
 const srgb = (x) => { const v = Math.max(0, Math.min(1, x)); return 255 * (v <= 0.0031308 ? 12.92 * v : 1.055 * v ** (1 / 2.4) - 0.055); };
@@ -47,10 +52,13 @@ fs.mkdirSync(shotsDir, { recursive: true });
 const srv = await startServer(gltfPath);
 const browser = await launchBrowser();
 try {
-  const v0 = await openPreview(browser, srv.url, { mode: 'lightmap', tonemap: 'none', cam: CAM, lightmap: 'hdr' });
+  const v0 = await openPreview(browser, srv.url, { mode: 'lightmap', tonemap: 'none', cam: CAM, lightmap: source });
   const g = v0.info.groups, ev = v0.info.ev, gain = 2 ** ev / Math.PI;
   check(g && g.names.join() === groups.map((x) => x.name).join() && g.weights.join() === groups.map((x) => x.scale).join(),
     `the page finds the bake's light groups at their scales: ${JSON.stringify(g)}`);
+  check(g && g.sources && g.sources[atlas] && g.sources[atlas].every((x) => x === source) &&
+    (source !== 'ktx2' || groups.every((x) => x.files.ktx2)),
+    `each group's lightmap read from its ${source === 'ktx2' ? '.ktx2 (extras.lightmap.groups[].files.ktx2)' : '.hdr'}: ${JSON.stringify(g && g.sources)}`);
   // pixels on the lightmapped surfaces, away from edges: what each sees (uv1 in the atlas)
   const grid = [];
   for (let y = 6; y < 720 - 6; y += 12) for (let x = 6; x < 960 - 6; x += 12) grid.push([x, y]);
@@ -62,8 +70,8 @@ try {
   }), grid)).filter((p) => p && p.atlas === atlas);
   const shots = [];
   for (const w of [[1, 0], [0, 1], [0.3, 2]]) {
-    const v = await showPreview(v0, { mode: 'lightmap', tonemap: 'none', cam: CAM, lightmap: 'hdr', ev, groups: w.join(',') });
-    const file = path.join(shotsDir, `preview-groups-${w.join('-')}.png`);
+    const v = await showPreview(v0, { mode: 'lightmap', tonemap: 'none', cam: CAM, lightmap: source, ev, groups: w.join(',') });
+    const file = path.join(shotsDir, `preview-groups-${source}-${w.join('-')}.png`);
     const png = decodePng(await v.page.screenshot({ path: file }));
     shots.push(png);
     let n = 0, bad = 0, worst = 0, skipped = 0, first = null;
@@ -86,7 +94,7 @@ try {
     `the weights change the picture: (1,0) vs (0,1) at ${differ(shots[0], shots[1])} pixels, (0,1) vs (0.3,2) at ${differ(shots[1], shots[2])} (by > 8 levels)`);
   // the lit view (the glTF's own materials, patched by lmbake-three's lightGroups as a game's are):
   // all groups at 0 is black where the lightmap is the only light, the bake's scales are not
-  const lit = async (w) => decodePng(await (await showPreview(v0, { mode: 'lit', tonemap: 'none', cam: CAM, lightmap: 'hdr', ev, groups: w })).page.screenshot());
+  const lit = async (w) => decodePng(await (await showPreview(v0, { mode: 'lit', tonemap: 'none', cam: CAM, lightmap: source, ev, groups: w })).page.screenshot());
   const off = await lit('0,0'), on = await lit(groups.map((x) => x.scale).join(','));
   const lum = (png, p) => Math.max(...png.at(p.px, p.py));
   const darkOff = picks.filter((p) => lum(off, p) <= 1).length, brightOn = picks.filter((p) => lum(on, p) > 8).length;

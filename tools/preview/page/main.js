@@ -249,7 +249,7 @@ const isInstancePatched = (m) => m.customProgramCacheKey().includes('lmbake-inst
 function updateInfo() {
   Object.assign(info, {
     gltf: sceneInfo.name, mode: state.mode, ev: state.ev, evAuto, tonemap: state.tonemap, view: state.cam ? 'cam' : state.view,
-    groups: groups ? { names: groups.names, scales: groups.scales, weights: groups.weights.map((w) => w.value) } : null,
+    groups: groups ? { names: groups.names, scales: groups.scales, weights: groups.weights.map((w) => w.value), sources: groups.sources } : null,
     camera: { position: camera.position.toArray(), target: controls.target.toArray(), fov: FOV },
     bounds: { min: box.min.toArray(), max: box.max.toArray() },
     canvas: { width: innerWidth, height: innerHeight, pixelRatio: devicePixelRatio },
