@@ -14,8 +14,9 @@ usage: check_irradiance_cache.py LMBAKE WORKDIR CHECK
                beyond the bound below (relative RMSE against per-texel under 0.25, measured
                0.18-0.21 on this scene, most of it the 2048-ray reference's own noise).
   per_texel    irradiance_cache.error: 0 gives exactly the per-texel gathering recorded: the pixels'
-               SHA-256 equals the one recorded for the same scene, config and seed (classic
-               gathering). Recorded from commit 821943f, the last without the cache, and again
+               SHA-256 equals one recorded for the same scene, config and seed (classic
+               gathering), or (another machine) the pixels match the recorded EXR within
+               PER_TEXEL_BOUND. Recorded from commit 821943f, the last without the cache, and again
                when the leak work (docs/leaks.md) changed what a texel under a block is dilated
                with and which texels a lookup beside geometry reads: 713 of 2,204 valid texels,
                all at the blocks' feet.
@@ -43,8 +44,18 @@ from bake_cli import ROOT, bake, scenes
 
 # tools/make_scenes.py cornell-point.gltf, config PER_TEXEL_CONFIG, seed 1: the EXR's half pixels
 # (44 x 80 x 3) hashed; first baked by commit 821943f (before the irradiance cache), recorded
-# again with the leak work (texels under geometry take their darkest neighbour).
-PER_TEXEL_SHA256 = "edff15abc8c46842edd75496f7fcea6c7ed08ae8690eeb7ecfd48bd4ffef3615"
+# again with the leak work (texels under geometry take their darkest neighbour). Two machines of
+# CI's kind have given two hashes of the same commit (the first one 2026-12-02, the second, an AMD
+# EPYC, 2026-12-03: its EXR is PER_TEXEL_REFERENCE); which library or instruction set tells them
+# apart is not known, so a bake whose hash is neither must match that EXR within PER_TEXEL_BOUND.
+PER_TEXEL_SHA256 = ("edff15abc8c46842edd75496f7fcea6c7ed08ae8690eeb7ecfd48bd4ffef3615",
+                    "b966ef69463f97f9f41a4d7b0f960bfa5ab7ceb7c0baae5512445df5b17bc5ab")
+PER_TEXEL_REFERENCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "reference",
+                                   "per-texel-cornell-point.exr")
+# mean relative difference per texel, and the largest (sum over channels of |got - ref| over the
+# reference's sum): last-bit differences of a ray's hit move a texel by far less; a change of the
+# per-texel gathering re-draws its noise (64 rays: several % per texel)
+PER_TEXEL_BOUND = (1e-4, 0.01)
 # (fireflies.spread, issue 14, is off: at 64 classic rays it moves 4 noise spikes of this bake)
 PER_TEXEL_CONFIG = ("texel_density: 16\nbounces: 2\nsamples: {texel: 2, direct: 4, gather: 64, bounce: 16}\n"
                     "output: {formats: [exr]}\ngather: {method: cosine}\nfireflies: {spread: false}\n")
@@ -100,8 +111,19 @@ def per_texel(lmbake, work):
     px = oiio.ImageBuf(exr).get_pixels(oiio.HALF)
     digest = hashlib.sha256(px.tobytes()).hexdigest()
     print("per_texel: %s pixels %s, sha256 %s (recorded: %s)" % (os.path.basename(exr), px.shape, digest,
-                                                                   PER_TEXEL_SHA256))
-    assert digest == PER_TEXEL_SHA256
+                                                                   " or ".join(PER_TEXEL_SHA256)))
+    if digest in PER_TEXEL_SHA256:
+        return
+    ref = oiio.ImageBuf(PER_TEXEL_REFERENCE).get_pixels(oiio.FLOAT)[..., :3].astype(np.float64)
+    got = px[..., :3].astype(np.float64)
+    assert ref.shape == got.shape, (ref.shape, got.shape)
+    lit = ref.sum(axis=-1) > 0
+    rel = np.abs(got - ref).sum(axis=-1)[lit] / ref.sum(axis=-1)[lit]
+    print("per_texel: against %s: %d lit texels, relative difference mean %.3g, largest %.3g (bounds %g, %g); "
+          "unlit texels lit: %d" % (os.path.basename(PER_TEXEL_REFERENCE), lit.sum(), rel.mean(), rel.max(),
+                                    PER_TEXEL_BOUND[0], PER_TEXEL_BOUND[1], int((got.sum(axis=-1)[~lit] > 0).sum())))
+    assert rel.mean() <= PER_TEXEL_BOUND[0] and rel.max() <= PER_TEXEL_BOUND[1]
+    assert not (got.sum(axis=-1)[~lit] > 0).any()
 
 
 def determinism(lmbake, work):
