@@ -124,7 +124,7 @@ def leak_scenes():
         out["two-rooms-%d" % t_cm] = ((t / 2, 0, -d / 2), (w + t / 2, h, d / 2),
                                       (-w - t / 2, 0, -d / 2), (-t / 2, h, d / 2), (0, t / 2, 1))
     # the floor inside the crate, but for the texels dilated under its walls for filtering (2 rings,
-    # post/dilate.h) at the coarsest density the suite bakes (4 cm texels)
+    # texels/dilate.h) at the coarsest density the suite bakes (4 cm texels)
     out["box-floor-T"] = ((-0.37, 0, -0.37), (0.37, 0.999, 0.37), (-3, 0, -3), (3, 0, 3), None)
     out["slab"] = ((-2.9, 0, -2.9), (2.9, 2.98, 2.9), (-10, 0, -10), (10, 0, 10), None)
     out["courtyard"] = ((-1.45, 0, -1.45), (1.45, 2.95, 1.45), (-6, 0, -6), (6, 0, 6), None)

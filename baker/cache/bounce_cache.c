@@ -1,7 +1,7 @@
 /* The bounce cache (see bounce_cache.h). */
 #include "bounce_cache.h"
 
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "util/lmb_math.h"
 #include "util/mat4.h"
 

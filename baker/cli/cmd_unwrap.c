@@ -11,7 +11,7 @@
 #include "pack/layout.h"
 #include "write/output_dir.h"
 #include "unwrap/metrics.h"
-#include "write/image_adapter.h"
+#include "image/image_adapter.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -125,7 +125,7 @@ static void draw_four(const proposal *p, const lmb_lobe *cosine, lmb_rng rng, ui
         base[b] = cosine_pick ? 1.0f : (float)(1.0 - u[b][0]);
         expo[b] = cosine_pick ? 0.0f : p->inv_a1[k];
     }
-    lmb_f4 ct = lmb_pow_f4(base, expo), wx, wy, wz; /* cos(theta) = (1 - u1)^(1 / (a + 1)), lobe.h */
+    lmb_f4 ct = lmb_pow_f4(base, expo), wx, wy, wz; /* cos(theta) = (1 - u1)^(1 / (a + 1)), util/sampling.h */
     for (int b = 0; b < 4; b++) {
         const double *axis = lobe[b] < 0 ? cosine->axis : p->lobe[lobe[b]].axis;
         const double *t = lobe[b] < 0 ? p->cos_t : p->t[lobe[b]], *bt = lobe[b] < 0 ? p->cos_b : p->b[lobe[b]];

@@ -39,7 +39,7 @@
 
 #include <lmbake/lmbake.h>
 
-#include "gather/lobe.h"
+#include "util/sampling.h"
 #include "gather/mixture.h"
 #include "util/rng.h"
 

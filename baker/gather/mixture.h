@@ -1,7 +1,7 @@
 /*
  * A learned directional distribution for guided gathering: a share of the cosine lobe around
  * the surface normal (the diffuse part: light from everywhere) and K cosine-power lobes
- * (lobe.h, eq. 1), g(w) = c p_cos(w) + (1 - c) sum_k pi_k p(w; n^_k, a_k), sum pi_k = 1.
+ * (util/sampling.h, eq. 1), g(w) = c p_cos(w) + (1 - c) sum_k pi_k p(w; n^_k, a_k), sum pi_k = 1.
  * A gather point learns one (lmb_mixture_fit) from its weighted samples; its neighbours sample
  * from it (spatial reuse, estimator.h), each lobe re-aimed at the place its light came from
  * (lmb_mixture_reaim: parallax).
@@ -17,7 +17,7 @@
 #ifndef LMBAKE_MIXTURE_H
 #define LMBAKE_MIXTURE_H
 
-#include "gather/lobe.h"
+#include "util/sampling.h"
 
 #include <stdint.h>
 

@@ -103,21 +103,6 @@ int lmb_light_direction(const point_ctx *c, const lmb_light *l, double d[3], dou
     return 1;
 }
 
-uint32_t lmb_cdf_pick(const double *cdf, uint32_t count, double u, double *prob)
-{
-    double total = cdf[count], target = u * total;
-    uint32_t lo = 0, hi = count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (cdf[mid + 1] <= target)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    *prob = (cdf[lo + 1] - cdf[lo]) / total;
-    return lo;
-}
-
 double lmb_punctual_falloff(const lmb_light *l, const double d[3], double dist)
 {
     if (l->type == LMB_LIGHT_DIRECTIONAL)

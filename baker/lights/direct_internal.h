@@ -8,6 +8,7 @@
 
 #include "direct.h"
 #include "point_validity.h"
+#include "util/sampling.h"
 
 typedef struct light_set {
     uint32_t *local, local_count;       /* point and spot lights */
@@ -59,10 +60,6 @@ typedef struct point_ctx {
     double dir[3];    /* sum of each contribution's luminance times its direction (unit, toward the light) */
     double deferred[3]; /* the part of e from `indirect` lights (not in the lightmap, not in dir) */
 } point_ctx;
-
-/* Index k of cdf[0..count] (cdf[0] = 0, increasing) with cdf[k] <= u cdf[count] < cdf[k + 1];
- * *prob its probability. Sampling in proportion to power (lights, emitters). */
-uint32_t lmb_cdf_pick(const double *cdf, uint32_t count, double u, double *prob);
 
 /* The unit direction from c's point toward light l and its distance (1e300 for a directional
  * light); 0 when the point is at the light. */

@@ -16,13 +16,13 @@
  */
 #include "sky.h"
 
-#include "gather/lobe.h"
+#include "util/sampling.h"
 #include "load/gltf_adapter.h"
 #include "load/uri.h"
 #include "util/frame.h"
 #include "util/lmb_math.h"
 #include "util/sh.h"
-#include "write/image_adapter.h"
+#include "image/image_adapter.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -88,22 +88,6 @@ void lmb_sky_radiance(const lmb_sky *s, const double w[3], double out[3])
         out[k] = p[k];
 }
 
-/* Index of the segment of cdf[0..n] (non-decreasing, cdf[n] > 0) holding x in [0, cdf[n]). */
-static uint32_t find_segment(const double *cdf, uint32_t n, double x)
-{
-    uint32_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (cdf[mid + 1] <= x)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    while (lo + 1 < n && !(cdf[lo + 1] > cdf[lo])) /* never a segment of zero weight */
-        lo++;
-    return lo;
-}
-
 double lmb_sky_pdf(const lmb_sky *s, const double w[3])
 {
     uint32_t i, j;
@@ -119,9 +103,9 @@ double lmb_sky_pdf(const lmb_sky *s, const double w[3])
 double lmb_sky_sample(const lmb_sky *s, double u1, double u2, double w[3])
 {
     double total = s->row_cdf[s->h];
-    uint32_t j = find_segment(s->row_cdf, s->h, u1 * total);
+    uint32_t j = lmb_cdf_segment(s->row_cdf, s->h, u1 * total);
     const double *cc = s->col_cdf + (size_t)j * (s->w + 1);
-    uint32_t i = find_segment(cc, s->w, u2 * cc[s->w]);
+    uint32_t i = lmb_cdf_segment(cc, s->w, u2 * cc[s->w]);
     /* where u fell inside the chosen segments: uniform in them */
     double f1 = (u1 * total - s->row_cdf[j]) / (s->row_cdf[j + 1] - s->row_cdf[j]);
     double f2 = (u2 * cc[s->w] - cc[i]) / (cc[i + 1] - cc[i]);

@@ -4,7 +4,7 @@
 #include "uri.h"
 
 #include "gltf_adapter.h"
-#include "write/image_adapter.h"
+#include "image/image_adapter.h"
 
 #include <math.h>
 #include <stdio.h>

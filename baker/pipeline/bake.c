@@ -27,7 +27,7 @@
 #include "load/textures.h"
 #include "pack/coverage.h"
 #include "pack/layout.h"
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "post/fireflies.h"
 #include "probes/probes.h"
 #include "seams/seams.h"

@@ -1,7 +1,7 @@
 /* Fireflies spread to their neighbours (see fireflies.h). */
 #include "fireflies.h"
 
-#include "dilate.h"
+#include "texels/dilate.h"
 
 #include <omp.h>
 

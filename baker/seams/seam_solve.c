@@ -1,7 +1,7 @@
 /* The stitching solve in independent blocks (see seam_solve.h). */
 #include "seam_solve.h"
 
-#include "post/dilate.h"
+#include "texels/dilate.h"
 
 #include "util/lmb_math.h"
 #include "util/spd_solve.h"

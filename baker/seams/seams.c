@@ -4,7 +4,7 @@
 #include "seam_edges.h"
 #include "seam_solve.h"
 
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "texels/texels.h"
 #include "util/clock.h"
 #include "util/lmb_math.h"

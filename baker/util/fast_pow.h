@@ -1,7 +1,7 @@
 /*
  * x^a for x in (0, 1] and a >= 0, four at a time in single precision (GCC/Clang vector
  * extensions: one SSE register), as exp2(a log2 x). Guided gathering evaluates a cosine-power
- * lobe (lobe.h) per lobe per sample, and libm's expf + logf were a third of its overhead.
+ * lobe (sampling.h) per lobe per sample, and libm's expf + logf were a third of its overhead.
  *   log2: x = m 2^e with m in [sqrt(1/2), sqrt(2)); log2 m = 2/ln 2 atanh(t), t = (m-1)/(m+1),
  *         |t| <= 0.1716, by its series to t^7 (truncation < 5e-8).
  *   exp2: y = i + f, i = round(y), |f| <= 1/2; 2^f by its Taylor series to f^6 (truncation

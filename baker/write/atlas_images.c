@@ -6,11 +6,11 @@
  */
 #include "atlas_images.h"
 
-#include "image_adapter.h"
-#include "image_native.h"
+#include "image/image_adapter.h"
+#include "image/image_native.h"
 #include "ktx2.h"
 #include "rgbm.h"
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "util/lmb_math.h"
 #include "util/select.h"
 

@@ -18,7 +18,7 @@
 
 #include "astc_adapter.h"
 #include "bc6h.h"
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "util/clock.h"
 
 #include <math.h>

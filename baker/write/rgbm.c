@@ -1,7 +1,7 @@
 /* RGBM encoding of a lightmap (see rgbm.h). */
 #include "rgbm.h"
 
-#include "post/dilate.h"
+#include "texels/dilate.h"
 
 #include <math.h>
 

@@ -6,7 +6,7 @@
  */
 #include "check.h"
 
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "post/fireflies.h"
 
 #include <stdlib.h>

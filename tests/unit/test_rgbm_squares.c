@@ -8,7 +8,7 @@
 #include "check.h"
 
 #include "pack/rects.h"
-#include "post/dilate.h"
+#include "texels/dilate.h"
 #include "write/rgbm.h"
 
 #include <stdlib.h>

@@ -1,5 +1,7 @@
 /*
- * The post stage: dilation. Texels that hold no valid value take the average of their
+ * Texel states (a texel of an atlas: empty, valid, or with every point inside geometry) and
+ * dilation, which the lighting's cache, the post stage, the seams and the writers all use.
+ * Dilation: texels that hold no valid value take the average of their
  * filled 8-neighbours, ring by ring outward from the valid texels. Padding (texels no
  * triangle touches) is filled all the way, so bilinear filtering and mipmaps never pull in
  * black; texels whose points lie inside geometry (under a wall or a box) are filled only

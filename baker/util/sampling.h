@@ -1,17 +1,29 @@
 /*
- * The cosine-power lobe of the AMIS paper (eq. 1): p(w; n^, a) = (a + 1) / (2 pi) (w.n^)^a on
- * the hemisphere around the unit axis n^, zero outside it. a = 1 is cosine sampling (the
- * Lambertian pdf cos/pi), the starting lobe of every gather point. Sampling inverts the
- * CDF of cos(theta): cos(theta) = u1^(1 / (a + 1)), phi = 2 pi u2, in the frame of
- * util/frame.h.
+ * Sampling helpers shared by the lights and the gather:
+ *   - the cosine-power lobe of the AMIS paper (eq. 1): p(w; n^, a) = (a + 1) / (2 pi) (w.n^)^a on
+ *     the hemisphere around the unit axis n^, zero outside it. a = 1 is cosine sampling (the
+ *     Lambertian pdf cos/pi), the starting lobe of every gather point. Sampling inverts the
+ *     CDF of cos(theta): cos(theta) = u1^(1 / (a + 1)), phi = 2 pi u2, in the frame of
+ *     util/frame.h;
+ *   - picking a segment of a tabulated CDF (lights by power, emitters by power, the sky map's rows
+ *     and columns) by binary search.
  */
-#ifndef LMBAKE_LOBE_H
-#define LMBAKE_LOBE_H
+#ifndef LMBAKE_SAMPLING_H
+#define LMBAKE_SAMPLING_H
 
 #include "util/frame.h"
 #include "util/lmb_math.h"
 
 #include <math.h>
+#include <stdint.h>
+
+/* The segment of cdf[0..count] (non-decreasing, cdf[count] > 0) that u in [0, 1) picks:
+ * u x cdf[count] lies in [cdf[k], cdf[k + 1]); *prob = its share of the total. */
+uint32_t lmb_cdf_pick(const double *cdf, uint32_t count, double u, double *prob);
+
+/* The segment of cdf[0..n] (non-decreasing, cdf[n] > 0) holding x in [0, cdf[n]), never one of
+ * zero weight (x rounded onto a boundary moves past it). */
+uint32_t lmb_cdf_segment(const double *cdf, uint32_t n, double x);
 
 typedef struct lmb_lobe {
     double axis[3]; /* unit */
