@@ -16,7 +16,7 @@
 // Light probes (asset.extras.lightmap.probes): read with the level, kept on the root mesh's
 // metadata (lmbakeProbes(result.meshes[0])); lmbake-babylon-probes.js lights meshes by them.
 // Light groups (extras.lightmap.groups on a lightmap texture; docs/light-groups.md): each group's
-// .hdr is read too, and a material plugin makes the lightmap sum_g w_g x intensity_g x group_g
+// lightmap is read too (its BC6H .ktx2 as the level's, else its .hdr), and a material plugin makes the lightmap sum_g w_g x intensity_g x group_g
 // (intensity_g: RGB, from the glTF), with one weight per group the game sets at run time:
 // lmbakeLightGroups(result.meshes[0]).setWeight('lamps', 0).
 // Per-copy rectangles: a node with EXT_mesh_gpu_instancing whose attributes hold _LIGHTMAP_SCALE
@@ -284,12 +284,46 @@ class MozLightmap {
     } else if (names.join('\n') !== this._groups.names.join('\n')) {
       throw new Error(`${context}: texture ${index} names light groups ${names} where another names ${this._groups.names}`);
     }
-    return Promise.all(groups.map(async (g) => {
-      const texture = this._hdrTexture(new Uint8Array(await this._fetch(context, def, g.files.hdr)), g.files.hdr);
+    // each group's BC6H .ktx2 where the glTF names one and the loader reads KTX2 here (as the
+    // level's: BC6H without supercompression, a GPU that samples it), else its .hdr
+    const read = await Promise.all(groups.map(async (g) => {
+      let texture = null;
+      if (g.files.ktx2 && this._options.source !== 'hdr') {
+        const k = readKtx2Level0(await this._fetch(context, def, g.files.ktx2));
+        const why = this._bc6hRefused(k);
+        if (!why) texture = this._bc6hTexture(k, g.files.ktx2);
+        else console.log(`lmbake-babylon: light group ${g.name}: ${g.files.ktx2}: ${why}; the .hdr instead`);
+      }
+      const source = texture ? 'ktx2' : 'hdr';
+      if (!texture) texture = this._hdrTexture(new Uint8Array(await this._fetch(context, def, g.files.hdr)), g.files.hdr);
       texture.wrapU = texture.wrapV = Texture.CLAMP_ADDRESSMODE;
       texture.anisotropicFilteringLevel = 1;
-      return texture;
+      return { texture, source };
     }));
+    console.log(`lmbake-babylon: texture ${index}: light groups from ${read.map((r, g) => `${names[g]} ${r.source}`).join(', ')}`);
+    return read.map((r) => r.texture);
+  }
+
+  // Why a KTX2 level 0 is not read as BC6H here, or '' when it is
+  _bc6hRefused(k) {
+    if (k.vkFormat !== 143) return `vkFormat ${k.vkFormat} (this loader reads BC6H, 143)`;
+    if (k.supercompression !== 0) return 'supercompressed (write it with output.ktx2_supercompression: none)';
+    if (!this._loader.babylonScene.getEngine().getCaps().bptc) return 'this GPU cannot sample BC6H';
+    return '';
+  }
+
+  // A BC6H level 0 as a texture. Babylon's raw textures take compressed formats from S3TC only:
+  // the texture is made empty, then its level 0 given the blocks (the engine's own compressed upload)
+  _bc6hTexture(k, name) {
+    const scene = this._loader.babylonScene, engine = scene.getEngine();
+    const internal = engine.createRawTexture(null, k.width, k.height, TEXTUREFORMAT_RGBA, false, false, BILINEAR, null, 0);
+    engine._bindTextureDirectly(engine._gl.TEXTURE_2D, internal, true);
+    engine._uploadCompressedDataToTextureDirectly(internal, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, k.width, k.height, k.data, 0, 0);
+    engine._bindTextureDirectly(engine._gl.TEXTURE_2D, null);
+    internal.isReady = true;
+    const texture = new Texture(null, scene, { noMipmap: true, invertY: false, samplingMode: BILINEAR, internalTexture: internal });
+    texture.name = name;
+    return texture;
   }
 
   // A Radiance .hdr as a half-float RGBA texture (Babylon's own RGBE reader)
@@ -317,28 +351,17 @@ class MozLightmap {
   }
 
   async _loadLightmap(context, index) {
-    const json = this._loader.gltf, scene = this._loader.babylonScene;
+    const json = this._loader.gltf;
     const def = json.textures && json.textures[index];
     if (!def) throw new Error(`${context}: texture ${index} does not exist`);
     const extras = (def.extras && def.extras.lightmap) || {}, files = extras.files || {};
     const rgbe = def.extensions && def.extensions.MOZ_texture_rgbe;
-    const engine = scene.getEngine();
     let texture = null, why = '';
     if (files.ktx2 && this._options.source !== 'hdr') {
       const k = readKtx2Level0(await this._fetch(context, def, files.ktx2));
-      if (k.vkFormat !== 143) why = `vkFormat ${k.vkFormat} (this loader reads BC6H, 143)`;
-      else if (k.supercompression !== 0) why = 'supercompressed (write it with output.ktx2_supercompression: none)';
-      else if (!engine.getCaps().bptc) why = 'this GPU cannot sample BC6H';
-      else {
-        // Babylon's raw textures take compressed formats from S3TC only: the texture is made
-        // empty, then its level 0 given the blocks (the engine's own compressed upload)
-        const internal = engine.createRawTexture(null, k.width, k.height, TEXTUREFORMAT_RGBA, false, false, BILINEAR, null, 0);
-        engine._bindTextureDirectly(engine._gl.TEXTURE_2D, internal, true);
-        engine._uploadCompressedDataToTextureDirectly(internal, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, k.width, k.height, k.data, 0, 0);
-        engine._bindTextureDirectly(engine._gl.TEXTURE_2D, null);
-        internal.isReady = true;
-        texture = new Texture(null, scene, { noMipmap: true, invertY: false, samplingMode: BILINEAR, internalTexture: internal });
-        texture.name = files.ktx2;
+      why = this._bc6hRefused(k);
+      if (!why) {
+        texture = this._bc6hTexture(k, files.ktx2);
         console.log(`lmbake-babylon: atlas from ${files.ktx2} (BC6H_UFLOAT_BLOCK)`);
       }
       if (why) console.log(`lmbake-babylon: ${files.ktx2}: ${why}; the .hdr instead`);

@@ -22,7 +22,8 @@ rectangles), BC6H: each page against its files, and the two pages against each o
 view: the same lightmap coordinates at every pixel, cross_check()); and Babylon's probe-lit
 sphere (probe_light()); and Babylon's light groups (light_groups(): make_scenes.py's sun-lamps
 with the sun and the lamps in two groups, at weights (0.3, 2): each pixel against the sum of the
-groups' .hdr files at its coordinates, each times its weight and the intensity the glTF names).
+groups' .hdr files at its coordinates, each times its weight and the intensity the glTF names;
+then again with every group read from its BC6H .ktx2, against the decoded blocks).
 Every page runs in one browser.
 """
 import json
@@ -182,11 +183,13 @@ def probe_light(work):
 GROUP_WEIGHTS = (0.3, 2.0)
 
 
-def light_groups(work, out):
-    """Babylon's page at GROUP_WEIGHTS against sum_g w_g x intensity_g x group g's .hdr (bilinear at
-    each pixel's coordinates); the bake's own lightmap (the sum at scales 1, 1) is not that sum,
-    so a page that ignored the groups fails."""
-    p = json.load(open(page_file(work, "babylon", "groups")))
+def light_groups(work, out, source):
+    """Babylon's page at GROUP_WEIGHTS against sum_g w_g x intensity_g x group g's file (bilinear at
+    each pixel's coordinates): its .hdr (source hdr), or its BC6H .ktx2 as decoded by
+    tools/ktx2_blocks.py (source ktx2: the page must say it read every group from its .ktx2); the
+    bake's own lightmap (the sum at scales 1, 1) is not that sum, so a page that ignored the groups
+    fails."""
+    p = json.load(open(page_file(work, "babylon", "groups-" + source)))
     value = np.array(p["value"], dtype=np.float64).reshape(-1, 4)
     uv = np.array(p["uv"], dtype=np.float64).reshape(-1, 4)
     lit = (uv[:, 3] > 0.5) & (value[:, 3] > 0.5)
@@ -197,17 +200,24 @@ def light_groups(work, out):
     want, plain = np.zeros((lit.sum(), 3)), bilinear(read_image(os.path.join(out, "sun-lamps-lightmap-0.hdr")),
                                                     uv[lit, 0], uv[lit, 1])
     for w, g in zip(GROUP_WEIGHTS, groups):
-        want += w * np.array(g["intensity"]) * bilinear(read_image(os.path.join(out, g["files"]["hdr"])), uv[lit, 0],
-                                                        uv[lit, 1])
+        img = kb.decode(os.path.join(out, g["files"]["ktx2"]), work)[1] if source == "ktx2" else \
+            read_image(os.path.join(out, g["files"]["hdr"]))
+        want += w * np.array(g["intensity"]) * bilinear(img, uv[lit, 0], uv[lit, 1])
     rel, off_plain = relative(value[lit, :3], want), relative(plain, want)
     said = any("at weights %s" % ", ".join("%g" % w for w in GROUP_WEIGHTS) in l for l in p["logs"])
-    good = (lit.sum() > 500 and said and rel.size and rel.mean() <= 0.005 and np.percentile(rel, 99) <= 0.01
-            and off_plain.mean() > 0.05)
-    print("babylon light groups %s at weights %s: %d pixels against sum_g w_g x intensity_g x group g's .hdr: mean "
-          "%.4f%% p99 %.3f%% (bounds 0.5%%, 1%%; the bake's own lightmap is %.1f%% off that sum); the page said the "
-          "weights: %s: %s" % ([g["name"] for g in groups], GROUP_WEIGHTS, lit.sum(), 100 * rel.mean(),
-                               100 * np.percentile(rel, 99) if rel.size else -1, 100 * off_plain.mean(), said,
-                               "ok" if good else "FAIL"), flush=True)
+    read = "light groups from %s" % ", ".join("%s %s" % (g["name"], source) for g in groups)
+    from_files = any(read in l for l in p["logs"])
+    # as the level's lightmap: the KTX2's texels are exact in the page (0.1%), the .hdr's differ by
+    # the RGBE decoders' half step (0.5%)
+    mean_bound = 0.001 if source == "ktx2" else 0.005
+    good = (lit.sum() > 500 and said and from_files and rel.size and rel.mean() <= mean_bound and
+            np.percentile(rel, 99) <= 0.01 and off_plain.mean() > 0.05)
+    print("babylon light groups %s at weights %s, read from their %s: %d pixels against sum_g w_g x intensity_g x "
+          "group g's file: mean %.4f%% p99 %.3f%% (bounds %g%%, 1%%; the bake's own lightmap is %.1f%% off that sum); "
+          "the page said the weights: %s, and '%s': %s: %s"
+          % ([g["name"] for g in groups], GROUP_WEIGHTS, source, lit.sum(), 100 * rel.mean(),
+             100 * np.percentile(rel, 99) if rel.size else -1, 100 * mean_bound, 100 * off_plain.mean(), said, read,
+             from_files, "ok" if good else "FAIL"), flush=True)
     return good
 
 
@@ -249,10 +259,12 @@ def main():
         subprocess.run([sys.executable, os.path.join(ROOT, "tools", "make_scenes.py"), os.path.join(work, "scenes")],
                        check=True, stdout=subprocess.DEVNULL)
         bake(lmbake, os.path.join(work, "scenes", "sun-lamps.gltf"), groups_out, os.path.join(work, "groups.yaml"),
-             CHEAP + "probes: {auto: false}\noutput:\n  directional: false\n  light_groups:\n"
+             CHEAP + "probes: {auto: false}\noutput:\n  directional: false\n  formats: [exr, hdr, png, ktx2]\n"
+             "  ktx2_format: bc6h\n  ktx2_supercompression: none\n  light_groups:\n"
              "    - {name: sun, match: sun}\n    - {name: lamps, match: \"lamp_*\"}\n")
-        jobs.append(dict(page_job(work, os.path.join(groups_out, "sun-lamps.gltf"), "babylon", "groups"), source="hdr",
-                         groups=",".join("%g" % w for w in GROUP_WEIGHTS)))
+        for source in ("hdr", "ktx2"):
+            jobs.append(dict(page_job(work, os.path.join(groups_out, "sun-lamps.gltf"), "babylon", "groups-" + source),
+                             source=source, groups=",".join("%g" % w for w in GROUP_WEIGHTS)))
     run_pages(work, jobs)
     ok, uvs = True, {}
     for out, stem, loader, fmt, tag, min_pixels in checks:
@@ -261,7 +273,8 @@ def main():
         uvs[(stem, loader)] = (uv, lit)
     if "babylon" in loaders:
         ok &= probe_light(work)
-        ok &= light_groups(work, groups_out)
+        ok &= light_groups(work, groups_out, "hdr")
+        ok &= light_groups(work, groups_out, "ktx2")
     for name, _ in levels:
         if len(loaders) == 2:
             ok &= cross_check(work, os.path.join(work, "out-" + name), name, loaders,
