@@ -372,6 +372,23 @@ def kept_between_bakes(lmbake, work, level, doc, short):
           "first bake's%s; the glTF names its intensity %s (want %s)"
           % (tint, len(names), " (differ: %s)" % differ if differ else "", len(own),
              " (differ: %s)" % moved if moved else "", named, want))
+    if not short:
+        # under a ground colour the sky's colour is not a weight (the ground is not tinted by it,
+        # and the two colours' ratio decides where samples go): a tint lights the sky's group again
+        def grounded(color):
+            return BASE + "sky: {intensity: 400.0, color: %r, ground_color: [0.3, 0.25, 0.2]}\noutput:\n" \
+                          "  light_groups:\n    - {name: sky, sky: true}\n    - {name: lights, match: \"*\"}\n" % color
+        ground_cache = os.path.join(work, "kept-ground")
+        shutil.rmtree(ground_cache, ignore_errors=True)
+        _, g1 = bake(lmbake, work, level, "ground-white-kept", grounded([1.0, 1.0, 1.0]), "--layout-cache",
+                     ground_cache, "--log")
+        _, g2 = bake(lmbake, work, level, "ground-tinted-kept", grounded(tint), "--layout-cache", ground_cache, "--log")
+        log1, log2 = g1.stdout + g1.stderr, g2.stdout + g2.stderr
+        check(g1.returncode == 0 and "weighed by sky.intensity: [400, 400, 400]" in log1 and g2.returncode == 0 and
+              "light group 'sky' (1 of 2): lighting" in log2 and log2.count("read back from the cache") == 1,
+              "with a ground colour the sky's weight is its intensity alone, and a tint lights its group again (the "
+              "other read back): %s" % ("yes" if g2.returncode == 0 and "light group 'sky' (1 of 2): lighting" in log2
+                                        else (log1 + log2)[-300:]))
 
     # the emissive surfaces alone in their group (one emissive material: its emission the weight)
     def glowing(factor, strength):
