@@ -45,6 +45,12 @@
 
 /* A bake of `texels` texels (0: not known yet) must fit the memory left: otherwise an error
  * naming the key, the estimate and what fits, before the work that would be killed. */
+/* The block KTX2 format's name as the log says it (output.ktx2_format: bc6h or astc_hdr). */
+static const char *block_format_name(const lmb_config *cfg)
+{
+    return cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR";
+}
+
 static lmb_status texels_fit_memory(const lmb_config *cfg, uint64_t texels, lmb_error *err)
 {
     uint64_t avail = lmb_memory_available();
@@ -437,12 +443,12 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
                      "fits the brightest texel)", a, (unsigned long long)outputs[a].rgbm_clamped, outputs[a].rgbm_range);
         if (st == LMB_OK && outputs[a].ktx2.encode_seconds > 0)
             lmb_info(log, "atlas %u: %s blocks of %ux%u texels encoded in %.2fs", a,
-                     cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR", l.width[a], l.height[a],
+                     block_format_name(cfg), l.width[a], l.height[a],
                      outputs[a].ktx2.encode_seconds);
         if (st == LMB_OK && outputs[a].ktx2.clamped)
             lmb_warn(log, "atlas %u: %llu texels brighter than %s's range (65504) were clamped in the .ktx2 (output.scale: "
                      "radiance divides by pi)", a, (unsigned long long)outputs[a].ktx2.clamped,
-                     cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR");
+                     block_format_name(cfg));
     }
     if (progress && st == LMB_OK)
         progress(user, "images", l.atlas_count, l.atlas_count);
@@ -465,7 +471,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
             if (st == LMB_OK && ktx2.clamped)
                 lmb_warn(log, "atlas %u, light group '%s': %llu texels brighter than %s's range (65504) were clamped in "
                          "its .ktx2", a, groups.name[g], (unsigned long long)ktx2.clamped,
-                         cfg->ktx2_format == LMB_KTX2_BC6H ? "BC6H" : "ASTC HDR");
+                         block_format_name(cfg));
             if (st == LMB_OK && groups_kept)
                 lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, files, log);
         }
