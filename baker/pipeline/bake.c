@@ -19,6 +19,7 @@
 #include "watch/validity_cache.h"
 #include "pipeline/group_cache.h"
 #include "pipeline/group_lighting.h"
+#include "pipeline/group_store.h"
 #include "pipeline/lighting.h"
 #include "pipeline/stage_options.h"
 #include "lights/direct.h"
@@ -405,12 +406,16 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++) {
         if (group_light.cached[g])
             continue;
+        st = lmb_group_light_bring_back(&group_light, g, err);
+        if (st != LMB_OK)
+            break;
         lmb_group_swap(&group_light, g, &cache);
         st = post_process(s, cfg, &l, &rt, &cache, progress, user, stats, log, err);
         lmb_group_swap(&group_light, g, &cache);
         if (st == LMB_OK && groups_kept)
             lmb_group_cache_write(groups_kept, group_light.key[g], g, &group_light, &cache, probes.count,
                                   stats->texels, stats->valid_texels, log);
+        lmb_group_light_put_away(&group_light, g, log);
     }
     if (st == LMB_OK && !dark && groups.count)
         st = lmb_group_compose(&groups, &group_light, &cache, &probes, err);
@@ -456,7 +461,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
     /* each group's own files: its light as lit (a group of one source at intensity 1; the glTF
      * names the intensity a game multiplies it by), the same bytes at any scale and intensity,
      * so a group read back from the cache copies the files it kept instead of encoding them */
-    for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++)
+    for (uint32_t g = 0; st == LMB_OK && !dark && g < groups.count; g++) {
         for (uint32_t a = 0; st == LMB_OK && a < l.atlas_count; a++) {
             char paths[LMB_GROUP_FILES][LMB_GROUP_IMAGE_PATH];
             const char *const names[LMB_GROUP_FILES] = {paths[0], paths[1], paths[2]};
@@ -464,6 +469,9 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
             if (group_light.cached[g] && groups_kept &&
                 lmb_group_cache_copy_files(groups_kept, group_light.key[g], a, names, files, log))
                 continue;
+            st = lmb_group_light_bring_back(&group_light, g, err); /* its images, for its files alone */
+            if (st != LMB_OK)
+                break;
             lmb_ktx2_report ktx2 = {0};
             st = lmb_write_group_images(cfg, od.staging, od.stem, a, groups.name[g],
                                         group_light.irradiance[(size_t)g * l.atlas_count + a], cache.state[a],
@@ -475,6 +483,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
             if (st == LMB_OK && groups_kept)
                 lmb_group_cache_keep_files(groups_kept, group_light.key[g], a, names, files, log);
         }
+        lmb_group_light_drop(&group_light, g); /* nothing reads its images after its files */
+    }
     for (uint32_t a = 0; st == LMB_OK && cache.shadowmask && a < l.atlas_count; a++)
         st = lmb_write_shadowmask_image(od.staging, od.stem, a, cache.shadowmask[a], l.width[a], l.height[a], err);
     for (uint32_t a = 0; st == LMB_OK && cache.direction && a < l.atlas_count; a++)

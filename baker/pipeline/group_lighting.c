@@ -2,6 +2,7 @@
 #include "group_lighting.h"
 
 #include "pipeline/group_cache.h"
+#include "pipeline/group_store.h"
 
 #include "util/lmb_math.h"
 
@@ -30,12 +31,17 @@ void lmb_group_light_free(lmb_group_light *gl)
     free(gl->records);
     free(gl->key);
     free(gl->cached);
+    lmb_group_store_close(gl);
+    free(gl->file);
+    free(gl->away);
+    free(gl->texels);
     memset(gl, 0, sizeof *gl);
 }
 
-static lmb_status light_alloc(lmb_group_light *gl, uint32_t groups, uint32_t atlases, int directional, int probes,
-                              lmb_error *err)
+static lmb_status light_alloc(lmb_group_light *gl, uint32_t groups, const lmb_layout *layout, int directional,
+                              int probes, lmb_error *err)
 {
+    uint32_t atlases = layout->atlas_count;
     memset(gl, 0, sizeof *gl);
     gl->groups = groups;
     gl->atlases = atlases;
@@ -47,8 +53,15 @@ static lmb_status light_alloc(lmb_group_light *gl, uint32_t groups, uint32_t atl
     gl->records = calloc((size_t)groups + 1, sizeof *gl->records);
     gl->key = calloc((size_t)groups + 1, sizeof *gl->key);
     gl->cached = calloc((size_t)groups + 1, 1);
+    gl->away = calloc((size_t)groups + 1, 1);
+    gl->file = malloc(((size_t)groups + 1) * sizeof *gl->file);
+    gl->texels = calloc((size_t)atlases + 1, sizeof *gl->texels);
+    for (uint32_t g = 0; gl->file && g < groups; g++)
+        gl->file[g] = -1;
+    for (uint32_t a = 0; gl->texels && a < atlases; a++)
+        gl->texels[a] = (uint64_t)layout->width[a] * layout->height[a];
     if (!gl->irradiance || (directional && !gl->direction) || (probes && (!gl->sh || !gl->cube)) || !gl->records ||
-        !gl->key || !gl->cached) {
+        !gl->key || !gl->cached || !gl->away || !gl->file || !gl->texels) {
         lmb_group_light_free(gl);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
     }
@@ -167,7 +180,7 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
 {
     lmb_scene *s = env->scene;
     memset(out, 0, sizeof *out);
-    lmb_status st = env->keep ? light_alloc(out, groups->count, env->cache->atlas_count, env->cfg->directional,
+    lmb_status st = env->keep ? light_alloc(out, groups->count, env->cache->layout, env->cfg->directional,
                                             env->probes != NULL, err)
                               : LMB_OK;
     saved_light *saved = malloc(((size_t)s->light_count + 1) * sizeof *saved);
@@ -179,8 +192,9 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
         for (uint32_t a = 0; a < env->cache->atlas_count; a++)
             texels += (uint64_t)env->cache->layout->width[a] * env->cache->layout->height[a];
         unsigned per = env->cfg->directional ? 24u : 12u;
-        lmb_info(env->log, "light groups: each group's light kept until the files are written: %u group(s) x %u bytes "
-                 "x %llu texels = %.1f MB", groups->count, per, (unsigned long long)texels,
+        lmb_info(env->log, "light groups: each group's light kept until the files are written, in a file in TMPDIR "
+                 "while no stage reads it: %u group(s) x %u bytes x %llu texels = %.1f MB", groups->count, per,
+                 (unsigned long long)texels,
                  (double)groups->count * per * (double)texels / 1048576.0);
     }
     if (st == LMB_OK && env->keep && env->cache_dir)
@@ -195,6 +209,7 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
             if (lmb_group_cache_read(env->cache_dir, out->key[g], g, out, env->cache, probes, &texels,
                                                      &valid, env->log)) {
                 out->cached[g] = 1;
+                lmb_group_light_put_away(out, g, env->log);
                 gs->texels = texels;
                 gs->valid_texels = valid;
                 lmb_info(env->log, "light group '%s' (%u of %u): read back from the cache (its lights, the level and "
@@ -211,6 +226,8 @@ lmb_status lmb_group_lighting(const lmb_group_env *env, const lmb_light_groups *
             stats->rays += other.rays;
         if (st == LMB_OK && env->keep)
             st = keep_group(env, g, dark, records, out, err);
+        if (st == LMB_OK && env->keep) /* out of memory until a stage reads it (group_store.h) */
+            lmb_group_light_put_away(out, g, env->log);
     }
     free(saved);
     /* the records written: the last group's (lit or read back) */
@@ -236,6 +253,44 @@ void lmb_group_swap(lmb_group_light *gl, uint32_t g, lmb_cache *cache)
     }
 }
 
+/* Texels a compose reads of each group at once: G x 3 x 4 x 65536 bytes (6 MB for 8 groups, twice
+ * with directions), the groups' files read in spans of 768 KB. */
+#define COMPOSE_SPAN 65536
+
+/* One texel of the sum: eg[g x stride] its light in group g, dg likewise its directions (NULL:
+ * none); e, d: the sum's (lmb_group_compose). */
+static void compose_texel(const lmb_light_groups *groups, uint32_t G, const float *eg0, const float *dg0, size_t stride,
+                          float *e, float *d)
+{
+    double sum[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+    for (uint32_t g = 0; g < G; g++) {
+        const float *eg = eg0 + g * stride; /* as its files hold it */
+        double part[3];
+        for (int c = 0; c < 3; c++) {
+            part[c] = groups->scale[g] * groups->weight[g][c] * (double)eg[c];
+            sum[c] += part[c];
+        }
+        if (d) {
+            const float *dg = dg0 + g * stride;
+            double w = 0.2126 * part[0] + 0.7152 * part[1] + 0.0722 * part[2];
+            for (int c = 0; c < 3; c++)
+                v[c] += w * (double)dg[c];
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        e[c] = (float)sum[c];
+    if (d) {
+        double lum = 0.2126 * sum[0] + 0.7152 * sum[1] + 0.0722 * sum[2], len = 0;
+        for (int c = 0; c < 3; c++) {
+            v[c] = lum > 0 ? v[c] / lum : 0;
+            len += v[c] * v[c];
+        }
+        len = sqrt(len);
+        for (int c = 0; c < 3; c++)
+            d[c] = (float)(len > 1 ? v[c] / len : v[c]);
+    }
+}
+
 lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_light *gl, lmb_cache *cache,
                              lmb_probe_set *probes, lmb_error *err)
 {
@@ -244,44 +299,34 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
         cache->direction = calloc((size_t)cache->atlas_count + 1, sizeof *cache->direction);
     if (gl->direction && !cache->direction)
         return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
-    for (uint32_t a = 0; a < cache->atlas_count; a++) {
+    /* each group's span of texels (from memory or its file), COMPOSE_SPAN texels at a time */
+    size_t span = COMPOSE_SPAN;
+    float *ge = malloc(((size_t)G * 3 * span + 1) * sizeof *ge), *gd = gl->direction ? malloc(((size_t)G * 3 * span + 1) * sizeof *gd) : NULL;
+    lmb_status st = ge && (!gl->direction || gd) ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
+    for (uint32_t a = 0; a < cache->atlas_count && st == LMB_OK; a++) {
         size_t n = (size_t)cache->layout->width[a] * cache->layout->height[a];
         float *e = malloc((3 * n + 1) * sizeof *e), *d = gl->direction ? malloc((3 * n + 1) * sizeof *d) : NULL;
         if (!e || (gl->direction && !d)) {
             free(e);
             free(d);
-            return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory for atlas %u", a);
+            break;
         }
         int threads = cache->threads > 0 ? (int)cache->threads : omp_get_max_threads();
+        for (size_t i0 = 0; i0 < n && st == LMB_OK; i0 += span) {
+            size_t i1 = i0 + span < n ? i0 + span : n;
+            for (uint32_t g = 0; g < G && st == LMB_OK; g++)
+                st = lmb_group_light_read_span(gl, g, a, i0, i1, ge + (size_t)g * 3 * span,
+                                               gd ? gd + (size_t)g * 3 * span : NULL, err);
 #pragma omp parallel for num_threads(threads) schedule(static)
-        for (size_t i = 0; i < n; i++) { /* each texel on its own: the same floats at any thread count */
-            double sum[3] = {0, 0, 0}, v[3] = {0, 0, 0};
-            for (uint32_t g = 0; g < G; g++) {
-                const float *eg = gl->irradiance[(size_t)g * gl->atlases + a] + 3 * i; /* as its files hold it */
-                double part[3];
-                for (int c = 0; c < 3; c++) {
-                    part[c] = groups->scale[g] * groups->weight[g][c] * (double)eg[c];
-                    sum[c] += part[c];
-                }
-                if (d) {
-                    const float *dg = gl->direction[(size_t)g * gl->atlases + a] + 3 * i;
-                    double w = 0.2126 * part[0] + 0.7152 * part[1] + 0.0722 * part[2];
-                    for (int c = 0; c < 3; c++)
-                        v[c] += w * (double)dg[c];
-                }
-            }
-            for (int c = 0; c < 3; c++)
-                e[3 * i + c] = (float)sum[c];
-            if (d) {
-                double lum = 0.2126 * sum[0] + 0.7152 * sum[1] + 0.0722 * sum[2], len = 0;
-                for (int c = 0; c < 3; c++) {
-                    v[c] = lum > 0 ? v[c] / lum : 0;
-                    len += v[c] * v[c];
-                }
-                len = sqrt(len);
-                for (int c = 0; c < 3; c++)
-                    d[3 * i + c] = (float)(len > 1 ? v[c] / len : v[c]);
-            }
+            for (size_t i = i0; i < i1; i++) /* each texel on its own: the same floats at any thread count */
+                compose_texel(groups, G, ge + 3 * (i - i0), gd ? gd + 3 * (i - i0) : NULL, 3 * span, e + 3 * i,
+                              d ? d + 3 * i : NULL);
+        }
+        if (st != LMB_OK) {
+            free(e);
+            free(d);
+            break;
         }
         free(cache->irradiance[a]);
         cache->irradiance[a] = e;
@@ -290,6 +335,10 @@ lmb_status lmb_group_compose(const lmb_light_groups *groups, const lmb_group_lig
             cache->direction[a] = d;
         }
     }
+    free(ge);
+    free(gd);
+    if (st != LMB_OK)
+        return st;
     for (uint32_t p = 0; gl->sh && probes && p < probes->count; p++) {
         double sh[LMB_PROBE_SH] = {0}, cube[LMB_PROBE_CUBE] = {0};
         for (uint32_t g = 0; g < G; g++) { /* channel k % 3 of each */

@@ -9,7 +9,8 @@
  * the sum a game computes from the groups' own files.
  * Every group runs the same steps in every farm process (steps/runner.h): a group's rays, its
  * records and its decisions depend on its own lights only, never on another group or a scale.
- * Costs one lighting per group (time, and 12 bytes per texel per group kept).
+ * Costs one lighting per group in time; each group's images are kept out of memory while no stage
+ * reads them (group_store.h).
  */
 #ifndef LMBAKE_GROUP_LIGHTING_H
 #define LMBAKE_GROUP_LIGHTING_H
@@ -29,6 +30,10 @@ typedef struct lmb_group_light {
     lmb_ic_points *records; /* [g]: the group's final-gather records (owned) */
     uint8_t (*key)[32];     /* [g]: its key in the cache between bakes (group_cache.h), when kept */
     uint8_t *cached;        /* [g]: 1 when read back from that cache (its post stage done) */
+    uint64_t *texels;       /* [a]: the atlas's width x height (its images hold 3 floats per texel) */
+    int *file;              /* [g]: the file its images are put away in (group_store.h), -1: none yet */
+    uint8_t *away;          /* [g]: 1 while its images are in that file only (their pointers NULL) */
+    int in_memory;          /* 1: a file could not be made or written; the images stay in memory */
 } lmb_group_light;
 
 /* What a group's lighting needs (the bake driver's, borrowed). */

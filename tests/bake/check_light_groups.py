@@ -225,6 +225,17 @@ def threads_and_farm(lmbake, work, level, ref, short):
                          os.path.join(work, "farm"), "-o", farm_out, "--shards", "2", "--threads", "1", "-q"],
                         capture_output=True, text=True)
     runs = [("farm parallel, 2 shards", farm_out, pf.returncode)]
+    # each group's light waits for the files in a file in TMPDIR; where none can be made it stays
+    # in memory, said once, the same bytes
+    cfg = os.path.join(work, "scales-1-1.yaml")
+    mem_out = os.path.join(work, "in-memory")
+    shutil.rmtree(mem_out, ignore_errors=True)
+    pm = subprocess.run([lmbake, "bake", level, "-c", cfg, "-o", mem_out], capture_output=True, text=True,
+                        env=dict(os.environ, TMPDIR=os.path.join(work, "no-such-folder")))
+    said = [l for l in pm.stderr.splitlines() if "stays in memory" in l]
+    check(pm.returncode == 0 and len(said) == 1 and "no-such-folder" in said[0],
+          "TMPDIR without a folder: the groups' light kept in memory, said once: %s" % (said or pm.stderr[-300:]))
+    runs.append(("the groups' light in memory", mem_out, pm.returncode))
     if not short:
         runs += [("--threads 3", t3, p.returncode), ("--threads 1", t1, p1.returncode)]
     for name, out, rc in runs:
