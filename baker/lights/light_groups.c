@@ -1,6 +1,9 @@
 /* Which group each light source is in (see light_groups.h). */
 #include "light_groups.h"
 
+#include "util/lmb_math.h"
+
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,6 +30,7 @@ static int32_t group_named(lmb_light_groups *g, const char *name)
 void lmb_light_groups_free(lmb_light_groups *g)
 {
     free(g->of_light);
+    free(g->merged);
     memset(g, 0, sizeof *g);
 }
 
@@ -60,6 +64,62 @@ static int shared_emission(const lmb_scene *s, double scale, float le[3])
     return first >= 0 && same;
 }
 
+/* The order in which one_per_light's lights get a group of their own when not all can: a
+ * directional light first (it lights the whole level), brighter before dimmer by the luminance of
+ * its intensity x colour; then the local lights by their power, luminance x intensity x the solid
+ * angle they shine into (4 pi; a spot 2 pi (1 - cos of its cone's middle angle), as pbrt-v4's
+ * SpotLight::Phi); equal ones in the file's order. A share of the level's light without a bake:
+ * a local light's power all lands on the level, a directional light's on all of it. */
+typedef struct ranked_light {
+    uint32_t light;
+    int directional;
+    double power;
+} ranked_light;
+
+static int rank_order(const void *pa, const void *pb)
+{
+    const ranked_light *a = pa, *b = pb;
+    if (a->directional != b->directional)
+        return a->directional ? -1 : 1;
+    if (a->power != b->power)
+        return a->power > b->power ? -1 : 1;
+    return a->light < b->light ? -1 : a->light > b->light;
+}
+
+static ranked_light rank_of(const lmb_light *l, uint32_t i)
+{
+    double lum = 0.2126 * l->color[0] + 0.7152 * l->color[1] + 0.0722 * l->color[2];
+    double solid = 4 * LMB_PI;
+    if (l->type == LMB_LIGHT_SPOT)
+        solid = 2 * LMB_PI * (1 - cos(0.5 * ((double)l->inner_cone + (double)l->outer_cone)));
+    int directional = l->type == LMB_LIGHT_DIRECTIONAL;
+    return (ranked_light){i, directional, lum * (double)l->intensity * (directional ? 1.0 : solid)};
+}
+
+/* A group for light i alone, named after it (its name, else its node's, each character that a
+ * group's name cannot hold as '_'; "-2", "-3", ... when taken). */
+static int32_t group_of_light(lmb_light_groups *g, const lmb_light *l, uint32_t i, double scale)
+{
+    char base[LMB_PATTERN_LEN - 8], name[LMB_PATTERN_LEN];
+    const char *from = l->name && l->name[0] ? l->name : l->node_name && l->node_name[0] ? l->node_name : "";
+    size_t n = 0;
+    for (; from[n] && n + 1 < sizeof base; n++) {
+        char ch = from[n];
+        int ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '-';
+        base[n] = ok ? ch : '_';
+    }
+    base[n] = 0;
+    if (!n)
+        snprintf(base, sizeof base, "light-%u", i);
+    snprintf(name, sizeof name, "%s", base);
+    for (uint32_t k = 2; find_group(g, name) >= 0 || !strcmp(name, "rest"); k++)
+        snprintf(name, sizeof name, "%s-%u", base, k);
+    int32_t k = group_named(g, name);
+    if (k >= 0)
+        g->scale[k] = scale;
+    return k;
+}
+
 lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
                                     lmb_light_groups *out, lmb_error *err)
 {
@@ -75,47 +135,85 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: output.light_groups and output.shadowmask: a bake holds one or "
                              "the other (light groups with shadowmasks are not built yet)", where);
     out->of_light = malloc(((size_t)s->light_count + 1) * sizeof *out->of_light);
-    if (!out->of_light)
+    out->merged = calloc((size_t)s->light_count + 1, 1);
+    int32_t *entry_of = malloc(((size_t)s->light_count + 1) * sizeof *entry_of); /* one_per_light's entry, or -1 */
+    ranked_light *ranked = malloc(((size_t)s->light_count + 1) * sizeof *ranked);
+    if (!out->of_light || !out->merged || !entry_of || !ranked) {
+        free(entry_of);
+        free(ranked);
+        lmb_light_groups_free(out);
         return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: out of memory");
-    for (uint32_t k = 0; k < cfg->light_group_count; k++) {
-        snprintf(out->name[k], sizeof out->name[k], "%s", cfg->light_groups[k].name);
-        out->scale[k] = cfg->light_groups[k].scale;
     }
-    out->count = cfg->light_group_count;
+    int32_t of_entry[LMB_MAX_LIGHT_GROUPS]; /* config entry j's group (-1: one_per_light) */
+    for (uint32_t j = 0; j < cfg->light_group_count; j++) {
+        of_entry[j] = -1;
+        if (cfg->light_groups[j].one_per_light)
+            continue;
+        snprintf(out->name[out->count], sizeof out->name[out->count], "%s", cfg->light_groups[j].name);
+        out->scale[out->count] = cfg->light_groups[j].scale;
+        of_entry[j] = (int32_t)out->count++;
+    }
+    uint32_t pending = 0; /* lights of one_per_light entries */
     for (uint32_t i = 0; i < s->light_count; i++) {
         const lmb_light *l = &s->lights[i];
         out->of_light[i] = -1;
+        entry_of[i] = -1;
         if (l->mode == LMB_LIGHT_REALTIME)
             continue;
         int32_t k = -1;
         if (l->group && l->group[0]) {
             k = group_named(out, l->group);
             if (k < 0) {
+                free(entry_of);
+                free(ranked);
                 lmb_light_groups_free(out);
                 return lmb_error_set(err, LMB_ERR_INPUT, "%s: light '%s' (node '%s'): extras.lightmap_group '%s' would "
                                      "make more than %d light groups (output.light_groups holds at most %d)", s->path,
                                      l->name, l->node_name, l->group, LMB_MAX_LIGHT_GROUPS, LMB_MAX_LIGHT_GROUPS);
             }
         }
-        for (uint32_t j = 0; k < 0 && j < cfg->light_group_count; j++) {
-            const char *p = cfg->light_groups[j].pattern;
-            if (p[0] && (lmb_glob_match(p, l->name) || lmb_glob_match(p, l->node_name)))
-                k = (int32_t)j;
+        for (uint32_t j = 0; k < 0 && entry_of[i] < 0 && j < cfg->light_group_count; j++) {
+            const lmb_light_group_spec *e = &cfg->light_groups[j];
+            const char *p = e->pattern[0] ? e->pattern : e->one_per_light ? "*" : "";
+            if (!p[0] || !(lmb_glob_match(p, l->name) || lmb_glob_match(p, l->node_name)))
+                continue;
+            if (e->one_per_light)
+                entry_of[i] = (int32_t)j;
+            else
+                k = of_entry[j];
         }
-        out->of_light[i] = k; /* -1: the rest's, below */
+        if (entry_of[i] >= 0)
+            ranked[pending++] = rank_of(l, i);
+        out->of_light[i] = k; /* -1: the rest's or its own, below */
     }
     for (uint32_t j = 0; j < cfg->light_group_count; j++) {
         if (has_sky && out->sky < 0 && cfg->light_groups[j].sky)
-            out->sky = (int32_t)j;
+            out->sky = of_entry[j];
         if (has_emissive && out->emissive < 0 && cfg->light_groups[j].emissive)
-            out->emissive = (int32_t)j;
+            out->emissive = of_entry[j];
     }
+    /* one_per_light: a group per light while the groups last; when they do not all fit with
+     * the rest's, the last group is `rest` and the lights that rank lowest share it */
+    int others = (has_sky && out->sky < 0) || (has_emissive && out->emissive < 0);
+    for (uint32_t i = 0; i < s->light_count; i++)
+        others |= s->lights[i].mode != LMB_LIGHT_REALTIME && out->of_light[i] < 0 && entry_of[i] < 0;
+    uint32_t room = LMB_MAX_LIGHT_GROUPS - out->count, own = pending;
+    if (pending + (uint32_t)others > room)
+        own = room > 0 ? room - 1 : 0;
+    qsort(ranked, pending, sizeof *ranked, rank_order);
+    for (uint32_t r = own; r < pending; r++)
+        out->merged[ranked[r].light] = 1;
+    for (uint32_t i = 0; i < s->light_count; i++) /* their groups in the file's order */
+        if (entry_of[i] >= 0 && !out->merged[i])
+            out->of_light[i] = group_of_light(out, &s->lights[i], i, cfg->light_groups[entry_of[i]].scale);
+    free(ranked);
     /* what no group claims: the group "rest" */
     int unclaimed = (has_sky && out->sky < 0) || (has_emissive && out->emissive < 0);
     for (uint32_t i = 0; i < s->light_count; i++)
         unclaimed |= s->lights[i].mode != LMB_LIGHT_REALTIME && out->of_light[i] < 0;
     int32_t rest = unclaimed ? group_named(out, "rest") : -1;
     if (unclaimed && rest < 0) {
+        free(entry_of);
         lmb_light_groups_free(out);
         return lmb_error_set(err, LMB_ERR_INPUT, "%s: %d light groups hold some of the level's light and the rest needs "
                              "one more (at most %d): name a group for every light, or give one sky: true / emissive: "
@@ -132,8 +230,21 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
             out->lights[out->of_light[i]]++;
     }
     /* a config group that holds nothing is a mistake (a typo in match, a renamed light) */
-    for (uint32_t j = 0; j < cfg->light_group_count; j++)
-        if (!out->lights[j] && out->sky != (int32_t)j && out->emissive != (int32_t)j) {
+    for (uint32_t j = 0; j < cfg->light_group_count; j++) {
+        int32_t k = of_entry[j];
+        int matched = 0;
+        for (uint32_t i = 0; k < 0 && i < s->light_count; i++)
+            matched |= entry_of[i] == (int32_t)j;
+        if (k < 0 && !matched) {
+            const lmb_light_group_spec *g = &cfg->light_groups[j];
+            lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: output.light_groups (one_per_light) holds no light: no light's "
+                          "name or node name matches '%s' (%s)", where, g->line, g->pattern[0] ? g->pattern : "*",
+                          s->path);
+            free(entry_of);
+            lmb_light_groups_free(out);
+            return LMB_ERR_INPUT;
+        }
+        if (k >= 0 && !out->lights[k] && out->sky != k && out->emissive != k) {
             const lmb_light_group_spec *g = &cfg->light_groups[j];
             char what[512];
             snprintf(what, sizeof what, "%s%s%s%s%s", g->pattern[0] ? "no light's name or node name matches '" : "",
@@ -141,9 +252,12 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
                      g->emissive && !has_emissive ? ", nothing in it emits" : "");
             lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: output.light_groups '%s' holds no light: %s, and no light's "
                           "extras.lightmap_group names it (%s)", where, g->line, g->name, what, s->path);
+            free(entry_of);
             lmb_light_groups_free(out);
             return LMB_ERR_INPUT;
         }
+    }
+    free(entry_of);
     /* unit groups: one light alone; the config's sky alone (sky.intensity its weight: a sky
      * from the file's image-based light is lit as it is); the emissive surfaces alone, when
      * they share one emission (its weight, per channel) */
@@ -194,4 +308,15 @@ void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, cons
                  g->sky == (int32_t)k ? ", the sky" : "", g->emissive == (int32_t)k ? ", the emissive surfaces" : "",
                  g->scale[k], weight);
     }
+    uint32_t merged = 0;
+    char names[400] = "";
+    for (uint32_t i = 0; g->merged && i < s->light_count; i++)
+        if (g->merged[i] && merged++ < 6) {
+            size_t n = strlen(names);
+            snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", s->lights[i].name);
+        }
+    if (merged)
+        lmb_info(log, "light groups: one_per_light: %u light(s) share 'rest' (%s%s): at most %d groups, and they rank "
+                 "lowest (a directional light first, then by power: docs/light-groups.md)", merged, names,
+                 merged > 6 ? ", ..." : "", LMB_MAX_LIGHT_GROUPS);
 }

@@ -19,6 +19,10 @@
  * the first config group whose match its name or node name matches; the sky and the emissive
  * surfaces: the first group with sky: true / emissive: true. What no group claims goes to a
  * group named "rest" (made when needed). Realtime lights are in no group (they are not baked).
+ * A config entry with one_per_light gives each light it matches a group of its own, named after
+ * the light, after the named groups; when they do not all fit in LMB_MAX_LIGHT_GROUPS with the
+ * rest's, the lights that rank lowest (rank_order: a directional light first, then by power)
+ * share "rest" and the log names them.
  */
 #ifndef LMBAKE_LIGHT_GROUPS_H
 #define LMBAKE_LIGHT_GROUPS_H
@@ -31,6 +35,8 @@ typedef struct lmb_light_groups {
     double scale[LMB_MAX_LIGHT_GROUPS];
     uint32_t lights[LMB_MAX_LIGHT_GROUPS]; /* how many of the level's lights each holds */
     int32_t *of_light;                     /* per scene light: its group, -1 (realtime: in none) */
+    uint8_t *merged;                       /* per scene light: 1 when one_per_light gave it no group of its
+                                              own (more lights than groups; it ranks lowest) but `rest` */
     int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
     /* A group of one light (neither the sky nor the emissive surfaces) is lit with that light at
      * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel);

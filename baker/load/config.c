@@ -189,6 +189,7 @@ static const key_spec light_group_keys[] = {
     STRING("output.light_groups.match", offsetof(lmb_light_group_spec, pattern)),
     BOOL("output.light_groups.sky", offsetof(lmb_light_group_spec, sky)),
     BOOL("output.light_groups.emissive", offsetof(lmb_light_group_spec, emissive)),
+    BOOL("output.light_groups.one_per_light", offsetof(lmb_light_group_spec, one_per_light)),
     FLOAT("output.light_groups.scale", offsetof(lmb_light_group_spec, scale), 0, 1e9, 0),
 };
 static const schema light_group_schema = {light_group_keys, sizeof light_group_keys / sizeof *light_group_keys};
@@ -343,7 +344,8 @@ static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_no
 }
 
 /* {name: NAME, match: GLOB, sky: BOOL, emissive: BOOL, scale: S}: name required (letters, digits,
- * '_', '-'; the group's files carry it), unique; scale 1 unless given */
+ * '_', '-'; the group's files carry it), unique; scale 1 unless given. Or {match: GLOB,
+ * one_per_light: true, scale: S}: a group per light it matches (lights/light_groups.h names them). */
 static lmb_status light_group_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
 {
     lmb_light_group_spec *all = (lmb_light_group_spec *)(void *)(base + k->offset), *o = all + index;
@@ -353,13 +355,16 @@ static lmb_status light_group_item(parse_ctx *c, const key_spec *k, const yaml_n
     if (item->type != YAML_MAPPING_NODE)
         return lmb_cfg_bad_value(c, k, item, "a mapping {name: NAME, match: GLOB, sky: BOOL, emissive: BOOL, scale: S}");
     lmb_status st = walk_mapping(c, &light_group_schema, item, k->path, (char *)o);
-    if (st == LMB_OK && !o->name[0])
-        return lmb_cfg_key_error(c, item, k->path, "each entry needs a name");
+    if (st == LMB_OK && o->one_per_light && (o->name[0] || o->sky || o->emissive))
+        return lmb_cfg_key_error(c, item, k->path, "one_per_light: true names its groups after its lights and holds "
+                                 "lights only: no name, sky or emissive with it");
+    if (st == LMB_OK && !o->name[0] && !o->one_per_light)
+        return lmb_cfg_key_error(c, item, k->path, "each entry needs a name (or one_per_light: true)");
     for (const char *p = o->name; st == LMB_OK && *p; p++)
         if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') || *p == '_' || *p == '-'))
             return lmb_cfg_key_error(c, item, k->path, "name '%s': letters, digits, '_' and '-' only (it names the "
                                      "group's files)", o->name);
-    for (uint32_t j = 0; st == LMB_OK && j < index; j++)
+    for (uint32_t j = 0; st == LMB_OK && o->name[0] && j < index; j++)
         if (!strcmp(all[j].name, o->name))
             return lmb_cfg_key_error(c, item, k->path, "name '%s' is given twice (lines %u and %u)", o->name,
                                      all[j].line, o->line);

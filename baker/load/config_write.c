@@ -136,9 +136,15 @@ static void put_value(text_out *o, const key_spec *k, const char *base)
         for (uint32_t i = 0; i < count; i++) {
             const char *item = at + (size_t)i * item_size;
             put(o, "%s{", i ? ", " : "");
-            for (size_t f = 0; f < ov->count; f++) {
-                put(o, "%s%s: ", f ? ", " : "", strrchr(ov->keys[f].path, '.') + 1);
-                put_value(o, &ov->keys[f], item);
+            for (size_t f = 0, first = 1; f < ov->count; f++) {
+                const key_spec *fk = &ov->keys[f];
+                /* an unset string (a light group's match or a one_per_light's name) is left out:
+                 * "" is no value a config may give, and the printed config must read back */
+                if ((fk->set == lmb_cfg_set_string || fk->set == lmb_cfg_set_path) && !item[fk->offset])
+                    continue;
+                put(o, "%s%s: ", first ? "" : ", ", strrchr(fk->path, '.') + 1);
+                put_value(o, fk, item);
+                first = 0;
             }
             put(o, "}");
         }

@@ -3,7 +3,8 @@
 
 usage: check_light_groups.py LMBAKE WORKDIR [short]   (short, the sanitizer pass: scales (0.3, 2)
        only, no plain bakes, no --threads runs, the sun off and lamp_a dimmed left out (the sun's
-       edit and lamp_b moved read back and relight the same way), one round of random lights:
+       edit and lamp_b moved read back and relight the same way), one round of random lights,
+       no bake with the groups' light in memory, one_per_light without its byte comparison:
        the same code, half the bakes)
 
 The level: sun-lamps.gltf (tools/make_scenes.py: a 10 x 10 ground, a closed 1 m cube on it, a sun
@@ -16,7 +17,8 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - the light probes likewise: their SH and ambient cubes = sum_g w_g x intensity_g x each group's
     own (named in asset.extras.lightmap.probes.groups), within 1e-6 relative;
   - the groups' files are the same bytes whatever the scales (no group reads a scale), and the
-    same at 1 and 3 threads and from a farm of 2 shards (every output file byte for byte);
+    same at 1 and 3 threads, from a farm of 2 shards, and with each group's light kept in memory
+    (no TMPDIR folder: said once) instead of in its file (every output file byte for byte);
   - the sum at (1, 1) is the level's light: against a bake without groups, the mean within 1% and
     the per-texel rms difference within 1.5x that between two seeds of the plain bake (+0.2%);
   - the glTF names each group's name, scale, intensity and files on every lightmap texture and node;
@@ -27,8 +29,12 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
     theirs; random intensities and colours of every light, each alone in its group; an edit or a move of a lamp lights the lamps' group again and reads the sun's
     back; every time the bytes of a bake without it;
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
+  - one_per_light: a group per light named after it, the bytes of the same groups named in the
+    config; with 11 lights (8 torches of 5-40 cd added) the sun, the lamps and the 4 brightest
+    torches get their own, the 4 dimmest share 'rest' and the log names them;
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
-    a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string.
+    a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string,
+    one_per_light with a name, one_per_light matching no light.
 """
 import filecmp
 import json
@@ -92,6 +98,14 @@ def group_intensities(gltf):
         doc = json.load(f)
     tex = next(t for t in doc["textures"] if t.get("extras", {}).get("lightmap", {}).get("groups"))
     return {g["name"]: np.array(g["intensity"], dtype=np.float64) for g in tex["extras"]["lightmap"]["groups"]}
+
+
+def group_intensities_list(gltf):
+    """The groups as the lightmap texture's extras.lightmap.groups lists them, in order."""
+    with open(gltf) as f:
+        doc = json.load(f)
+    tex = next(t for t in doc["textures"] if t.get("extras", {}).get("lightmap", {}).get("groups"))
+    return tex["extras"]["lightmap"]["groups"]
 
 
 def group_light(out, stem, group):
@@ -226,7 +240,9 @@ def threads_and_farm(lmbake, work, level, ref, short):
                         capture_output=True, text=True)
     runs = [("farm parallel, 2 shards", farm_out, pf.returncode)]
     # each group's light waits for the files in a file in TMPDIR; where none can be made it stays
-    # in memory, said once, the same bytes
+    # in memory, said once, the same bytes (Release only: every bake above takes the files' way)
+    if short:
+        return check_runs(ref, runs)
     cfg = os.path.join(work, "scales-1-1.yaml")
     mem_out = os.path.join(work, "in-memory")
     shutil.rmtree(mem_out, ignore_errors=True)
@@ -236,8 +252,12 @@ def threads_and_farm(lmbake, work, level, ref, short):
     check(pm.returncode == 0 and len(said) == 1 and "no-such-folder" in said[0],
           "TMPDIR without a folder: the groups' light kept in memory, said once: %s" % (said or pm.stderr[-300:]))
     runs.append(("the groups' light in memory", mem_out, pm.returncode))
-    if not short:
-        runs += [("--threads 3", t3, p.returncode), ("--threads 1", t1, p1.returncode)]
+    runs += [("--threads 3", t3, p.returncode), ("--threads 1", t1, p1.returncode)]
+    check_runs(ref, runs)
+
+
+def check_runs(ref, runs):
+    """Every run's files the bytes of ref's."""
     for name, out, rc in runs:
         listed = sorted(os.listdir(ref))
         differ = [f for f in listed if rc == 0 and (not os.path.exists(os.path.join(out, f)) or
@@ -503,6 +523,53 @@ def extras_group(lmbake, work, level, doc):
           "extras.lightmap_group 3: exit %d, %s" % (p.returncode, p.stderr.strip()[-200:]))
 
 
+def one_per_light(lmbake, work, level, doc, short):
+    """output.light_groups' one_per_light: a group per light, named after it; beyond 8 groups the
+    lights that rank lowest share `rest`."""
+    each = BASE + "output:\n  light_groups:\n    - {one_per_light: true}\n"
+    named = BASE + "output:\n  light_groups:\n" + "".join(
+        "    - {name: %s, match: %s}\n" % (n, n) for n in ("sun", "lamp_a", "lamp_b"))
+    if not short:  # (Release only: the sanitizers' pass runs the same code below)
+        out_each, p = bake(lmbake, work, level, "one-per-light", each)
+        out_named, pn = bake(lmbake, work, level, "one-per-light-named", named)
+        listed = sorted(os.listdir(out_named)) if pn.returncode == 0 else []
+        differ = [f for f in listed if p.returncode or not filecmp.cmp(os.path.join(out_named, f),
+                                                                      os.path.join(out_each, f), shallow=False)]
+        check(p.returncode == 0 and listed and not differ and
+              [g["name"] for g in group_intensities_list(os.path.join(out_each, "sun-lamps.gltf"))] ==
+              ["sun", "lamp_a", "lamp_b"],
+              "one_per_light: groups sun, lamp_a, lamp_b, every one of %d files the bytes of the three named in the "
+              "config%s" % (len(listed), " (differ: %s)" % differ if differ else ""))
+    # 11 lights: the sun, the two lamps and torch_0..7 at 5, 10, ..., 40 cd (dimmer than the lamps)
+    d = json.loads(json.dumps(doc))
+    lights = d["extensions"]["KHR_lights_punctual"]["lights"]
+    for k in range(8):
+        lights.append({"name": "torch_%d" % k, "type": "point", "intensity": 5.0 * (k + 1), "color": [1, 1, 1]})
+        d["nodes"].append({"name": "torch_%d" % k, "translation": [-2.0 + 0.5 * k, 1.0, 0.5],
+                           "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}})
+        d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)
+    path = os.path.join(os.path.dirname(level), "torches.gltf")
+    with open(path, "w") as f:
+        json.dump(d, f)
+    out, p = bake(lmbake, work, path, "one-per-light-11", each.replace(BASE, BASE + "bounces: 0\nprobes:\n  auto: false\n"), "--log")
+    names = [g["name"] for g in group_intensities_list(os.path.join(out, "torches.gltf"))] if p.returncode == 0 else []
+    want = ["sun", "lamp_a", "lamp_b", "torch_4", "torch_5", "torch_6", "torch_7", "rest"]
+    said = [l for l in (p.stdout + p.stderr).splitlines() if "share 'rest'" in l]
+    check(p.returncode == 0 and names == want and len(said) == 1 and
+          "4 light(s) share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3')" in said[0],
+          "one_per_light, 11 lights: groups %s (want %s); %s" % (names, want, said or (p.stdout + p.stderr)[-300:]))
+    cases = [("one-per-light-named-too", BASE + "output:\n  light_groups:\n    - {name: x, one_per_light: true}\n",
+              "one-per-light-named-too.yaml:4: key 'output.light_groups': one_per_light: true names its groups after "
+              "its lights"),
+             ("one-per-light-none", BASE + "output:\n  light_groups:\n    - {match: \"torch*\", one_per_light: true}\n",
+              "one-per-light-none.yaml:4: output.light_groups (one_per_light) holds no light: no light's name or node "
+              "name matches 'torch*'")]
+    for name, config, want in cases:
+        out, p = bake(lmbake, work, level, name, config)
+        check(p.returncode == 2 and want in p.stderr and not os.path.exists(out),
+              "%s: exit %d, nothing written, %r" % (name, p.returncode, p.stderr.strip()[-220:]))
+
+
 def errors(lmbake, work, level):
     cases = [
         ("unused", BASE + "output:\n  light_groups:\n    - {name: sun, match: sun}\n    - {name: torches, match: \"torch*\"}\n",
@@ -529,6 +596,7 @@ def main():
     kept_between_bakes(lmbake, work, level, doc, short)
     random_lights(lmbake, work, level, doc, short)
     extras_group(lmbake, work, level, doc)
+    one_per_light(lmbake, work, level, doc, short)
     errors(lmbake, work, level)
     print("%d failed" % len(fails))
     return 1 if fails else 0
