@@ -55,6 +55,7 @@ struct lmb_gltf_doc {
         uint32_t res[3], config_entry;
         std::string node_name; /* "" unless from a node's extras.lightmap_probes (then matrix places it) */
         double matrix[16];
+        std::vector<std::string> group_uris; /* light groups: each group's own volume, in probe_groups' order */
     };
     std::vector<volume> volumes;
     /* writer: materials.default.albedo for primitives with no material, if given */

@@ -502,7 +502,8 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         lmb_gltf_probes out_probes;
         st = lmb_probes_output(&probes, cfg, od.staging, od.stem, log, &out_probes, err);
         for (uint32_t g = 0; st == LMB_OK && !dark && group_light.sh && g < groups.count; g++) /* as its files */
-            st = lmb_probes_output_group(&out_probes, cfg, g, groups.name[g], groups.scale[g], groups.weight[g],
+            st = lmb_probes_output_group(&out_probes, &probes, cfg, od.staging, od.stem, g, groups.name[g],
+                                         groups.scale[g], groups.weight[g],
                                          group_light.sh[g], group_light.cube[g], err);
         if (st == LMB_OK)
             st = lmb_write_lightmapped_gltf(s, cfg, &l, od.staging, od.stem, outputs, &records, cache.direction != NULL,

@@ -5,13 +5,39 @@
 
 #include "util/lmb_math.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Each grid's volume file beside the glTF (STEM-irradiance-volume.ktx2 for the auto grid,
+/* Grid g's volume file's name (STEM-irradiance-volume.ktx2 for the auto grid,
  * STEM-irradiance-volume-K.ktx2 for probes.volumes entry K, STEM-irradiance-volume-node-N.ktx2
- * for node N's extras.lightmap_probes); out->volumes owned (node names borrowed from the scene). */
+ * for node N's extras.lightmap_probes; light group NAME's: ...-group-NAME.ktx2). */
+static void volume_name(const lmb_probe_set *set, uint32_t g, const char *stem, const char *group, char *name,
+                        size_t size)
+{
+    char tail[160] = "";
+    if (group)
+        snprintf(tail, sizeof tail, "-group-%s", group);
+    if (set->grids[g].from_node)
+        snprintf(name, size, "%s-irradiance-volume-node-%u%s.ktx2", stem, set->grids[g].node, tail);
+    else if (set->grids[g].volume)
+        snprintf(name, size, "%s-irradiance-volume-%u%s.ktx2", stem, set->grids[g].volume, tail);
+    else
+        snprintf(name, size, "%s-irradiance-volume%s.ktx2", stem, tail);
+}
+
+/* A copy of name (NULL: out of memory). */
+static char *copy_name(const char *name)
+{
+    char *c = malloc(strlen(name) + 1);
+    if (c)
+        memcpy(c, name, strlen(name) + 1);
+    return c;
+}
+
+/* Each grid's volume file beside the glTF (volume_name); out->volumes owned (node names borrowed
+ * from the scene). */
 static lmb_status write_volumes(const lmb_probe_set *set, double scale, const char *dir, const char *stem,
                                 lmb_gltf_probes *out, lmb_error *err)
 {
@@ -22,22 +48,16 @@ static lmb_status write_volumes(const lmb_probe_set *set, double scale, const ch
     lmb_status st = LMB_OK;
     for (uint32_t g = 0; st == LMB_OK && g < set->grid_count; g++) {
         lmb_probe_volume v;
-        st = lmb_probe_volume_make(set, g, &v, err);
+        st = lmb_probe_volume_make(set, g, NULL, &v, err);
         char name[512], path[4096 + 520];
-        if (set->grids[g].from_node)
-            snprintf(name, sizeof name, "%s-irradiance-volume-node-%u.ktx2", stem, set->grids[g].node);
-        else if (set->grids[g].volume)
-            snprintf(name, sizeof name, "%s-irradiance-volume-%u.ktx2", stem, set->grids[g].volume);
-        else
-            snprintf(name, sizeof name, "%s-irradiance-volume.ktx2", stem);
+        volume_name(set, g, stem, NULL, name, sizeof name);
         snprintf(path, sizeof path, "%s/%s", dir, name);
         if (st == LMB_OK)
             st = lmb_probe_volume_write_ktx2(&v, scale, path, err);
-        char *uri = st == LMB_OK ? malloc(strlen(name) + 1) : NULL;
+        char *uri = st == LMB_OK ? copy_name(name) : NULL;
         if (st == LMB_OK && !uri)
             st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
         if (st == LMB_OK) {
-            memcpy(uri, name, strlen(name) + 1);
             lmb_gltf_volume *o = &vols[out->volume_count++];
             o->uri = uri;
             memcpy(o->lo, v.lo, sizeof v.lo);
@@ -101,8 +121,9 @@ lmb_status lmb_probes_output(lmb_probe_set *set, const lmb_config *cfg, const ch
     return write_volumes(set, scale, dir, stem, out, err);
 }
 
-lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, uint32_t g, const char *name,
-                                   double scale, const double intensity[3], const float *sh_lux, const float *cube_lux,
+lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_probe_set *set, const lmb_config *cfg,
+                                   const char *dir, const char *stem, uint32_t g, const char *name, double scale,
+                                   const double intensity[3], const float *sh_lux, const float *cube_lux,
                                    lmb_error *err)
 {
     if (!out->count || g >= LMB_MAX_LIGHT_GROUPS)
@@ -126,7 +147,25 @@ lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, 
     out->group_sh[g] = sh;
     out->group_cube[g] = cube;
     out->groups = g + 1;
-    return LMB_OK;
+    /* its own bevy volumes: the group's light in each grid, as its files hold it (a game blends
+     * them with the lightmaps' weights) */
+    float *dark = cube_lux ? NULL : calloc(LMB_PROBE_CUBE * n + 1, sizeof *dark);
+    lmb_status st = cube_lux || dark ? LMB_OK : lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
+    lmb_gltf_volume *vols = (lmb_gltf_volume *)(uintptr_t)out->volumes; /* owned by out */
+    for (uint32_t v = 0; st == LMB_OK && v < out->volume_count; v++) {
+        lmb_probe_volume vol;
+        char file[512], path[4096 + 520];
+        volume_name(set, v, stem, name, file, sizeof file);
+        snprintf(path, sizeof path, "%s/%s", dir, file);
+        st = lmb_probe_volume_make(set, v, cube_lux ? cube_lux : dark, &vol, err);
+        if (st == LMB_OK)
+            st = lmb_probe_volume_write_ktx2(&vol, k, path, err);
+        lmb_probe_volume_free(&vol);
+        if (st == LMB_OK && !(vols[v].group_uri[g] = copy_name(file)))
+            st = lmb_error_set(err, LMB_ERR_INTERNAL, "probes: out of memory");
+    }
+    free(dark);
+    return st;
 }
 
 void lmb_probes_output_free(lmb_gltf_probes *out)
@@ -139,8 +178,11 @@ void lmb_probes_output_free(lmb_gltf_probes *out)
     free((void *)out->sh);
     free((void *)out->cube);
     free((void *)out->tetrahedra);
-    for (uint32_t i = 0; out->volumes && i < out->volume_count; i++)
+    for (uint32_t i = 0; out->volumes && i < out->volume_count; i++) {
         free((void *)out->volumes[i].uri);
+        for (uint32_t g = 0; g < LMB_MAX_LIGHT_GROUPS; g++)
+            free((void *)out->volumes[i].group_uri[g]);
+    }
     free((void *)out->volumes);
     memset(out, 0, sizeof *out);
 }

@@ -7,8 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, lmb_probe_volume *out, lmb_error *err)
+lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, const float *cube, lmb_probe_volume *out,
+                                 lmb_error *err)
 {
+    const float *cubes = cube ? cube : set->cube;
     memset(out, 0, sizeof *out);
     const lmb_probe_grid *grid = &set->grids[g];
     size_t n = (size_t)grid->res[0] * grid->res[1] * grid->res[2];
@@ -29,7 +31,7 @@ lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, lmb_probe
         size_t v = set->cell[i] - grid->first_voxel;
         count[v]++;
         for (int k = 0; k < LMB_PROBE_CUBE; k++)
-            sum[v * LMB_PROBE_CUBE + k] += set->cube[(size_t)i * LMB_PROBE_CUBE + k];
+            sum[v * LMB_PROBE_CUBE + k] += cubes[(size_t)i * LMB_PROBE_CUBE + k];
     }
     for (size_t v = 0; v < n; v++) {
         has[v] = count[v] > 0;

@@ -87,9 +87,11 @@ typedef struct lmb_probe_volume {
 } lmb_probe_volume;
 
 /* Grid g of the set as a volume (probe_volume.c): a voxel per cell, the mean of its probes'
- * cubes; a cell with none (inside geometry) takes the mean of its neighbours', pass by pass, so
- * that trilinear filtering next to walls does not read black. */
-lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, lmb_probe_volume *out, lmb_error *err);
+ * cubes (the set's, or `cube`'s when not NULL: LMB_PROBE_CUBE per probe, a light group's); a cell
+ * with none (inside geometry) takes the mean of its neighbours', pass by pass, so that trilinear
+ * filtering next to walls does not read black. */
+lmb_status lmb_probe_volume_make(const lmb_probe_set *set, uint32_t g, const float *cube, lmb_probe_volume *out,
+                                 lmb_error *err);
 void lmb_probe_volume_free(lmb_probe_volume *v);
 
 /* The volume in bevy's layout as KTX2 (E5B9G9R9, vkFormat 123, no supercompression): a texture
@@ -138,11 +140,13 @@ lmb_status lmb_probe_set_tetrahedra(lmb_probe_set *set, lmb_error *err);
 lmb_status lmb_probes_output(lmb_probe_set *set, const lmb_config *cfg, const char *dir, const char *stem,
                              const lmb_log *log, lmb_gltf_probes *out, lmb_error *err);
 /* Light groups: group g's own probes' light (sh_lux, cube_lux: LMB_PROBE_SH and LMB_PROBE_CUBE per
- * probe, lux, as lmb_probe_set holds them; a group of one source at intensity 1) into out, in the
- * output's scale, with its scale and intensity (RGB, what the game multiplies it by); out->groups
- * = g + 1. */
-lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_config *cfg, uint32_t g, const char *name,
-                                   double scale, const double intensity[3], const float *sh_lux, const float *cube_lux,
+ * probe, lux, as lmb_probe_set holds them; a group of one source at intensity 1; NULL: dark) into
+ * out, in the output's scale, with its scale and intensity (RGB, what the game multiplies it by),
+ * and each of the set's grids as the group's own bevy volume, DIR/<the grid's volume
+ * name>-group-NAME.ktx2 (out->volumes[k].group_uri[g]); out->groups = g + 1. */
+lmb_status lmb_probes_output_group(lmb_gltf_probes *out, const lmb_probe_set *set, const lmb_config *cfg,
+                                   const char *dir, const char *stem, uint32_t g, const char *name, double scale,
+                                   const double intensity[3], const float *sh_lux, const float *cube_lux,
                                    lmb_error *err);
 void lmb_probes_output_free(lmb_gltf_probes *out);
 

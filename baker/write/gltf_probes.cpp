@@ -17,8 +17,9 @@ using namespace lmb_gltf_out;
 namespace {
 
 /* One irradiance volume as a node of the default scene (see lmb_gltf_set_probes). */
-void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, int radiance)
+void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, const lmb_gltf_doc &doc)
 {
+    int radiance = doc.probe_radiance;
     tinygltf::Node node;
     node.name = !v.node_name.empty() ? "lightmap irradiance volume of " + v.node_name
                 : v.config_entry      ? "lightmap irradiance volume " + std::to_string(v.config_entry)
@@ -39,6 +40,19 @@ void add_volume_node(tinygltf::Model &m, const lmb_gltf_doc::volume &v, int radi
     volume["scale"] = Value(std::string(radiance ? "radiance" : "irradiance"));
     volume["unit"] = Value(std::string(radiance ? "nits (E / pi)" : "lux (E)"));
     volume["configEntry"] = Value((int)v.config_entry);
+    if (!v.group_uris.empty()) { /* each light group's own volume: a game blends them as the lightmaps */
+        Value::Array groups;
+        for (size_t g = 0; g < v.group_uris.size() && g < doc.probe_groups.size(); g++) {
+            const auto &pg = doc.probe_groups[g];
+            Value::Object o;
+            o["name"] = Value(pg.name);
+            o["scale"] = Value(pg.scale);
+            o["intensity"] = Value(Value::Array{Value(pg.intensity[0]), Value(pg.intensity[1]), Value(pg.intensity[2])});
+            o["uri"] = Value(v.group_uris[g]);
+            groups.push_back(Value(o));
+        }
+        volume["groups"] = Value(groups);
+    }
     if (!v.node_name.empty())
         volume["node"] = Value(v.node_name);
     Value::Object node_lightmap;
@@ -128,7 +142,7 @@ void lmb_gltf_add_probes(lmb_gltf_doc *doc)
     extras["lightmap"] = Value(lightmap);
     asset.extras = Value(extras);
     for (const auto &v : doc->volumes)
-        add_volume_node(m, v, doc->probe_radiance);
+        add_volume_node(m, v, *doc);
 }
 
 
@@ -152,8 +166,10 @@ extern "C" lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_prob
         for (uint32_t i = 0; i < p->volume_count; i++) {
             const lmb_gltf_volume &v = p->volumes[i];
             lmb_gltf_doc::volume d{v.uri, {v.lo[0], v.lo[1], v.lo[2]}, {v.hi[0], v.hi[1], v.hi[2]},
-                                   {v.res[0], v.res[1], v.res[2]}, v.config_entry, v.node_name ? v.node_name : "", {0}};
+                                   {v.res[0], v.res[1], v.res[2]}, v.config_entry, v.node_name ? v.node_name : "", {0}, {}};
             std::copy(v.matrix, v.matrix + 16, d.matrix);
+            for (uint32_t g = 0; g < p->groups && v.group_uri[g]; g++)
+                d.group_uris.push_back(v.group_uri[g]);
             doc->volumes.push_back(d);
         }
         return LMB_OK;

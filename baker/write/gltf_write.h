@@ -129,6 +129,7 @@ typedef struct lmb_gltf_volume {
     const char *node_name; /* a node's extras.lightmap_probes: its name (NULL otherwise); matrix places
                               the unit cube (lo, hi unused) */
     double matrix[16];
+    const char *group_uri[LMB_MAX_LIGHT_GROUPS]; /* light groups: group g's own volume (lmb_gltf_probes.groups) */
 } lmb_gltf_volume;
 
 /* Adds the probes to the new buffer (positions as a VEC3 accessor, the SH and the ambient cubes
@@ -138,7 +139,8 @@ typedef struct lmb_gltf_volume {
  * are kept. Per volume a node "lightmap irradiance volume" (or "... K" for probes.volumes entry
  * K) in the default scene whose transform takes a unit cube centred on the origin to the
  * volume's box (bevy's IrradianceVolume), with extras.lightmap.irradianceVolume {uri,
- * resolution, layout, scale, unit, configEntry}. Nothing when count is 0. Added when the
+ * resolution, layout, scale, unit, configEntry, groups [{name, scale, intensity, uri}] (light
+ * groups: each group's own volume)}. Nothing when count is 0. Added when the
  * document is saved. */
 lmb_status lmb_gltf_set_probes(lmb_gltf_doc *doc, const lmb_gltf_probes *p, lmb_error *err);
 

@@ -15,7 +15,9 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
     1; the lamps' 1 1 1), equals the lightmap of a bake whose groups have those scales, within
     1e-6 relative at every texel above 1e-6 of the brightest;
   - the light probes likewise: their SH and ambient cubes = sum_g w_g x intensity_g x each group's
-    own (named in asset.extras.lightmap.probes.groups), within 1e-6 relative;
+    own (named in asset.extras.lightmap.probes.groups), within 1e-6 relative; and bevy's volume =
+    sum_g w_g x intensity_g x each group's own volume (extras.lightmap.irradianceVolume.groups),
+    read with tests/ktx2/read_ktx2.mjs, within E5B9G9R9's rounding;
   - the groups' files are the same bytes whatever the scales (no group reads a scale), and the
     same at 1 and 3 threads, from a farm of 2 shards, and with each group's light kept in memory
     (no TMPDIR folder: said once) instead of in its file (every output file byte for byte);
@@ -185,10 +187,48 @@ def engine(lmbake, work, level, short):
               "scales %s: the probes' SH and ambient cubes = sum_g w_g x the groups' (asset.extras.lightmap.probes."
               "groups), worst %.2e relative (bound 1e-6); the groups' probes the same at every scale: %s"
               % (ws, worst, same_groups))
+        volumes_sum(work, ref, out, ws)
     if not short:
         plain_against(lmbake, work, level, sun, lamps)
     gltf_names(ref, level)
     threads_and_farm(lmbake, work, level, ref, short)
+
+
+def read_volume(work, path):
+    """A bevy volume's texels (float32 RGB) through the independent reader (tests/ktx2/read_ktx2.mjs)."""
+    f32 = os.path.join(work, "volume.f32")
+    p = subprocess.run(["node", os.path.join(ROOT, "tests", "ktx2", "read_ktx2.mjs"), path, f32], capture_output=True,
+                       text=True, cwd=ROOT)
+    if p.returncode:
+        return None
+    return np.fromfile(f32, dtype="<f4").reshape(-1, 3).astype(np.float64)
+
+
+def volumes_sum(work, ref, out, ws):
+    """Each group's own bevy volume (named in the volume node's extras.lightmap.irradianceVolume.groups):
+    sum_g w_g x intensity_g x volume_g = the volume of the bake at scales ws, within E5B9G9R9's
+    rounding (2^-9 of each texel's largest channel, in every term)."""
+    def volume_of(folder):
+        with open(os.path.join(folder, "sun-lamps.gltf")) as f:
+            doc = json.load(f)
+        return next(n["extras"]["lightmap"]["irradianceVolume"] for n in doc["nodes"]
+                    if "irradianceVolume" in n.get("extras", {}).get("lightmap", {}))
+    v_ref, v_out = volume_of(ref), volume_of(out)
+    groups = {g["name"]: g for g in v_ref.get("groups", [])}
+    level = read_volume(work, os.path.join(out, v_out["uri"]))
+    parts = {n: read_volume(work, os.path.join(ref, g["uri"])) for n, g in groups.items()}
+    if sorted(groups) != ["lamps", "sun"] or level is None or any(v is None for v in parts.values()):
+        check(False, "scales %s: each group's bevy volume named and read (%s)" % (ws, sorted(groups)))
+        return
+    summed, tol = np.zeros_like(level), 2.0 ** -9 * level.max(axis=1, keepdims=True)
+    for w, n in zip(ws, ("sun", "lamps")):
+        term = w * np.array(groups[n]["intensity"]) * parts[n]
+        summed += term
+        tol += 2.0 ** -9 * term.max(axis=1, keepdims=True)
+    worst = float(np.max(np.abs(summed - level) / (tol + 1e-9)))
+    check(worst <= 1.0 and level.max() > 0,
+          "scales %s: the engine's sum of the groups' bevy volumes (%d texels) = the bake's volume, worst %.2f of "
+          "E5B9G9R9's rounding" % (ws, level.shape[0], worst))
 
 
 def plain_against(lmbake, work, level, sun, lamps):
