@@ -32,32 +32,33 @@ static int unnamed_file(char *dir_out, size_t size)
     return fd;
 }
 
-static int write_all(int fd, const void *p, size_t n, off_t at)
+/* All n bytes at offset `at`, written from p (writing) or read into p; 0, or -1 and errno. */
+static int whole(int fd, void *p, size_t n, off_t at, int writing)
 {
-    const char *b = p;
+    char *b = p;
     while (n) {
-        ssize_t w = pwrite(fd, b, n, at);
-        if (w <= 0)
-            return w < 0 ? -1 : (errno = ENOSPC, -1);
-        b += w;
-        n -= (size_t)w;
-        at += w;
+        ssize_t k = writing ? pwrite(fd, b, n, at) : pread(fd, b, n, at);
+        if (k <= 0)
+            return k < 0 ? -1 : (errno = writing ? ENOSPC : EIO, -1);
+        b += k;
+        n -= (size_t)k;
+        at += k;
     }
     return 0;
 }
 
-static int read_all(int fd, void *p, size_t n, off_t at)
+/* Group g's images freed (their pointers NULL). */
+static void free_images(lmb_group_light *gl, uint32_t g)
 {
-    char *b = p;
-    while (n) {
-        ssize_t r = pread(fd, b, n, at);
-        if (r <= 0)
-            return r < 0 ? -1 : (errno = EIO, -1);
-        b += r;
-        n -= (size_t)r;
-        at += r;
+    for (uint32_t a = 0; a < gl->atlases; a++) {
+        size_t k = (size_t)g * gl->atlases + a;
+        free(gl->irradiance[k]);
+        gl->irradiance[k] = NULL;
+        if (gl->direction) {
+            free(gl->direction[k]);
+            gl->direction[k] = NULL;
+        }
     }
-    return 0;
 }
 
 void lmb_group_light_put_away(lmb_group_light *gl, uint32_t g, const lmb_log *log)
@@ -71,8 +72,8 @@ void lmb_group_light_put_away(lmb_group_light *gl, uint32_t g, const lmb_log *lo
     for (uint32_t a = 0; ok && a < gl->atlases; a++) {
         size_t k = (size_t)g * gl->atlases + a, bytes = 3 * (size_t)gl->texels[a] * sizeof(float);
         off_t at = atlas_offset(gl, a);
-        ok = write_all(gl->file[g], gl->irradiance[k], bytes, at) == 0 &&
-             (!gl->direction || write_all(gl->file[g], gl->direction[k], bytes, at + (off_t)bytes) == 0);
+        ok = whole(gl->file[g], gl->irradiance[k], bytes, at, 1) == 0 &&
+             (!gl->direction || whole(gl->file[g], gl->direction[k], bytes, at + (off_t)bytes, 1) == 0);
     }
     if (!ok) { /* the images stay where they are, and so do every later group's */
         lmb_warn(log, "light groups: each group's light stays in memory until the files are written (a file in %s for "
@@ -80,15 +81,7 @@ void lmb_group_light_put_away(lmb_group_light *gl, uint32_t g, const lmb_log *lo
         gl->in_memory = 1;
         return;
     }
-    for (uint32_t a = 0; a < gl->atlases; a++) {
-        size_t k = (size_t)g * gl->atlases + a;
-        free(gl->irradiance[k]);
-        gl->irradiance[k] = NULL;
-        if (gl->direction) {
-            free(gl->direction[k]);
-            gl->direction[k] = NULL;
-        }
-    }
+    free_images(gl, g);
     gl->away[g] = 1;
 }
 
@@ -128,7 +121,7 @@ lmb_status lmb_group_light_read_span(const lmb_group_light *gl, uint32_t g, uint
     }
     off_t at = atlas_offset(gl, a), skip = (off_t)(3 * i0 * sizeof(float));
     off_t dirs = (off_t)(3 * (size_t)gl->texels[a] * sizeof(float));
-    if (read_all(gl->file[g], e, bytes, at + skip) != 0 || (d && read_all(gl->file[g], d, bytes, at + dirs + skip) != 0))
+    if (whole(gl->file[g], e, bytes, at + skip, 0) != 0 || (d && whole(gl->file[g], d, bytes, at + dirs + skip, 0) != 0))
         return lmb_error_set(err, LMB_ERR_INTERNAL, "light groups: reading group %u's light back from its file in TMPDIR: %s",
                              g + 1, strerror(errno));
     return LMB_OK;
@@ -136,15 +129,7 @@ lmb_status lmb_group_light_read_span(const lmb_group_light *gl, uint32_t g, uint
 
 void lmb_group_light_drop(lmb_group_light *gl, uint32_t g)
 {
-    for (uint32_t a = 0; a < gl->atlases; a++) {
-        size_t k = (size_t)g * gl->atlases + a;
-        free(gl->irradiance[k]);
-        gl->irradiance[k] = NULL;
-        if (gl->direction) {
-            free(gl->direction[k]);
-            gl->direction[k] = NULL;
-        }
-    }
+    free_images(gl, g);
     if (gl->file[g] >= 0)
         close(gl->file[g]);
     gl->file[g] = -1;
