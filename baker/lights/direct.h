@@ -34,6 +34,9 @@ lmb_status lmb_emitters_build(const lmb_scene *scene, const lmb_emitter_options 
                               lmb_emitters **out, lmb_error *err);
 void lmb_emitters_free(lmb_emitters *e);
 uint32_t lmb_emitters_count(const lmb_emitters *e);
+/* Their power, pi x sum of area x luminance of the emission (x 2 for a surface emitting from
+ * both sides; a texture's mean): what the light groups rank them by; 0 without emitters. */
+double lmb_emitters_power(const lmb_emitters *e);
 
 typedef struct lmb_direct lmb_direct; /* opaque: a scene's lights ready to evaluate at any point */
 

@@ -12,6 +12,13 @@ uint32_t lmb_emitters_count(const lmb_emitters *e)
     return e ? e->count : 0;
 }
 
+/* The power CDF's total is sum of area x luminance x sides: times pi, the flux a Lambertian
+ * emitter of that radiance sends out (pbrt-v4's DiffuseAreaLight::Phi). */
+double lmb_emitters_power(const lmb_emitters *e)
+{
+    return e && e->count ? LMB_PI * e->cdf[e->count] : 0.0;
+}
+
 void lmb_emitters_free(lmb_emitters *e)
 {
     if (!e)

@@ -64,23 +64,27 @@ static int shared_emission(const lmb_scene *s, double scale, float le[3])
     return first >= 0 && same;
 }
 
-/* The order in which one_per_light's lights get a group of their own when not all can: a
+/* The order in which one_per_light's sources get a group of their own when not all can: a
  * directional light first (it lights the whole level), brighter before dimmer by the luminance of
- * its intensity x colour; then the local lights by their power, luminance x intensity x the solid
- * angle they shine into (4 pi; a spot 2 pi (1 - cos of its cone's middle angle), as pbrt-v4's
- * SpotLight::Phi); equal ones in the file's order. A share of the level's light without a bake:
- * a local light's power all lands on the level, a directional light's on all of it. */
+ * its intensity x colour; then the sky (it too lights the whole level; its power is not known
+ * before a bake); then the local lights and the emissive surfaces by their power: a light's
+ * luminance x intensity x the solid angle it shines into (4 pi; a spot 2 pi (1 - cos of its
+ * cone's middle angle), as pbrt-v4's SpotLight::Phi), the surfaces' pi x sum of area x luminance
+ * of their emission (lmb_emitters_power); equal ones in the file's order, the sky and the
+ * surfaces after the lights. A share of the level's light without a bake: a local light's power
+ * all lands on the level, a directional light's on all of it. */
+enum { RANK_DIRECTIONAL, RANK_SKY, RANK_LOCAL };
 typedef struct ranked_light {
-    uint32_t light;
-    int directional;
+    uint32_t light; /* the scene light, or light_count: the sky, light_count + 1: the emissive surfaces */
+    int rank;
     double power;
 } ranked_light;
 
 static int rank_order(const void *pa, const void *pb)
 {
     const ranked_light *a = pa, *b = pb;
-    if (a->directional != b->directional)
-        return a->directional ? -1 : 1;
+    if (a->rank != b->rank)
+        return a->rank < b->rank ? -1 : 1;
     if (a->power != b->power)
         return a->power > b->power ? -1 : 1;
     return a->light < b->light ? -1 : a->light > b->light;
@@ -93,15 +97,15 @@ static ranked_light rank_of(const lmb_light *l, uint32_t i)
     if (l->type == LMB_LIGHT_SPOT)
         solid = 2 * LMB_PI * (1 - cos(0.5 * ((double)l->inner_cone + (double)l->outer_cone)));
     int directional = l->type == LMB_LIGHT_DIRECTIONAL;
-    return (ranked_light){i, directional, lum * (double)l->intensity * (directional ? 1.0 : solid)};
+    return (ranked_light){i, directional ? RANK_DIRECTIONAL : RANK_LOCAL,
+                          lum * (double)l->intensity * (directional ? 1.0 : solid)};
 }
 
-/* A group for light i alone, named after it (its name, else its node's, each character that a
- * group's name cannot hold as '_'; "-2", "-3", ... when taken). */
-static int32_t group_of_light(lmb_light_groups *g, const lmb_light *l, uint32_t i, double scale)
+/* A group named base (each character a group's name cannot hold as '_'; `fallback` when nothing
+ * is left; "-2", "-3", ... when taken, and never "rest"), at the given scale. */
+static int32_t group_of_own(lmb_light_groups *g, const char *from, const char *fallback, double scale)
 {
     char base[LMB_PATTERN_LEN - 8], name[LMB_PATTERN_LEN];
-    const char *from = l->name && l->name[0] ? l->name : l->node_name && l->node_name[0] ? l->node_name : "";
     size_t n = 0;
     for (; from[n] && n + 1 < sizeof base; n++) {
         char ch = from[n];
@@ -110,7 +114,7 @@ static int32_t group_of_light(lmb_light_groups *g, const lmb_light *l, uint32_t 
     }
     base[n] = 0;
     if (!n)
-        snprintf(base, sizeof base, "light-%u", i);
+        snprintf(base, sizeof base, "%s", fallback);
     snprintf(name, sizeof name, "%s", base);
     for (uint32_t k = 2; find_group(g, name) >= 0 || !strcmp(name, "rest"); k++)
         snprintf(name, sizeof name, "%s-%u", base, k);
@@ -120,9 +124,19 @@ static int32_t group_of_light(lmb_light_groups *g, const lmb_light *l, uint32_t 
     return k;
 }
 
-lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
+/* A group for light i alone, named after it (its name, else its node's). */
+static int32_t group_of_light(lmb_light_groups *g, const lmb_light *l, uint32_t i, double scale)
+{
+    char fallback[32];
+    snprintf(fallback, sizeof fallback, "light-%u", i);
+    const char *from = l->name && l->name[0] ? l->name : l->node_name && l->node_name[0] ? l->node_name : "";
+    return group_of_own(g, from, fallback, scale);
+}
+
+lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, double emissive_power,
                                     lmb_light_groups *out, lmb_error *err)
 {
+    int has_emissive = emissive_power > 0;
     memset(out, 0, sizeof *out);
     out->sky = out->emissive = -1;
     int any_extra = 0;
@@ -137,7 +151,7 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
     out->of_light = malloc(((size_t)s->light_count + 1) * sizeof *out->of_light);
     out->merged = calloc((size_t)s->light_count + 1, 1);
     int32_t *entry_of = malloc(((size_t)s->light_count + 1) * sizeof *entry_of); /* one_per_light's entry, or -1 */
-    ranked_light *ranked = malloc(((size_t)s->light_count + 1) * sizeof *ranked);
+    ranked_light *ranked = malloc(((size_t)s->light_count + 2) * sizeof *ranked);
     if (!out->of_light || !out->merged || !entry_of || !ranked) {
         free(entry_of);
         free(ranked);
@@ -192,20 +206,41 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
         if (has_emissive && out->emissive < 0 && cfg->light_groups[j].emissive)
             out->emissive = of_entry[j];
     }
-    /* one_per_light: a group per light while the groups last; when they do not all fit with
-     * the rest's, the last group is `rest` and the lights that rank lowest share it */
-    int others = (has_sky && out->sky < 0) || (has_emissive && out->emissive < 0);
+    /* one_per_light for every light (no match) gives the sky and the emissive surfaces their own
+     * groups too, when no entry claims them */
+    int32_t every = -1; /* that entry */
+    for (uint32_t j = 0; j < cfg->light_group_count && every < 0; j++)
+        if (cfg->light_groups[j].one_per_light && !cfg->light_groups[j].pattern[0])
+            every = (int32_t)j;
+    int sky_own = every >= 0 && has_sky && out->sky < 0, emissive_own = every >= 0 && has_emissive && out->emissive < 0;
+    if (sky_own)
+        ranked[pending++] = (ranked_light){s->light_count, RANK_SKY, 0};
+    if (emissive_own)
+        ranked[pending++] = (ranked_light){s->light_count + 1, RANK_LOCAL, emissive_power};
+    /* a group per source while the groups last; when they do not all fit with the rest's, the
+     * last group is `rest` and the sources that rank lowest share it */
+    int others = (has_sky && out->sky < 0 && !sky_own) || (has_emissive && out->emissive < 0 && !emissive_own);
     for (uint32_t i = 0; i < s->light_count; i++)
         others |= s->lights[i].mode != LMB_LIGHT_REALTIME && out->of_light[i] < 0 && entry_of[i] < 0;
     uint32_t room = LMB_MAX_LIGHT_GROUPS - out->count, own = pending;
     if (pending + (uint32_t)others > room)
         own = room > 0 ? room - 1 : 0;
     qsort(ranked, pending, sizeof *ranked, rank_order);
-    for (uint32_t r = own; r < pending; r++)
-        out->merged[ranked[r].light] = 1;
-    for (uint32_t i = 0; i < s->light_count; i++) /* their groups in the file's order */
+    for (uint32_t r = own; r < pending; r++) {
+        if (ranked[r].light < s->light_count)
+            out->merged[ranked[r].light] = 1;
+        else if (ranked[r].light == s->light_count)
+            sky_own = 0, out->sky_merged = 1;
+        else
+            emissive_own = 0, out->emissive_merged = 1;
+    }
+    for (uint32_t i = 0; i < s->light_count; i++) /* their groups in the file's order, then the sky's, the surfaces' */
         if (entry_of[i] >= 0 && !out->merged[i])
             out->of_light[i] = group_of_light(out, &s->lights[i], i, cfg->light_groups[entry_of[i]].scale);
+    if (sky_own)
+        out->sky = group_of_own(out, "sky", "sky", cfg->light_groups[every].scale);
+    if (emissive_own)
+        out->emissive = group_of_own(out, "emissive", "emissive", cfg->light_groups[every].scale);
     free(ranked);
     /* what no group claims: the group "rest" */
     int unclaimed = (has_sky && out->sky < 0) || (has_emissive && out->emissive < 0);
@@ -235,6 +270,7 @@ lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, i
         int matched = 0;
         for (uint32_t i = 0; k < 0 && i < s->light_count; i++)
             matched |= entry_of[i] == (int32_t)j;
+        matched |= (int32_t)j == every && (sky_own || emissive_own || out->sky_merged || out->emissive_merged);
         if (k < 0 && !matched) {
             const lmb_light_group_spec *g = &cfg->light_groups[j];
             lmb_error_set(err, LMB_ERR_INPUT, "%s:%u: output.light_groups (one_per_light) holds no light: no light's "
@@ -309,14 +345,17 @@ void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, cons
                  g->scale[k], weight);
     }
     uint32_t merged = 0;
-    char names[400] = "";
+    char names[400] = "", also[80] = "";
     for (uint32_t i = 0; g->merged && i < s->light_count; i++)
         if (g->merged[i] && merged++ < 6) {
             size_t n = strlen(names);
             snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", s->lights[i].name);
         }
-    if (merged)
-        lmb_info(log, "light groups: one_per_light: %u light(s) share 'rest' (%s%s): at most %d groups, and they rank "
-                 "lowest (a directional light first, then by power: docs/light-groups.md)", merged, names,
-                 merged > 6 ? ", ..." : "", LMB_MAX_LIGHT_GROUPS);
+    if (g->sky_merged || g->emissive_merged)
+        snprintf(also, sizeof also, "%s%s%s", merged ? " and " : "", g->sky_merged ? "the sky" : "",
+                 g->emissive_merged ? (g->sky_merged ? ", the emissive surfaces" : "the emissive surfaces") : "");
+    if (merged || also[0])
+        lmb_info(log, "light groups: one_per_light: %u light(s)%s share 'rest' (%s%s): at most %d groups, and they rank "
+                 "lowest (a directional light first, then the sky, then by power: docs/light-groups.md)", merged, also,
+                 names, merged > 6 ? ", ..." : "", LMB_MAX_LIGHT_GROUPS);
 }

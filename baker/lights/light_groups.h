@@ -20,9 +20,10 @@
  * surfaces: the first group with sky: true / emissive: true. What no group claims goes to a
  * group named "rest" (made when needed). Realtime lights are in no group (they are not baked).
  * A config entry with one_per_light gives each light it matches a group of its own, named after
- * the light, after the named groups; when they do not all fit in LMB_MAX_LIGHT_GROUPS with the
- * rest's, the lights that rank lowest (rank_order: a directional light first, then by power)
- * share "rest" and the log names them.
+ * the light, after the named groups; one with no match (every light) gives the sky and the
+ * emissive surfaces theirs too ("sky", "emissive") unless an entry claims them. When they do not
+ * all fit in LMB_MAX_LIGHT_GROUPS with the rest's, the sources that rank lowest (rank_order: a
+ * directional light first, then the sky, then by power) share "rest" and the log names them.
  */
 #ifndef LMBAKE_LIGHT_GROUPS_H
 #define LMBAKE_LIGHT_GROUPS_H
@@ -38,6 +39,8 @@ typedef struct lmb_light_groups {
     uint8_t *merged;                       /* per scene light: 1 when one_per_light gave it no group of its
                                               own (more lights than groups; it ranks lowest) but `rest` */
     int32_t sky, emissive;                 /* the group holding the sky / the emissive surfaces, -1 none */
+    int sky_merged, emissive_merged;       /* one_per_light gave the sky / the emissive surfaces no group of
+                                              their own (more sources than groups; they rank lowest) but `rest` */
     /* A group of one light (neither the sky nor the emissive surfaces) is lit with that light at
      * intensity 1 and white (unit), and weighed by its intensity x colour (weight, per channel);
      * a group of the config's sky alone is lit at sky.intensity 1 and weighed by it (and at
@@ -50,12 +53,12 @@ typedef struct lmb_light_groups {
     double weight[LMB_MAX_LIGHT_GROUPS][3];
 } lmb_light_groups;
 
-/* The groups of scene s under cfg (after lmb_scene_set_light_modes). has_sky, has_emissive:
- * whether the level has a sky and emissive surfaces. Errors (LMB_ERR_INPUT, nothing baked): a
+/* The groups of scene s under cfg (after lmb_scene_set_light_modes). has_sky: whether the level
+ * has a sky; emissive_power: its emissive surfaces' power (lmb_emitters_power; 0: none). Errors (LMB_ERR_INPUT, nothing baked): a
  * config group that ends up holding no light source (named with its line), a light's group
  * that would make more than LMB_MAX_LIGHT_GROUPS (the file, light and node named), groups with
  * output.shadowmask. Free with lmb_light_groups_free. */
-lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, int has_emissive,
+lmb_status lmb_light_groups_resolve(const lmb_scene *s, const lmb_config *cfg, int has_sky, double emissive_power,
                                     lmb_light_groups *out, lmb_error *err);
 void lmb_light_groups_free(lmb_light_groups *g);
 

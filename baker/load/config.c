@@ -345,7 +345,8 @@ static lmb_status set_light_modes(parse_ctx *c, const key_spec *k, const yaml_no
 
 /* {name: NAME, match: GLOB, sky: BOOL, emissive: BOOL, scale: S}: name required (letters, digits,
  * '_', '-'; the group's files carry it), unique; scale 1 unless given. Or {match: GLOB,
- * one_per_light: true, scale: S}: a group per light it matches (lights/light_groups.h names them). */
+ * one_per_light: true, scale: S}: a group per light it matches, and without match the sky's and
+ * the emissive surfaces' (lights/light_groups.h names them). */
 static lmb_status light_group_item(parse_ctx *c, const key_spec *k, const yaml_node_t *item, char *base, uint32_t index)
 {
     lmb_light_group_spec *all = (lmb_light_group_spec *)(void *)(base + k->offset), *o = all + index;
@@ -356,8 +357,9 @@ static lmb_status light_group_item(parse_ctx *c, const key_spec *k, const yaml_n
         return lmb_cfg_bad_value(c, k, item, "a mapping {name: NAME, match: GLOB, sky: BOOL, emissive: BOOL, scale: S}");
     lmb_status st = walk_mapping(c, &light_group_schema, item, k->path, (char *)o);
     if (st == LMB_OK && o->one_per_light && (o->name[0] || o->sky || o->emissive))
-        return lmb_cfg_key_error(c, item, k->path, "one_per_light: true names its groups after its lights and holds "
-                                 "lights only: no name, sky or emissive with it");
+        return lmb_cfg_key_error(c, item, k->path, "one_per_light: true names its groups after its lights: no name, sky "
+                                 "or emissive with it (without match it gives the sky and the emissive "
+                                 "surfaces groups of their own too)");
     if (st == LMB_OK && !o->name[0] && !o->one_per_light)
         return lmb_cfg_key_error(c, item, k->path, "each entry needs a name (or one_per_light: true)");
     for (const char *p = o->name; st == LMB_OK && *p; p++)

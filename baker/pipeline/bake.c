@@ -294,7 +294,7 @@ lmb_status lmb_bake_farm(lmb_scene *s, const lmb_config *cfg, const char *plan_p
         st = lmb_direct_create(s, &direct_opt, &rt, em, sky, &direct, err);
     /* light groups (not for bake --direct-of: the watch's look at some lights' direct light) */
     if (st == LMB_OK && !cfg->direct_of_count)
-        st = lmb_light_groups_resolve(s, cfg, sky != NULL, lmb_emitters_count(em) > 0, &groups, err);
+        st = lmb_light_groups_resolve(s, cfg, sky != NULL, lmb_emitters_power(em), &groups, err);
     if (st == LMB_OK && groups.count && !shard)
         lmb_light_groups_report(&groups, s, log);
     if (st == LMB_OK && run->relight_only)

@@ -322,7 +322,8 @@ typedef struct lmb_light_group_spec {
     char pattern[LMB_PATTERN_LEN]; /* match: the lights whose name or node name matches ("" none) */
     int sky, emissive;             /* the sky's light, every emissive surface's light */
     int one_per_light;             /* every light it matches in a group of its own, named after the light (no
-                                      name, sky or emissive then); beyond the limit the dimmest share `rest` */
+                                      name, sky or emissive then; without match the sky and the emissive
+                                      surfaces too); beyond the limit the dimmest share `rest` */
     double scale;                  /* its weight in the lightmap the bake writes (1) */
     uint32_t line;                 /* the config's line that starts it (for messages; not part of its text) */
 } lmb_light_group_spec;

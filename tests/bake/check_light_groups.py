@@ -33,7 +33,11 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - a light's extras.lightmap_group makes a group of its own, the rest go to 'rest';
   - one_per_light: a group per light named after it, the bytes of the same groups named in the
     config; with 11 lights (8 torches of 5-40 cd added) the sun, the lamps and the 4 brightest
-    torches get their own, the 4 dimmest share 'rest' and the log names them;
+    torches get their own, the 4 dimmest share 'rest' and the log names them; with a sky and
+    the level's material glowing too, groups sun, lamps, 3 torches, sky and rest (5 torches and
+    the emissive surfaces, which rank lowest); on the 3-light level with both, groups sun,
+    lamp_a, lamp_b, sky, emissive (their weights the sky's intensity and the emission), every file
+    the bytes of those five groups named in the config;
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
     a name that cannot name a file, 9 groups, an extras.lightmap_group that is not a string,
     one_per_light with a name, one_per_light matching no light.
@@ -593,13 +597,47 @@ def one_per_light(lmbake, work, level, doc, short):
     path = os.path.join(os.path.dirname(level), "torches.gltf")
     with open(path, "w") as f:
         json.dump(d, f)
-    out, p = bake(lmbake, work, path, "one-per-light-11", each.replace(BASE, BASE + "bounces: 0\nprobes:\n  auto: false\n"), "--log")
+    quick = BASE + "bounces: 0\nprobes:\n  auto: false\n"
+    out, p = bake(lmbake, work, path, "one-per-light-11", each.replace(BASE, quick), "--log")
     names = [g["name"] for g in group_intensities_list(os.path.join(out, "torches.gltf"))] if p.returncode == 0 else []
     want = ["sun", "lamp_a", "lamp_b", "torch_4", "torch_5", "torch_6", "torch_7", "rest"]
     said = [l for l in (p.stdout + p.stderr).splitlines() if "share 'rest'" in l]
     check(p.returncode == 0 and names == want and len(said) == 1 and
           "4 light(s) share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3')" in said[0],
           "one_per_light, 11 lights: groups %s (want %s); %s" % (names, want, said or (p.stdout + p.stderr)[-300:]))
+    # the sky and the emissive surfaces: groups of their own when the entry takes every light; the
+    # sky ranks after the sun, the surfaces (the grey material at 0.01: pi x 112 m^2 x 0.01 = 3.5)
+    # below the dimmest torch (5 cd x 4 pi = 63)
+    sky = "sky:\n  intensity: 500\n"
+    for level_doc, lit_path in ((doc, level), (d, path)):
+        level_doc["materials"][0]["emissiveFactor"] = [0.01, 0.01, 0.01]
+        with open(lit_path.replace(".gltf", "-glowing.gltf"), "w") as f:
+            json.dump(level_doc, f)
+        level_doc["materials"][0].pop("emissiveFactor")
+    glowing, torches_glowing = level.replace(".gltf", "-glowing.gltf"), path.replace(".gltf", "-glowing.gltf")
+    out, p = bake(lmbake, work, torches_glowing, "one-per-light-13", each.replace(BASE, quick + sky), "--log")
+    names = [g["name"] for g in group_intensities_list(os.path.join(out, "torches-glowing.gltf"))] if not p.returncode else []
+    want = ["sun", "lamp_a", "lamp_b", "torch_5", "torch_6", "torch_7", "sky", "rest"]
+    said = [l for l in (p.stdout + p.stderr).splitlines() if "share 'rest'" in l]
+    check(p.returncode == 0 and names == want and len(said) == 1 and
+          "5 light(s) and the emissive surfaces share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3', 'torch_4')"
+          in said[0],
+          "one_per_light, 11 lights, a sky, emissive surfaces: groups %s (want %s); %s" %
+          (names, want, said or (p.stdout + p.stderr)[-300:]))
+    out_each, p = bake(lmbake, work, glowing, "one-per-light-sky", each.replace(BASE, quick + sky))
+    named_too = named.replace(BASE, quick + sky) + "    - {name: sky, sky: true}\n    - {name: emissive, emissive: true}\n"
+    out_named, pn = bake(lmbake, work, glowing, "one-per-light-sky-named", named_too)
+    listed = sorted(os.listdir(out_named)) if pn.returncode == 0 else []
+    differ = [f for f in listed if p.returncode or not filecmp.cmp(os.path.join(out_named, f),
+                                                                  os.path.join(out_each, f), shallow=False)]
+    groups = group_intensities_list(os.path.join(out_each, "sun-lamps-glowing.gltf")) if not p.returncode else []
+    check(p.returncode == 0 and listed and not differ and [g["name"] for g in groups] ==
+          ["sun", "lamp_a", "lamp_b", "sky", "emissive"] and groups[3]["intensity"] == [500, 500, 500] and
+          np.allclose(groups[4]["intensity"], [0.01] * 3, rtol=1e-6, atol=0),
+          "one_per_light with a sky and emissive surfaces: groups %s, the sky's and the surfaces' weights %s, every "
+          "one of %d files the bytes of the same groups named in the config%s" %
+          ([g["name"] for g in groups], [g["intensity"] for g in groups[3:]], len(listed),
+           " (differ: %s)" % differ if differ else ""))
     cases = [("one-per-light-named-too", BASE + "output:\n  light_groups:\n    - {name: x, one_per_light: true}\n",
               "one-per-light-named-too.yaml:4: key 'output.light_groups': one_per_light: true names its groups after "
               "its lights"),
