@@ -18,7 +18,7 @@
 
 #include "util/sampling.h"
 #include "load/gltf_adapter.h"
-#include "load/uri.h"
+#include "load/config_file.h"
 #include "util/frame.h"
 #include "util/lmb_math.h"
 #include "util/sh.h"
@@ -144,29 +144,12 @@ static lmb_status build_tables(lmb_sky *s, lmb_error *err)
     return LMB_OK;
 }
 
-lmb_status lmb_sky_image_path(const char *config_path, const char *image, char *real, size_t size, lmb_error *err)
-{
-    char dir[4096], rel[4096], path[8300];
-    const char *cfg_name = config_path[0] ? config_path : "config";
-    const char *slash = strrchr(config_path, '/');
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - config_path) : 1, slash ? config_path : ".");
-    lmb_uri_kind kind = lmb_uri_check(image, rel, sizeof rel);
-    if (kind != LMB_URI_INSIDE)
-        return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' %s; the map must be a file in the "
-                             "config's folder or below", cfg_name, image, lmb_uri_refusal(kind));
-    snprintf(path, sizeof path, "%s/%s", dir, rel);
-    if (!lmb_path_inside(dir, path, real, size))
-        return lmb_error_set(err, LMB_ERR_INPUT, "%s: key 'sky.image': '%s' is not a file inside the config's folder "
-                             "'%s'", cfg_name, image, dir);
-    return LMB_OK;
-}
-
 /* The image at opt->image, inside the config's folder, as radiance times colour x intensity. */
 static lmb_status read_image(const lmb_sky_options *opt, const lmb_log *log, lmb_sky *s, lmb_error *err)
 {
     char real[4096];
     const char *cfg_name = opt->config_path[0] ? opt->config_path : "config";
-    lmb_status st = lmb_sky_image_path(opt->config_path, opt->image, real, sizeof real, err);
+    lmb_status st = lmb_config_file(opt->config_path, "sky.image", opt->image, real, sizeof real, err);
     if (st != LMB_OK)
         return st;
     float *rgb = NULL;

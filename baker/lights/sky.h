@@ -39,10 +39,6 @@ typedef struct lmb_sky_options {
  * warning naming how many. */
 lmb_status lmb_sky_create(const lmb_sky_options *opt, const lmb_scene *scene, const lmb_log *log, lmb_sky **out,
                           lmb_error *err);
-/* Where sky.image `image` lies: a file in the folder of config_path (the config file; "" for
- * none) or below, resolved into real; else LMB_ERR_INPUT naming the config and the key (read or
- * not: lmb_config_lint checks it too). */
-lmb_status lmb_sky_image_path(const char *config_path, const char *image, char *real, size_t size, lmb_error *err);
 void lmb_sky_free(lmb_sky *s);
 
 /* Radiance (nits, RGB) of the sky seen looking along world direction w (unit). */

@@ -6,8 +6,7 @@
  * from the default: a key at its default loses nothing when it is switched off.
  * Paths are checked whether or not they are used.
  */
-#include "load/uri.h"
-#include "lights/sky.h"
+#include "load/config_file.h"
 
 #include <lmbake/lmbake.h>
 
@@ -32,7 +31,7 @@ lmb_status lmb_config_lint(const lmb_config *c, const lmb_log *log, lmb_error *e
     int sky = c->sky_intensity > 0;
     if (c->sky_image[0]) {
         char real[4096];
-        lmb_status st = lmb_sky_image_path(c->config_path, c->sky_image, real, sizeof real, err);
+        lmb_status st = lmb_config_file(c->config_path, "sky.image", c->sky_image, real, sizeof real, err);
         if (st != LMB_OK)
             return st;
         if (!sky)
