@@ -34,8 +34,9 @@ of 1000 lux, two coloured point lamps: lamp_a 200 cd, lamp_b 100 cd), baked at 6
   - one_per_light: a group per light named after it, the bytes of the same groups named in the
     config; with 11 lights (8 torches of 5-40 cd added) the sun, the lamps and the 4 brightest
     torches get their own, the 4 dimmest share 'rest' and the log names them; with a sky and
-    the level's material glowing too, groups sun, lamps, 3 torches, sky and rest (5 torches and
-    the emissive surfaces, which rank lowest); on the 3-light level with both, groups sun,
+    the level's material glowing too (106 pi S of power at emissive strength S), the surfaces
+    take torch_5's group at S = 1.16 and share 'rest' at 1.10 (torch_5's power 120 pi: S = 1.132);
+    on the 3-light level with both, groups sun,
     lamp_a, lamp_b, sky, emissive (their weights the sky's intensity and the emission), every file
     the bytes of those five groups named in the config;
   - bad input exits 2 with nothing written: a group that holds no light (its config line named),
@@ -606,24 +607,37 @@ def one_per_light(lmbake, work, level, doc, short):
           "4 light(s) share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3')" in said[0],
           "one_per_light, 11 lights: groups %s (want %s); %s" % (names, want, said or (p.stdout + p.stderr)[-300:]))
     # the sky and the emissive surfaces: groups of their own when the entry takes every light; the
-    # sky ranks after the sun, the surfaces (the grey material at 0.01: pi x 112 m^2 x 0.01 = 3.5)
-    # below the dimmest torch (5 cd x 4 pi = 63)
+    # sky ranks after the sun, the surfaces by their power pi x area x luminance: the grey
+    # material (106 m^2: the ground's 100, the cube's 6) at emissive strength S has 106 pi S,
+    # which passes torch_5's 6 x 5 cd x 4 pi = 120 pi at S = 1.132: at 1.16 (2.5% above) the
+    # surfaces take torch_5's group, at 1.10 (2.8% below) they share 'rest' with torch_0..4
     sky = "sky:\n  intensity: 500\n"
-    for level_doc, lit_path in ((doc, level), (d, path)):
-        level_doc["materials"][0]["emissiveFactor"] = [0.01, 0.01, 0.01]
-        with open(lit_path.replace(".gltf", "-glowing.gltf"), "w") as f:
-            json.dump(level_doc, f)
-        level_doc["materials"][0].pop("emissiveFactor")
-    glowing, torches_glowing = level.replace(".gltf", "-glowing.gltf"), path.replace(".gltf", "-glowing.gltf")
-    out, p = bake(lmbake, work, torches_glowing, "one-per-light-13", each.replace(BASE, quick + sky), "--log")
-    names = [g["name"] for g in group_intensities_list(os.path.join(out, "torches-glowing.gltf"))] if not p.returncode else []
-    want = ["sun", "lamp_a", "lamp_b", "torch_5", "torch_6", "torch_7", "sky", "rest"]
-    said = [l for l in (p.stdout + p.stderr).splitlines() if "share 'rest'" in l]
-    check(p.returncode == 0 and names == want and len(said) == 1 and
-          "5 light(s) and the emissive surfaces share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3', 'torch_4')"
-          in said[0],
-          "one_per_light, 11 lights, a sky, emissive surfaces: groups %s (want %s); %s" %
-          (names, want, said or (p.stdout + p.stderr)[-300:]))
+    cases = [(1.16, ["sun", "lamp_a", "lamp_b", "torch_6", "torch_7", "sky", "emissive", "rest"],
+              "6 light(s) share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3', 'torch_4', 'torch_5')"),
+             (1.10, ["sun", "lamp_a", "lamp_b", "torch_5", "torch_6", "torch_7", "sky", "rest"],
+              "5 light(s) and the emissive surfaces share 'rest' ('torch_0', 'torch_1', 'torch_2', 'torch_3', "
+              "'torch_4')")]
+    for strength, want, line in cases:
+        g = json.loads(json.dumps(d))
+        g["materials"][0]["emissiveFactor"] = [1.0, 1.0, 1.0]
+        g["materials"][0].setdefault("extensions", {})["KHR_materials_emissive_strength"] = \
+            {"emissiveStrength": strength}
+        g["extensionsUsed"] = sorted(set(g.get("extensionsUsed", []) + ["KHR_materials_emissive_strength"]))
+        name = "torches-glowing-%g" % strength
+        with open(os.path.join(os.path.dirname(level), name + ".gltf"), "w") as f:
+            json.dump(g, f)
+        out, p = bake(lmbake, work, os.path.join(os.path.dirname(level), name + ".gltf"), "one-per-light-" + name,
+                      each.replace(BASE, quick + sky), "--log")
+        names = [x["name"] for x in group_intensities_list(os.path.join(out, name + ".gltf"))] if not p.returncode else []
+        said = [l for l in (p.stdout + p.stderr).splitlines() if "share 'rest'" in l]
+        check(p.returncode == 0 and names == want and len(said) == 1 and line in said[0],
+              "one_per_light, 11 lights, a sky, emissive surfaces at strength %g: groups %s (want %s); %s" %
+              (strength, names, want, said or (p.stdout + p.stderr)[-300:]))
+    doc["materials"][0]["emissiveFactor"] = [0.01, 0.01, 0.01]
+    glowing = level.replace(".gltf", "-glowing.gltf")
+    with open(glowing, "w") as f:
+        json.dump(doc, f)
+    doc["materials"][0].pop("emissiveFactor")
     if short:  # (the byte comparison: Release only)
         return errors_of_one_per_light(lmbake, work, level)
     out_each, p = bake(lmbake, work, glowing, "one-per-light-sky", each.replace(BASE, quick + sky))
