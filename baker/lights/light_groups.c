@@ -345,17 +345,23 @@ void lmb_light_groups_report(const lmb_light_groups *g, const lmb_scene *s, cons
                  g->scale[k], weight);
     }
     uint32_t merged = 0;
-    char names[400] = "", also[80] = "";
+    char names[400] = "", who[160] = "";
     for (uint32_t i = 0; g->merged && i < s->light_count; i++)
         if (g->merged[i] && merged++ < 6) {
             size_t n = strlen(names);
             snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", s->lights[i].name);
         }
-    if (g->sky_merged || g->emissive_merged)
-        snprintf(also, sizeof also, "%s%s%s", merged ? " and " : "", g->sky_merged ? "the sky" : "",
-                 g->emissive_merged ? (g->sky_merged ? ", the emissive surfaces" : "the emissive surfaces") : "");
-    if (merged || also[0])
-        lmb_info(log, "light groups: one_per_light: %u light(s)%s share 'rest' (%s%s): at most %d groups, and they rank "
-                 "lowest (a directional light first, then the sky, then by power: docs/light-groups.md)", merged, also,
-                 names, merged > 6 ? ", ..." : "", LMB_MAX_LIGHT_GROUPS);
+    /* "4 light(s)", "5 light(s) and the emissive surfaces", "the sky and the emissive surfaces" */
+    if (merged)
+        snprintf(who, sizeof who, "%u light(s)", merged);
+    const char *others[2] = {g->sky_merged ? "the sky" : NULL, g->emissive_merged ? "the emissive surfaces" : NULL};
+    for (int k = 0; k < 2; k++)
+        if (others[k]) {
+            size_t n = strlen(who);
+            snprintf(who + n, sizeof who - n, "%s%s", n ? " and " : "", others[k]);
+        }
+    if (who[0])
+        lmb_info(log, "light groups: one_per_light: %s share 'rest'%s%s%s%s: at most %d groups, and they rank lowest (a "
+                 "directional light first, then the sky, then by power: docs/light-groups.md)", who, merged ? " (" : "",
+                 names, merged > 6 ? ", ..." : "", merged ? ")" : "", LMB_MAX_LIGHT_GROUPS);
 }
